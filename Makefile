@@ -1,0 +1,59 @@
+# beatlite: the two commands of a fresh machine are `make run` and `make test`.
+# Both bootstrap .venv (Python 3.11) and install the project with its notebook and dev extras.
+
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV   := .venv
+VPY    := $(VENV)/bin/python
+STAMP  := $(VENV)/.beatlite-installed
+
+# Headless, deterministic defaults for the notebooks and tests (override on the command line).
+export MPLBACKEND ?= Agg
+export BEATLITE_THREADS ?= 1
+export BEATLITE_MODE ?= lecture
+export PYTHONHASHSEED ?= 0
+
+.PHONY: run test lint venv system-deps data checkpoints results bench clean
+
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml
+	@test -x $(VPY) || $(PYTHON) -m venv $(VENV)
+	$(VPY) -m pip install --quiet --upgrade pip
+	$(VPY) -m pip install --quiet -e ".[notebooks,dev]"
+	@touch $(STAMP)
+
+# Debian packages needed at run/test time (offscreen OpenGL for pyvista, espeak-ng for the corpus
+# generator). Installs them when running as root with apt-get, otherwise says what is missing.
+system-deps:
+	@bash scripts/system_deps.sh
+
+## The main job: execute every notebook in order on data_samples/ and write build/.
+run: $(STAMP) system-deps
+	$(VPY) scripts/run_notebooks.py --out build
+
+## The test suite: lint, unit tests and nbval over every notebook.
+test: $(STAMP) system-deps lint
+	$(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
+
+lint: $(STAMP)
+	$(VPY) -m ruff check beatlite tests bench scripts
+	$(VPY) -m ruff format --check beatlite tests bench scripts
+
+## Regenerate the embedded corpus (needs espeak-ng).
+data: $(STAMP) system-deps
+	$(VPY) -m beatlite.synth --out data_samples
+
+## Retrain every shipped checkpoint on data_samples/.
+checkpoints: $(STAMP)
+	$(VPY) -m beatlite.train retrain-all
+
+## The model results table on the data_samples test split (build/results_models.md).
+results: $(STAMP)
+	$(VPY) -m beatlite.train results
+
+## Speed benchmarks (run on demand; they print ratios against the named alternatives).
+bench: $(STAMP)
+	@for b in bench/bench_*.py; do echo "== $$b"; $(VPY) $$b || exit 1; done
+
+clean:
+	rm -rf build .pytest_cache .ruff_cache

@@ -1,0 +1,50 @@
+"""Errors raised by the readers of :mod:`beatlite.io`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class FormatError(ValueError):
+    """A file does not follow the format its reader expects.
+
+    The message always names the file and, where it can, the line, column or
+    field that is wrong, e.g. ``take.bvh, line 433, column 17: 'abc' is not a
+    number``.
+
+    Parameters
+    ----------
+    path : str or Path or None
+        File being read (``None`` for in-memory text).
+    message : str
+        What is wrong.
+    line : int, optional
+        1-based line number.
+    column : int, optional
+        1-based column (token) number.
+    field : str, optional
+        Name of the field (JSON key, CSV column, ...).
+    """
+
+    def __init__(
+        self,
+        path: str | Path | None,
+        message: str,
+        *,
+        line: int | None = None,
+        column: int | None = None,
+        field: str | None = None,
+    ) -> None:
+        self.path = None if path is None else Path(path)
+        self.line = line
+        self.column = column
+        self.field = field
+        self.reason = message
+        where = [str(self.path) if self.path is not None else "<text>"]
+        if line is not None:
+            where.append(f"line {line}")
+        if column is not None:
+            where.append(f"column {column}")
+        if field is not None:
+            where.append(f"field {field!r}")
+        super().__init__(f"{', '.join(where)}: {message}")

@@ -1,0 +1,85 @@
+"""Gesture models (CaMN, HA2G and baselines), built by name; torch is imported lazily.
+
+>>> from beatlite.models import build_model          # doctest: +SKIP
+>>> model = build_model("camn", preset="tiny", use_audio=False)  # doctest: +SKIP
+
+``import beatlite.models`` does not import torch: :func:`build_model` and
+:func:`model_class` import the model module on first use. Every model follows the
+:class:`beatlite.models.base.GestureModel` contract.
+
+==================  =============================================  ===============
+name                class                                          representation
+==================  =============================================  ===============
+``camn``            :class:`beatlite.models.camn.CaMN`             euler141
+``ha2g``            ``beatlite.models.ha2g.HA2G``                  dirvec126
+``s2g``             :class:`beatlite.models.baselines.S2G`         euler141
+``trimodal``        :class:`beatlite.models.baselines.Trimodal`    euler141
+``mean_pose``       :class:`beatlite.models.baselines.MeanPose`    euler141
+``random_clip``     :class:`beatlite.models.baselines.RandomClip`  euler141
+==================  =============================================  ===============
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    from beatlite.models.base import GestureModel
+
+MODELS: dict[str, tuple[str, str]] = {
+    "camn": ("beatlite.models.camn", "CaMN"),
+    "ha2g": ("beatlite.models.ha2g", "HA2G"),
+    "s2g": ("beatlite.models.baselines", "S2G"),
+    "trimodal": ("beatlite.models.baselines", "Trimodal"),
+    "mean_pose": ("beatlite.models.baselines", "MeanPose"),
+    "random_clip": ("beatlite.models.baselines", "RandomClip"),
+}
+"""Registry: model name -> (module, class name)."""
+
+__all__ = ["MODELS", "build_model", "model_class", "presets"]
+
+
+def model_class(name: str) -> type[GestureModel]:
+    """The model class registered as ``name`` (imports its module, hence torch).
+
+    Raises
+    ------
+    ValueError
+        Unknown name.
+    """
+    if name not in MODELS:
+        raise ValueError(f"model name must be one of {sorted(MODELS)}, got {name!r}")
+    module_name, class_name = MODELS[name]
+    return getattr(importlib.import_module(module_name), class_name)
+
+
+def presets(name: str) -> dict[str, dict[str, Any]]:
+    """Preset table of model ``name``: the ``PRESETS`` dict of its module (preset -> field overrides)."""
+    module = importlib.import_module(MODELS[model_class(name).name][0])
+    return dict(module.PRESETS)
+
+
+def build_model(name: str, *, preset: str = "tiny", **overrides: Any) -> GestureModel:
+    """Build model ``name`` from its preset plus config overrides (e.g. ``use_audio=False``).
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`MODELS`.
+    preset : str
+        A key of the model module's ``PRESETS`` (``"tiny"``, ``"paper"``, ...).
+    **overrides
+        Fields of the model's config dataclass.
+
+    Returns
+    -------
+    GestureModel
+        A freshly initialised model (seed torch first for reproducible weights).
+    """
+    from beatlite.models.base import config_from_preset
+
+    cls = model_class(name)
+    module = importlib.import_module(MODELS[name][0])
+    config = config_from_preset(cls.config_class, module.PRESETS, preset, **overrides)
+    return cls(config)

@@ -1,0 +1,265 @@
+"""The interface every beatlite gesture model implements: :class:`GestureModel`.
+
+A model maps a *window batch* (a dict of tensors, see ``docs/architecture.md``)
+to a pose sequence in its normalised representation:
+
+=============  ==================  ==========================================================
+key            shape, dtype        meaning
+=============  ==================  ==========================================================
+``"pose"``     (B, T, 141) float   z-scored Euler degrees of ``spine_neck_141`` (euler141 models)
+``"dirvec"``   (B, T, 126) float   TED-43 unit bone directions minus the train mean (dirvec126)
+``"audio"``    (B, S) float        16 kHz mono waveform, S = floor(T / 15 * 16000) (36266 for T = 34)
+``"mel"``      (B, M, 128) float   log-mel spectrogram (HA2G settings; M = 70 for T = 34)
+``"face"``     (B, T, 51) float    ARKit blendshape weights
+``"word"``     (B, T) int64        vocabulary ids per frame (0 = PAD)
+``"emotion"``  (B, T) int64        emotion id 0..7 per frame
+``"semantic"`` (B, T) float        semantic relevance score in [0, 1] per frame
+``"speaker"``  (B,) int64          0-based speaker index
+=============  ==================  ==========================================================
+
+Contract (shared by CaMN, HA2G and the baselines; the harness in
+:mod:`beatlite.train` relies on nothing else):
+
+- class attributes ``name`` (registry name), ``representation`` (``"euler141"`` or
+  ``"dirvec126"``), ``config_class`` (a dataclass with a ``preset`` field);
+- ``forward(batch) -> dict`` with at least ``"pose"``: (B, T, D) in the normalised
+  representation (for dirvec126 models too: the key is always ``"pose"``);
+- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` with a scalar ``"total"``;
+- ``discriminator``: an ``nn.Module`` or ``None``; when present,
+  ``discriminator_losses(batch, out) -> dict`` with ``"total"`` and the harness runs a
+  discriminator step whenever :meth:`GestureModel.adversarial_active` says so;
+- ``generate(batch) -> (B, T, D)``: inference seeded only by the first ``n_pre`` frames
+  of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
+- ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
+- optional ``prepare(train_windows)``: called once by ``fit`` before training with the
+  numpy window dict (used by the untrained baselines to store a mean pose / clip bank).
+
+Torch is imported at module import time here; :mod:`beatlite.models` itself stays lazy.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+import torch
+from torch import nn
+
+Batch = dict[str, torch.Tensor]
+
+REPRESENTATIONS: dict[str, tuple[str, int]] = {"euler141": ("pose", 141), "dirvec126": ("dirvec", 126)}
+"""Representation name -> (window key of its target, channels D)."""
+
+N_POSES = 34
+N_PRE = 4
+
+
+@dataclasses.dataclass
+class ModelConfig:
+    """Base of every model configuration dataclass.
+
+    Attributes
+    ----------
+    preset : str
+        Name of the preset the configuration started from (``"tiny"``, ``"paper"``, ...).
+    """
+
+    preset: str = "tiny"
+
+
+def config_from_preset(
+    config_class: type, presets: Mapping[str, Mapping[str, Any]], preset: str, **overrides: Any
+) -> Any:
+    """Build ``config_class(**presets[preset], **overrides, preset=preset)`` with checked names.
+
+    Raises
+    ------
+    ValueError
+        Unknown preset name.
+    TypeError
+        An override that is not a field of ``config_class``.
+    """
+    if preset not in presets:
+        raise ValueError(f"preset must be one of {sorted(presets)}, got {preset!r}")
+    fields = {f.name for f in dataclasses.fields(config_class)}
+    unknown = sorted(set(overrides) - fields)
+    if unknown:
+        raise TypeError(f"{config_class.__name__}: unknown option(s) {unknown}; known: {sorted(fields)}")
+    values = {**dict(presets[preset]), **overrides, "preset": preset}
+    return config_class(**values)
+
+
+def seed_input(pose: torch.Tensor, n_pre: int = N_PRE) -> torch.Tensor:
+    """The seed-pose input ``pre_seq`` of CaMN / HA2G / Trimodal.
+
+    Parameters
+    ----------
+    pose : (B, T, D) float tensor
+        Target pose sequence (normalised); only its first ``n_pre`` frames are read.
+    n_pre : int
+        Number of seed frames.
+
+    Returns
+    -------
+    (B, T, D + 1) float tensor
+        Frames ``< n_pre`` hold ``pose`` and an indicator bit 1 in the last channel;
+        later frames are all zero.
+    """
+    if pose.ndim != 3:
+        raise ValueError(f"pose must be (B, T, D), got shape {tuple(pose.shape)}")
+    b, t, d = pose.shape
+    if not 0 <= n_pre <= t:
+        raise ValueError(f"n_pre must be in [0, {t}], got {n_pre}")
+    pre = pose.new_zeros(b, t, d + 1)
+    pre[:, :n_pre, :d] = pose[:, :n_pre]
+    pre[:, :n_pre, d] = 1.0
+    return pre
+
+
+def huber(pred: torch.Tensor, target: torch.Tensor, beta: float = 0.1) -> torch.Tensor:
+    """Mean Huber loss as the reference defines it: ``smooth_l1(pred/beta, target/beta) * beta``.
+
+    Equals ``0.5 * d**2 / beta`` for ``|d| < beta`` and ``|d| - 0.5 * beta`` otherwise
+    (``d = pred - target``), averaged over all elements.
+    """
+    return nn.functional.smooth_l1_loss(pred / beta, target / beta) * beta
+
+
+def check_batch(batch: Mapping[str, Any], keys: tuple[str, ...], who: str) -> None:
+    """Raise ``KeyError``/``TypeError`` naming ``who`` when ``batch`` lacks a key or is not a tensor."""
+    for key in keys:
+        if key not in batch:
+            raise KeyError(f"{who}: batch has no {key!r} (keys: {sorted(batch)})")
+        if not isinstance(batch[key], torch.Tensor):
+            raise TypeError(f"{who}: batch[{key!r}] must be a torch.Tensor, got {type(batch[key]).__name__}")
+
+
+class GestureModel(nn.Module):
+    """Base class of every gesture model (see the module docstring for the contract).
+
+    Subclasses set ``name``, ``representation``, ``config_class``, ``input_keys`` and
+    implement :meth:`forward` and :meth:`losses`.
+
+    Parameters
+    ----------
+    config : ModelConfig subclass instance
+        The model's configuration (stored in checkpoints via :meth:`to_config`).
+    """
+
+    name: ClassVar[str] = "base"
+    representation: ClassVar[str] = "euler141"
+    config_class: ClassVar[type] = ModelConfig
+    input_keys: ClassVar[tuple[str, ...]] = ()
+    n_pre: int = N_PRE
+
+    def __init__(self, config: ModelConfig) -> None:
+        super().__init__()
+        if not isinstance(config, self.config_class):
+            raise TypeError(
+                f"{type(self).__name__}: config must be {self.config_class.__name__}, "
+                f"got {type(config).__name__}"
+            )
+        self.config = config
+        self.discriminator: nn.Module | None = None
+
+    # ---------------------------------------------------------------- representation
+    @property
+    def target_key(self) -> str:
+        """Window key of the training target: ``"pose"`` (euler141) or ``"dirvec"`` (dirvec126)."""
+        return REPRESENTATIONS[self.representation][0]
+
+    @property
+    def pose_dim(self) -> int:
+        """Channels D of the output (141 or 126)."""
+        return REPRESENTATIONS[self.representation][1]
+
+    # ---------------------------------------------------------------- interface
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:  # pragma: no cover - abstract
+        """Map a window batch to ``{"pose": (B, T, D), ...}`` (normalised representation)."""
+        raise NotImplementedError
+
+    def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
+        """Generator losses; ``"total"`` is what the harness back-propagates."""
+        raise NotImplementedError  # pragma: no cover - abstract
+
+    def discriminator_losses(self, batch: Batch, out: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+        """Discriminator losses (``"total"``); only called when :attr:`discriminator` is set."""
+        raise NotImplementedError(f"{type(self).__name__} has no discriminator")
+
+    def adversarial_active(self, epoch: int) -> bool:
+        """Whether epoch ``epoch`` (0-based) trains adversarially.
+
+        True when a discriminator exists and ``epoch >= config.no_adv_epochs``
+        (``no_adv_epochs`` defaults to 0 when the config has no such field).
+        """
+        return self.discriminator is not None and epoch >= int(getattr(self.config, "no_adv_epochs", 0))
+
+    def generator_parameters(self) -> list[nn.Parameter]:
+        """Trainable parameters that are not part of :attr:`discriminator`."""
+        d_ids = set() if self.discriminator is None else {id(p) for p in self.discriminator.parameters()}
+        return [p for p in self.parameters() if p.requires_grad and id(p) not in d_ids]
+
+    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+        """Hook called once by ``fit`` with the numpy training windows (default: nothing)."""
+
+    @property
+    def trainable(self) -> bool:
+        """False for baselines without trainable generator parameters (``fit`` then only calls prepare)."""
+        return len(self.generator_parameters()) > 0
+
+    @torch.no_grad()
+    def generate(self, batch: Batch) -> torch.Tensor:
+        """Inference on a window batch seeded by its first ``n_pre`` target frames.
+
+        Parameters
+        ----------
+        batch : dict of tensors
+            A window batch; ``batch[target_key]`` (B, T, D) only provides the seed:
+            frames ``>= n_pre`` are zeroed before the forward pass, so they cannot leak.
+
+        Returns
+        -------
+        (B, T, D) float tensor
+            The generated pose in the normalised representation.
+        """
+        check_batch(batch, (self.target_key,), f"{type(self).__name__}.generate")
+        was_training = self.training
+        self.eval()
+        try:
+            seeded = dict(batch)
+            target = batch[self.target_key].clone()
+            target[:, self.n_pre :] = 0.0
+            seeded[self.target_key] = target
+            return self.forward(seeded)["pose"]
+        finally:
+            self.train(was_training)
+
+    # ---------------------------------------------------------------- (de)serialisation
+    def to_config(self) -> dict[str, Any]:
+        """``{"name": <registry name>, **dataclasses.asdict(config)}`` (JSON-serialisable)."""
+        return {"name": self.name, **dataclasses.asdict(self.config)}
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any]) -> GestureModel:
+        """Rebuild an (untrained) model from :meth:`to_config`'s dict.
+
+        Called on :class:`GestureModel` itself it dispatches on ``config["name"]``
+        through :func:`beatlite.models.model_class`.
+        """
+        values = dict(config)
+        name = values.pop("name", cls.name)
+        if cls is GestureModel:
+            from beatlite.models import model_class
+
+            return model_class(name).from_config({"name": name, **values})
+        fields = {f.name for f in dataclasses.fields(cls.config_class)}
+        unknown = sorted(set(values) - fields)
+        if unknown:
+            raise TypeError(f"{cls.__name__}.from_config: unknown field(s) {unknown}")
+        return cls(cls.config_class(**values))
+
+    def n_parameters(self) -> int:
+        """Number of trainable parameters (discriminator included)."""
+        return sum(p.numel() for p in self.parameters() if p.requires_grad)

@@ -1,0 +1,69 @@
+"""Where beatlite finds its data, checkpoints and outputs.
+
+Every function reads the environment at call time (no global state):
+
+- ``BEATLITE_DATA``: the BEAT-format folder to use (default: the repository's
+  ``data_samples/``). Point it at a real BEAT download to run everything on it.
+- ``BEATLITE_MODE``: ``lecture`` (default; load shipped checkpoints) or ``full``
+  (train live).
+- ``BEATLITE_THREADS``: torch CPU threads (default 1; see :func:`n_threads`).
+- ``BEATLITE_BUILD``: output folder of the main job (default ``build/``).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+MODES = ("lecture", "full")
+
+
+def repo_root() -> Path:
+    """The repository root (the folder that holds ``beatlite/``)."""
+    return Path(__file__).resolve().parent.parent
+
+
+def data_dir() -> Path:
+    """The BEAT-format data folder: ``$BEATLITE_DATA`` or ``<repo>/data_samples``."""
+    env = os.environ.get("BEATLITE_DATA")
+    return Path(env).expanduser() if env else repo_root() / "data_samples"
+
+
+def checkpoints_dir() -> Path:
+    """Folder of the shipped checkpoints: ``<repo>/checkpoints``."""
+    return repo_root() / "checkpoints"
+
+
+def build_dir() -> Path:
+    """Output folder of the main job: ``$BEATLITE_BUILD`` or ``<repo>/build``."""
+    env = os.environ.get("BEATLITE_BUILD")
+    return Path(env).expanduser() if env else repo_root() / "build"
+
+
+def cache_dir() -> Path:
+    """Folder for derived caches (window ``.npz`` files): ``<build>/cache``."""
+    return build_dir() / "cache"
+
+
+def mode() -> str:
+    """``"lecture"`` (load checkpoints, the default) or ``"full"`` (train live) from ``$BEATLITE_MODE``."""
+    value = os.environ.get("BEATLITE_MODE", "lecture").strip().lower() or "lecture"
+    if value not in MODES:
+        raise ValueError(f"BEATLITE_MODE must be one of {MODES}, got {value!r}")
+    return value
+
+
+def n_threads() -> int:
+    """Torch CPU threads from ``$BEATLITE_THREADS`` (default 1).
+
+    One thread is the safe default on a shared 2-core machine: two OpenMP
+    threads next to any other busy process spin-wait and run 10x slower.
+    """
+    value = os.environ.get("BEATLITE_THREADS", "1")
+    try:
+        n = int(value)
+    except ValueError:
+        raise ValueError(f"BEATLITE_THREADS must be a positive integer, got {value!r}") from None
+    if n < 1:
+        raise ValueError(f"BEATLITE_THREADS must be a positive integer, got {value!r}")
+    return n

@@ -1,0 +1,57 @@
+"""Tables and figures that the notebooks hand to the main job's ``build/results.md``.
+
+A notebook calls :func:`save_table` for every table it reproduces; ``make run``
+collects ``build/tables/*.md`` into ``build/results.md`` in notebook order.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from beatlite.paths import build_dir
+
+
+def tables_dir() -> Path:
+    """Folder of the reproduced tables: ``<build>/tables``."""
+    return build_dir() / "tables"
+
+
+def figures_dir() -> Path:
+    """Folder of the saved figures: ``<build>/figures``."""
+    return build_dir() / "figures"
+
+
+def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
+    """Write a Markdown table to ``<build>/tables/<name>.md`` atomically.
+
+    Parameters
+    ----------
+    name : str
+        File stem, e.g. ``"02_table1"``; letters, digits, ``_`` and ``-`` only.
+        The numeric prefix orders the tables in ``results.md``.
+    markdown : str
+        The table (any Markdown).
+    title : str, optional
+        A heading written above the table.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    if not name or not all(c.isalnum() or c in "_-" for c in name):
+        raise ValueError(f"save_table: name must be letters, digits, '_' or '-', got {name!r}")
+    out = tables_dir() / f"{name}.md"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    text = (f"### {title}\n\n" if title else "") + markdown.rstrip() + "\n"
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return out

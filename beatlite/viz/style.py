@@ -1,0 +1,130 @@
+"""One figure style for every beatlite plot, and a helper that saves a figure in several formats.
+
+Nothing here changes matplotlib's global state at import time: apply the style
+for a block of code with :func:`figure_style` (a ``plt.rc_context``), or pass
+:data:`STYLE` to ``plt.rc_context`` yourself.
+
+>>> import matplotlib.pyplot as plt
+>>> from beatlite.viz.style import figure_style, save_figure
+>>> with figure_style():                                  # doctest: +SKIP
+...     fig, ax = plt.subplots()
+...     ax.plot([0, 1], [0, 1])
+...     save_figure(fig, "build/figures/line")           # -> line.png, line.svg
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from cycler import cycler
+
+from beatlite.viz._files import atomic_target
+
+#: Colours of the three joint groups (body, hands, head) used by every skeleton plot.
+GROUP_COLOURS: Mapping[str, str] = MappingProxyType({"body": "#1f4e79", "hands": "#c0392b", "head": "#2e8b57"})
+
+#: Colours of the compared systems, in the order ground truth, CaMN, HA2G, then extras.
+SYSTEM_COLOURS: tuple[str, ...] = ("#333333", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b")
+
+#: The beatlite rcParams (read-only). Use with ``plt.rc_context(dict(STYLE))`` or :func:`figure_style`.
+STYLE: Mapping[str, Any] = MappingProxyType(
+    {
+        "figure.dpi": 100,
+        "savefig.dpi": 150,
+        "savefig.bbox": "tight",
+        "figure.figsize": (6.4, 4.0),
+        "figure.facecolor": "white",
+        "axes.facecolor": "white",
+        "axes.grid": True,
+        "grid.alpha": 0.3,
+        "grid.linewidth": 0.6,
+        "axes.spines.top": False,
+        "axes.spines.right": False,
+        "axes.titlesize": 11,
+        "axes.labelsize": 10,
+        "axes.prop_cycle": cycler(color=list(SYSTEM_COLOURS)),
+        "font.size": 10,
+        "legend.fontsize": 9,
+        "legend.frameon": False,
+        "xtick.labelsize": 9,
+        "ytick.labelsize": 9,
+        "lines.linewidth": 1.5,
+        "image.cmap": "viridis",
+        "svg.fonttype": "none",
+        "svg.hashsalt": "beatlite",  # deterministic SVG ids
+        "animation.embed_limit": 50.0,  # MB; lets to_jshtml embed a few hundred frames
+    }
+)
+
+
+@contextlib.contextmanager
+def figure_style(**overrides: Any) -> Iterator[None]:
+    """Apply the beatlite style (plus any rcParams overrides) inside a ``with`` block.
+
+    Parameters
+    ----------
+    **overrides
+        rcParams to change on top of :data:`STYLE`; their names contain dots, so
+        pass them as ``figure_style(**{"font.size": 12})``.
+
+    Yields
+    ------
+    None
+        Figures created inside the block use the style; rcParams are restored on exit.
+    """
+    import matplotlib.pyplot as plt
+
+    params = dict(STYLE)
+    params.update(overrides)
+    with plt.rc_context(params):
+        yield
+
+
+def save_figure(
+    fig: Any, path_stem: str | os.PathLike[str], formats: Sequence[str] = ("png", "svg"), **savefig_kwargs: Any
+) -> list[Path]:
+    """Save ``fig`` once per format as ``<path_stem>.<fmt>``, atomically; create the folder if needed.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure to save.
+    path_stem : str or Path
+        Output path without extension, e.g. ``"build/figures/fig2_emotion"``. A
+        suffix that equals one of ``formats`` is dropped (``"a.png"`` -> ``"a"``).
+    formats : sequence of str
+        File extensions understood by matplotlib (``"png"``, ``"svg"``, ``"pdf"``, ...).
+    **savefig_kwargs
+        Passed to ``fig.savefig`` (``dpi``, ``bbox_inches``, ...); the style's
+        ``savefig.*`` rcParams apply otherwise.
+
+    Returns
+    -------
+    list of Path
+        The written files, in the order of ``formats``.
+    """
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise TypeError(f"save_figure: fig must be a matplotlib Figure, got {type(fig).__name__}")
+    if isinstance(formats, str):
+        formats = (formats,)
+    if not formats:
+        raise ValueError("save_figure: formats must name at least one format, got an empty sequence")
+    stem = Path(path_stem)
+    if stem.suffix.lstrip(".").lower() in {f.lower().lstrip(".") for f in formats}:
+        stem = stem.with_suffix("")
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    for fmt in formats:
+        fmt = fmt.lower().lstrip(".")
+        target = stem.parent / f"{stem.name}.{fmt}"
+        with atomic_target(target) as tmp:
+            fig.savefig(tmp, format=fmt, **savefig_kwargs)
+        written.append(target)
+    return written
