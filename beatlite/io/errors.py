@@ -48,3 +48,11 @@ class FormatError(ValueError):
         if field is not None:
             where.append(f"field {field!r}")
         super().__init__(f"{', '.join(where)}: {message}")
+
+
+class BVHWarning(UserWarning):
+    """A BVH file is readable but inconsistent, e.g. ``Frames: 100`` above 99 motion rows."""
+
+
+class AlignmentWarning(UserWarning):
+    """The modalities of a take have different durations and were truncated to the shortest."""

@@ -55,9 +55,13 @@ def model_class(name: str) -> type[GestureModel]:
 
 
 def presets(name: str) -> dict[str, dict[str, Any]]:
-    """Preset table of model ``name``: the ``PRESETS`` dict of its module (preset -> field overrides)."""
-    module = importlib.import_module(MODELS[model_class(name).name][0])
-    return dict(module.PRESETS)
+    """Preset table of model ``name`` (preset -> config field overrides).
+
+    The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module.
+    """
+    cls = model_class(name)
+    table = cls.presets if cls.presets is not None else importlib.import_module(MODELS[name][0]).PRESETS
+    return {k: dict(v) for k, v in table.items()}
 
 
 def build_model(name: str, *, preset: str = "tiny", **overrides: Any) -> GestureModel:
@@ -68,7 +72,7 @@ def build_model(name: str, *, preset: str = "tiny", **overrides: Any) -> Gesture
     name : str
         A key of :data:`MODELS`.
     preset : str
-        A key of the model module's ``PRESETS`` (``"tiny"``, ``"paper"``, ...).
+        A key of :func:`presets` (the class's ``presets`` or its module's ``PRESETS``) (``"tiny"``, ``"paper"``, ...).
     **overrides
         Fields of the model's config dataclass.
 
@@ -80,6 +84,5 @@ def build_model(name: str, *, preset: str = "tiny", **overrides: Any) -> Gesture
     from beatlite.models.base import config_from_preset
 
     cls = model_class(name)
-    module = importlib.import_module(MODELS[name][0])
-    config = config_from_preset(cls.config_class, module.PRESETS, preset, **overrides)
+    config = config_from_preset(cls.config_class, presets(name), preset, **overrides)
     return cls(config)

@@ -139,7 +139,8 @@ def check_batch(batch: Mapping[str, Any], keys: tuple[str, ...], who: str) -> No
 class GestureModel(nn.Module):
     """Base class of every gesture model (see the module docstring for the contract).
 
-    Subclasses set ``name``, ``representation``, ``config_class``, ``input_keys`` and
+    Subclasses set ``name``, ``representation``, ``config_class``, ``input_keys``
+    (optionally ``presets``: preset -> config overrides; else their module's ``PRESETS``) and
     implement :meth:`forward` and :meth:`losses`.
 
     Parameters
@@ -152,6 +153,7 @@ class GestureModel(nn.Module):
     representation: ClassVar[str] = "euler141"
     config_class: ClassVar[type] = ModelConfig
     input_keys: ClassVar[tuple[str, ...]] = ()
+    presets: ClassVar[Mapping[str, Mapping[str, Any]] | None] = None
     n_pre: int = N_PRE
 
     def __init__(self, config: ModelConfig) -> None:

@@ -1,11 +1,25 @@
 """Skeleton plots and animations: matplotlib always, pyvista renders behind a subprocess probe.
 
-Submodules are imported lazily (``import beatlite.viz`` imports neither
-matplotlib's pyplot, pyvista nor torch):
+Submodules are imported lazily (``import beatlite.viz`` imports neither pyplot,
+pyvista nor torch); the names below are importable from ``beatlite.viz``.
 
 ==========================  ==================================================================
-``beatlite.viz.style``       one figure style (:func:`figure_style`) and :func:`save_figure`
+``style``                    one figure style (:func:`figure_style`, :data:`STYLE`), :func:`save_figure`
+``plot3d``                   :func:`plot_frame`, :func:`plot_filmstrip`, :func:`plot_views`,
+                             :func:`plot_trajectories` (matplotlib 3D)
+``animation``                :func:`animate_skeletons` (GT | CaMN | HA2G side by side, audio/beats,
+                             words, face panels) -> :class:`SkeletonAnimation` (inline JS/HTML,
+                             ``.save_as`` GIF/MP4/HTML)
+``face``                     :func:`plot_blendshapes` (ARKit heat map / bars)
+``render``                   pyvista: :func:`render_frame`, :func:`render_animation`, :func:`show_skeleton`
+``probe``                    :func:`probe_offscreen`, :func:`use_pyvista` (subprocess probe, cached)
+``bvh_export``               :func:`motion_from_subset`, :func:`export_bvh` (Blender import steps)
 ==========================  ==================================================================
+
+Rendering backends: pyvista needs an off-screen OpenGL (EGL or OSMesa on a
+headless Linux, see :mod:`beatlite.viz.probe` and ``scripts/system_deps.sh``);
+when it is missing every pyvista function warns once and draws with matplotlib.
+``BEATLITE_PYVISTA=off`` forces matplotlib.
 """
 
 from __future__ import annotations
@@ -13,13 +27,28 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-_SUBMODULES = ("style",)
+_SUBMODULES = ("style", "plot3d", "animation", "face", "render", "probe", "bvh_export")
 _EXPORTS: dict[str, str] = {
     "STYLE": "style",
-    "figure_style": "style",
-    "save_figure": "style",
     "GROUP_COLOURS": "style",
     "SYSTEM_COLOURS": "style",
+    "figure_style": "style",
+    "save_figure": "style",
+    "plot_frame": "plot3d",
+    "plot_filmstrip": "plot3d",
+    "plot_views": "plot3d",
+    "plot_trajectories": "plot3d",
+    "animate_skeletons": "animation",
+    "save_animation": "animation",
+    "SkeletonAnimation": "animation",
+    "plot_blendshapes": "face",
+    "render_frame": "render",
+    "render_animation": "render",
+    "show_skeleton": "render",
+    "probe_offscreen": "probe",
+    "use_pyvista": "probe",
+    "motion_from_subset": "bvh_export",
+    "export_bvh": "bvh_export",
 }
 
 __all__ = [*_SUBMODULES, *_EXPORTS]

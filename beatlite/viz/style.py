@@ -21,12 +21,14 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from cycler import cycler
+from matplotlib.rcsetup import cycler
 
 from beatlite.viz._files import atomic_target
 
 #: Colours of the three joint groups (body, hands, head) used by every skeleton plot.
-GROUP_COLOURS: Mapping[str, str] = MappingProxyType({"body": "#1f4e79", "hands": "#c0392b", "head": "#2e8b57"})
+GROUP_COLOURS: Mapping[str, str] = MappingProxyType(
+    {"body": "#1f4e79", "hands": "#c0392b", "head": "#2e8b57"}
+)
 
 #: Colours of the compared systems, in the order ground truth, CaMN, HA2G, then extras.
 SYSTEM_COLOURS: tuple[str, ...] = ("#333333", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b")
@@ -86,7 +88,10 @@ def figure_style(**overrides: Any) -> Iterator[None]:
 
 
 def save_figure(
-    fig: Any, path_stem: str | os.PathLike[str], formats: Sequence[str] = ("png", "svg"), **savefig_kwargs: Any
+    fig: Any,
+    path_stem: str | os.PathLike[str],
+    formats: Sequence[str] = ("png", "svg"),
+    **savefig_kwargs: Any,
 ) -> list[Path]:
     """Save ``fig`` once per format as ``<path_stem>.<fmt>``, atomically; create the folder if needed.
 
@@ -108,6 +113,7 @@ def save_figure(
     list of Path
         The written files, in the order of ``formats``.
     """
+    import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
 
     if not isinstance(fig, Figure):
@@ -116,6 +122,7 @@ def save_figure(
         formats = (formats,)
     if not formats:
         raise ValueError("save_figure: formats must name at least one format, got an empty sequence")
+    save_params = {k: v for k, v in STYLE.items() if k.startswith(("savefig.", "svg."))}
     stem = Path(path_stem)
     if stem.suffix.lstrip(".").lower() in {f.lower().lstrip(".") for f in formats}:
         stem = stem.with_suffix("")
@@ -124,7 +131,7 @@ def save_figure(
     for fmt in formats:
         fmt = fmt.lower().lstrip(".")
         target = stem.parent / f"{stem.name}.{fmt}"
-        with atomic_target(target) as tmp:
+        with atomic_target(target) as tmp, plt.rc_context(save_params):
             fig.savefig(tmp, format=fmt, **savefig_kwargs)
         written.append(target)
     return written

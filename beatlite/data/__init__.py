@@ -1,0 +1,35 @@
+"""Dataset index, vocabulary and aligned training windows (NumPy; torch only in ``torch_dataset``).
+
+=====================  =============================================================
+``index``               :func:`index_folder` -> :class:`TakeIndex` of :class:`TakeRecord`
+``vocab``               :class:`Vocab` (PAD/SOS/EOS/UNK = 0..3), offline word vectors
+``normalize``           :class:`Normalizer` (train-split mean/std)
+``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract)
+``torch_dataset``       ``WindowDataset`` (imports torch; import it explicitly)
+=====================  =============================================================
+"""
+
+from __future__ import annotations
+
+from beatlite.data.index import TakeIndex, TakeRecord, index_folder
+from beatlite.data.normalize import Normalizer
+from beatlite.data.vocab import EOS, PAD, SOS, UNK, Vocab, build_vocab, word_vectors
+from beatlite.data.windows import WINDOW_KEYS, Windows, build_windows, window_starts
+
+__all__ = [
+    "EOS",
+    "PAD",
+    "SOS",
+    "UNK",
+    "WINDOW_KEYS",
+    "Normalizer",
+    "TakeIndex",
+    "TakeRecord",
+    "Vocab",
+    "Windows",
+    "build_vocab",
+    "build_windows",
+    "index_folder",
+    "window_starts",
+    "word_vectors",
+]

@@ -1,0 +1,552 @@
+"""Index a BEAT-format folder into a table of takes, reading only file headers.
+
+A *take* is every file sharing one stem, e.g. ``2_scott_0_1_1.bvh``, ``.wav``,
+``.json``, ``.TextGrid``, ``.txt`` and ``.csv`` (each possibly ``.gz``). The
+index works on real BEAT's layout (``{speaker_id}/{stem}.*``, also nested as
+``beat_english_v0.2.1/2/...``) and on a flat folder. Problems (a ``.wav``
+without ``.bvh``, a name that does not parse, an unreadable file, modalities
+whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds) are
+recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
+
+>>> from beatlite.data.index import index_folder
+>>> idx = index_folder("data_samples")  # doctest: +SKIP
+>>> print(idx.where(split="test").to_markdown())  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import gzip
+import json
+import os
+import re
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+#: File extension (lower case, without ``.gz``) -> modality name.
+MODALITIES: dict[str, str] = {
+    "bvh": "motion",
+    "wav": "audio",
+    "json": "face",
+    "textgrid": "text",
+    "txt": "semantic",
+    "csv": "emotion",
+}
+#: Modalities without which a take cannot be used for training.
+REQUIRED = ("motion", "audio")
+#: Modalities whose durations are compared (seconds).
+TIMED = ("motion", "audio", "face", "text")
+#: Largest allowed disagreement between two modality durations, seconds.
+MAX_DURATION_GAP = 1.0
+
+_SUFFIX = re.compile(r"^(?P<stem>.+)\.(?P<ext>bvh|wav|json|textgrid|txt|csv)(?P<gz>\.gz)?$", re.IGNORECASE)
+
+
+@dataclass
+class TakeRecord:
+    """One take of the index: name fields, files, durations and problems.
+
+    Attributes
+    ----------
+    stem : str
+        File name without extensions, e.g. ``"2_scott_0_1_1"``.
+    speaker_id : int or None
+        BEAT speaker id 1..30 (``None`` when the name does not parse; likewise below).
+    speaker : str or None
+        Speaker name, e.g. ``"scott"``.
+    language : str or None
+        ``"english"``, ``"chinese"``, ``"spanish"`` or ``"japanese"`` (as ``parse_take_name`` says).
+    session_type : int or None
+        BEAT recording type 0..7 (even = speech/self-talk, odd = conversation).
+    conversation : bool or None
+        True for conversation sessions.
+    sequence : int or None
+        Sequence id (the name's start field).
+    half : str or None
+        ``"a"`` / ``"b"`` for the halves of split sequences of the 1-hour speakers, else None.
+    emotion : int or None
+        Emotion id 0..7 implied by the sequence id.
+    emotion_name : str or None
+        ``"neutral"``, ``"happiness"``, ...
+    split : str or None
+        ``"train"``, ``"val"``, ``"test"`` (BEAT's rule) or ``None``.
+    files : dict str -> Path
+        Modality (``"motion"``, ``"audio"``, ``"face"``, ``"text"``, ``"semantic"``,
+        ``"emotion"``) -> file path.
+    durations : dict str -> float
+        Modality -> duration in seconds, read from headers (motion: ``Frames`` x
+        ``Frame Time``; audio: frames / samplerate; face: frames / fps; text: ``xmax``).
+    problems : list of str
+        Human-readable explanations; empty when the take is consistent.
+    """
+
+    stem: str
+    speaker_id: int | None = None
+    speaker: str | None = None
+    language: str | None = None
+    session_type: int | None = None
+    conversation: bool | None = None
+    sequence: int | None = None
+    half: str | None = None
+    emotion: int | None = None
+    emotion_name: str | None = None
+    split: str | None = None
+    files: dict[str, Path] = field(default_factory=dict)
+    durations: dict[str, float] = field(default_factory=dict)
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def duration(self) -> float:
+        """Take duration in seconds: the motion's if known, else the audio's, else 0.0."""
+        for modality in ("motion", "audio", "face", "text"):
+            if modality in self.durations:
+                return float(self.durations[modality])
+        return 0.0
+
+    @property
+    def ok(self) -> bool:
+        """True when no problem was found."""
+        return not self.problems
+
+    @property
+    def usable(self) -> bool:
+        """True when the take can feed training windows.
+
+        The name parsed, motion and audio exist and were readable, and the timed
+        modalities agree within :data:`MAX_DURATION_GAP`. Missing optional files
+        (face, text, annotations) are problems but do not make a take unusable.
+        """
+        return (
+            self.speaker_id is not None
+            and all(m in self.durations for m in REQUIRED)
+            and not any(p.startswith("durations disagree") for p in self.problems)
+        )
+
+    def has(self, modality: str) -> bool:
+        """Whether the file of ``modality`` (a key of :data:`MODALITIES` values) exists."""
+        return modality in self.files
+
+    def path(self, modality: str) -> Path:
+        """Path of the ``modality`` file; ``KeyError`` naming the take when absent."""
+        try:
+            return self.files[modality]
+        except KeyError:
+            raise KeyError(f"take {self.stem!r} has no {modality} file (has {sorted(self.files)})") from None
+
+    def to_row(self) -> dict[str, Any]:
+        """Flat dict of the record (one table row): fields, ``dur_<modality>``, ``has_<modality>``."""
+        row: dict[str, Any] = {
+            "stem": self.stem,
+            "speaker_id": self.speaker_id,
+            "speaker": self.speaker,
+            "language": self.language,
+            "session_type": self.session_type,
+            "sequence": self.sequence,
+            "emotion": self.emotion,
+            "emotion_name": self.emotion_name,
+            "split": self.split,
+            "duration": round(self.duration, 3),
+        }
+        for modality in MODALITIES.values():
+            row[f"has_{modality}"] = modality in self.files
+        for modality in TIMED:
+            value = self.durations.get(modality)
+            row[f"dur_{modality}"] = None if value is None else round(value, 3)
+        row["problems"] = "; ".join(self.problems)
+        return row
+
+
+class TakeIndex:
+    """An ordered, immutable table of :class:`TakeRecord` rows (no pandas).
+
+    Parameters
+    ----------
+    records : iterable of TakeRecord
+        Rows, kept in the given order.
+    root : Path, optional
+        Folder the index was built from.
+
+    Examples
+    --------
+    >>> idx = TakeIndex([TakeRecord("2_scott_0_1_1", speaker_id=2, split="test")])
+    >>> len(idx.where(split="test")), len(idx.where(split="train"))
+    (1, 0)
+    """
+
+    def __init__(self, records: Iterable[TakeRecord], root: str | Path | None = None) -> None:
+        self._records = tuple(records)
+        for r in self._records:
+            if not isinstance(r, TakeRecord):
+                raise TypeError(f"TakeIndex: records must be TakeRecord, got {type(r).__name__}")
+        self.root = None if root is None else Path(root)
+
+    # -------------------------------------------------------------- container
+    def __len__(self) -> int:
+        return len(self._records)
+
+    def __iter__(self) -> Iterator[TakeRecord]:
+        return iter(self._records)
+
+    def __getitem__(self, key: int | str) -> TakeRecord:
+        """Row by position or by stem (``KeyError`` listing close stems)."""
+        if isinstance(key, str):
+            for r in self._records:
+                if r.stem == key:
+                    return r
+            close = [r.stem for r in self._records if key.split("_")[0] == r.stem.split("_")[0]][:5]
+            raise KeyError(f"no take {key!r} in the index; same speaker: {close}")
+        return self._records[key]
+
+    def __repr__(self) -> str:
+        n_bad = sum(not r.ok for r in self._records)
+        return f"TakeIndex({len(self)} takes, {self.total_duration / 60:.1f} min, {n_bad} with problems)"
+
+    @property
+    def records(self) -> tuple[TakeRecord, ...]:
+        """All rows."""
+        return self._records
+
+    @property
+    def stems(self) -> list[str]:
+        """Stems in row order."""
+        return [r.stem for r in self._records]
+
+    @property
+    def total_duration(self) -> float:
+        """Sum of :attr:`TakeRecord.duration`, seconds."""
+        return float(sum(r.duration for r in self._records))
+
+    def speaker_ids(self) -> list[int]:
+        """Sorted distinct speaker ids."""
+        return sorted({r.speaker_id for r in self._records if r.speaker_id is not None})
+
+    # -------------------------------------------------------------- filtering
+    def where(self, **criteria: Any) -> TakeIndex:
+        """Rows whose attributes match every criterion.
+
+        Parameters
+        ----------
+        **criteria
+            ``name=value`` for any :class:`TakeRecord` attribute or property
+            (``split``, ``speaker_id``, ``emotion``, ``ok``, ``usable``, ...). The
+            value may be a scalar (equality), a list/tuple/set (membership) or a
+            callable ``value -> bool``.
+
+        Returns
+        -------
+        TakeIndex
+            The matching rows, in order, with the same root.
+        """
+        for name in criteria:
+            if not hasattr(TakeRecord, name) and name not in TakeRecord.__dataclass_fields__:
+                raise ValueError(
+                    f"where: unknown field {name!r}; fields: {sorted(TakeRecord.__dataclass_fields__)}"
+                )
+
+        def match(record: TakeRecord) -> bool:
+            for name, wanted in criteria.items():
+                value = getattr(record, name)
+                if callable(wanted):
+                    if not wanted(value):
+                        return False
+                elif isinstance(wanted, list | tuple | set | frozenset):
+                    if value not in wanted:
+                        return False
+                elif value != wanted:
+                    return False
+            return True
+
+        return TakeIndex([r for r in self._records if match(r)], self.root)
+
+    def filter(self, predicate: Callable[[TakeRecord], bool]) -> TakeIndex:
+        """Rows for which ``predicate(record)`` is true."""
+        return TakeIndex([r for r in self._records if predicate(r)], self.root)
+
+    def problems(self) -> dict[str, list[str]]:
+        """Stem -> problems, for flagged takes only."""
+        return {r.stem: list(r.problems) for r in self._records if r.problems}
+
+    # -------------------------------------------------------------- export
+    def to_rows(self) -> list[dict[str, Any]]:
+        """One flat dict per take (see :meth:`TakeRecord.to_row`)."""
+        return [r.to_row() for r in self._records]
+
+    def to_markdown(self, columns: Iterable[str] | None = None, *, max_rows: int | None = None) -> str:
+        """A Markdown table of the index.
+
+        Parameters
+        ----------
+        columns : iterable of str, optional
+            Row keys to show (default: stem, speaker, language, emotion_name, split,
+            duration, the ``has_*`` flags as one ``files`` column, problems).
+        max_rows : int, optional
+            Show at most this many rows and a final ``... (n more)`` line.
+        """
+        rows = self.to_rows()
+        if columns is None:
+            columns = [
+                "stem",
+                "speaker",
+                "language",
+                "emotion_name",
+                "split",
+                "duration",
+                "files",
+                "problems",
+            ]
+            for row in rows:
+                row["files"] = " ".join(ext for ext, m in MODALITIES.items() if row[f"has_{m}"])
+        columns = list(columns)
+        if rows and not all(c in rows[0] for c in columns):
+            missing = [c for c in columns if c not in rows[0]]
+            raise ValueError(f"to_markdown: unknown columns {missing}; available: {sorted(rows[0])}")
+        lines = ["| " + " | ".join(columns) + " |", "|" + "|".join("---" for _ in columns) + "|"]
+        shown = rows if max_rows is None else rows[:max_rows]
+        for row in shown:
+            cells = ["" if row[c] is None else str(row[c]).replace("|", "\\|") for c in columns]
+            lines.append("| " + " | ".join(cells) + " |")
+        if len(shown) < len(rows):
+            lines.append(f"... ({len(rows) - len(shown)} more)")
+        return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------- headers
+def _open_binary(path: Path) -> IO[bytes]:
+    return gzip.open(path, "rb") if path.suffix.lower() == ".gz" else open(path, "rb")
+
+
+def _open_text(path: Path) -> IO[str]:
+    if path.suffix.lower() == ".gz":
+        return gzip.open(path, "rt", encoding="utf-8", errors="replace")
+    return open(path, encoding="utf-8", errors="replace")
+
+
+def bvh_duration(path: str | Path) -> float:
+    """Duration of a BVH file from its header, ``Frames`` x ``Frame Time``, seconds.
+
+    Uses :func:`beatlite.io.read_bvh_header` (reads the HIERARCHY, not the motion rows).
+    Note that some real BEAT files declare a wrong ``Frame Time`` (facts A.3); the
+    index then reports a duration disagreement with the audio.
+    """
+    from beatlite.io import read_bvh_header
+
+    _, n_frames, frame_time = read_bvh_header(path)
+    return float(n_frames) * float(frame_time)
+
+
+def wav_duration(path: str | Path) -> float:
+    """Duration of a WAV (or ``.wav.gz``) file from its header, seconds (soundfile)."""
+    import soundfile as sf
+
+    path = Path(path)
+    with _open_binary(path) as f:
+        info = sf.info(f)
+    return float(info.frames) / float(info.samplerate)
+
+
+def face_duration(path: str | Path) -> float:
+    """Duration of a BEAT facial JSON: number of frames / fps, seconds.
+
+    The fps comes from the median spacing of the frames' ``time`` values (60 in BEAT).
+    """
+    from beatlite.io.errors import FormatError
+
+    path = Path(path)
+    with _open_text(path) as f:
+        try:
+            data = json.load(f)
+        except json.JSONDecodeError as e:
+            raise FormatError(path, f"invalid JSON: {e.msg}", line=e.lineno, column=e.colno) from None
+    frames = data.get("frames") if isinstance(data, dict) else None
+    if not isinstance(frames, list):
+        raise FormatError(path, "no 'frames' list", field="frames")
+    if len(frames) < 2:
+        return len(frames) / 60.0
+    try:
+        times = sorted(float(fr["time"]) for fr in frames)
+    except (KeyError, TypeError, ValueError):
+        raise FormatError(path, "a frame has no numeric 'time'", field="frames[].time") from None
+    gaps = sorted(b - a for a, b in zip(times[:-1], times[1:]))
+    dt = gaps[len(gaps) // 2]
+    if dt <= 0:
+        raise FormatError(path, "frame times do not increase", field="frames[].time")
+    return len(frames) * dt
+
+
+_XMAX = re.compile(r"^\s*xmax\s*=\s*([-+0-9.eE]+)")
+
+
+def textgrid_duration(path: str | Path) -> float:
+    """The ``xmax`` of a Praat TextGrid (long or short text format), seconds."""
+    from beatlite.io.errors import FormatError
+
+    path = Path(path)
+    with _open_text(path) as f:
+        head = [line for _, line in zip(range(12), f)]
+    if "textgrid" not in "".join(head[:2]).lower():
+        raise FormatError(path, "not a TextGrid (no 'Object class = \"TextGrid\"' line)", line=2)
+    for line in head:
+        m = _XMAX.match(line)
+        if m:
+            return float(m.group(1))
+    # short format: File type, Object class, blank, xmin, xmax
+    numbers = [
+        line.strip() for line in head[1:] if line.strip() and not line.strip().startswith(("Object", '"'))
+    ]
+    try:
+        return float(numbers[1])
+    except (IndexError, ValueError):
+        raise FormatError(path, "no xmax in the first lines", field="xmax") from None
+
+
+_DURATION_READERS: dict[str, Callable[[Path], float]] = {
+    "motion": bvh_duration,
+    "audio": wav_duration,
+    "face": face_duration,
+    "text": textgrid_duration,
+}
+
+
+# ---------------------------------------------------------------------- index
+def _scan(root: Path, recursive: bool) -> dict[str, dict[str, list[Path]]]:
+    """stem -> modality -> paths (sorted, plain files before ``.gz``)."""
+    found: dict[str, dict[str, list[Path]]] = {}
+    if recursive:
+        walker = (
+            (Path(d), files)
+            for d, dirs, files in os.walk(root)
+            if not any(part.startswith(".") for part in Path(d).relative_to(root).parts)
+        )
+    else:
+        walker = iter([(root, [p.name for p in root.iterdir() if p.is_file()])])
+    for folder, names in walker:
+        for name in names:
+            m = _SUFFIX.match(name)
+            if m is None or name.startswith("."):
+                continue
+            modality = MODALITIES[m.group("ext").lower()]
+            found.setdefault(m.group("stem"), {}).setdefault(modality, []).append(folder / name)
+    for by_modality in found.values():
+        for paths in by_modality.values():
+            paths.sort(key=lambda p: (p.suffix.lower() == ".gz", str(p)))
+    return found
+
+
+def _name_fields(stem: str) -> tuple[dict[str, Any], str | None]:
+    """Parsed name fields for a TakeRecord, or ({}, problem)."""
+    from beatlite.io.names import parse_take_name
+
+    try:
+        name = parse_take_name(stem)
+    except (ValueError, KeyError, IndexError) as e:
+        return {}, f"bad name: {e}"
+    fields = {
+        "speaker_id": int(name.speaker_id),
+        "speaker": name.speaker,
+        "language": name.language,
+        "session_type": int(name.session_type),
+        "conversation": bool(name.conversation),
+        "sequence": int(name.start),
+        "half": name.half,
+        "emotion": None if name.emotion is None else int(name.emotion),
+        "emotion_name": name.emotion_name,
+        "split": name.split,
+    }
+    return fields, None
+
+
+def index_take(stem: str, files: dict[str, list[Path]], *, read_durations: bool = True) -> TakeRecord:
+    """Build the :class:`TakeRecord` of one take from its files; never raises for bad files.
+
+    Parameters
+    ----------
+    stem : str
+        Take name without extensions.
+    files : dict str -> list of Path
+        Modality -> candidate files (the first is used, the rest flagged as duplicates).
+    read_durations : bool
+        Read the headers of the timed modalities (default True).
+    """
+    fields, problem = _name_fields(stem)
+    record = TakeRecord(stem=stem, **fields)
+    if problem:
+        record.problems.append(problem)
+    for modality, paths in files.items():
+        record.files[modality] = paths[0]
+        if len(paths) > 1:
+            others = ", ".join(str(p) for p in paths[1:])
+            record.problems.append(f"duplicate {modality} files: using {paths[0]}, ignoring {others}")
+    for modality in REQUIRED:
+        if modality not in record.files:
+            ext = next(e for e, m in MODALITIES.items() if m == modality)
+            record.problems.append(f"missing {modality} (.{ext}) file")
+    for modality in ("face", "text", "semantic", "emotion"):
+        if modality not in record.files:
+            ext = next(e for e, m in MODALITIES.items() if m == modality)
+            ext = "TextGrid" if ext == "textgrid" else ext
+            record.problems.append(f"missing {modality} (.{ext}) file")
+    if read_durations:
+        for modality in TIMED:
+            if modality not in record.files:
+                continue
+            try:
+                record.durations[modality] = float(_DURATION_READERS[modality](record.files[modality]))
+            except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
+                record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
+        if len(record.durations) >= 2:
+            lo = min(record.durations, key=record.durations.__getitem__)
+            hi = max(record.durations, key=record.durations.__getitem__)
+            if record.durations[hi] - record.durations[lo] > MAX_DURATION_GAP:
+                listing = ", ".join(f"{m} {d:.2f} s" for m, d in record.durations.items())
+                record.problems.append(f"durations disagree by more than {MAX_DURATION_GAP:g} s: {listing}")
+    return record
+
+
+def _sort_key(record: TakeRecord) -> tuple:
+    return (
+        record.speaker_id is None,
+        record.speaker_id or 0,
+        record.session_type or 0,
+        record.sequence or 0,
+        record.stem,
+    )
+
+
+def index_folder(
+    root: str | Path | None = None, *, recursive: bool = True, read_durations: bool = True
+) -> TakeIndex:
+    """Index every take under ``root``.
+
+    Parameters
+    ----------
+    root : str or Path, optional
+        A BEAT-format folder: flat, ``{speaker_id}/{stem}.*`` or nested deeper
+        (default :func:`beatlite.paths.data_dir`). Hidden folders are skipped.
+    recursive : bool
+        Walk sub-folders (default True).
+    read_durations : bool
+        Read the headers of BVH/WAV/JSON/TextGrid files for durations (default True;
+        False lists files only, which is instant).
+
+    Returns
+    -------
+    TakeIndex
+        One :class:`TakeRecord` per stem that has at least one BEAT file
+        (``.bvh .wav .json .TextGrid .txt .csv``, optionally ``.gz``), sorted by
+        speaker id, session type, sequence, stem; takes with bad names last.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``root`` is not a folder.
+    """
+    from beatlite.paths import data_dir
+
+    root = data_dir() if root is None else Path(root)
+    if not root.is_dir():
+        raise FileNotFoundError(f"index_folder: {root} is not a folder")
+    found = _scan(root, recursive)
+    records = [index_take(stem, files, read_durations=read_durations) for stem, files in found.items()]
+    records.sort(key=_sort_key)
+    return TakeIndex(records, root)

@@ -1,0 +1,665 @@
+"""Aligned, fixed-length training windows (and whole-take evaluation items) for CaMN and HA2G.
+
+:func:`build_windows` cuts every usable take of one split into windows of
+``length`` frames at ``fps`` with hop ``stride`` (BEAT: 34 frames at 15 fps,
+stride 10; facts A.10) and returns a :class:`Windows` whose arrays follow the
+batch contract of ``docs/architecture.md``:
+
+=============  =======================  =============================================================
+key            shape, dtype              content
+=============  =======================  =============================================================
+``pose``       (N, 34, 141) float32      z-scored Euler degrees of ``spine_neck_141`` (train stats)
+``pose_raw``   (N, 34, 141) float32      Euler degrees
+``positions``  (N, 34, 47, 3) float32    cm, the 47 ``spine_neck_141`` joints (``positions=True`` only)
+``dirvec``     (N, 34, 126) float32      unit directions of the 42 TED bones minus their train mean
+``audio``      (N, 36266) float32        16 kHz, ``floor(34/15*16000)`` samples from ``floor(s*16000/15)``
+``mel``        (N, 70, 128) float32      log-mel (HA2G: 128 mels, n_fft 1024, hop 512, power 2, dB ref=max)
+``face``       (N, 34, 51) float32       ARKit blendshape weights (zeros when the take has no JSON)
+``word``       (N, 34) int64             vocabulary ids per frame (PAD=0 where no word / no TextGrid)
+``emotion``    (N, 34) int64             emotion id 0..7 per frame
+``semantic``   (N, 34) float32           semantic relevance score in [0, 1] per frame
+``speaker``    (N,) int64                ``speaker_id - 1`` (0..29, the reference's index)
+``take``       (N,) str                  stem of the source take
+``start``      (N,) int64                first frame of the window in the take
+=============  =======================  =============================================================
+
+Normalisation statistics (pose mean/std, direction mean) are computed on the
+**train** split only and saved with the arrays. Results are cached as ``.npz``
+under :func:`beatlite.paths.cache_dir` keyed by a fingerprint of the source
+files (name, size, mtime) and every parameter.
+
+With ``whole_takes=True`` there is one item per take, full length (the
+reference's test mode); per-frame keys are then lists of (T_i, ...) arrays.
+
+The log-mel is computed once per take (``center=True``, ``ref=max`` over the
+take, as HA2G does per clip) and sliced: a window starting at audio sample
+``a0`` takes the 70 mel frames from ``floor(a0 / 512)``. No window is dropped
+(the reference drops near-static training windows; beatlite keeps them).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from beatlite.data.normalize import Normalizer
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeIndex, TakeRecord
+    from beatlite.data.vocab import Vocab
+
+#: Keys of a window batch, in contract order (``positions`` only when asked for).
+WINDOW_KEYS = (
+    "pose",
+    "pose_raw",
+    "positions",
+    "dirvec",
+    "audio",
+    "mel",
+    "face",
+    "word",
+    "emotion",
+    "semantic",
+    "speaker",
+    "take",
+    "start",
+)
+#: Keys with one row per frame (sliced along time).
+FRAME_KEYS = ("pose", "pose_raw", "positions", "dirvec", "face", "word", "emotion", "semantic")
+#: Size of the reference's speaker embedding (speaker index = id - 1).
+N_SPEAKERS = 30
+#: HA2G log-mel settings (facts C.7).
+MEL_SETTINGS = {"n_mels": 128, "n_fft": 1024, "hop_length": 512, "power": 2.0}
+POSE_SUBSET = "spine_neck_141"
+#: Bump when the content of the cache changes.
+CACHE_VERSION = 1
+
+
+def window_starts(n_frames: int, length: int, stride: int) -> np.ndarray:
+    """First frames of the windows of a take: ``0, stride, ...`` while ``start + length <= n_frames``.
+
+    >>> window_starts(100, 34, 10).tolist()
+    [0, 10, 20, 30, 40, 50, 60]
+    """
+    for name, v in (("n_frames", n_frames), ("length", length), ("stride", stride)):
+        if not isinstance(v, int | np.integer) or v < (0 if name == "n_frames" else 1):
+            raise ValueError(
+                f"window_starts: {name} must be a {'non-negative' if name == 'n_frames' else 'positive'} int, got {v!r}"
+            )
+    if n_frames < length:
+        return np.zeros(0, dtype=np.int64)
+    return np.arange(0, n_frames - length + 1, stride, dtype=np.int64)
+
+
+def audio_samples(n_frames: int, fps: float, sr: int) -> int:
+    """Audio samples covering ``n_frames`` pose frames: ``floor(n_frames / fps * sr)`` (36266 for 34)."""
+    return int(np.floor(n_frames * sr / fps + 1e-9))
+
+
+def audio_start(frame: int, fps: float, sr: int) -> int:
+    """First audio sample of pose frame ``frame``: ``floor(frame * sr / fps)``."""
+    return int(np.floor(frame * sr / fps + 1e-9))
+
+
+def mel_frames(n_samples: int) -> int:
+    """Mel frames per clip of ``n_samples`` (HA2G): ``round((n - n_fft) / hop + 1)`` (70 for 36266)."""
+    return max(1, int(round((n_samples - MEL_SETTINGS["n_fft"]) / MEL_SETTINGS["hop_length"] + 1)))
+
+
+def log_mel(audio: np.ndarray, sr: int = 16000) -> np.ndarray:
+    """Log-mel spectrogram with HA2G settings, (M, 128) float32 dB (``power_to_db(ref=np.max)``).
+
+    Parameters
+    ----------
+    audio : (N,) float
+        Mono waveform in [-1, 1].
+    sr : int
+        Sample rate, Hz.
+
+    Returns
+    -------
+    (M, 128) float32, M = 1 + N // 512 (librosa ``center=True``); max 0 dB, min -80 dB.
+    """
+    import librosa
+
+    y = np.asarray(audio, dtype=np.float32)
+    if y.ndim != 1:
+        raise ValueError(f"log_mel: audio must be (N,), got {y.shape}")
+    spec = librosa.feature.melspectrogram(y=y, sr=sr, **MEL_SETTINGS)
+    return librosa.power_to_db(spec, ref=np.max).T.astype(np.float32)
+
+
+# ---------------------------------------------------------------------- per take
+@dataclass
+class TakeFeatures:
+    """All per-frame streams of one take at the model frame rate, aligned to ``n_frames``.
+
+    Attributes
+    ----------
+    stem : str
+    speaker : int
+        ``speaker_id - 1``.
+    pose_raw : (T, 141) float64, degrees
+    dirs : (T, 126) float64, unit bone directions (not centred)
+    positions : (T, 47, 3) float32 cm or None
+    audio : (N,) float32, N >= audio_samples(T)
+    mel : (M, 128) float32 dB (whole take)
+    face : (T, 51) float32
+    word : (T,) int64
+    emotion : (T,) int64
+    semantic : (T,) float32
+    """
+
+    stem: str
+    speaker: int
+    pose_raw: np.ndarray
+    dirs: np.ndarray
+    positions: np.ndarray | None
+    audio: np.ndarray
+    mel: np.ndarray
+    face: np.ndarray
+    word: np.ndarray
+    emotion: np.ndarray
+    semantic: np.ndarray
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.pose_raw.shape[0])
+
+
+def take_features(
+    record: TakeRecord,
+    *,
+    fps: float = 15,
+    sr: int = 16000,
+    vocab: Mapping | None = None,
+    word_rule: str = "span",
+    positions: bool = False,
+) -> TakeFeatures:
+    """Load one take and compute its aligned per-frame streams (see :class:`TakeFeatures`).
+
+    The frame count is the one :func:`beatlite.io.load_take` aligned every modality to: the
+    smallest of the motion frames, ``floor(audio seconds * fps)`` and the face frames (BEAT:
+    truncate to the shortest modality, facts A.9).
+    """
+    from beatlite.io import load_take, words_to_frames
+    from beatlite.skeleton import subset_columns
+    from beatlite.skeleton.beat import JOINT_SUBSETS
+    from beatlite.skeleton.directions import positions_to_directions
+    from beatlite.skeleton.ted import TED_BONES, beat_to_ted43
+
+    take = load_take(record.path("motion"), fps=fps, audio_sr=sr)
+    motion = take.motion
+    audio = np.asarray(take.audio, dtype=np.float32)
+    n = take.n_frames  # load_take already cut every modality to the shortest one
+    skel = motion.skeleton
+    cols = subset_columns(skel, POSE_SUBSET)
+    pose_raw = motion.channels[:n, cols]
+    world = motion.positions()[:n]
+    dirs = positions_to_directions(beat_to_ted43(world), np.asarray(TED_BONES)).reshape(n, -1)
+    pos = None
+    if positions:
+        pos = world[:, skel.indices(JOINT_SUBSETS[POSE_SUBSET])].astype(np.float32)
+    face = np.zeros((n, 51), np.float32) if take.face is None else np.asarray(take.face, np.float32)[:n]
+    if take.words is not None and vocab is not None:
+        # the TextGrid of a "_b" half keeps the whole sequence's times (facts A.5)
+        offset = 0.0 if record.half != "b" else (300.0 if record.conversation else 30.0)
+        word = words_to_frames(take.words, n, fps, vocab, rule=word_rule, offset=offset).astype(np.int64)
+    else:
+        word = np.zeros(n, dtype=np.int64)
+    return TakeFeatures(
+        stem=record.stem,
+        speaker=int(record.speaker_id) - 1,
+        pose_raw=pose_raw,
+        dirs=dirs,
+        positions=pos,
+        audio=audio,
+        mel=log_mel(audio, sr),
+        face=face,
+        word=word,
+        emotion=np.asarray(take.emotion, dtype=np.int64)[:n],
+        semantic=np.asarray(take.semantic, dtype=np.float32)[:n],
+    )
+
+
+def _fit_audio(audio: np.ndarray, start: int, n: int) -> np.ndarray:
+    """``audio[start:start+n]`` zero-padded to exactly n samples."""
+    out = audio[start : start + n]
+    if len(out) < n:
+        out = np.concatenate([out, np.zeros(n - len(out), dtype=audio.dtype)])
+    return out
+
+
+def _fit_rows(x: np.ndarray, start: int, n: int) -> np.ndarray:
+    """``x[start:start+n]`` padded by repeating the last row (or zeros if empty)."""
+    out = x[start : start + n]
+    if len(out) < n:
+        pad = np.repeat(out[-1:] if len(out) else np.zeros((1, *x.shape[1:]), x.dtype), n - len(out), axis=0)
+        out = np.concatenate([out, pad])
+    return out
+
+
+# ---------------------------------------------------------------------- container
+class Windows:
+    """The windows (or whole takes) of one split, with their normalisation statistics.
+
+    Index it like the batch dict of the contract: ``w["pose"]`` is (N, 34, 141) float32.
+    With ``whole_takes=True`` per-frame keys (and ``audio``, ``mel``) give lists of
+    per-take arrays instead. :meth:`item` returns one item as a dict of arrays,
+    :meth:`batch` a batch dict for given indices.
+
+    Attributes
+    ----------
+    pose_norm : Normalizer
+        141-d pose statistics of the train split (degrees).
+    dir_norm : Normalizer
+        126-d direction mean of the train split (``std = 1``).
+    params : dict
+        Parameters the windows were built with (split, length, stride, fps, sr, ...).
+    whole_takes : bool
+        One full-length item per take.
+    path : Path or None
+        Cache file the windows were loaded from / saved to.
+    """
+
+    def __init__(
+        self,
+        arrays: dict[str, np.ndarray],
+        *,
+        pose_norm: Normalizer,
+        dir_norm: Normalizer,
+        params: dict[str, Any],
+        path: Path | None = None,
+    ) -> None:
+        self._arrays = arrays
+        self.pose_norm = pose_norm
+        self.dir_norm = dir_norm
+        self.params = dict(params)
+        self.whole_takes = bool(params.get("whole_takes", False))
+        self.path = path
+        n = len(arrays["take"])
+        if self.whole_takes:
+            self._offsets = {
+                k: np.concatenate([[0], np.cumsum(arrays[f"_len_{k}"])]).astype(np.int64)
+                for k in ("frames", "audio", "mel")
+            }
+        elif any(len(arrays[k]) != n for k in self.keys()):
+            raise ValueError("Windows: arrays have different numbers of rows")
+
+    # mapping-like access -----------------------------------------------------
+    def keys(self) -> list[str]:
+        """Batch keys present, in contract order."""
+        return [k for k in WINDOW_KEYS if k in self._arrays]
+
+    def __len__(self) -> int:
+        return int(len(self._arrays["take"]))
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.keys()
+
+    def _span(self, key: str, i: int) -> slice:
+        kind = "audio" if key == "audio" else "mel" if key == "mel" else "frames"
+        off = self._offsets[kind]
+        return slice(int(off[i]), int(off[i + 1]))
+
+    def __getitem__(self, key: str) -> np.ndarray | list[np.ndarray]:
+        if key not in self.keys():
+            raise KeyError(f"Windows has no key {key!r}; keys: {self.keys()}")
+        arr = self._arrays[key]
+        if not self.whole_takes or key in ("speaker", "take", "start"):
+            return arr
+        return [arr[self._span(key, i)] for i in range(len(self))]
+
+    def item(self, i: int) -> dict[str, np.ndarray]:
+        """Item ``i`` as a dict (per-frame arrays without the leading N axis)."""
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"Windows.item: index {i} out of range for {len(self)} items")
+        i = i % len(self)
+        out = {}
+        for k in self.keys():
+            arr = self._arrays[k]
+            if self.whole_takes and k not in ("speaker", "take", "start"):
+                out[k] = arr[self._span(k, i)]
+            else:
+                out[k] = arr[i]
+        return out
+
+    def batch(self, indices: Sequence[int] | np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """Batch dict (the contract) of the given windows (default all); windowed mode only."""
+        if self.whole_takes:
+            raise ValueError("Windows.batch: whole-take items have different lengths; use item(i)")
+        idx = np.arange(len(self)) if indices is None else np.asarray(indices, dtype=np.int64)
+        return {k: self._arrays[k][idx] for k in self.keys()}
+
+    def __repr__(self) -> str:
+        mode = "whole takes" if self.whole_takes else f"windows of {self.params['length']} frames"
+        return f"Windows({len(self)} {mode}, split={self.params['split']!r}, keys={self.keys()})"
+
+    # persistence ---------------------------------------------------------------
+    def save(self, path: str | Path) -> Path:
+        """Write arrays, statistics and parameters to one ``.npz`` (atomic). Returns the path."""
+        from beatlite.io.atomic import atomic_write
+
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        payload = dict(self._arrays)
+        payload.update(self.pose_norm.to_arrays("pose"))
+        payload.update(self.dir_norm.to_arrays("dirvec"))
+        payload["_params"] = np.array(json.dumps(self.params, sort_keys=True))
+        with atomic_write(path, "wb") as f:
+            np.savez(f, **payload)
+        self.path = path
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Windows:
+        """Read windows written by :meth:`save` (no pickle)."""
+        from beatlite.io.errors import FormatError
+
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                data = {k: z[k] for k in z.files}
+        except (OSError, ValueError) as e:
+            raise FormatError(path, f"not a windows .npz: {e}") from None
+        for key in ("_params", "pose_mean", "pose_std", "dirvec_mean", "dirvec_std", "take"):
+            if key not in data:
+                raise FormatError(path, "missing array", field=key)
+        params = json.loads(str(data.pop("_params")))
+        pose_norm = Normalizer(data.pop("pose_mean"), data.pop("pose_std"))
+        dir_norm = Normalizer(data.pop("dirvec_mean"), data.pop("dirvec_std"))
+        return cls(data, pose_norm=pose_norm, dir_norm=dir_norm, params=params, path=path)
+
+
+# ---------------------------------------------------------------------- building
+def _fingerprint(records: Sequence[TakeRecord], payload: dict[str, Any]) -> str:
+    """sha256 over the files (name, size, mtime_ns) of ``records`` and the JSON of ``payload``."""
+    h = hashlib.sha256()
+    h.update(json.dumps({**payload, "version": CACHE_VERSION}, sort_keys=True, default=str).encode())
+    for r in sorted(records, key=lambda r: r.stem):
+        for modality in sorted(r.files):
+            p = r.files[modality]
+            st = p.stat()
+            h.update(f"{r.stem}|{modality}|{p.name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+    return h.hexdigest()
+
+
+def _usable(index: TakeIndex, split: str | None) -> list[TakeRecord]:
+    chosen = [r for r in index if split is None or r.split == split]
+    skipped = [r.stem for r in chosen if not r.usable]
+    if skipped:
+        warnings.warn(
+            f"build_windows: skipping {len(skipped)} unusable takes (see TakeIndex.problems()): {skipped[:5]}",
+            stacklevel=3,
+        )
+    return [r for r in chosen if r.usable]
+
+
+def _stats_path(records: Sequence[TakeRecord], fps: float, sr: int, cache: bool | str | Path) -> Path | None:
+    folder = _cache_folder(cache)
+    if folder is None:
+        return None
+    fp = _fingerprint(records, {"kind": "stats", "fps": fps, "sr": sr})
+    return folder / f"stats_{fp[:20]}.npz"
+
+
+def _load_stats(path: Path | None) -> tuple[Normalizer, Normalizer] | None:
+    if path is None or not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return Normalizer.from_arrays(z, "pose"), Normalizer.from_arrays(z, "dirvec")
+    except (OSError, ValueError, KeyError):
+        return None  # a broken cache file is rebuilt
+
+
+def _fit_stats(features: Sequence[TakeFeatures], path: Path | None) -> tuple[Normalizer, Normalizer]:
+    pose_norm = Normalizer.fit([f.pose_raw for f in features])
+    dir_norm = Normalizer.fit([f.dirs for f in features], center_only=True)
+    if path is not None:
+        _save_npz(path, {**pose_norm.to_arrays("pose"), **dir_norm.to_arrays("dirvec")})
+    return pose_norm, dir_norm
+
+
+def _train_records(index: TakeIndex) -> list[TakeRecord]:
+    records = _usable(index, "train")
+    if not records:
+        raise ValueError("train_statistics: the index has no usable train takes to compute statistics from")
+    return records
+
+
+def train_statistics(
+    index: TakeIndex,
+    *,
+    fps: float = 15,
+    sr: int = 16000,
+    cache: bool | str | Path = True,
+) -> tuple[Normalizer, Normalizer]:
+    """Pose and direction statistics of the **train** split of ``index`` (cached like the windows).
+
+    Returns
+    -------
+    pose_norm : Normalizer
+        (141,) mean/std over all train frames of the Euler degrees (std < 1e-6 -> 1).
+    dir_norm : Normalizer
+        (126,) mean over all train frames of the unit directions, ``std = 1``.
+
+    Raises
+    ------
+    ValueError
+        If the index has no usable train take.
+    """
+    records = _train_records(index)
+    path = _stats_path(records, fps, sr, cache)
+    stats = _load_stats(path)
+    if stats is None:
+        stats = _fit_stats([take_features(r, fps=fps, sr=sr) for r in records], path)
+    return stats
+
+
+def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    from beatlite.io.atomic import atomic_write
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def _cache_folder(cache: bool | str | Path) -> Path | None:
+    from beatlite.paths import cache_dir
+
+    if cache is False or cache is None:
+        return None
+    if cache is True:
+        return cache_dir() / "windows"
+    return Path(cache)
+
+
+def build_windows(
+    index: TakeIndex,
+    *,
+    split: str | None,
+    length: int = 34,
+    stride: int = 10,
+    fps: float = 15,
+    sr: int = 16000,
+    whole_takes: bool = False,
+    vocab: Vocab | None = None,
+    stats: tuple[Normalizer, Normalizer] | None = None,
+    positions: bool = False,
+    word_rule: str = "span",
+    cache: bool | str | Path = True,
+    progress: bool = False,
+) -> Windows:
+    """Windows (or whole takes) of one split, aligned across all modalities.
+
+    Parameters
+    ----------
+    index : TakeIndex
+        The indexed corpus (:func:`beatlite.data.index.index_folder`); its train split
+        provides the normalisation statistics and (by default) all its TextGrids the vocabulary.
+    split : {"train", "val", "test"} or None
+        Takes to cut (None: all usable takes).
+    length, stride : int
+        Window length and hop, frames (34 and 10).
+    fps : float
+        Model frame rate (15).
+    sr : int
+        Audio sample rate (16000).
+    whole_takes : bool
+        One item per take, full length (evaluation mode); ``length``/``stride`` unused.
+    vocab : Vocab, optional
+        Word ids; default :func:`beatlite.data.vocab.build_vocab` of the whole index.
+    stats : (pose Normalizer, direction Normalizer), optional
+        Statistics to use instead of the index's train split (e.g. ``(w.pose_norm, w.dir_norm)``
+        of the training windows).
+    positions : bool
+        Also return ``"positions"`` (N, length, 47, 3) float32 cm.
+    word_rule : {"span", "onset", "beat"}
+        Word-to-frame rule of :func:`beatlite.io.words_to_frames`.
+    cache : bool or str or Path
+        True: cache under ``cache_dir()/windows``; a folder: cache there; False: no cache.
+    progress : bool
+        Show a tqdm bar while loading takes.
+
+    Returns
+    -------
+    Windows
+
+    Raises
+    ------
+    ValueError
+        Bad parameters, or no usable take in ``split``.
+    """
+    from beatlite.data.vocab import build_vocab
+
+    if split not in ("train", "val", "test", None):
+        raise ValueError(f"build_windows: split must be 'train', 'val', 'test' or None, got {split!r}")
+    for name, v in (("length", length), ("stride", stride), ("sr", sr)):
+        if not isinstance(v, int | np.integer) or v < 1:
+            raise ValueError(f"build_windows: {name} must be a positive int, got {v!r}")
+    if not fps > 0:
+        raise ValueError(f"build_windows: fps must be positive, got {fps!r}")
+    records = _usable(index, split)
+    if not records:
+        raise ValueError(f"build_windows: no usable takes in split {split!r} ({len(index)} takes indexed)")
+    if vocab is None:
+        vocab = build_vocab(index)
+    loaded: dict[str, TakeFeatures] = {}
+    feature_args: dict[str, Any] = {
+        "fps": fps,
+        "sr": sr,
+        "vocab": vocab,
+        "word_rule": word_rule,
+        "positions": positions,
+    }
+    if stats is None:
+        train_records = _train_records(index)
+        stats_path = _stats_path(train_records, fps, sr, cache)
+        stats = _load_stats(stats_path)
+        if stats is None:
+            if split == "train":  # load the train takes once: for the statistics and the windows
+                loaded = {r.stem: take_features(r, **feature_args) for r in train_records}
+                stats = _fit_stats(list(loaded.values()), stats_path)
+            else:
+                stats = _fit_stats([take_features(r, fps=fps, sr=sr) for r in train_records], stats_path)
+    pose_norm, dir_norm = stats
+    params: dict[str, Any] = {
+        "split": split,
+        "length": int(length),
+        "stride": int(stride),
+        "fps": float(fps),
+        "sr": int(sr),
+        "whole_takes": bool(whole_takes),
+        "positions": bool(positions),
+        "word_rule": word_rule,
+        "vocab_size": len(vocab),
+        "mel": dict(MEL_SETTINGS),
+        "subset": POSE_SUBSET,
+    }
+    folder = _cache_folder(cache)
+    path = None
+    if folder is not None:
+        vocab_hash = hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
+        stats_hash = hashlib.sha256(
+            b"".join(a.tobytes() for a in (pose_norm.mean, pose_norm.std, dir_norm.mean))
+        ).hexdigest()
+        fp = _fingerprint(records, {**params, "vocab": vocab_hash, "stats": stats_hash})
+        path = folder / f"windows_{split}_{'takes' if whole_takes else 'win'}_{fp[:20]}.npz"
+        if path.is_file():
+            try:
+                return Windows.load(path)
+            except ValueError:
+                pass  # broken cache: rebuild
+    items = records
+    if progress:
+        from tqdm import tqdm
+
+        items = tqdm(records, desc=f"windows {split}")
+    parts: dict[str, list[np.ndarray]] = {k: [] for k in WINDOW_KEYS}
+    lens: dict[str, list[int]] = {"frames": [], "audio": [], "mel": []}
+    for record in items:
+        f = loaded.pop(record.stem, None) or take_features(record, **feature_args)
+        pose = pose_norm.transform(f.pose_raw).astype(np.float32)
+        dirvec = dir_norm.transform(f.dirs).astype(np.float32)
+        per_frame = {
+            "pose": pose,
+            "pose_raw": f.pose_raw.astype(np.float32),
+            "positions": f.positions,
+            "dirvec": dirvec,
+            "face": f.face,
+            "word": f.word,
+            "emotion": f.emotion,
+            "semantic": f.semantic,
+        }
+        if whole_takes:
+            n = f.n_frames
+            n_audio = audio_samples(n, fps, sr)
+            n_mel = mel_frames(n_audio)
+            for k, v in per_frame.items():
+                if v is not None:
+                    parts[k].append(v)
+            parts["audio"].append(_fit_audio(f.audio, 0, n_audio))
+            parts["mel"].append(_fit_rows(f.mel, 0, n_mel))
+            parts["speaker"].append(np.array([f.speaker], np.int64))
+            parts["take"].append(np.array([f.stem]))
+            parts["start"].append(np.zeros(1, np.int64))
+            lens["frames"].append(n)
+            lens["audio"].append(n_audio)
+            lens["mel"].append(n_mel)
+            continue
+        starts = window_starts(f.n_frames, int(length), int(stride))
+        if len(starts) == 0:
+            continue
+        n_audio = audio_samples(int(length), fps, sr)
+        n_mel = mel_frames(n_audio)
+        frame_idx = starts[:, None] + np.arange(length)[None, :]
+        for k, v in per_frame.items():
+            if v is not None:
+                parts[k].append(v[frame_idx])
+        a0 = [audio_start(int(s), fps, sr) for s in starts]
+        parts["audio"].append(np.stack([_fit_audio(f.audio, a, n_audio) for a in a0]))
+        hop = MEL_SETTINGS["hop_length"]
+        parts["mel"].append(np.stack([_fit_rows(f.mel, a // hop, n_mel) for a in a0]))
+        parts["speaker"].append(np.full(len(starts), f.speaker, np.int64))
+        parts["take"].append(np.array([f.stem] * len(starts)))
+        parts["start"].append(starts)
+    if not parts["take"]:
+        raise ValueError(
+            f"build_windows: no take of split {split!r} is at least {length} frames long ({len(records)} takes)"
+        )
+    arrays = {k: np.concatenate(v) for k, v in parts.items() if v}
+    if whole_takes:
+        for k, v in lens.items():
+            arrays[f"_len_{k}"] = np.array(v, dtype=np.int64)
+    windows = Windows(arrays, pose_norm=pose_norm, dir_norm=dir_norm, params=params)
+    if path is not None:
+        windows.save(path)
+    return windows

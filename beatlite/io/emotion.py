@@ -1,0 +1,120 @@
+"""BEAT emotion annotations (``.csv``, comma-separated, no header; facts A.7).
+
+Each line is ``name,start,end,duration,class`` with ``class`` in 0..7
+(neutral, happiness, anger, sadness, contempt, surprise, fear, disgust).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from beatlite.io.atomic import atomic_write
+from beatlite.io.errors import FormatError
+from beatlite.io.semantic import parse_number, segments_to_frames
+from beatlite.io.textfile import read_text
+
+__all__ = ["EmotionSegment", "read_emotion", "write_emotion", "emotion_to_frames", "N_EMOTIONS"]
+
+N_EMOTIONS = 8
+
+
+class EmotionSegment(NamedTuple):
+    """One emotion span: a label ``name``, times in seconds and the class ``emotion`` in 0..7."""
+
+    name: str
+    start: float
+    end: float
+    duration: float
+    emotion: int
+
+
+def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
+    """Read a BEAT emotion ``.csv`` file (``.gz`` transparent).
+
+    Returns
+    -------
+    list of EmotionSegment
+        In file order.
+
+    Raises
+    ------
+    FormatError
+        Not 5 fields, a non-numeric field, ``start > end`` or a class that is
+        not a whole number in 0..7, naming the line and the field.
+    """
+    p = Path(path)
+    out: list[EmotionSegment] = []
+    for lineno, raw in enumerate(read_text(p).split("\n"), start=1):
+        if not raw.strip():
+            continue
+        parts = [x.strip() for x in raw.split(",")]
+        if len(parts) != 5:
+            raise FormatError(
+                p,
+                f"expected 5 comma-separated fields (name,start,end,duration,class), found {len(parts)}",
+                line=lineno,
+            )
+        start = parse_number(p, parts[1], lineno, "start")
+        end = parse_number(p, parts[2], lineno, "end")
+        duration = parse_number(p, parts[3], lineno, "duration")
+        value = parse_number(p, parts[4], lineno, "class")
+        if start > end:
+            raise FormatError(p, f"start {start} is after end {end}", line=lineno, field="start")
+        if value != int(value) or not 0 <= value < N_EMOTIONS:
+            raise FormatError(
+                p,
+                f"emotion class {parts[4]!r} is not an integer in 0..{N_EMOTIONS - 1}",
+                line=lineno,
+                field="class",
+            )
+        out.append(EmotionSegment(parts[0], start, end, duration, int(value)))
+    return out
+
+
+def emotion_to_frames(
+    segments: Sequence[EmotionSegment], n_frames: int, fps: float, default: int = 0
+) -> np.ndarray:
+    """Emotion class of every frame: the class of the segment whose ``[start, end]`` holds ``t = i / fps``.
+
+    Parameters
+    ----------
+    segments : sequence of EmotionSegment
+        From :func:`read_emotion`.
+    n_frames : int
+        T.
+    fps : float
+        Frame rate.
+    default : int
+        Class of frames outside every segment (BEAT: 0, neutral).
+
+    Returns
+    -------
+    (T,) int64
+    """
+    starts = np.array([s.start for s in segments], dtype=np.float64)
+    ends = np.array([s.end for s in segments], dtype=np.float64)
+    classes = np.array([s.emotion for s in segments], dtype=np.int64)
+    return segments_to_frames(starts, ends, classes, n_frames, fps, default, np.int64)
+
+
+def write_emotion(path: str | os.PathLike[str], segments: Sequence[EmotionSegment]) -> None:
+    """Write segments as a BEAT emotion ``.csv`` (atomic)."""
+    lines = []
+    for i, s in enumerate(segments):
+        seg = EmotionSegment(*s)
+        if "," in seg.name or "\n" in seg.name:
+            raise ValueError(f"write_emotion: segment {i} name {seg.name!r} contains a comma or newline")
+        if not 0 <= int(seg.emotion) < N_EMOTIONS or seg.start > seg.end:
+            raise ValueError(
+                f"write_emotion: segment {i} has class {seg.emotion} / times {seg.start}-{seg.end}"
+            )
+        lines.append(
+            f"{seg.name},{float(seg.start)!r},{float(seg.end)!r},{float(seg.duration)!r},{int(seg.emotion)}"
+        )
+    with atomic_write(path, "w") as f:
+        f.write("".join(line + "\n" for line in lines))

@@ -1,0 +1,221 @@
+"""Facial blendshape weights (ARKit, 60 fps) stored as BEAT's JSON.
+
+The format is ``{"names": [51 names], "frames": [{"time": t, "weights": [51 floats]}, ...]}``
+with ``time`` in seconds (facts A.4). BEAT has 51 weights: ARKit's 52 minus
+``tongueOut``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from beatlite.io.atomic import atomic_write
+from beatlite.io.errors import FormatError
+from beatlite.io.textfile import read_text
+
+__all__ = ["ARKIT_52", "ARKIT_51", "Facial", "read_facial", "write_facial", "estimate_fps"]
+
+#: The 52 ARKit blendshapes in the standard order (ARKit documentation / Live Link Face CSV).
+ARKIT_52: tuple[str, ...] = (
+    "eyeBlinkLeft", "eyeLookDownLeft", "eyeLookInLeft", "eyeLookOutLeft", "eyeLookUpLeft",
+    "eyeSquintLeft", "eyeWideLeft", "eyeBlinkRight", "eyeLookDownRight", "eyeLookInRight",
+    "eyeLookOutRight", "eyeLookUpRight", "eyeSquintRight", "eyeWideRight", "jawForward", "jawLeft",
+    "jawRight", "jawOpen", "mouthClose", "mouthFunnel", "mouthPucker", "mouthLeft", "mouthRight",
+    "mouthSmileLeft", "mouthSmileRight", "mouthFrownLeft", "mouthFrownRight", "mouthDimpleLeft",
+    "mouthDimpleRight", "mouthStretchLeft", "mouthStretchRight", "mouthRollLower", "mouthRollUpper",
+    "mouthShrugLower", "mouthShrugUpper", "mouthPressLeft", "mouthPressRight", "mouthLowerDownLeft",
+    "mouthLowerDownRight", "mouthUpperUpLeft", "mouthUpperUpRight", "browDownLeft", "browDownRight",
+    "browInnerUp", "browOuterUpLeft", "browOuterUpRight", "cheekPuff", "cheekSquintLeft",
+    "cheekSquintRight", "noseSneerLeft", "noseSneerRight", "tongueOut",
+)  # fmt: skip
+
+#: BEAT's 51 facial channels: :data:`ARKIT_52` without ``tongueOut`` (facts A.4).
+ARKIT_51: tuple[str, ...] = tuple(n for n in ARKIT_52 if n != "tongueOut")
+
+DEFAULT_FPS = 60.0
+
+
+@dataclass(eq=False)
+class Facial:
+    """Blendshape weights of one take.
+
+    Attributes
+    ----------
+    names : tuple of str, length K
+        Blendshape names (51 for BEAT, :data:`ARKIT_51`).
+    weights : (T, K) float32
+        Weights, nominally in [0, 1].
+    times : (T,) float64, seconds
+        Time stamp of each frame, strictly increasing.
+    fps : float
+        Frame rate estimated from ``times`` (:func:`estimate_fps`).
+    """
+
+    names: tuple[str, ...]
+    weights: np.ndarray
+    times: np.ndarray
+    fps: float
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames T."""
+        return int(self.weights.shape[0])
+
+    def __repr__(self) -> str:
+        return f"Facial({self.n_frames} frames x {len(self.names)} blendshapes @ {self.fps:g} fps)"
+
+
+def estimate_fps(times: np.ndarray, default: float = DEFAULT_FPS) -> float:
+    """Frame rate from time stamps: ``1 / median(diff(times))``, snapped to an integer within 1 %.
+
+    Parameters
+    ----------
+    times : (T,) float, seconds
+        Increasing time stamps.
+    default : float
+        Returned when there are fewer than two frames.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"estimate_fps: times must be (T,), got shape {t.shape}")
+    if t.size < 2:
+        return float(default)
+    fps = 1.0 / float(np.median(np.diff(t)))
+    n = round(fps)
+    return float(n) if n >= 1 and abs(fps - n) <= 0.01 * n else fps
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def read_facial(path: str | os.PathLike[str]) -> Facial:
+    """Read a BEAT facial JSON file (``.json`` or ``.json.gz``).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The file.
+
+    Returns
+    -------
+    Facial
+        ``weights`` (T, K) float32 (K = 51 for BEAT), ``times`` (T,) float64 seconds, ``fps``.
+
+    Raises
+    ------
+    FormatError
+        Invalid JSON (line/column), a missing key, a frame whose weight count
+        differs from the number of names, a non-numeric or non-finite value, or
+        time stamps that do not increase (each naming the frame index).
+    """
+    p = Path(path)
+    text = read_text(p)
+    if not text.strip():
+        raise FormatError(p, "empty file: expected facial JSON")
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FormatError(p, f"invalid JSON: {exc.msg}", line=exc.lineno, column=exc.colno) from None
+    if not isinstance(doc, dict):
+        raise FormatError(p, f"top level must be an object, got {type(doc).__name__}")
+    for key in ("names", "frames"):
+        if key not in doc:
+            raise FormatError(p, f"missing key {key!r} (keys present: {sorted(doc)})", field=key)
+    names = doc["names"]
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names) or not names:
+        raise FormatError(p, "'names' must be a non-empty list of strings", field="names")
+    frames = doc["frames"]
+    if not isinstance(frames, list):
+        raise FormatError(p, f"'frames' must be a list, got {type(frames).__name__}", field="frames")
+    k = len(names)
+    times = np.empty(len(frames), dtype=np.float64)
+    weights = np.empty((len(frames), k), dtype=np.float32)
+    for i, frame in enumerate(frames):
+        if not isinstance(frame, dict):
+            raise FormatError(p, f"frame {i} is not an object", field=f"frames[{i}]")
+        for key in ("time", "weights"):
+            if key not in frame:
+                raise FormatError(p, f"frame {i} has no {key!r}", field=f"frames[{i}].{key}")
+        t, w = frame["time"], frame["weights"]
+        if not _number(t) or not math.isfinite(t):
+            raise FormatError(p, f"frame {i}: time {t!r} is not a finite number", field=f"frames[{i}].time")
+        if not isinstance(w, list) or len(w) != k:
+            got = len(w) if isinstance(w, list) else type(w).__name__
+            raise FormatError(
+                p, f"frame {i} has {got} weights but there are {k} names", field=f"frames[{i}].weights"
+            )
+        times[i] = t
+        try:
+            weights[i] = w
+        except (TypeError, ValueError):
+            bad = next(v for v in w if not _number(v))
+            raise FormatError(
+                p, f"frame {i}: weight {bad!r} is not a number", field=f"frames[{i}].weights"
+            ) from None
+    bad_rows = np.flatnonzero(~np.isfinite(weights).all(axis=1))
+    if bad_rows.size:
+        i = int(bad_rows[0])
+        raise FormatError(p, f"frame {i} has a non-finite weight", field=f"frames[{i}].weights")
+    steps = np.diff(times)
+    if steps.size and not (steps > 0).all():
+        i = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise FormatError(
+            p,
+            f"time stamps must increase: frame {i} has time {times[i]} after {times[i - 1]}",
+            field=f"frames[{i}].time",
+        )
+    return Facial(names=tuple(names), weights=weights, times=times, fps=estimate_fps(times))
+
+
+def write_facial(
+    path: str | os.PathLike[str],
+    names: Sequence[str],
+    weights: np.ndarray,
+    fps: float = DEFAULT_FPS,
+    *,
+    times: np.ndarray | None = None,
+) -> None:
+    """Write blendshape weights as BEAT facial JSON, atomically (``.gz`` suffix gzips).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        Destination.
+    names : sequence of str, length K
+        Blendshape names (e.g. :data:`ARKIT_51`).
+    weights : (T, K) float
+        Weights, written rounded to 6 decimals (values already rounded read back equal as float32).
+    fps : float
+        Frame rate; frame ``i`` gets ``time = i / fps`` unless ``times`` is given.
+    times : (T,) float, optional
+        Explicit increasing time stamps in seconds (written rounded to 6 decimals).
+    """
+    names = [str(n) for n in names]
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim != 2 or w.shape[1] != len(names):
+        raise ValueError(f"write_facial: weights must be (T, {len(names)}), got shape {w.shape}")
+    if not np.isfinite(w).all():
+        raise ValueError("write_facial: weights contain NaN or infinite values")
+    if not math.isfinite(fps) or fps <= 0:
+        raise ValueError(f"write_facial: fps must be positive, got {fps}")
+    if times is None:
+        t = np.arange(w.shape[0], dtype=np.float64) / float(fps)
+    else:
+        t = np.asarray(times, dtype=np.float64)
+        if t.shape != (w.shape[0],):
+            raise ValueError(f"write_facial: times must be ({w.shape[0]},), got shape {t.shape}")
+        if t.size > 1 and not (np.diff(t) > 0).all():
+            raise ValueError("write_facial: times must be strictly increasing")
+    frames = [
+        {"time": round(float(ti), 6), "weights": [round(v, 6) for v in row]} for ti, row in zip(t, w.tolist())
+    ]
+    with atomic_write(path, "w") as f:
+        json.dump({"names": names, "frames": frames}, f, separators=(",", ":"))

@@ -1,0 +1,179 @@
+"""BEAT semantic-relevance annotations (``.txt``, tab-separated, no header; facts A.6).
+
+Each line is ``type  start  end  duration  score  [keywords]``, e.g.
+``08_metaphoric_l\\t31.931\\t34.035\\t2.104\\t0.8\\tlove``: a gesture type, its
+time span in seconds and a relevance score in [0, 1].
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from beatlite.io.atomic import atomic_write
+from beatlite.io.errors import FormatError
+from beatlite.io.textfile import read_text
+
+__all__ = ["SemanticSegment", "read_semantic", "write_semantic", "semantic_to_frames", "segments_to_frames"]
+
+_FIELDS = ("type", "start", "end", "duration", "score")
+
+
+class SemanticSegment(NamedTuple):
+    """One annotated gesture: ``type`` (e.g. ``"01_beat_align"``), times in seconds, score in [0, 1]."""
+
+    type: str
+    start: float
+    end: float
+    duration: float
+    score: float
+    keywords: str = ""
+
+
+def parse_number(path: Path, token: str, line: int, field: str) -> float:
+    """``float(token)``, or a :class:`FormatError` naming ``line`` and ``field`` (also for NaN/inf)."""
+    try:
+        value = float(token)
+    except ValueError:
+        raise FormatError(path, f"{token!r} is not a number", line=line, field=field) from None
+    if not math.isfinite(value):
+        raise FormatError(path, f"{token!r} is not a finite number", line=line, field=field)
+    return value
+
+
+def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
+    """Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The file. Fields are separated by TABs (lines without a TAB are split on
+        whitespace). Blank lines are skipped.
+
+    Returns
+    -------
+    list of SemanticSegment
+        In file order.
+
+    Raises
+    ------
+    FormatError
+        Fewer than 5 fields, a non-numeric time/score, ``start > end`` or a
+        score outside [0, 1], naming the line and the field.
+    """
+    p = Path(path)
+    out: list[SemanticSegment] = []
+    for lineno, raw in enumerate(read_text(p).split("\n"), start=1):
+        if not raw.strip():
+            continue
+        parts = raw.rstrip().split("\t") if "\t" in raw else raw.split(maxsplit=5)
+        parts = [x.strip() for x in parts]
+        if len(parts) < 5:
+            raise FormatError(
+                p, f"expected at least 5 fields {_FIELDS}, found {len(parts)}: {raw.strip()!r}", line=lineno
+            )
+        start = parse_number(p, parts[1], lineno, "start")
+        end = parse_number(p, parts[2], lineno, "end")
+        duration = parse_number(p, parts[3], lineno, "duration")
+        score = parse_number(p, parts[4], lineno, "score")
+        if not parts[0]:
+            raise FormatError(p, "empty gesture type", line=lineno, field="type")
+        if start > end:
+            raise FormatError(p, f"start {start} is after end {end}", line=lineno, field="start")
+        if not 0.0 <= score <= 1.0:
+            raise FormatError(p, f"score {score} is outside [0, 1]", line=lineno, field="score")
+        keywords = " ".join(x for x in parts[5:] if x)
+        out.append(SemanticSegment(parts[0], start, end, duration, score, keywords))
+    return out
+
+
+def segments_to_frames(
+    starts: np.ndarray,
+    ends: np.ndarray,
+    values: np.ndarray,
+    n_frames: int,
+    fps: float,
+    default: float,
+    dtype: type,
+) -> np.ndarray:
+    """Per-frame value of the first segment (in the given order) whose closed ``[start, end]`` holds ``t = i / fps``.
+
+    Parameters
+    ----------
+    starts, ends, values : (S,) arrays
+        Segment times (seconds) and values.
+    n_frames : int
+        T.
+    fps : float
+        Frame rate.
+    default : float
+        Value of frames outside every segment.
+    dtype : numpy dtype
+        Output dtype.
+
+    Returns
+    -------
+    (T,) array of ``dtype``
+    """
+    if isinstance(n_frames, bool) or not isinstance(n_frames, int | np.integer) or n_frames < 0:
+        raise ValueError(f"n_frames must be a non-negative integer, got {n_frames!r}")
+    if not np.isfinite(fps) or fps <= 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    t = np.arange(int(n_frames), dtype=np.float64) / float(fps)
+    out = np.full(int(n_frames), default, dtype=dtype)
+    lo = np.searchsorted(t, np.asarray(starts, dtype=np.float64), side="left")
+    hi = np.searchsorted(t, np.asarray(ends, dtype=np.float64), side="right")
+    for a, b, v in zip(lo[::-1].tolist(), hi[::-1].tolist(), np.asarray(values)[::-1].tolist()):
+        out[a:b] = v  # reversed, so the first segment of the file wins where segments overlap
+    return out
+
+
+def semantic_to_frames(segments: Sequence[SemanticSegment], n_frames: int, fps: float) -> np.ndarray:
+    """Semantic score of every frame: the score of the segment containing ``t = i / fps``, else 0.
+
+    Parameters
+    ----------
+    segments : sequence of SemanticSegment
+        From :func:`read_semantic`.
+    n_frames : int
+        T.
+    fps : float
+        Frame rate.
+
+    Returns
+    -------
+    (T,) float32
+        Scores in [0, 1] (closed intervals; the first segment wins on overlap, as BEAT's loop does).
+    """
+    starts = np.array([s.start for s in segments], dtype=np.float64)
+    ends = np.array([s.end for s in segments], dtype=np.float64)
+    scores = np.array([s.score for s in segments], dtype=np.float32)
+    return segments_to_frames(starts, ends, scores, n_frames, fps, 0.0, np.float32)
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+def write_semantic(path: str | os.PathLike[str], segments: Sequence[SemanticSegment]) -> None:
+    """Write segments as a BEAT semantic ``.txt`` (TAB-separated, atomic; keywords omitted when empty)."""
+    lines = []
+    for i, s in enumerate(segments):
+        seg = SemanticSegment(*s)
+        if not seg.type or any(c in seg.type for c in "\t\n"):
+            raise ValueError(f"write_semantic: segment {i} has an invalid type {seg.type!r}")
+        if not 0.0 <= seg.score <= 1.0 or seg.start > seg.end:
+            raise ValueError(
+                f"write_semantic: segment {i} has score {seg.score} / times {seg.start}-{seg.end}"
+            )
+        fields = [seg.type, _fmt(seg.start), _fmt(seg.end), _fmt(seg.duration), _fmt(seg.score)]
+        if seg.keywords:
+            fields.append(seg.keywords.replace("\t", " ").replace("\n", " "))
+        lines.append("\t".join(fields))
+    with atomic_write(path, "w") as f:
+        f.write("".join(line + "\n" for line in lines))

@@ -1,0 +1,199 @@
+"""Opening text files that may be gzipped, finding ``x.ext`` or ``x.ext.gz``, and sniffing bytes.
+
+Every reader of :mod:`beatlite.io` goes through these helpers, so ``take.bvh``
+and ``take.bvh.gz`` are read the same way.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import os
+from pathlib import Path
+from typing import IO
+
+from beatlite.io.errors import FormatError
+
+GZIP_MAGIC = b"\x1f\x8b"
+LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
+
+
+def is_gzip(path: str | os.PathLike[str]) -> bool:
+    """True when the file starts with the gzip magic bytes ``1f 8b`` (whatever its name)."""
+    with open(path, "rb") as f:
+        return f.read(2) == GZIP_MAGIC
+
+
+def open_binary(path: str | os.PathLike[str]) -> IO[bytes]:
+    """Open ``path`` for binary reading, decompressing gzip transparently.
+
+    Gzip is recognised by its magic bytes, so a ``.gz`` file and a gzipped
+    file without the suffix both work.
+    """
+    p = Path(path)
+    if is_gzip(p):
+        return gzip.open(p, "rb")
+    return open(p, "rb")
+
+
+def read_bytes(path: str | os.PathLike[str]) -> bytes:
+    """The whole (decompressed) content of ``path`` as bytes."""
+    p = Path(path)
+    with open_binary(p) as f:
+        try:
+            return f.read()
+        except (OSError, EOFError) as exc:  # corrupt or truncated gzip stream
+            raise FormatError(p, f"cannot decompress gzip data: {exc}") from None
+
+
+def decode_text(data: bytes, path: str | os.PathLike[str] | None, encoding: str = "utf-8") -> str:
+    """Decode ``data``; a byte that is not valid ``encoding`` raises :class:`FormatError` naming its line.
+
+    A UTF-8 byte-order mark is dropped. ``encoding="auto"`` also accepts
+    UTF-16 files that start with a BOM (as Praat writes them).
+    """
+    if encoding == "auto":
+        if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+            encoding = "utf-16"
+        else:
+            encoding = "utf-8-sig"
+    elif encoding.lower().replace("_", "-") == "utf-8":
+        encoding = "utf-8-sig"
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise FormatError(
+            path,
+            f"byte {exc.start} is not valid {encoding} text ({describe_bytes(data[:64])})",
+            line=line,
+        ) from None
+
+
+def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
+    """The whole text of ``path`` (``.gz`` transparent), universal newlines (CRLF becomes LF).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        File to read.
+    encoding : str
+        Text encoding; ``"auto"`` accepts UTF-8 and UTF-16 with BOM.
+
+    Returns
+    -------
+    str
+        The text with ``\\r\\n`` and ``\\r`` turned into ``\\n`` and any BOM removed.
+    """
+    text = decode_text(read_bytes(path), path, encoding)
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    return text
+
+
+def open_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> IO[str]:
+    """Open ``path`` as a text stream (``.gz`` transparent, universal newlines).
+
+    Decoding errors surface as ``UnicodeDecodeError`` while reading; use
+    :func:`read_text` to get a :class:`FormatError` that names the line.
+    """
+    if encoding.lower().replace("_", "-") == "utf-8":
+        encoding = "utf-8-sig"
+    return io.TextIOWrapper(open_binary(path), encoding=encoding, newline=None)
+
+
+def resolve(path_or_stem: str | os.PathLike[str], ext: str) -> Path:
+    """Find the file for ``path_or_stem`` with extension ``ext``, plain or gzipped.
+
+    Parameters
+    ----------
+    path_or_stem : str or PathLike
+        Either a file that exists (``take.bvh``, ``take.bvh.gz``) or a stem
+        (``data/2_scott_0_1_1``) to which ``ext`` and ``ext + ".gz"`` are appended.
+    ext : str
+        Extension with or without the dot, e.g. ``".bvh"`` or ``"TextGrid"``.
+        Matching falls back to a case-insensitive comparison (``.textgrid``).
+
+    Returns
+    -------
+    Path
+        The first of ``stem + ext``, ``stem + ext + ".gz"`` that exists.
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming every path tried.
+    """
+    if not ext.startswith("."):
+        ext = "." + ext
+    p = Path(path_or_stem)
+    name = p.name
+    low = name.lower()
+    if p.is_file() and (low.endswith(ext.lower()) or low.endswith(ext.lower() + ".gz")):
+        return p
+    stem = str(p)
+    tried = [Path(stem + ext), Path(stem + ext + ".gz")]
+    for cand in tried:
+        if cand.is_file():
+            return cand
+    folder = p.parent
+    if folder.is_dir():
+        wanted = {(name + ext).lower(), (name + ext + ".gz").lower()}
+        matches = sorted(c for c in folder.iterdir() if c.name.lower() in wanted and c.is_file())
+        if matches:
+            return matches[0]
+    raise FileNotFoundError(f"no file {tried[0]} or {tried[1]}")
+
+
+def describe_bytes(head: bytes) -> str:
+    """A short human description of what the first bytes of a file look like.
+
+    Used in error messages: ``"an empty file"``, ``"a Git-LFS pointer (run
+    `git lfs pull`)"``, ``"MP3 audio"``, ``"an HTML page"``, ``"binary data"`` ...
+    """
+    if not head:
+        return "an empty file"
+    stripped = head.lstrip(b"\xef\xbb\xbf").lstrip()
+    if head.startswith(LFS_POINTER_PREFIX):
+        return "a Git-LFS pointer text, not the file content (run `git lfs pull`)"
+    if head.startswith(b"ID3") or (len(head) > 1 and head[0] == 0xFF and head[1] & 0xE0 == 0xE0):
+        return "MP3 audio"
+    if head.startswith(b"RIFF") and head[8:12] == b"WAVE":
+        return "a RIFF/WAVE file"
+    if head.startswith(b"RIFF"):
+        return f"a RIFF file of type {head[8:12]!r}"
+    if head.startswith(b"RF64"):
+        return "an RF64 WAVE file"
+    if head.startswith(b"fLaC"):
+        return "FLAC audio"
+    if head.startswith(b"OggS"):
+        return "an Ogg file"
+    if head[4:8] == b"ftyp":
+        return "an MP4/M4A file"
+    if head.startswith(GZIP_MAGIC):
+        return "gzip-compressed data"
+    if head.startswith(b"PK\x03\x04"):
+        return "a ZIP archive"
+    if head.startswith(b"\x89PNG"):
+        return "a PNG image"
+    if head.startswith(b"\xff\xd8\xff"):
+        return "a JPEG image"
+    if head.startswith(b"%PDF"):
+        return "a PDF document"
+    low = stripped[:256].lower()
+    if low.startswith((b"<!doctype html", b"<html")) or b"<html" in low:
+        return "an HTML page (a download that returned a web page?)"
+    if low.startswith(b"<?xml"):
+        return "an XML document"
+    if stripped[:1] in (b"{", b"["):
+        return "JSON text"
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return "UTF-16 text"
+    if b"\x00" in head:
+        return "binary data"
+    try:
+        text = head.decode("utf-8")
+    except UnicodeDecodeError:
+        return "binary data (not UTF-8 text)"
+    first = text.strip().splitlines()[0][:40] if text.strip() else ""
+    return f"text starting with {first!r}"

@@ -1,0 +1,57 @@
+"""Evaluation metrics of co-speech gesture synthesis (numpy; torch only in ``extractor``).
+
+==============================  ===================================================================
+``fgd``, ``frechet_distance``   Fréchet Gesture Distance on extractor features (BEAT, HA2G)
+``srgr``                        Semantic-Relevant Gesture Recall, ``variant="paper"|"reference"``
+``beat_align``                  BEAT BeatAlign: audio onsets vs speed minima (sigma 0.3 s)
+``beat_consistency``            HA2G Beat Consistency: onsets vs bone-angle-change minima (0.1 s)
+``l1_diversity``, ``diversity`` BEAT L1div on poses; HA2G Diversity on features of clip pairs
+``pck``, ``mae``, ``mpjpe``     extras, plus ``velocity_stats``, ``jerk_stats``
+``evaluate``                    all of the above at once -> ``Evaluation`` (``to_markdown()``)
+``load_extractor``              the shipped FGD feature extractor (imports torch lazily)
+==============================  ===================================================================
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from beatlite.metrics.beat_align import beat_align
+from beatlite.metrics.beat_consistency import beat_consistency
+from beatlite.metrics.beats import audio_beats, gaussian_alignment, mean_angle_change
+from beatlite.metrics.diversity import diversity, l1_diversity
+from beatlite.metrics.evaluate import Evaluation, MetricResult, evaluate
+from beatlite.metrics.extras import jerk_stats, mae, mpjpe, pck, velocity_stats
+from beatlite.metrics.fgd import fgd, fit_gaussian, frechet_distance
+from beatlite.metrics.srgr import srgr
+
+__all__ = [
+    "Evaluation",
+    "MetricResult",
+    "audio_beats",
+    "beat_align",
+    "beat_consistency",
+    "diversity",
+    "evaluate",
+    "fgd",
+    "fit_gaussian",
+    "frechet_distance",
+    "gaussian_alignment",
+    "jerk_stats",
+    "l1_diversity",
+    "load_extractor",
+    "mae",
+    "mean_angle_change",
+    "mpjpe",
+    "pck",
+    "srgr",
+    "velocity_stats",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name == "load_extractor":
+        from beatlite.metrics.extractor import load_extractor
+
+        return load_extractor
+    raise AttributeError(f"module 'beatlite.metrics' has no attribute {name!r}")

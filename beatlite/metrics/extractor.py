@@ -1,0 +1,407 @@
+"""The FGD feature extractor: a small BEAT-style convolutional motion autoencoder (torch).
+
+FGD compares *features* of motion windows, so it needs a network that maps a 34-frame
+window to a vector. BEAT trains a convolutional autoencoder (facts B.7) and uses its
+encoder output; beatlite does the same at a laptop scale:
+
+- encoder: Conv1d(D -> c, k3) -> BN -> LeakyReLU(0.2) -> Conv1d(c -> 2c, k3) -> BN -> LReLU
+  -> Conv1d(2c -> 2c, k4, stride 2) -> BN -> LReLU -> Conv1d(2c -> c, k3); time 34 -> 32 -> 30
+  -> 14 -> **12**; flatten (12 c) -> Linear(12c, 4L) -> BN -> LReLU -> Linear(4L, L) = latent.
+  (BEAT: c = L = 300 with slope-1 "LeakyReLU(True)" in the MLP; beatlite uses c = 32 and
+  L = 32 by default, with a real LeakyReLU: a 300-d Gaussian is badly estimated from the few
+  thousand windows of ``data_samples/``, the covariance alone having 45150 parameters.)
+- decoder: the mirror (Linear, then ConvTranspose1d 12 -> 14 -> 30 -> 32 -> 34).
+- loss: ``L1(x^, x) + 0.1 * MSE(diff_t x^, diff_t x)`` (reconstruction + velocity, facts B.7).
+- input normalisation: per-channel mean/std of the training windows, stored in the checkpoint.
+
+Train with ``python -m beatlite.metrics.extractor train [--space dirvec|pose]`` (one thread,
+deterministic with ``--seed``); the shipped checkpoints are ``checkpoints/fgd_dirvec.pt``
+(TED-43 direction vectors, 126-d, the common evaluation space) and
+``checkpoints/fgd_euler141.pt`` (z-scored Euler angles, 141-d, BEAT's space).
+:func:`load_extractor` returns a callable ``windows (N, 34, D) -> features (N, L)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+FORMAT = "beatlite-fgd-extractor/1"
+#: Window key of ``beatlite.data.windows`` for each extractor space, and the shipped file name.
+SPACES = {"dirvec": ("dirvec", "fgd_dirvec.pt"), "pose": ("pose", "fgd_euler141.pt")}
+WINDOW = 34
+
+
+@dataclass(frozen=True)
+class ExtractorConfig:
+    """Architecture and training settings of the motion autoencoder.
+
+    Attributes
+    ----------
+    input_dim : int
+        Channels D of a window (126 dirvec, 141 pose).
+    latent_dim : int
+        Feature size L (default 32).
+    channels : int
+        Base conv width c (default 32).
+    epochs, batch_size, lr, velocity_weight, seed : training settings.
+    """
+
+    input_dim: int
+    latent_dim: int = 32
+    channels: int = 32
+    epochs: int = 40
+    batch_size: int = 64
+    lr: float = 1e-3
+    velocity_weight: float = 0.1
+    seed: int = 0
+
+
+class MotionAutoencoder(nn.Module):
+    """Convolutional autoencoder of (B, 34, D) windows; ``encode`` gives (B, L) features."""
+
+    def __init__(self, config: ExtractorConfig) -> None:
+        super().__init__()
+        d, c, z = config.input_dim, config.channels, config.latent_dim
+        act = nn.LeakyReLU(0.2)
+        self.config = config
+        self.encoder = nn.Sequential(
+            nn.Conv1d(d, c, 3), nn.BatchNorm1d(c), act,
+            nn.Conv1d(c, 2 * c, 3), nn.BatchNorm1d(2 * c), act,
+            nn.Conv1d(2 * c, 2 * c, 4, stride=2), nn.BatchNorm1d(2 * c), act,
+            nn.Conv1d(2 * c, c, 3),
+        )  # fmt: skip
+        self.to_latent = nn.Sequential(
+            nn.Linear(12 * c, 4 * z), nn.BatchNorm1d(4 * z), act, nn.Linear(4 * z, z)
+        )
+        self.from_latent = nn.Sequential(nn.Linear(z, 12 * c), act)
+        self.decoder = nn.Sequential(
+            nn.ConvTranspose1d(c, 2 * c, 3), nn.BatchNorm1d(2 * c), act,
+            nn.ConvTranspose1d(2 * c, 2 * c, 4, stride=2), nn.BatchNorm1d(2 * c), act,
+            nn.ConvTranspose1d(2 * c, c, 3), nn.BatchNorm1d(c), act,
+            nn.ConvTranspose1d(c, d, 3),
+        )  # fmt: skip
+
+    def encode(self, x: torch.Tensor) -> torch.Tensor:
+        """(B, 34, D) normalised windows -> (B, L) features."""
+        h = self.encoder(x.transpose(1, 2))
+        return self.to_latent(h.flatten(1))
+
+    def decode(self, z: torch.Tensor) -> torch.Tensor:
+        """(B, L) -> (B, 34, D) normalised windows."""
+        h = self.from_latent(z).view(z.shape[0], self.config.channels, 12)
+        return self.decoder(h).transpose(1, 2)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        """Reconstruction of (B, 34, D) windows."""
+        return self.decode(self.encode(x))
+
+
+def autoencoder_loss(recon: torch.Tensor, target: torch.Tensor, velocity_weight: float = 0.1) -> torch.Tensor:
+    """``mean|x^ - x| + w * mean((diff_t x^ - diff_t x)^2)`` on (B, T, D) tensors."""
+    vel = torch.diff(recon, dim=1) - torch.diff(target, dim=1)
+    return (recon - target).abs().mean() + velocity_weight * vel.pow(2).mean()
+
+
+class FeatureExtractor:
+    """A trained encoder as a callable ``windows (N, 34, D) -> features (N, L)`` (numpy).
+
+    Attributes
+    ----------
+    model : MotionAutoencoder (eval mode, CPU)
+    mean, std : (D,) float32
+        Input normalisation applied before encoding.
+    space : str
+        ``"dirvec"`` or ``"pose"`` (what the windows must be).
+    meta : dict
+        Everything else stored in the checkpoint (fingerprint, training history...).
+    """
+
+    def __init__(
+        self, model: MotionAutoencoder, mean: np.ndarray, std: np.ndarray, space: str, meta: dict
+    ) -> None:
+        self.model = model.eval()
+        self.mean = np.asarray(mean, dtype=np.float32)
+        self.std = np.asarray(std, dtype=np.float32)
+        self.space = space
+        self.meta = meta
+
+    @property
+    def latent_dim(self) -> int:
+        """Feature size L."""
+        return self.model.config.latent_dim
+
+    def _check(self, windows: np.ndarray) -> np.ndarray:
+        w = np.asarray(windows, dtype=np.float32)
+        d = self.model.config.input_dim
+        if w.ndim != 3 or w.shape[1] != WINDOW or w.shape[2] != d:
+            raise ValueError(f"windows must be (N, {WINDOW}, {d}) ({self.space} space), got shape {w.shape}")
+        if not np.all(np.isfinite(w)):
+            raise ValueError("windows contain NaN or infinite values")
+        return (w - self.mean) / self.std
+
+    def __call__(self, windows: np.ndarray, batch_size: int = 512) -> np.ndarray:
+        """Features of (N, 34, D) windows: (N, L) float64."""
+        x = self._check(windows)
+        out = []
+        with torch.no_grad():
+            for i in range(0, len(x), batch_size):
+                out.append(self.model.encode(torch.from_numpy(x[i : i + batch_size])).numpy())
+        return np.concatenate(out).astype(np.float64) if out else np.zeros((0, self.latent_dim))
+
+    def reconstruct(self, windows: np.ndarray) -> np.ndarray:
+        """Autoencoder reconstruction of (N, 34, D) windows, same shape, float32, input units."""
+        x = self._check(windows)
+        with torch.no_grad():
+            r = self.model(torch.from_numpy(x)).numpy()
+        return r * self.std + self.mean
+
+
+# ----------------------------------------------------------------------------- training
+def data_fingerprint(windows: np.ndarray) -> str:
+    """sha256 (first 16 hex digits) of the float32 training windows and their shape."""
+    w = np.ascontiguousarray(windows, dtype=np.float32)
+    h = hashlib.sha256(str(w.shape).encode())
+    h.update(w.tobytes())
+    return h.hexdigest()[:16]
+
+
+def train_autoencoder(
+    windows: np.ndarray,
+    config: ExtractorConfig,
+    *,
+    val_windows: np.ndarray | None = None,
+    log: bool = True,
+) -> tuple[MotionAutoencoder, dict[str, Any]]:
+    """Train the autoencoder on (N, 34, D) windows, deterministically (one thread by default).
+
+    Parameters
+    ----------
+    windows : (N, 34, D) float
+        Training windows in the extractor's space.
+    config : ExtractorConfig
+    val_windows : (M, 34, D) float, optional
+        Held-out windows whose loss is reported.
+    log : bool
+        Print one line per 10 epochs.
+
+    Returns
+    -------
+    model : MotionAutoencoder (eval mode)
+    info : dict
+        ``mean``/``std`` (D,) input normalisation, ``history`` of per-epoch losses, ``seconds``.
+    """
+    from beatlite.paths import n_threads
+
+    w = np.asarray(windows, dtype=np.float32)
+    if w.ndim != 3 or w.shape[1] != WINDOW or w.shape[2] != config.input_dim:
+        raise ValueError(f"windows must be (N, {WINDOW}, {config.input_dim}), got shape {w.shape}")
+    if len(w) < 2:
+        raise ValueError(f"need at least 2 training windows, got {len(w)}")
+    torch.set_num_threads(n_threads())
+    torch.manual_seed(config.seed)
+    was_deterministic = torch.are_deterministic_algorithms_enabled()
+    torch.use_deterministic_algorithms(True)
+    try:
+        return _train(w, config, val_windows, log)
+    finally:
+        torch.use_deterministic_algorithms(was_deterministic)
+
+
+def _train(
+    w: np.ndarray, config: ExtractorConfig, val_windows: np.ndarray | None, log: bool
+) -> tuple[MotionAutoencoder, dict[str, Any]]:
+    mean = w.reshape(-1, w.shape[2]).mean(axis=0)
+    std = np.maximum(w.reshape(-1, w.shape[2]).std(axis=0), 1e-3).astype(np.float32)
+    x = torch.from_numpy((w - mean) / std)
+    xv = None if val_windows is None else torch.from_numpy((np.asarray(val_windows, np.float32) - mean) / std)
+    model = MotionAutoencoder(config)
+    opt = torch.optim.Adam(model.parameters(), lr=config.lr, betas=(0.5, 0.999))
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
+    gen = torch.Generator().manual_seed(config.seed)
+    history = []
+    t0 = time.perf_counter()
+    for epoch in range(config.epochs):
+        model.train()
+        perm = torch.randperm(len(x), generator=gen)
+        total, n = 0.0, 0
+        for i in range(0, len(x), config.batch_size):
+            idx = perm[i : i + config.batch_size]
+            if len(idx) < 2:  # BatchNorm needs 2 samples
+                continue
+            loss = autoencoder_loss(model(x[idx]), x[idx], config.velocity_weight)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            total += float(loss.detach()) * len(idx)
+            n += len(idx)
+        sched.step()
+        row = {"epoch": epoch + 1, "train": total / n}
+        if xv is not None and len(xv) >= 1:
+            model.eval()
+            with torch.no_grad():
+                row["val"] = float(autoencoder_loss(model(xv), xv, config.velocity_weight))
+        history.append(row)
+        if log and ((epoch + 1) % 10 == 0 or epoch == 0):
+            extra = f", val {row['val']:.4f}" if "val" in row else ""
+            print(f"epoch {epoch + 1:3d}: train {row['train']:.4f}{extra}", flush=True)
+    model.eval()
+    return model, {"mean": mean, "std": std, "history": history, "seconds": time.perf_counter() - t0}
+
+
+def save_extractor(
+    path: str | Path, model: MotionAutoencoder, info: dict[str, Any], *, space: str, meta: dict
+) -> Path:
+    """Write the checkpoint atomically: config, weights, input normalisation, fingerprint, history.
+
+    Only tensors and plain Python values are stored, so it loads with ``weights_only=True``.
+    """
+    from beatlite.io.atomic import atomic_write
+
+    payload = {
+        "format": FORMAT,
+        "space": space,
+        "config": asdict(model.config),
+        "state_dict": {k: v.detach().clone() for k, v in model.state_dict().items()},
+        "input_mean": torch.from_numpy(np.asarray(info["mean"], np.float32)),
+        "input_std": torch.from_numpy(np.asarray(info["std"], np.float32)),
+        "history": info["history"],
+        "meta": meta,
+    }
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path, "wb") as f:
+        torch.save(payload, f)
+    return path
+
+
+def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> FeatureExtractor:
+    """The shipped (or a given) FGD extractor as a callable ``(N, 34, D) -> (N, L)``.
+
+    Parameters
+    ----------
+    space : "dirvec" or "pose"
+        Which shipped checkpoint: ``checkpoints/fgd_dirvec.pt`` (126-d TED direction windows)
+        or ``checkpoints/fgd_euler141.pt`` (141-d z-scored Euler windows).
+    path : str or Path, optional
+        Load this checkpoint instead.
+
+    Returns
+    -------
+    FeatureExtractor
+
+    Raises
+    ------
+    FileNotFoundError
+        The checkpoint does not exist (train it with ``python -m beatlite.metrics.extractor train``).
+    ValueError
+        The file is not a beatlite FGD extractor checkpoint.
+    """
+    from beatlite.paths import checkpoints_dir
+
+    if space not in SPACES:
+        raise ValueError(f"space must be one of {sorted(SPACES)}, got {space!r}")
+    p = checkpoints_dir() / SPACES[space][1] if path is None else Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(
+            f"FGD extractor checkpoint {p} not found; train it with "
+            f"`python -m beatlite.metrics.extractor train --space {space}`"
+        )
+    data = torch.load(p, map_location="cpu", weights_only=True)
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise ValueError(f"{p}: not a beatlite FGD extractor checkpoint (format {data.get('format')!r})")
+    model = MotionAutoencoder(ExtractorConfig(**data["config"]))
+    model.load_state_dict(data["state_dict"])
+    meta = {**data.get("meta", {}), "history": data.get("history", []), "path": str(p)}
+    return FeatureExtractor(model, data["input_mean"].numpy(), data["input_std"].numpy(), data["space"], meta)
+
+
+# ----------------------------------------------------------------------------- command line
+def _train_command(args: argparse.Namespace) -> int:
+    from beatlite.data.index import index_folder
+    from beatlite.data.windows import build_windows
+    from beatlite.paths import checkpoints_dir, data_dir
+
+    key, fname = SPACES[args.space]
+    root = Path(args.data) if args.data else data_dir()
+    index = index_folder(root)
+    train = build_windows(index, split="train", cache=not args.no_cache)
+    w = np.asarray(train[key], dtype=np.float32)
+    try:
+        val = np.asarray(build_windows(index, split="val", stats=(train.pose_norm, train.dir_norm),
+                                       cache=not args.no_cache)[key], dtype=np.float32)  # fmt: skip
+    except ValueError:
+        val = None
+    config = ExtractorConfig(
+        input_dim=w.shape[2], latent_dim=args.latent, channels=args.channels, epochs=args.epochs,
+        batch_size=args.batch_size, lr=args.lr, seed=args.seed,
+    )  # fmt: skip
+    print(
+        f"training the {args.space} FGD autoencoder on {len(w)} windows {w.shape[1:]} from {root}", flush=True
+    )
+    model, info = train_autoencoder(w, config, val_windows=val)
+    takes = sorted({str(t) for t in np.asarray(train["take"]).tolist()})
+    meta = {
+        "data_fingerprint": data_fingerprint(w),
+        "n_windows": int(len(w)),
+        "n_val_windows": 0 if val is None else int(len(val)),
+        "takes": takes,
+        "window_key": key,
+        "seconds": round(float(info["seconds"]), 1),
+        "torch": torch.__version__,
+    }
+    out = Path(args.out) if args.out else checkpoints_dir() / fname
+    save_extractor(out, model, info, space=args.space, meta=meta)
+    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB) in {info['seconds']:.0f} s; "
+          f"fingerprint {meta['data_fingerprint']}", flush=True)  # fmt: skip
+    return 0
+
+
+def _info_command(args: argparse.Namespace) -> int:
+    ex = load_extractor(args.space, args.path)
+    print(f"{ex.meta['path']}: space {ex.space}, config {asdict(ex.model.config)}")
+    keys = ("data_fingerprint", "n_windows", "n_val_windows", "seconds")
+    print({k: ex.meta.get(k) for k in keys})
+    if ex.meta["history"]:
+        print("last epoch:", ex.meta["history"][-1])
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m beatlite.metrics.extractor {train,info} ...``"""
+    parser = argparse.ArgumentParser(
+        prog="python -m beatlite.metrics.extractor", description=__doc__.split("\n")[0]
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    t = sub.add_parser("train", help="train an FGD autoencoder on the corpus' train-split windows")
+    t.add_argument("--space", choices=sorted(SPACES), default="dirvec")
+    t.add_argument("--data", help="BEAT-format folder (default $BEATLITE_DATA or data_samples/)")
+    t.add_argument("--out", help="checkpoint path (default checkpoints/fgd_<space>.pt)")
+    t.add_argument("--latent", type=int, default=32)
+    t.add_argument("--channels", type=int, default=32)
+    t.add_argument("--epochs", type=int, default=40)
+    t.add_argument("--batch-size", type=int, default=64)
+    t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--no-cache", action="store_true", help="do not read/write the window cache")
+    t.set_defaults(func=_train_command)
+    i = sub.add_parser("info", help="describe a checkpoint")
+    i.add_argument("--space", choices=sorted(SPACES), default="dirvec")
+    i.add_argument("--path")
+    i.set_defaults(func=_info_command)
+    args = parser.parse_args(argv)
+    return int(args.func(args))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

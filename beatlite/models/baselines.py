@@ -1,0 +1,396 @@
+"""Baselines with the :class:`~beatlite.models.base.GestureModel` interface (all ``euler141``).
+
+- :class:`MeanPose` (floor row, not trained): every frame is the training-set mean pose.
+- :class:`RandomClip` (reference row, not trained): real 34-frame training clips drawn at
+  random, ignoring every input.
+- :class:`S2G`: audio-only convolutional model in the style of Speech2Gesture
+  (Ginosar et al. 2019): log-mel encoder + 1-D U-Net, no seed pose, regression + NS-GAN.
+- :class:`Trimodal`: text + audio + speaker GRU in the style of Trimodal / MultiContext
+  (Yoon et al. 2020; facts G): 4-conv wave encoder, TCN text encoder, reparameterised
+  speaker style z, bidirectional GRU (directions summed), seed pose.
+
+Common objective of the learned baselines, as CaMN's (so differences come from the
+architectures): ``rec_weight * Huber_0.1(pred, target)`` (no semantic weighting; at
+z-scored error sizes Huber_0.1 is L1 minus 0.05, i.e. S2G's L1 loss) plus NS-GAN from
+``no_adv_epochs`` on. Trimodal adds ``kld_weight * KLD`` of its speaker z; its
+diversity regulariser is not implemented.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch, huber, seed_input
+from beatlite.models.layers import (
+    ConvDiscriminator,
+    PlainWavEncoder,
+    TextEncoderTCN,
+    match_length,
+    ns_gan_d_loss,
+    ns_gan_g_loss,
+    sum_directions,
+)
+
+POSE_DIM = 141
+
+
+def _check_pose(batch: Batch, who: str) -> torch.Tensor:
+    check_batch(batch, ("pose",), who)
+    pose = batch["pose"]
+    if pose.ndim != 3 or pose.shape[-1] != POSE_DIM:
+        raise ValueError(f"{who}: batch['pose'] must be (B, T, {POSE_DIM}), got shape {tuple(pose.shape)}")
+    return pose
+
+
+def _train_poses(train_windows: Mapping[str, np.ndarray], who: str) -> np.ndarray:
+    if "pose" not in train_windows:
+        raise KeyError(f"{who}.prepare: train_windows has no 'pose' (keys: {sorted(train_windows)})")
+    pose = np.asarray(train_windows["pose"], dtype=np.float32)
+    if pose.ndim != 3 or pose.shape[-1] != POSE_DIM or pose.shape[0] == 0:
+        raise ValueError(
+            f"{who}.prepare: train_windows['pose'] must be (N>0, T, {POSE_DIM}), got {pose.shape}"
+        )
+    return pose
+
+
+# ------------------------------------------------------------------------------------ untrained rows
+@dataclasses.dataclass
+class MeanPoseConfig(ModelConfig):
+    """No options (the mean comes from :meth:`MeanPose.prepare`)."""
+
+
+@dataclasses.dataclass
+class RandomClipConfig(ModelConfig):
+    """``n_clips`` training windows are kept (drawn with ``seed``); ``n_frames`` per clip."""
+
+    n_clips: int = 32
+    n_frames: int = 34
+    seed: int = 0
+
+
+class _Untrained(GestureModel):
+    """Shared parts of the two untrained rows: no generator parameters, zero loss."""
+
+    input_keys = ("pose",)
+
+    def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
+        """``{"total": 0}`` (nothing to train)."""
+        return {"total": out["pose"].new_zeros(())}
+
+
+class MeanPose(_Untrained):
+    """Frozen mean pose: ``forward`` returns the training mean (z-scored units) on every frame.
+
+    ``prepare(train_windows)`` stores ``mean over windows and frames of train_windows["pose"]``;
+    before it, the mean is 0 (the z-scoring mean).
+    """
+
+    name = "mean_pose"
+    representation = "euler141"
+    config_class = MeanPoseConfig
+
+    def __init__(self, config: MeanPoseConfig) -> None:
+        super().__init__(config)
+        self.register_buffer("mean", torch.zeros(POSE_DIM))
+
+    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+        pose = _train_poses(train_windows, "MeanPose")
+        self.mean.copy_(
+            torch.from_numpy(pose.reshape(-1, POSE_DIM).mean(axis=0, dtype=np.float64).astype(np.float32))
+        )
+
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+        """``{"pose": (B, T, 141)}``, every frame = the stored mean."""
+        pose = _check_pose(batch, "MeanPose")
+        return {"pose": self.mean.to(pose.dtype).expand(pose.shape).clone()}
+
+
+class RandomClip(_Untrained):
+    """Random real clips: each call returns ``B`` clips drawn from a bank of training windows.
+
+    Draws are deterministic: call ``k`` (counted from construction or :meth:`reset`) uses
+    ``torch.Generator().manual_seed(seed + k)``. Sequences longer than ``n_frames`` are
+    made of consecutive random clips.
+    """
+
+    name = "random_clip"
+    representation = "euler141"
+    config_class = RandomClipConfig
+
+    def __init__(self, config: RandomClipConfig) -> None:
+        super().__init__(config)
+        if config.n_clips < 1 or config.n_frames < 1:
+            raise ValueError(
+                f"RandomClip: n_clips and n_frames must be >= 1, got {config.n_clips}, {config.n_frames}"
+            )
+        self.register_buffer("bank", torch.zeros(config.n_clips, config.n_frames, POSE_DIM))
+        self._calls = 0
+
+    def reset(self) -> None:
+        """Restart the sequence of draws."""
+        self._calls = 0
+
+    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+        pose = _train_poses(train_windows, "RandomClip")
+        cfg = self.config
+        if pose.shape[1] < cfg.n_frames:
+            raise ValueError(
+                f"RandomClip.prepare: windows have {pose.shape[1]} frames < n_frames={cfg.n_frames}"
+            )
+        rng = np.random.default_rng(cfg.seed)
+        idx = rng.choice(pose.shape[0], size=cfg.n_clips, replace=pose.shape[0] < cfg.n_clips)
+        self.bank.copy_(torch.from_numpy(pose[idx, : cfg.n_frames]))
+
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+        """``{"pose": (B, T, 141)}`` of random bank clips (not depending on any input)."""
+        pose = _check_pose(batch, "RandomClip")
+        b, t, _ = pose.shape
+        gen = torch.Generator().manual_seed(int(self.config.seed) + self._calls)
+        self._calls += 1
+        n_units = -(-t // self.config.n_frames)
+        idx = torch.randint(0, self.config.n_clips, (b, n_units), generator=gen)
+        clips = self.bank[idx.reshape(-1)].reshape(b, n_units * self.config.n_frames, POSE_DIM)
+        return {"pose": clips[:, :t].to(pose.dtype).clone()}
+
+
+# ------------------------------------------------------------------------------------ learned
+class _Adversarial(GestureModel):
+    """Reconstruction + NS-GAN objective shared by the learned baselines."""
+
+    def _build_discriminator(self) -> None:
+        cfg = self.config
+        if cfg.adversarial:
+            self.discriminator = ConvDiscriminator(
+                POSE_DIM, hidden=cfg.d_hidden, n_layers=cfg.d_layers, n_frames=cfg.n_frames
+            )
+
+    def _losses(self, batch: Batch, out: dict[str, torch.Tensor], epoch: int) -> dict[str, torch.Tensor]:
+        cfg = self.config
+        rec = huber(out["pose"], batch["pose"])
+        adv = rec.new_zeros(())
+        if self.adversarial_active(epoch):
+            adv = ns_gan_g_loss(self.discriminator(out["pose"]))
+        return {"rec": rec, "adv": adv, "total": cfg.rec_weight * rec + cfg.adv_weight * adv}
+
+    def discriminator_losses(self, batch: Batch, out: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+        """NS-GAN discriminator loss on real ``batch["pose"]`` vs detached ``out["pose"]``."""
+        if self.discriminator is None:
+            raise RuntimeError(f"{type(self).__name__} was built with adversarial=False")
+        d = ns_gan_d_loss(self.discriminator(batch["pose"]), self.discriminator(out["pose"].detach()))
+        return {"d": d, "total": d}
+
+
+@dataclasses.dataclass
+class S2GConfig(ModelConfig):
+    """Speech2Gesture-style model: ``channels`` wide convolutions over 128-bin log-mel frames."""
+
+    preset: str = "paper"
+    n_mels: int = 128
+    channels: int = 256
+    n_frames: int = 34
+    slope: float = 0.2
+    rec_weight: float = 500.0
+    adversarial: bool = True
+    adv_weight: float = 0.5
+    no_adv_epochs: int = 10
+    d_hidden: int = 64
+    d_layers: int = 4
+
+
+def _conv_block(a: int, b: int, k: int, stride: int, pad: int, slope: float) -> nn.Sequential:
+    return nn.Sequential(
+        nn.Conv1d(a, b, k, stride=stride, padding=pad), nn.BatchNorm1d(b), nn.LeakyReLU(slope)
+    )
+
+
+class S2G(_Adversarial):
+    """Audio-only convolutional generator in the style of Speech2Gesture.
+
+    ``mel (B, M, 128)`` (dB, ``ref=max``) is mapped to ``mel / 40 + 1``, encoded by two
+    ``Conv1d(k3)`` blocks, linearly resampled from M to T frames, then a 1-D U-Net
+    (two stride-2 downsamplings, nearest upsampling with additive skips) and a 1x1
+    convolution output 141 channels. It ignores the seed pose (as S2G has none).
+
+    Shapes: ``batch["mel"]`` (B, M, 128), ``batch["pose"]`` (B, T, 141) (only T is read)
+    -> ``{"pose": (B, T, 141)}``.
+    """
+
+    name = "s2g"
+    representation = "euler141"
+    config_class = S2GConfig
+    input_keys = ("pose", "mel")
+
+    def __init__(self, config: S2GConfig) -> None:
+        super().__init__(config)
+        c, s = config.channels, config.slope
+        self.audio = nn.Sequential(_conv_block(config.n_mels, c, 3, 1, 1, s), _conv_block(c, c, 3, 1, 1, s))
+        self.down0 = _conv_block(c, c, 3, 1, 1, s)
+        self.down1 = _conv_block(c, c, 4, 2, 1, s)
+        self.down2 = _conv_block(c, c, 4, 2, 1, s)
+        self.up1 = _conv_block(c, c, 3, 1, 1, s)
+        self.up0 = _conv_block(c, c, 3, 1, 1, s)
+        self.out = nn.Conv1d(c, POSE_DIM, 1)
+        self._build_discriminator()
+
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+        """``{"pose": (B, T, 141)}`` from ``batch["mel"]`` alone."""
+        pose = _check_pose(batch, "S2G")
+        check_batch(batch, ("mel",), "S2G")
+        mel = batch["mel"]
+        if mel.ndim != 3 or mel.shape[-1] != self.config.n_mels:
+            raise ValueError(
+                f"S2G: batch['mel'] must be (B, M, {self.config.n_mels}), got shape {tuple(mel.shape)}"
+            )
+        t = pose.shape[1]
+        x = self.audio((mel / 40.0 + 1.0).transpose(1, 2))
+        x = nn.functional.interpolate(x, size=t, mode="linear", align_corners=False)
+        d0 = self.down0(x)
+        d1 = self.down1(d0)
+        d2 = self.down2(d1)
+        u1 = self.up1(nn.functional.interpolate(d2, size=d1.shape[-1], mode="nearest") + d1)
+        u0 = self.up0(nn.functional.interpolate(u1, size=t, mode="nearest") + d0)
+        return {"pose": self.out(u0).transpose(1, 2)}
+
+    def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
+        """``{"rec", "adv", "total"}``."""
+        return self._losses(batch, out, epoch)
+
+
+@dataclasses.dataclass
+class TrimodalConfig(ModelConfig):
+    """Trimodal / MultiContext-style hyper-parameters (defaults = ``paper``: facts G, hidden 300, 4 layers)."""
+
+    preset: str = "paper"
+    vocab_size: int = 5793
+    word_dim: int = 300
+    text_hidden: int = 300
+    text_layers: int = 4
+    text_features: int = 32
+    audio_channels: tuple[int, ...] = (16, 32, 64, 32)
+    n_speakers: int = 30
+    speaker_z: int = 16
+    hidden: int = 300
+    n_layers: int = 4
+    dropout: float = 0.3
+    slope: float = 0.1
+    rec_weight: float = 500.0
+    kld_weight: float = 0.1
+    adversarial: bool = True
+    adv_weight: float = 0.5
+    no_adv_epochs: int = 10
+    d_hidden: int = 64
+    d_layers: int = 4
+    n_frames: int = 34
+
+    def __post_init__(self) -> None:
+        self.audio_channels = tuple(int(c) for c in self.audio_channels)
+
+
+class Trimodal(_Adversarial):
+    """Text + audio + speaker GRU in the style of Trimodal / MultiContext.
+
+    ``x = cat[pre_seq (T, 142), text (T, text_features), audio (T, audio_channels[-1]), z (T, speaker_z)]``
+    -> biGRU (directions summed) -> ``Linear(h, h/2) -> LReLU(0.1) -> Linear(h/2, 141)``.
+    The speaker style ``z`` is sampled with the reparameterisation trick while training
+    and is its mean ``mu`` in eval mode (deterministic generation).
+
+    Returns ``{"pose": (B, T, 141), "z_mu": (B, Z), "z_logvar": (B, Z)}``.
+    """
+
+    name = "trimodal"
+    representation = "euler141"
+    config_class = TrimodalConfig
+    input_keys = ("pose", "audio", "word", "speaker")
+
+    def __init__(self, config: TrimodalConfig) -> None:
+        super().__init__(config)
+        cfg = config
+        self.text_encoder = TextEncoderTCN(
+            cfg.vocab_size, cfg.word_dim, cfg.text_hidden, cfg.text_layers, cfg.text_features, cfg.dropout
+        )
+        self.audio_encoder = PlainWavEncoder(cfg.audio_channels)
+        self.speaker_embedding = nn.Sequential(
+            nn.Embedding(cfg.n_speakers, cfg.speaker_z), nn.Linear(cfg.speaker_z, cfg.speaker_z)
+        )
+        self.speaker_mu = nn.Linear(cfg.speaker_z, cfg.speaker_z)
+        self.speaker_logvar = nn.Linear(cfg.speaker_z, cfg.speaker_z)
+        in_size = POSE_DIM + 1 + cfg.text_features + cfg.audio_channels[-1] + cfg.speaker_z
+        self.gru = nn.GRU(
+            in_size,
+            cfg.hidden,
+            num_layers=cfg.n_layers,
+            batch_first=True,
+            bidirectional=True,
+            dropout=cfg.dropout if cfg.n_layers > 1 else 0.0,
+        )
+        self.head = nn.Sequential(
+            nn.Linear(cfg.hidden, cfg.hidden // 2),
+            nn.LeakyReLU(cfg.slope),
+            nn.Linear(cfg.hidden // 2, POSE_DIM),
+        )
+        self._build_discriminator()
+
+    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
+        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim)."""
+        self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+        """``{"pose": (B,T,141), "z_mu", "z_logvar"}``."""
+        pose = _check_pose(batch, "Trimodal")
+        check_batch(batch, self.input_keys, "Trimodal")
+        speaker = batch["speaker"]
+        if speaker.ndim != 1 or int(speaker.max()) >= self.config.n_speakers or int(speaker.min()) < 0:
+            raise ValueError(
+                f"Trimodal: batch['speaker'] must be (B,) ids in [0, {self.config.n_speakers}), "
+                f"got shape {tuple(speaker.shape)}"
+            )
+        b, t, _ = pose.shape
+        text = match_length(self.text_encoder(batch["word"]), t)
+        audio = match_length(self.audio_encoder(batch["audio"]), t)
+        h = self.speaker_embedding(speaker)
+        mu, logvar = self.speaker_mu(h), self.speaker_logvar(h)
+        z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
+        x = torch.cat([seed_input(pose, self.n_pre), text, audio, z.unsqueeze(1).expand(b, t, -1)], -1)
+        seq, _ = self.gru(x)
+        return {"pose": self.head(sum_directions(seq, self.config.hidden)), "z_mu": mu, "z_logvar": logvar}
+
+    def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
+        """``{"rec", "adv", "kld", "total"}``; KLD = ``-0.5 mean(1 + logvar - mu^2 - exp(logvar))``."""
+        parts = self._losses(batch, out, epoch)
+        mu, logvar = out["z_mu"], out["z_logvar"]
+        kld = -0.5 * torch.mean(1 + logvar - mu.pow(2) - logvar.exp())
+        parts["kld"] = kld
+        parts["total"] = parts["total"] + self.config.kld_weight * kld
+        return parts
+
+
+PRESETS: dict[str, dict[str, Any]] = {"tiny": {}, "paper": {}}
+"""Presets of the untrained rows (no options)."""
+
+S2G_PRESETS: dict[str, dict[str, Any]] = {
+    "paper": {},
+    "tiny": {"channels": 48, "d_hidden": 32, "d_layers": 1},
+}
+TRIMODAL_PRESETS: dict[str, dict[str, Any]] = {
+    "paper": {},
+    "tiny": {
+        "vocab_size": 1000,
+        "word_dim": 64,
+        "text_hidden": 48,
+        "text_layers": 2,
+        "hidden": 64,
+        "n_layers": 1,
+        "dropout": 0.1,
+        "d_hidden": 32,
+        "d_layers": 1,
+    },
+}
+
+S2G.presets = S2G_PRESETS
+Trimodal.presets = TRIMODAL_PRESETS

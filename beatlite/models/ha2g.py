@@ -1,0 +1,675 @@
+"""HA2G: Hierarchical Audio-to-Gesture (Liu et al., CVPR 2022), a CPU-sized re-implementation (torch).
+
+The model predicts 34-frame windows of TED-43 bone directions (``windows["dirvec"]``,
+(B, 34, 126): 42 unit vectors minus their training mean) from
+
+- a log-mel spectrogram (``"mel"`` (B, 70, 128)) through the hierarchical audio learner
+  (:mod:`beatlite.models.ha2g_audio`: low / mid / high features per frame),
+- word ids (``"word"`` (B, 34)) through a TCN text encoder,
+- a speaker id (``"speaker"`` (B,)) through a reparameterised style vector z (mu, logvar),
+- the first ``n_pre = 4`` frames of ``"dirvec"`` (the seed poses).
+
+A style coordinator turns z into softmax weights over the three audio levels for each
+body level (paper eq. 3). The pose inferer runs one bidirectional GRU per body level
+(``beatlite.skeleton.ted.HA2G_LEVELS``: spine/shoulders/head -> upper arms -> forearms ->
+three rings of finger phalanges, 24/30/36/66/96/126 channels); level k's seed input
+carries level k-1's prediction in the channels they share (facts C.7). Losses: hierarchical
+Huber, NS-GAN on the last level, style diverging, KL, multi-level audio-text contrastive
+and the bone-angle physical constraint (:mod:`beatlite.models.ha2g_losses`).
+
+Ablations (paper Tables 3-4) are config switches, named in :data:`ABLATIONS`:
+``holistic`` (one level with all 42 bones), ``single_audio`` (low-level audio only),
+``same_audio`` (one coordinator column for all levels), ``no_contrastive``,
+``no_physical``.
+
+Call :meth:`HA2G.prepare` with the training windows before training (``fit`` does): it
+stores the mean direction vectors and the bone-angle statistics of the physical constraint
+as buffers (saved in the checkpoint's state dict).
+
+Differences from the reference, on purpose: the output heads and the discriminator use
+``LeakyReLU(slope)`` with a real slope (the reference's ``LeakyReLU(True)`` is an identity);
+the discriminator returns logits (NS-GAN through ``logsigmoid``); the contrastive logits
+``1 / distance`` have the distance floored at ``contrastive_min_distance``; the text
+encoders use learned word embeddings (no FastText); the spectrogram is scaled by
+``mel / 40 + 1`` before the first convolution.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
+from beatlite.models.ha2g_losses import (
+    N_BONES,
+    angle_statistics,
+    bone_angles,
+    default_angle_pairs,
+    hierarchical_huber,
+    kl_divergence,
+    multilevel_contrastive_loss,
+    physical_constraint_loss,
+    style_diverging_loss,
+)
+from beatlite.models.layers import TextEncoderTCN, ns_gan_d_loss, ns_gan_g_loss, sum_directions
+
+AUDIO_MODES = ("blend", *AUDIO_LEVELS)
+
+
+@dataclasses.dataclass
+class HA2GConfig(ModelConfig):
+    """HA2G hyper-parameters (defaults = the ``paper`` preset, facts C.7).
+
+    Switches: ``hierarchical`` (False = "holistic": one level with all 42 bones),
+    ``audio_mode`` (``"blend"`` = style-coordinated mix of the 3 levels; ``"low"``/``"mid"``/
+    ``"high"`` = that level only), ``same_audio`` (one coordinator column shared by every body
+    level), ``use_contrastive``, ``use_physical``, ``adversarial``, ``use_style_loss``.
+    ``no_adv_epochs`` is the 0-based epoch from which the GAN term is on (reference: epoch >
+    ``loss_warmup`` = 10). ``d_lr_scale`` is the discriminator's learning rate relative to the
+    generator's (reference 0.2).
+    """
+
+    preset: str = "paper"
+    vocab_size: int = 5793
+    word_dim: int = 300
+    text_hidden: int = 300
+    text_layers: int = 4
+    text_features: int = 32
+    text_per_level: bool = True
+    n_speakers: int = 30
+    z_dim: int = 16
+    style_hidden: int = 32
+    audio_channels: tuple[int, ...] = (32, 64, 128, 256)
+    audio_blocks: tuple[int, ...] = (3, 4, 6, 3)
+    se_reduction: int = 8
+    audio_features: int = 32
+    hidden: int = 300
+    n_layers: int = 4
+    dropout: float = 0.3
+    slope: float = 0.1
+    hierarchical: bool = True
+    audio_mode: str = "blend"
+    same_audio: bool = False
+    use_contrastive: bool = True
+    use_physical: bool = True
+    adversarial: bool = True
+    use_style_loss: bool = True
+    huber_weight: float = 250.0
+    huber_beta: float = 0.1
+    adv_weight: float = 5.0
+    no_adv_epochs: int = 11
+    kld_weight: float = 0.1
+    style_weight: float = 0.05
+    style_beta: float = 0.05
+    style_clip: float = 1000.0
+    contrastive_pos_weight: float = 0.2
+    contrastive_neg_weight: float = 0.005
+    contrastive_min_distance: float = 1e-2
+    physical_weight: float = 0.01
+    angle_var_floor: float = 1e-5
+    d_hidden: int = 64
+    d_layers: int = 4
+    d_lr_scale: float = 0.2
+    n_frames: int = 34
+
+    def __post_init__(self) -> None:
+        self.audio_channels = tuple(int(c) for c in self.audio_channels)
+        self.audio_blocks = tuple(int(c) for c in self.audio_blocks)
+        if len(self.audio_channels) != 4 or len(self.audio_blocks) != 4:
+            raise ValueError(
+                f"audio_channels and audio_blocks must have 4 entries, got {self.audio_channels} "
+                f"and {self.audio_blocks}"
+            )
+        if self.audio_mode not in AUDIO_MODES:
+            raise ValueError(f"audio_mode must be one of {AUDIO_MODES}, got {self.audio_mode!r}")
+        if self.n_frames <= N_PRE + 6:
+            raise ValueError(f"n_frames must be > {N_PRE + 6}, got {self.n_frames}")
+        for name in ("vocab_size", "n_speakers", "z_dim", "hidden", "n_layers", "audio_features"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "paper": {},
+    "tiny": {
+        "vocab_size": 1000,
+        "word_dim": 16,
+        "text_hidden": 24,
+        "text_layers": 2,
+        "text_features": 16,
+        "text_per_level": False,
+        "z_dim": 8,
+        "style_hidden": 16,
+        "audio_channels": (4, 8, 16, 32),
+        "audio_blocks": (1, 1, 1, 1),
+        "se_reduction": 4,
+        "audio_features": 16,
+        "hidden": 32,
+        "n_layers": 1,
+        "dropout": 0.1,
+        "no_adv_epochs": 4,
+        "d_hidden": 32,
+        "d_layers": 1,
+    },
+}
+"""Preset name -> overrides of :class:`HA2GConfig` (``paper``: facts C.7; ``tiny``: CPU minutes)."""
+
+ABLATIONS: dict[str, dict[str, Any]] = {
+    "full": {},
+    "holistic": {"hierarchical": False},
+    "single_audio": {"audio_mode": "low"},
+    "same_audio": {"same_audio": True},
+    "no_contrastive": {"use_contrastive": False},
+    "no_physical": {"use_physical": False},
+}
+"""Ablation switch name -> config overrides (HA2G Tables 3-4)."""
+
+CHECKPOINTS: dict[str, dict[str, Any]] = {
+    "ha2g_tiny": {},
+    "ha2g_tiny_holistic": ABLATIONS["holistic"],
+    "ha2g_tiny_single_audio": ABLATIONS["single_audio"],
+    "ha2g_tiny_no_contrastive": ABLATIONS["no_contrastive"],
+    "ha2g_tiny_no_physical": ABLATIONS["no_physical"],
+}
+"""Shipped checkpoint name (``checkpoints/<name>.pt``, tiny preset) -> config overrides."""
+
+
+def body_levels(hierarchical: bool = True) -> list[np.ndarray]:
+    """Bone indices of each body level.
+
+    Parameters
+    ----------
+    hierarchical : bool
+        True: the 6 levels of ``beatlite.skeleton.ted.HA2G_LEVELS`` (8/10/12/22/32/42 bones);
+        False: one level with all 42 bones ("holistic").
+
+    Returns
+    -------
+    list of (K_l,) int64 arrays
+    """
+    if not hierarchical:
+        return [np.arange(N_BONES, dtype=np.int64)]
+    from beatlite.skeleton import ted
+
+    return [np.asarray(level, dtype=np.int64) for level in ted.HA2G_LEVELS]
+
+
+def _bone_columns(bones: np.ndarray) -> np.ndarray:
+    """(K,) bone ids -> (3K,) channel columns of the 126-d vector (bone-major, x y z)."""
+    return (3 * bones[:, None] + np.arange(3)[None, :]).reshape(-1)
+
+
+class LevelGenerator(nn.Module):
+    """One body level's pose generator (``Hierarchical_PoseGenerator``).
+
+    ``cat[pre_seq (D+1), audio F_a, text F_t, z Z] -> bidirectional GRU (directions summed)
+    -> Linear(H, H/2) -> LeakyReLU(slope) -> Linear(H/2, D)``.
+
+    Shapes
+    ------
+    pre_seq (B, T, D+1), audio (B, T, F_a), text (B, T, F_t), z (B, Z) -> (B, T, D)
+    """
+
+    def __init__(
+        self, in_features: int, out_dim: int, hidden: int, n_layers: int, dropout: float, slope: float
+    ) -> None:
+        super().__init__()
+        self.hidden = hidden
+        self.gru = nn.GRU(
+            in_features,
+            hidden,
+            num_layers=n_layers,
+            batch_first=True,
+            bidirectional=True,
+            dropout=dropout if n_layers > 1 else 0.0,
+        )
+        half = max(1, hidden // 2)
+        self.head = nn.Sequential(nn.Linear(hidden, half), nn.LeakyReLU(slope), nn.Linear(half, out_dim))
+
+    def forward(
+        self, pre_seq: torch.Tensor, audio: torch.Tensor, text: torch.Tensor, z: torch.Tensor
+    ) -> torch.Tensor:
+        zt = z[:, None, :].expand(-1, pre_seq.shape[1], -1)
+        seq, _ = self.gru(torch.cat([pre_seq, audio, text, zt], dim=-1))
+        return self.head(sum_directions(seq, self.hidden))
+
+
+class HA2GDiscriminator(nn.Module):
+    """HA2G's ``Hierarchical_ConvDiscriminator`` on the last level (126 channels), returning logits.
+
+    ``Conv1d(D, 16, 3) -> BN -> LReLU -> Conv1d(16, 8, 3) -> BN -> LReLU -> Conv1d(8, 8, 3)``
+    (T -> T - 6), bidirectional GRU (directions summed), ``Linear(hidden, 1)`` per frame,
+    ``Linear(T - 6, 1)`` over time.
+
+    Shapes
+    ------
+    (B, T, D) -> (B, 1) logits (``sigmoid`` = the reference's probability of "real").
+    """
+
+    def __init__(self, input_dim: int, hidden: int, n_layers: int, n_frames: int, slope: float) -> None:
+        super().__init__()
+        self.convs = nn.Sequential(
+            nn.Conv1d(input_dim, 16, 3),
+            nn.BatchNorm1d(16),
+            nn.LeakyReLU(slope),
+            nn.Conv1d(16, 8, 3),
+            nn.BatchNorm1d(8),
+            nn.LeakyReLU(slope),
+            nn.Conv1d(8, 8, 3),
+        )
+        self.hidden = hidden
+        self.gru = nn.GRU(
+            8,
+            hidden,
+            num_layers=n_layers,
+            batch_first=True,
+            bidirectional=True,
+            dropout=0.3 if n_layers > 1 else 0,
+        )
+        self.out = nn.Linear(hidden, 1)
+        self.out2 = nn.Linear(n_frames - 6, 1)
+        self.n_frames = n_frames
+        self.input_dim = input_dim
+
+    def forward(self, pose: torch.Tensor) -> torch.Tensor:
+        if pose.ndim != 3 or pose.shape[1] != self.n_frames or pose.shape[2] != self.input_dim:
+            raise ValueError(
+                f"HA2GDiscriminator: pose must be (B, {self.n_frames}, {self.input_dim}), "
+                f"got shape {tuple(pose.shape)}"
+            )
+        feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
+        seq, _ = self.gru(feat)
+        return self.out2(self.out(sum_directions(seq, self.hidden)).squeeze(-1))
+
+
+class HA2G(GestureModel):
+    """Hierarchical Audio-to-Gesture on TED-43 direction vectors (see the module docstring).
+
+    Parameters
+    ----------
+    config : HA2GConfig
+
+    ``forward(batch)`` returns
+        ``"pose"`` (B, T, 126) the last level's prediction in the 126-d layout;
+        ``"level0"`` ... ``"level{H-1}"`` (B, T, D_k) every level's prediction (bones of
+        :attr:`level_bones`);
+        ``"mu"``, ``"logvar"``, ``"z"`` (B, Z) the speaker style distribution and sample;
+        ``"style_weights"`` (B, 3, H) audio-level weights per body level;
+        ``"audio_low"`` / ``"audio_mid"`` / ``"audio_high"`` (B, T, F) the levels computed;
+        ``"text_contrast"`` (B, T, F) the contrastive text features (when used).
+    """
+
+    name = "ha2g"
+    representation = "dirvec126"
+    config_class = HA2GConfig
+    input_keys = ("mel", "word", "speaker", "dirvec")
+
+    def __init__(self, config: HA2GConfig) -> None:
+        super().__init__(config)
+        c = config
+        levels = body_levels(c.hierarchical)
+        if not np.array_equal(np.sort(levels[-1]), np.arange(N_BONES)):
+            raise ValueError("the last body level must hold all 42 bones")
+        self.level_bones: tuple[tuple[int, ...], ...] = tuple(tuple(int(b) for b in lv) for lv in levels)
+        self.n_levels = len(levels)
+        self.level_dims: tuple[int, ...] = tuple(3 * len(lv) for lv in levels)
+        for k, lv in enumerate(levels):
+            self.register_buffer(f"_cols{k}", torch.as_tensor(_bone_columns(lv)), persistent=False)
+            if k:
+                prev = {int(b): i for i, b in enumerate(levels[k - 1])}
+                dst = [i for i, b in enumerate(lv) if int(b) in prev]
+                src = [prev[int(lv[i])] for i in dst]
+                self.register_buffer(
+                    f"_dst{k}",
+                    torch.as_tensor(_bone_columns(np.asarray(dst, dtype=np.int64))),
+                    persistent=False,
+                )
+                self.register_buffer(
+                    f"_src{k}",
+                    torch.as_tensor(_bone_columns(np.asarray(src, dtype=np.int64))),
+                    persistent=False,
+                )
+
+        # audio: which levels must be computed
+        needed = set(AUDIO_LEVELS) if c.audio_mode == "blend" else {c.audio_mode}
+        if c.use_contrastive:
+            needed |= {"low", "high"}
+        self.audio = HierarchicalAudioEncoder(
+            c.audio_channels, c.audio_blocks, c.se_reduction, c.audio_features, sorted(needed), c.n_frames
+        )
+        # speaker style: Embedding -> Linear -> LReLU -> (mu, logvar)
+        self.speaker_embedding = nn.Sequential(
+            nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim), nn.LeakyReLU(c.slope)
+        )
+        self.speaker_mu = nn.Linear(c.z_dim, c.z_dim)
+        self.speaker_logvar = nn.Linear(c.z_dim, c.z_dim)
+        self.coordinator: StyleCoordinator | None = None
+        if c.audio_mode == "blend":
+            self.coordinator = StyleCoordinator(c.z_dim, c.style_hidden, 1 if c.same_audio else self.n_levels)
+
+        def text_encoder() -> TextEncoderTCN:
+            return TextEncoderTCN(
+                c.vocab_size, c.word_dim, c.text_hidden, c.text_layers, c.text_features, c.dropout
+            )
+
+        n_text = self.n_levels if c.text_per_level else 1
+        self.text_encoders = nn.ModuleList([text_encoder() for _ in range(n_text)])
+        self.contrastive_text = text_encoder() if c.use_contrastive else None
+        self.generators = nn.ModuleList(
+            [
+                LevelGenerator(
+                    d + 1 + c.audio_features + c.text_features + c.z_dim,
+                    d,
+                    c.hidden,
+                    c.n_layers,
+                    c.dropout,
+                    c.slope,
+                )
+                for d in self.level_dims
+            ]
+        )
+        if c.adversarial:
+            self.discriminator = HA2GDiscriminator(3 * N_BONES, c.d_hidden, c.d_layers, c.n_frames, c.slope)
+
+        # data statistics (set by prepare / set_statistics; saved in the state dict)
+        pairs = default_angle_pairs() if c.use_physical else np.zeros((0, 2), dtype=np.int64)
+        self.register_buffer("angle_pairs", torch.as_tensor(pairs), persistent=False)
+        self.register_buffer("mean_dirvec", torch.zeros(3 * N_BONES))
+        self.register_buffer("angle_mean", torch.zeros(len(pairs)))
+        self.register_buffer("angle_var", torch.ones(len(pairs)))
+        self.register_buffer("angle_change", torch.ones(len(pairs)))
+        self.register_buffer("statistics_ready", torch.zeros((), dtype=torch.bool))
+
+    # ------------------------------------------------------------------ data statistics
+    def set_statistics(self, mean_dirvec: np.ndarray, dirvec_windows: np.ndarray | None = None) -> None:
+        """Store the mean direction vector and (when ``use_physical``) the angle statistics.
+
+        Parameters
+        ----------
+        mean_dirvec : (126,) float
+            The training mean subtracted from the unit direction vectors.
+        dirvec_windows : (N, T, 126) float, optional
+            Training windows (``windows["dirvec"]``); required when ``use_physical``.
+        """
+        m = np.asarray(mean_dirvec, dtype=np.float64)
+        if m.shape != (3 * N_BONES,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"mean_dirvec must be (126,) finite, got shape {m.shape}")
+        with torch.no_grad():
+            self.mean_dirvec.copy_(torch.as_tensor(m, dtype=self.mean_dirvec.dtype))
+            if self.config.use_physical:
+                if dirvec_windows is None:
+                    raise ValueError("set_statistics: dirvec_windows is required when use_physical is on")
+                stats = angle_statistics(
+                    dirvec_windows, m, pairs=self.angle_pairs.numpy(), var_floor=self.config.angle_var_floor
+                )
+                self.angle_mean.copy_(torch.as_tensor(stats.mean))
+                self.angle_var.copy_(torch.as_tensor(stats.var))
+                self.angle_change.copy_(torch.as_tensor(stats.change))
+            self.statistics_ready.fill_(True)
+
+    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+        """Compute the data statistics from the numpy training windows (called by ``fit``).
+
+        The mean direction vector is ``train_windows["dirvec_mean"]`` (126,), a ``dirvec_mean``
+        attribute or ``train_windows.dir_norm.mean``; without any of them it is recovered from
+        the unit-norm constraint (:func:`recover_dirvec_mean`).
+        """
+        if "dirvec" not in train_windows:
+            raise KeyError(f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows)})")
+        mean = _find_dirvec_mean(train_windows)
+        self.set_statistics(mean, np.asarray(train_windows["dirvec"]))
+
+    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
+        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into every text encoder's embedding."""
+        encoders = [
+            *self.text_encoders,
+            *([self.contrastive_text] if self.contrastive_text is not None else []),
+        ]
+        for enc in encoders:
+            enc.set_word_vectors(torch.as_tensor(np.asarray(vectors), dtype=torch.float32))
+
+    # ------------------------------------------------------------------ forward
+    def _check_inputs(self, batch: Batch) -> None:
+        check_batch(batch, self.input_keys, "HA2G")
+        b = batch["dirvec"].shape[0]
+        t = self.config.n_frames
+        want = {"dirvec": (b, t, 3 * N_BONES), "word": (b, t), "speaker": (b,)}
+        for key, shape in want.items():
+            if tuple(batch[key].shape) != shape:
+                raise ValueError(
+                    f"HA2G: batch[{key!r}] must have shape {shape}, got {tuple(batch[key].shape)}"
+                )
+        mel = batch["mel"]
+        if mel.ndim != 3 or mel.shape[0] != b or mel.shape[2] != 128:
+            raise ValueError(f"HA2G: batch['mel'] must be ({b}, M, 128), got {tuple(mel.shape)}")
+        spk = batch["speaker"]
+        if b and (int(spk.min()) < 0 or int(spk.max()) >= self.config.n_speakers):
+            raise ValueError(
+                f"HA2G: speaker ids must be in [0, {self.config.n_speakers}), "
+                f"got range [{int(spk.min())}, {int(spk.max())}]"
+            )
+
+    def speaker_style(self, speaker: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Speaker ids (B,) -> (mu, logvar, z), each (B, Z); z is sampled in training, mu in eval."""
+        h = self.speaker_embedding(speaker)
+        mu, logvar = self.speaker_mu(h), self.speaker_logvar(h)
+        z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
+        return mu, logvar, z
+
+    def _style_weights(self, z: torch.Tensor) -> torch.Tensor:
+        """(B, Z) -> (B, 3, H) audio-level weights (fixed one-hot for a single audio level)."""
+        if self.coordinator is None:
+            w = z.new_zeros(z.shape[0], 3, self.n_levels)
+            w[:, AUDIO_LEVELS.index(self.config.audio_mode)] = 1.0
+            return w
+        w = self.coordinator(z)
+        return w.expand(-1, -1, self.n_levels) if self.config.same_audio else w
+
+    def _decode(
+        self, dirvec: torch.Tensor, audio: dict[str, torch.Tensor], texts: list[torch.Tensor], z: torch.Tensor
+    ) -> tuple[list[torch.Tensor], torch.Tensor]:
+        """Run the cascade of level generators; returns (per-level predictions, style weights)."""
+        weights = self._style_weights(z)
+        full = {lv: audio.get(lv, audio[next(iter(audio))]) for lv in AUDIO_LEVELS}
+        level_audio = blend_audio(full, weights)  # (B, H, T, F)
+        b, t, _ = dirvec.shape
+        n_pre = self.n_pre
+        preds: list[torch.Tensor] = []
+        for k, gen in enumerate(self.generators):
+            cols = getattr(self, f"_cols{k}")
+            d = self.level_dims[k]
+            seed = torch.cat([dirvec[:, :n_pre, cols], dirvec.new_ones(b, n_pre, 1)], dim=-1)
+            rest = dirvec.new_zeros(b, t - n_pre, d + 1)
+            if k:
+                dst, src = getattr(self, f"_dst{k}"), getattr(self, f"_src{k}")
+                rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src])
+            pre_seq = torch.cat([seed, rest], dim=1)
+            text = texts[k] if len(texts) > 1 else texts[0]
+            preds.append(gen(pre_seq, level_audio[:, k], text, z))
+        return preds, weights
+
+    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+        """See the class docstring; reads ``mel``, ``word``, ``speaker`` and seed frames of ``dirvec``."""
+        self._check_inputs(batch)
+        dirvec = batch["dirvec"]
+        audio = self.audio(batch["mel"])
+        mu, logvar, z = self.speaker_style(batch["speaker"])
+        texts = [enc(batch["word"]) for enc in self.text_encoders]
+        preds, weights = self._decode(dirvec, audio, texts, z)
+        pose = dirvec.new_zeros(dirvec.shape).index_copy(
+            -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1]
+        )
+        out: dict[str, torch.Tensor] = {
+            "pose": pose,
+            "mu": mu,
+            "logvar": logvar,
+            "z": z,
+            "style_weights": weights,
+        }
+        out.update({f"level{k}": p for k, p in enumerate(preds)})
+        out.update({f"audio_{lv}": f for lv, f in audio.items()})
+        for k, text in enumerate(texts):
+            out[f"text{k}"] = text
+        if self.contrastive_text is not None:
+            out["text_contrast"] = self.contrastive_text(batch["word"])
+        return out
+
+    # ------------------------------------------------------------------ losses
+    def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
+        """Generator losses (unweighted terms plus the weighted ``"total"``).
+
+        Keys: ``"huber"`` (sum over levels), ``"kld"``, and when switched on ``"adv"`` (only
+        when :meth:`adversarial_active`), ``"style"``, ``"contrastive_pos"``/``"contrastive_neg"``,
+        ``"physical"``. ``total = 250 huber + 5 adv + 0.1 kld + 0.05 style + 0.2 pos - 0.005 neg
+        + 0.01 physical`` (weights from the config).
+        """
+        c = self.config
+        target = batch["dirvec"]
+        preds = [out[f"level{k}"] for k in range(self.n_levels)]
+        targets = [target[..., getattr(self, f"_cols{k}")] for k in range(self.n_levels)]
+        terms: dict[str, torch.Tensor] = {
+            "huber": hierarchical_huber(preds, targets, beta=c.huber_beta),
+            "kld": kl_divergence(out["mu"], out["logvar"]),
+        }
+        total = c.huber_weight * terms["huber"] + c.kld_weight * terms["kld"]
+        if self.discriminator is not None and self.adversarial_active(epoch):
+            terms["adv"] = ns_gan_g_loss(self.discriminator(out["pose"]))
+            total = total + c.adv_weight * terms["adv"]
+        if c.use_style_loss:
+            terms["style"] = self._style_loss(batch, out)
+            total = total + c.style_weight * terms["style"]
+        if c.use_contrastive:
+            audio = {lv: out[f"audio_{lv}"] for lv in ("low", "high")}
+            con = multilevel_contrastive_loss(
+                out["text_contrast"], audio, min_distance=c.contrastive_min_distance
+            )
+            terms["contrastive_pos"] = con["positive"]
+            terms["contrastive_neg"] = con["negative"]
+            total = (
+                total
+                + c.contrastive_pos_weight * con["positive"]
+                - c.contrastive_neg_weight * con["negative"]
+            )
+        if c.use_physical:
+            if not bool(self.statistics_ready):
+                raise RuntimeError(
+                    "HA2G: call prepare(train_windows) before training (angle statistics unset)"
+                )
+            angles = bone_angles(out["pose"], self.mean_dirvec, self.angle_pairs)
+            terms["physical"] = physical_constraint_loss(angles, self.angle_mean, self.angle_var)
+            total = total + c.physical_weight * terms["physical"]
+        terms["total"] = total
+        return terms
+
+    def _style_loss(self, batch: Batch, out: dict[str, torch.Tensor]) -> torch.Tensor:
+        """Style diverging loss against the outputs for random speakers' style vectors."""
+        b = out["z"].shape[0]
+        other = torch.randint(0, self.config.n_speakers, (b,), device=out["z"].device)
+        _, _, z_other = self.speaker_style(other)
+        audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
+        texts = [out[f"text{k}"] for k in range(len(self.text_encoders))]
+        preds_other, _ = self._decode(batch["dirvec"], audio, texts, z_other)
+        return style_diverging_loss(
+            out[f"level{self.n_levels - 1}"],
+            preds_other[-1],
+            out["z"],
+            z_other,
+            beta=self.config.style_beta,
+            clip=self.config.style_clip,
+        )
+
+    def discriminator_losses(self, batch: Batch, out: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+        """NS-GAN discriminator loss on real ``dirvec`` vs the detached generated pose."""
+        if self.discriminator is None:
+            raise RuntimeError("HA2G: adversarial is off, there is no discriminator")
+        real = self.discriminator(batch["dirvec"])
+        fake = self.discriminator(out["pose"].detach())
+        return {"total": ns_gan_d_loss(real, fake)}
+
+
+def _find_dirvec_mean(windows: Mapping[str, Any]) -> np.ndarray:
+    """The (126,) mean direction vector of ``windows``.
+
+    Looked up as the key ``"dirvec_mean"``, an attribute ``dirvec_mean`` or ``dir_norm.mean``
+    (:class:`beatlite.data.windows.Windows`); otherwise recovered from the windows themselves
+    with :func:`recover_dirvec_mean`. If that fails too (e.g. random test windows that are not
+    shifted unit vectors) a warning is issued and zeros are used.
+    """
+    if "dirvec_mean" in windows:
+        return np.asarray(windows["dirvec_mean"], dtype=np.float64).reshape(-1)
+    for value in (
+        getattr(windows, "dirvec_mean", None),
+        getattr(getattr(windows, "dir_norm", None), "mean", None),
+    ):
+        if value is not None and np.size(value) == 3 * N_BONES:
+            return np.asarray(value, dtype=np.float64).reshape(-1)
+    try:
+        return recover_dirvec_mean(np.asarray(windows["dirvec"]))
+    except ValueError as exc:
+        warnings.warn(f"HA2G.prepare: no dirvec mean given and {exc}; using zeros", stacklevel=3)
+        return np.zeros(3 * N_BONES)
+
+
+def recover_dirvec_mean(dirvec: np.ndarray, *, tol: float = 1e-3, max_frames: int = 20000) -> np.ndarray:
+    """Recover the subtracted mean ``m`` from mean-subtracted unit vectors ``d = u - m``.
+
+    Every frame satisfies ``|d + m|^2 = 1``, i.e. ``2 d.m + |m|^2 = 1 - |d|^2``: linear in
+    ``(m, s = |m|^2)``, solved per bone by least squares over the frames.
+
+    Parameters
+    ----------
+    dirvec : (..., 126) float
+        Mean-subtracted unit direction vectors (e.g. ``windows["dirvec"]``).
+    tol : float
+        Largest accepted ``| |d + m| - 1 |`` over the frames used.
+    max_frames : int
+        Use at most this many frames (evenly spaced).
+
+    Returns
+    -------
+    (126,) float64
+
+    Raises
+    ------
+    ValueError
+        A bone's directions do not span 3-D (ill-posed) or are not shifted unit vectors.
+    """
+    d = np.asarray(dirvec, dtype=np.float64).reshape(-1, N_BONES, 3)
+    if d.shape[0] < 4:
+        raise ValueError(f"need at least 4 frames to recover the dirvec mean, got {d.shape[0]}")
+    d = d[:: max(1, d.shape[0] // max_frames)]
+    mean = np.zeros((N_BONES, 3))
+    for j in range(N_BONES):
+        a = np.concatenate([2.0 * d[:, j], np.ones((d.shape[0], 1))], axis=1)
+        y = 1.0 - (d[:, j] ** 2).sum(axis=1)
+        x, _, rank, _ = np.linalg.lstsq(a, y, rcond=1e-9)
+        if rank < 4:
+            raise ValueError(f"bone {j}'s directions do not vary enough to recover the dirvec mean")
+        err = np.abs(np.linalg.norm(d[:, j] + x[:3], axis=1) - 1.0).max()
+        if err > tol:
+            raise ValueError(f"bone {j}: the windows are not mean-subtracted unit vectors (error {err:.3g})")
+        mean[j] = x[:3]
+    return mean.reshape(-1)
+
+
+def build_ha2g(preset: str = "tiny", ablation: str = "full", **overrides: Any) -> HA2G:
+    """An HA2G model from a preset, an ablation switch name and further config overrides."""
+    from beatlite.models.base import config_from_preset
+
+    if ablation not in ABLATIONS:
+        raise ValueError(f"ablation must be one of {sorted(ABLATIONS)}, got {ablation!r}")
+    return HA2G(config_from_preset(HA2GConfig, PRESETS, preset, **{**ABLATIONS[ablation], **overrides}))
+
+
+def retrain(names: Sequence[str] | None = None, **kwargs: Any) -> dict[str, float]:
+    """Retrain the shipped HA2G checkpoints (:func:`beatlite.models.ha2g_train.retrain`)."""
+    from beatlite.models.ha2g_train import retrain as _retrain
+
+    return _retrain(names, **kwargs)

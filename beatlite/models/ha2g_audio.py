@@ -1,0 +1,245 @@
+"""HA2G's hierarchical audio learner and style coordinator (torch).
+
+The audio encoder is a compact SE-ResNet (the reference uses SE-ResNet-34 "V2",
+blocks ``[3, 4, 6, 3]``, channels ``[32, 64, 128, 256]``; facts C.7) on a log-mel
+spectrogram. Three streams read three depths of the backbone and are each mapped
+to one feature vector per pose frame:
+
+==========  ==========================  =================================  ===============
+level       backbone output             stream                             per frame
+==========  ==========================  =================================  ===============
+``low``     layer2, (C1, 64, M/2)       Conv2d k2                          63 x C1 -> F
+``mid``     layer3, (C2, 32, M/4)       PixelShuffle(2), Conv2d k3         62 x C2/4 -> F
+``high``    layer4, (C3, 16, M/8)       PixelShuffle(4), Conv2d k3         62 x C3/16 -> F
+==========  ==========================  =================================  ===============
+
+For the 34-frame window the spectrogram has M = 70 frames and every stream ends with
+exactly 34 time steps (70 -> 35 -> 34, 70 -> 18 -> 36 -> 34, 70 -> 9 -> 36 -> 34).
+
+The style coordinator turns a speaker style vector into softmax weights over the
+three audio levels for each body level (paper eq. 3).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import torch
+from torch import nn
+
+AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
+"""Names of the three audio feature levels, in the order of the style-coordinator weights."""
+
+N_MELS = 128
+
+
+class SEBlock2d(nn.Module):
+    """Squeeze-and-excitation: per-channel gates from global average pooling.
+
+    Shapes
+    ------
+    (B, C, H, W) -> (B, C, H, W)
+    """
+
+    def __init__(self, channels: int, reduction: int) -> None:
+        super().__init__()
+        hidden = max(1, channels // reduction)
+        self.fc = nn.Sequential(
+            nn.Linear(channels, hidden), nn.ReLU(inplace=True), nn.Linear(hidden, channels), nn.Sigmoid()
+        )
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        gate = self.fc(x.mean(dim=(2, 3)))
+        return x * gate[:, :, None, None]
+
+
+class SEBasicBlock2d(nn.Module):
+    """Residual block ``conv3x3(stride) -> BN -> ReLU -> conv3x3 -> BN -> SE`` plus a shortcut, then ReLU.
+
+    The shortcut is ``conv1x1(stride) + BN`` when the shape changes, else the identity.
+
+    Shapes
+    ------
+    (B, in_ch, H, W) -> (B, out_ch, ceil(H / stride), ceil(W / stride))
+    """
+
+    def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int) -> None:
+        super().__init__()
+        self.conv1 = nn.Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
+        self.bn1 = nn.BatchNorm2d(out_ch)
+        self.conv2 = nn.Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
+        self.bn2 = nn.BatchNorm2d(out_ch)
+        self.se = SEBlock2d(out_ch, reduction)
+        self.relu = nn.ReLU(inplace=True)
+        self.shortcut: nn.Module = (
+            nn.Sequential(nn.Conv2d(in_ch, out_ch, 1, stride=stride, bias=False), nn.BatchNorm2d(out_ch))
+            if stride != 1 or in_ch != out_ch
+            else nn.Identity()
+        )
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        y = self.relu(self.bn1(self.conv1(x)))
+        y = self.se(self.bn2(self.conv2(y)))
+        return self.relu(y + self.shortcut(x))
+
+
+def _layer(in_ch: int, out_ch: int, n_blocks: int, stride: int, reduction: int) -> nn.Sequential:
+    blocks = [SEBasicBlock2d(in_ch, out_ch, stride, reduction)]
+    blocks += [SEBasicBlock2d(out_ch, out_ch, 1, reduction) for _ in range(n_blocks - 1)]
+    return nn.Sequential(*blocks)
+
+
+class _Stream(nn.Module):
+    """One feature stream: optional PixelShuffle, a 2-D conv, then a per-frame Linear."""
+
+    def __init__(self, channels: int, upscale: int, kernel: int, freq_in: int, out_features: int) -> None:
+        super().__init__()
+        if channels % (upscale * upscale):
+            raise ValueError(
+                f"HierarchicalAudioEncoder: {channels} channels cannot be pixel-shuffled by {upscale} "
+                f"(need a multiple of {upscale * upscale})"
+            )
+        self.shuffle: nn.Module = nn.PixelShuffle(upscale) if upscale > 1 else nn.Identity()
+        ch = channels // (upscale * upscale)
+        self.conv = nn.Conv2d(ch, ch, kernel)
+        freq = freq_in * upscale - kernel + 1
+        self.proj = nn.Linear(freq * ch, out_features)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        y = self.conv(self.shuffle(x))  # (B, C', F', T')
+        b, c, f, t = y.shape
+        return self.proj(y.permute(0, 3, 1, 2).reshape(b, t, c * f))  # (B, T', out)
+
+
+class HierarchicalAudioEncoder(nn.Module):
+    """Log-mel spectrogram -> low / mid / high audio features per pose frame.
+
+    Parameters
+    ----------
+    channels : 4 ints
+        Output channels of the four residual layers (reference ``(32, 64, 128, 256)``).
+        ``channels[2]`` must be a multiple of 4 and ``channels[3]`` of 16 (pixel shuffles).
+    blocks : 4 ints
+        Residual blocks per layer (reference ``(3, 4, 6, 3)``).
+    reduction : int
+        Squeeze-and-excitation reduction (reference 8).
+    out_features : int
+        Feature size F of every level (reference 32).
+    levels : sequence of str
+        Which of ``"low"``, ``"mid"``, ``"high"`` to compute (an ablation that never
+        reads a level does not build it).
+    n_frames : int
+        Pose frames T per window; every stream is cropped / edge-padded to T.
+
+    Shapes
+    ------
+    mel (B, M, 128) float, dB (``power_to_db(ref=max)``, about [-80, 0]; scaled by
+    ``mel / 40 + 1`` inside) -> dict level -> (B, T, F).
+    """
+
+    def __init__(
+        self,
+        channels: Sequence[int] = (32, 64, 128, 256),
+        blocks: Sequence[int] = (3, 4, 6, 3),
+        reduction: int = 8,
+        out_features: int = 32,
+        levels: Sequence[str] = AUDIO_LEVELS,
+        n_frames: int = 34,
+    ) -> None:
+        super().__init__()
+        c = tuple(int(v) for v in channels)
+        nb = tuple(int(v) for v in blocks)
+        if len(c) != 4 or len(nb) != 4 or min(c) < 1 or min(nb) < 1:
+            raise ValueError(f"channels and blocks must be 4 positive ints, got {c} and {nb}")
+        unknown = sorted(set(levels) - set(AUDIO_LEVELS))
+        if unknown or not levels:
+            raise ValueError(f"levels must be a non-empty subset of {AUDIO_LEVELS}, got {tuple(levels)}")
+        self.levels = tuple(lv for lv in AUDIO_LEVELS if lv in levels)
+        self.n_frames = int(n_frames)
+        self.stem = nn.Sequential(
+            nn.Conv2d(1, c[0], 3, padding=1, bias=False), nn.BatchNorm2d(c[0]), nn.ReLU(inplace=True)
+        )
+        self.layer1 = _layer(c[0], c[0], nb[0], 1, reduction)
+        self.layer2 = _layer(c[0], c[1], nb[1], 2, reduction)
+        need3 = "mid" in self.levels or "high" in self.levels
+        need4 = "high" in self.levels
+        self.layer3 = _layer(c[1], c[2], nb[2], 2, reduction) if need3 else None
+        self.layer4 = _layer(c[2], c[3], nb[3], 2, reduction) if need4 else None
+        streams: dict[str, nn.Module] = {}
+        if "low" in self.levels:
+            streams["low"] = _Stream(c[1], 1, 2, N_MELS // 2, out_features)
+        if "mid" in self.levels:
+            streams["mid"] = _Stream(c[2], 2, 3, N_MELS // 4, out_features)
+        if "high" in self.levels:
+            streams["high"] = _Stream(c[3], 4, 3, N_MELS // 8, out_features)
+        self.streams = nn.ModuleDict(streams)
+        self.out_features = int(out_features)
+
+    def forward(self, mel: torch.Tensor) -> dict[str, torch.Tensor]:
+        if mel.ndim != 3 or mel.shape[2] != N_MELS or mel.shape[1] < 8:
+            raise ValueError(
+                f"HierarchicalAudioEncoder: mel must be (B, M >= 8, {N_MELS}), got shape {tuple(mel.shape)}"
+            )
+        x = (mel / 40.0 + 1.0).transpose(1, 2).unsqueeze(1)  # (B, 1, 128 mels, M frames)
+        x2 = self.layer2(self.layer1(self.stem(x)))
+        feats = {"low": x2}
+        if self.layer3 is not None:
+            feats["mid"] = self.layer3(x2)
+            if self.layer4 is not None:
+                feats["high"] = self.layer4(feats["mid"])
+        out = {}
+        for level in self.levels:
+            y = self.streams[level](feats[level])
+            out[level] = _match_length(y, self.n_frames)
+        return out
+
+
+def _match_length(x: torch.Tensor, n: int) -> torch.Tensor:
+    """Crop or last-frame-pad ``(B, T, C)`` to ``(B, n, C)``."""
+    t = x.shape[1]
+    if t >= n:
+        return x[:, :n]
+    return torch.cat([x, x[:, -1:].expand(-1, n - t, -1)], dim=1)
+
+
+class StyleCoordinator(nn.Module):
+    """Speaker style vector -> softmax weights of the three audio levels for each body level.
+
+    ``ELU -> Linear(z_dim, hidden) -> ELU -> Linear(hidden, 3 * n_body_levels)``, reshaped to
+    ``(B, 3, H)`` and soft-maxed over the 3 audio levels (reference: hidden 32, H = 6).
+
+    Shapes
+    ------
+    (B, z_dim) -> (B, 3, H); every column sums to 1.
+    """
+
+    def __init__(self, z_dim: int, hidden: int, n_body_levels: int) -> None:
+        super().__init__()
+        self.n_body_levels = int(n_body_levels)
+        self.net = nn.Sequential(
+            nn.ELU(), nn.Linear(z_dim, hidden), nn.ELU(), nn.Linear(hidden, 3 * self.n_body_levels)
+        )
+
+    def forward(self, z: torch.Tensor) -> torch.Tensor:
+        if z.ndim != 2:
+            raise ValueError(f"StyleCoordinator: z must be (B, z_dim), got shape {tuple(z.shape)}")
+        return torch.softmax(self.net(z).view(z.shape[0], 3, self.n_body_levels), dim=1)
+
+
+def blend_audio(features: dict[str, torch.Tensor], weights: torch.Tensor) -> torch.Tensor:
+    """Paper eq. 3: ``f^h = w_low[h] f_low + w_mid[h] f_mid + w_high[h] f_high`` for each body level h.
+
+    Parameters
+    ----------
+    features : dict level -> (B, T, F)
+        The three audio levels.
+    weights : (B, 3, H)
+        Style-coordinator weights (rows in :data:`AUDIO_LEVELS` order).
+
+    Returns
+    -------
+    (B, H, T, F)
+        The blended audio feature of every body level.
+    """
+    stacked = torch.stack([features[level] for level in AUDIO_LEVELS], dim=1)  # (B, 3, T, F)
+    return torch.einsum("bsh,bstf->bhtf", weights, stacked)

@@ -1,0 +1,294 @@
+"""HA2G's training losses (torch) and the bone-angle statistics of the physical constraint.
+
+All losses are means (scalars); the model multiplies them by its weights (facts C.7):
+hierarchical Huber 250, GAN 5, KL 0.1, style diverging 0.05, contrastive 0.2 (positive)
+and 0.005 (negative), physical constraint 0.01.
+
+Angles are in units of pi radians (``arccos(cos) / pi`` in [0, 1]), as in the reference
+and :func:`beatlite.metrics.beats.included_angles`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+
+from beatlite.models.base import huber
+
+N_BONES = 42
+PALM_BONES: tuple[tuple[int, int], ...] = ((11, 17), (28, 34))
+"""TED-43 direction-vector pairs whose cross products are the left / right palm normals (facts C.5)."""
+
+
+def default_angle_pairs() -> np.ndarray:
+    """``beatlite.skeleton.ted.ANGLE_PAIRS`` as a (P, 2) int64 array (into 42 bones + 2 palm normals)."""
+    from beatlite.skeleton import ted
+
+    return np.asarray(ted.ANGLE_PAIRS, dtype=np.int64).reshape(-1, 2)
+
+
+# ----------------------------------------------------------------------------- contrastive
+def contrastive_ce(query: torch.Tensor, key: torch.Tensor, *, min_distance: float = 1e-2) -> torch.Tensor:
+    """HA2G's ``SoftmaxContrastiveLoss``: cross-entropy of inverse-distance logits against the diagonal.
+
+    Features are flattened to ``(B*T, F)`` rows and L2-normalised; ``logit_ij = 1 / max(|q_i - k_j|,
+    min_distance)`` and row i's correct class is j = i (same clip, same frame).
+
+    Parameters
+    ----------
+    query, key : (B, T, F) float tensors
+        E.g. text features and one level of audio features.
+    min_distance : float
+        Floor of the distance (the reference divides by the raw distance, which is infinite
+        for identical features); caps every logit at ``1 / min_distance``.
+
+    Returns
+    -------
+    scalar tensor
+        Mean cross-entropy, >= 0; small when every row's nearest key is its own frame.
+    """
+    if query.ndim != 3 or query.shape != key.shape:
+        raise ValueError(
+            f"contrastive_ce: query and key must be equal (B, T, F) shapes, got {tuple(query.shape)} "
+            f"and {tuple(key.shape)}"
+        )
+    q = nn.functional.normalize(query.reshape(-1, query.shape[-1]), dim=1)
+    k = nn.functional.normalize(key.reshape(-1, key.shape[-1]), dim=1)
+    # |q - k|^2 = 2 - 2 <q, k> for unit rows; clamp keeps sqrt differentiable at 0.
+    dist = torch.sqrt(torch.clamp(2.0 - 2.0 * q @ k.T, min=min_distance**2))
+    logits = 1.0 / dist
+    target = torch.arange(q.shape[0], device=q.device)
+    return nn.functional.cross_entropy(logits, target)
+
+
+def multilevel_contrastive_loss(
+    text: torch.Tensor,
+    audio: dict[str, torch.Tensor],
+    *,
+    positive: str = "high",
+    negative: str = "low",
+    min_distance: float = 1e-2,
+) -> dict[str, torch.Tensor]:
+    """Paper eq. 2 as implemented: text is pulled towards one audio level and pushed from another.
+
+    Returns ``{"positive": CE(text, audio[positive]), "negative": CE(text, audio[negative])}``;
+    the model adds ``w_pos * positive - w_neg * negative`` (reference 0.2 and 0.005).
+
+    Parameters
+    ----------
+    text : (B, T, F)
+        Text features (a separate text encoder).
+    audio : dict level -> (B, T, F)
+        Audio features with at least the ``positive`` and ``negative`` levels.
+    """
+    for level in (positive, negative):
+        if level not in audio:
+            raise KeyError(f"multilevel_contrastive_loss: audio has no level {level!r} (has {sorted(audio)})")
+    return {
+        "positive": contrastive_ce(text, audio[positive], min_distance=min_distance),
+        "negative": contrastive_ce(text, audio[negative], min_distance=min_distance),
+    }
+
+
+# ----------------------------------------------------------------------------- regression, KL, style
+def hierarchical_huber(
+    predictions: Sequence[torch.Tensor], targets: Sequence[torch.Tensor], *, beta: float = 0.1
+) -> torch.Tensor:
+    """Sum over body levels of the mean Huber loss (beta 0.1; paper eq. 5 without the 1/H).
+
+    Parameters
+    ----------
+    predictions, targets : sequences of (B, T, D_k) tensors, one per level
+
+    Returns
+    -------
+    scalar tensor, 0 exactly when every prediction equals its target.
+    """
+    if len(predictions) != len(targets) or not predictions:
+        raise ValueError(f"need one target per level, got {len(predictions)} predictions and {len(targets)}")
+    total = predictions[0].new_zeros(())
+    for k, (p, t) in enumerate(zip(predictions, targets)):
+        if p.shape != t.shape:
+            raise ValueError(f"level {k}: prediction {tuple(p.shape)} and target {tuple(t.shape)} differ")
+        total = total + huber(p, t, beta)
+    return total
+
+
+def kl_divergence(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
+    """KL(N(mu, exp(logvar)) || N(0, I)) averaged over batch and dimensions.
+
+    ``-0.5 * mean(1 + logvar - mu^2 - exp(logvar))``; 0 exactly for mu = 0, logvar = 0.
+
+    Parameters
+    ----------
+    mu, logvar : (B, Z) tensors
+    """
+    if mu.shape != logvar.shape:
+        raise ValueError(f"mu {tuple(mu.shape)} and logvar {tuple(logvar.shape)} must have one shape")
+    return -0.5 * torch.mean(1.0 + logvar - mu.pow(2) - logvar.exp())
+
+
+def style_diverging_loss(
+    pose: torch.Tensor,
+    pose_other: torch.Tensor,
+    z: torch.Tensor,
+    z_other: torch.Tensor,
+    *,
+    beta: float = 0.05,
+    clip: float = 1000.0,
+) -> torch.Tensor:
+    """Paper eq. 7 (Trimodal's diversity regulariser): reward outputs that move with the style vector.
+
+    ``-mean_b min(sum_{t,d} Huber_beta(pose_b, pose_other_b) / (mean|z - z_other| + 1e-5), clip)``;
+    the z distance is detached.
+
+    Parameters
+    ----------
+    pose, pose_other : (B, T, D)
+        Outputs for the batch's style vectors and for other (random speakers') style vectors.
+    z, z_other : (B, Z)
+        The two style vectors.
+
+    Returns
+    -------
+    scalar tensor in [-clip, 0].
+    """
+    if pose.shape != pose_other.shape or pose.ndim != 3:
+        raise ValueError(
+            f"pose {tuple(pose.shape)} and pose_other {tuple(pose_other.shape)} must be (B, T, D)"
+        )
+    diff = nn.functional.smooth_l1_loss(pose / beta, pose_other / beta, reduction="none") * beta
+    per_clip = diff.sum(dim=(1, 2))
+    z_l1 = (z - z_other).abs().mean().detach()
+    return -torch.clamp(per_clip / (z_l1 + 1e-5), max=clip).mean()
+
+
+# ----------------------------------------------------------------------------- physical constraint
+def directions_with_palms(dirvec: torch.Tensor, mean_dirvec: torch.Tensor) -> torch.Tensor:
+    """Mean-subtracted 126-d direction vectors -> 44 unit vectors (42 bones + 2 palm normals).
+
+    Adds ``mean_dirvec`` back, normalises each bone, appends ``cross(v11, v17)`` and
+    ``cross(v28, v34)`` normalised (facts C.5/C.7).
+
+    Parameters
+    ----------
+    dirvec : (..., 126) tensor
+    mean_dirvec : (126,) tensor
+
+    Returns
+    -------
+    (..., 44, 3) tensor
+    """
+    if dirvec.shape[-1] != 3 * N_BONES:
+        raise ValueError(f"dirvec must end with {3 * N_BONES} channels, got shape {tuple(dirvec.shape)}")
+    v = (dirvec + mean_dirvec).reshape(*dirvec.shape[:-1], N_BONES, 3)
+    v = nn.functional.normalize(v, dim=-1, eps=1e-8)
+    palms = [torch.linalg.cross(v[..., a, :], v[..., b, :], dim=-1) for a, b in PALM_BONES]
+    palms_t = nn.functional.normalize(torch.stack(palms, dim=-2), dim=-1, eps=1e-8)
+    return torch.cat([v, palms_t], dim=-2)
+
+
+def bone_angles(dirvec: torch.Tensor, mean_dirvec: torch.Tensor, pairs: torch.Tensor) -> torch.Tensor:
+    """Included angles of ``pairs`` of the 44 vectors, in units of pi (differentiable).
+
+    Parameters
+    ----------
+    dirvec : (..., 126) tensor, mean-subtracted directions
+    mean_dirvec : (126,) tensor
+    pairs : (P, 2) int64 tensor, indices into the 44 vectors
+
+    Returns
+    -------
+    (..., P) tensor in [0, 1]. The cosine is clamped to ``±(1 - 1e-6)`` so the gradient stays finite.
+    """
+    v = directions_with_palms(dirvec, mean_dirvec)
+    cos = (v[..., pairs[:, 0], :] * v[..., pairs[:, 1], :]).sum(-1)
+    return torch.arccos(torch.clamp(cos, -1.0 + 1e-6, 1.0 - 1e-6)) / torch.pi
+
+
+def physical_constraint_loss(angles: torch.Tensor, mean: torch.Tensor, var: torch.Tensor) -> torch.Tensor:
+    """Paper eq. 8 as implemented: ``sum_p mean_{b,t} (theta_p - mu_p)^2 / (2 sigma_p^2)``.
+
+    The negative Gaussian log-likelihood without its constant; 0 exactly at the mean angles.
+
+    Parameters
+    ----------
+    angles : (..., P) tensor, units of pi
+    mean, var : (P,) tensors
+    """
+    if angles.shape[-1] != mean.shape[0] or mean.shape != var.shape:
+        raise ValueError(
+            f"angles (..., P) {tuple(angles.shape)}, mean {tuple(mean.shape)} and var {tuple(var.shape)} "
+            "must agree on P"
+        )
+    z = (angles - mean).pow(2) / (2.0 * var)
+    return z.reshape(-1, mean.shape[0]).mean(dim=0).sum()
+
+
+@dataclass(frozen=True)
+class AngleStatistics:
+    """Training-set statistics of the bone angles (units of pi radians).
+
+    Attributes
+    ----------
+    mean, var : (P,) float64
+        Mean and variance over all training frames (var floored at ``var_floor``).
+    change : (P,) float64
+        Mean absolute frame-to-frame change (HA2G's ``change_angle``, for beat consistency).
+    """
+
+    mean: np.ndarray
+    var: np.ndarray
+    change: np.ndarray
+
+
+def angle_statistics(
+    dirvec_windows: np.ndarray,
+    mean_dirvec: np.ndarray,
+    *,
+    pairs: np.ndarray | None = None,
+    var_floor: float = 1e-5,
+) -> AngleStatistics:
+    """Per-pair mean / variance / mean change of the bone angles over training windows.
+
+    The reference hard-codes these numbers for TED Expressive (``calculate_angle_stats.py``);
+    beatlite computes them from whichever training data it is given.
+
+    Parameters
+    ----------
+    dirvec_windows : (N, T, 126) float
+        Mean-subtracted unit direction vectors (``windows["dirvec"]``).
+    mean_dirvec : (126,) float
+        The mean that was subtracted.
+    pairs : (P, 2) int, optional
+        Indices into the 42 bones + 2 palm normals (default ``ted.ANGLE_PAIRS``).
+    var_floor : float
+        Lower bound of the variance (a pair that never moves would divide by zero).
+
+    Returns
+    -------
+    AngleStatistics
+    """
+    from beatlite.metrics.beats import append_palm_normals, included_angles
+
+    d = np.asarray(dirvec_windows, dtype=np.float64)
+    if d.ndim != 3 or d.shape[2] != 3 * N_BONES or d.shape[0] < 1 or d.shape[1] < 2:
+        raise ValueError(f"dirvec_windows must be (N >= 1, T >= 2, 126), got shape {d.shape}")
+    m = np.asarray(mean_dirvec, dtype=np.float64)
+    if m.shape != (3 * N_BONES,):
+        raise ValueError(f"mean_dirvec must be (126,), got shape {m.shape}")
+    if not (np.all(np.isfinite(d)) and np.all(np.isfinite(m))):
+        raise ValueError("dirvec_windows and mean_dirvec must be finite")
+    pr = default_angle_pairs() if pairs is None else np.asarray(pairs, dtype=np.int64)
+    n, t, _ = d.shape
+    v = (d + m).reshape(n * t, N_BONES, 3)
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    v = np.divide(v, norm, out=np.zeros_like(v), where=norm > 1e-12)
+    theta = included_angles(append_palm_normals(v), pr).reshape(n, t, -1)
+    flat = theta.reshape(n * t, -1)
+    change = np.abs(np.diff(theta, axis=1)).mean(axis=(0, 1))
+    return AngleStatistics(mean=flat.mean(axis=0), var=np.maximum(flat.var(axis=0), var_floor), change=change)

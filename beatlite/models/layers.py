@@ -1,0 +1,335 @@
+"""Building blocks shared by CaMN and the baselines (torch).
+
+All blocks work on channel-first sequences ``(B, C, T)`` unless said otherwise.
+
+LeakyReLU slopes: the reference code wrote ``nn.LeakyReLU(True)`` in many places,
+which sets ``negative_slope=1.0`` (an identity, so those MLPs were linear; fixed
+upstream in PantoMatrix PR #52). beatlite uses the corrected slopes: 0.1 in fusion
+MLPs, output heads and the discriminator, 0.01 (torch's default, as the reference)
+inside the residual :class:`BasicBlock1d`, 0.3 in the emotion encoder and the
+Trimodal wave encoder.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import torch
+from torch import nn
+from torch.nn.utils.parametrizations import weight_norm
+
+
+class BasicBlock1d(nn.Module):
+    """timm-style residual block on 1-D sequences (CaMN's ``BasicBlock``).
+
+    ``conv(k, stride, padding) -> BN -> LReLU -> conv(k, 1, k//2) -> BN``, plus a shortcut
+    (``conv(k, stride, padding) + BN`` when ``downsample`` else identity), then LReLU.
+
+    Parameters
+    ----------
+    in_ch, out_ch : int
+        Channels in / out.
+    kernel : int
+        Kernel size of both convolutions (odd).
+    stride : int
+        Stride of the first convolution (and of the shortcut).
+    padding : int
+        Padding of the first convolution (the reference's ``first_dilation``).
+    downsample : bool
+        Use a convolutional shortcut (required when shape changes).
+    slope : float
+        LeakyReLU negative slope (reference: torch default 0.01).
+
+    Shapes
+    ------
+    (B, in_ch, L) -> (B, out_ch, floor((L + 2 padding - kernel) / stride) + 1)
+    """
+
+    def __init__(
+        self,
+        in_ch: int,
+        out_ch: int,
+        kernel: int,
+        stride: int = 1,
+        padding: int = 0,
+        *,
+        downsample: bool = False,
+        slope: float = 0.01,
+    ) -> None:
+        super().__init__()
+        if not downsample and (in_ch != out_ch or stride != 1 or 2 * padding != kernel - 1):
+            raise ValueError(
+                f"BasicBlock1d: an identity shortcut needs in_ch == out_ch, stride 1 and 'same' padding; "
+                f"got in_ch={in_ch}, out_ch={out_ch}, stride={stride}, padding={padding}, kernel={kernel}"
+            )
+        self.conv1 = nn.Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False)
+        self.bn1 = nn.BatchNorm1d(out_ch)
+        self.conv2 = nn.Conv1d(out_ch, out_ch, kernel, padding=kernel // 2, bias=False)
+        self.bn2 = nn.BatchNorm1d(out_ch)
+        self.act = nn.LeakyReLU(slope)
+        self.shortcut: nn.Module = (
+            nn.Sequential(
+                nn.Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False),
+                nn.BatchNorm1d(out_ch),
+            )
+            if downsample
+            else nn.Identity()
+        )
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        y = self.act(self.bn1(self.conv1(x)))
+        y = self.bn2(self.conv2(y))
+        return self.act(y + self.shortcut(x))
+
+
+class WavEncoder(nn.Module):
+    """CaMN's raw-waveform encoder: 6 residual blocks, 16 kHz audio -> 15 fps features.
+
+    Block layout (in, out, kernel, stride, padding; facts B.2):
+    (1, c0, 15, 5, 1600)*, (c0, c1, 15, 6, 0)*, (c1, c2, 15, 1, 7), (c2, c3, 15, 6, 0)*,
+    (c3, c4, 15, 1, 7), (c4, c5, 15, 6, 0)* (* = conv shortcut); the paper widths are
+    ``channels = (32, 32, 32, 64, 64, 128)``. The total stride is 5 * 6 * 6 * 6 = 1080
+    samples per frame: 36266 samples (34 frames at 15 fps) -> 7891 -> 1313 -> 1313 -> 217
+    -> 217 -> 34 frames.
+
+    Parameters
+    ----------
+    channels : sequence of 6 int
+        Output channels of the six blocks; the feature size is ``channels[-1]``.
+
+    Shapes
+    ------
+    (B, S) float waveform -> (B, T', channels[-1]) with T' = 34 for S = 36266.
+    """
+
+    def __init__(self, channels: Sequence[int] = (32, 32, 32, 64, 64, 128)) -> None:
+        super().__init__()
+        c = tuple(int(v) for v in channels)
+        if len(c) != 6:
+            raise ValueError(f"WavEncoder: channels must have 6 entries, got {c}")
+        same_c2 = c[2] == c[1]
+        same_c4 = c[4] == c[3]
+        self.blocks = nn.Sequential(
+            BasicBlock1d(1, c[0], 15, 5, 1600, downsample=True),
+            BasicBlock1d(c[0], c[1], 15, 6, 0, downsample=True),
+            BasicBlock1d(c[1], c[2], 15, 1, 7, downsample=not same_c2),
+            BasicBlock1d(c[2], c[3], 15, 6, 0, downsample=True),
+            BasicBlock1d(c[3], c[4], 15, 1, 7, downsample=not same_c4),
+            BasicBlock1d(c[4], c[5], 15, 6, 0, downsample=True),
+        )
+        self.out_features = c[5]
+
+    def forward(self, audio: torch.Tensor) -> torch.Tensor:
+        if audio.ndim != 2:
+            raise ValueError(f"WavEncoder: audio must be (B, S), got shape {tuple(audio.shape)}")
+        return self.blocks(audio.unsqueeze(1)).transpose(1, 2)
+
+
+class PlainWavEncoder(nn.Module):
+    """Trimodal's waveform encoder: 4 plain convolutions (facts G), 36266 samples -> 34 frames.
+
+    ``Conv1d(1, c0, 15, stride 5, padding 1600) -> BN -> LReLU(0.3)``, then three
+    ``Conv1d(k15, stride 6)`` layers (the last without BN/activation); reference widths
+    ``channels = (16, 32, 64, 32)``.
+
+    Shapes
+    ------
+    (B, S) -> (B, T', channels[-1])
+    """
+
+    def __init__(self, channels: Sequence[int] = (16, 32, 64, 32)) -> None:
+        super().__init__()
+        c = tuple(int(v) for v in channels)
+        if len(c) != 4:
+            raise ValueError(f"PlainWavEncoder: channels must have 4 entries, got {c}")
+        self.net = nn.Sequential(
+            nn.Conv1d(1, c[0], 15, stride=5, padding=1600),
+            nn.BatchNorm1d(c[0]),
+            nn.LeakyReLU(0.3),
+            nn.Conv1d(c[0], c[1], 15, stride=6),
+            nn.BatchNorm1d(c[1]),
+            nn.LeakyReLU(0.3),
+            nn.Conv1d(c[1], c[2], 15, stride=6),
+            nn.BatchNorm1d(c[2]),
+            nn.LeakyReLU(0.3),
+            nn.Conv1d(c[2], c[3], 15, stride=6),
+        )
+        self.out_features = c[3]
+
+    def forward(self, audio: torch.Tensor) -> torch.Tensor:
+        if audio.ndim != 2:
+            raise ValueError(f"PlainWavEncoder: audio must be (B, S), got shape {tuple(audio.shape)}")
+        return self.net(audio.unsqueeze(1)).transpose(1, 2)
+
+
+class _TemporalBlock(nn.Module):
+    """Two weight-normalised causal dilated convolutions with a residual connection."""
+
+    def __init__(self, in_ch: int, out_ch: int, kernel: int, dilation: int, dropout: float) -> None:
+        super().__init__()
+        pad = (kernel - 1) * dilation
+        self.pad = pad
+        self.conv1 = weight_norm(nn.Conv1d(in_ch, out_ch, kernel, padding=pad, dilation=dilation))
+        self.conv2 = weight_norm(nn.Conv1d(out_ch, out_ch, kernel, padding=pad, dilation=dilation))
+        self.drop = nn.Dropout(dropout)
+        self.relu = nn.ReLU()
+        self.down = nn.Conv1d(in_ch, out_ch, 1) if in_ch != out_ch else nn.Identity()
+
+    def _causal(self, y: torch.Tensor) -> torch.Tensor:
+        return y[:, :, : -self.pad] if self.pad else y
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        y = self.drop(self.relu(self._causal(self.conv1(x))))
+        y = self.drop(self.relu(self._causal(self.conv2(y))))
+        return self.relu(y + self.down(x))
+
+
+class TextEncoderTCN(nn.Module):
+    """Word-id sequence -> per-frame text features (Trimodal/CaMN ``TextEncoderTCN``).
+
+    ``Embedding(vocab, word_dim) -> Dropout(0.1) -> TCN(n_layers levels of hidden channels,
+    kernel 2, dilations 1, 2, 4, ..., weight norm, causal) -> Linear(hidden, out_features)``.
+
+    Parameters
+    ----------
+    vocab_size, word_dim : int
+        Embedding table size (id 0 = PAD). Load pretrained vectors with :meth:`set_word_vectors`.
+    hidden, n_layers : int
+        TCN width and depth.
+    out_features : int
+        Feature size per frame.
+    dropout : float
+        Dropout inside the TCN (reference 0.3).
+
+    Shapes
+    ------
+    (B, T) int64 -> (B, T, out_features)
+    """
+
+    def __init__(
+        self, vocab_size: int, word_dim: int, hidden: int, n_layers: int, out_features: int, dropout: float
+    ) -> None:
+        super().__init__()
+        self.embedding = nn.Embedding(vocab_size, word_dim)
+        self.emb_drop = nn.Dropout(0.1)
+        layers = []
+        for i in range(n_layers):
+            layers.append(_TemporalBlock(word_dim if i == 0 else hidden, hidden, 2, 2**i, dropout))
+        self.tcn = nn.Sequential(*layers)
+        self.proj = nn.Linear(hidden, out_features)
+        self.out_features = out_features
+
+    def set_word_vectors(self, vectors: torch.Tensor) -> None:
+        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into the embedding (stays trainable)."""
+        vectors = torch.as_tensor(vectors, dtype=self.embedding.weight.dtype)
+        if tuple(vectors.shape) != tuple(self.embedding.weight.shape):
+            raise ValueError(
+                f"vectors must be {tuple(self.embedding.weight.shape)} (vocab_size, word_dim), "
+                f"got {tuple(vectors.shape)}"
+            )
+        with torch.no_grad():
+            self.embedding.weight.copy_(vectors)
+
+    def forward(self, words: torch.Tensor) -> torch.Tensor:
+        if words.ndim != 2:
+            raise ValueError(f"TextEncoderTCN: words must be (B, T), got shape {tuple(words.shape)}")
+        if words.numel() and (int(words.min()) < 0 or int(words.max()) >= self.embedding.num_embeddings):
+            raise ValueError(
+                f"TextEncoderTCN: word ids must be in [0, {self.embedding.num_embeddings}), "
+                f"got range [{int(words.min())}, {int(words.max())}]"
+            )
+        x = self.emb_drop(self.embedding(words)).transpose(1, 2)
+        return self.proj(self.tcn(x).transpose(1, 2))
+
+
+class ConvDiscriminator(nn.Module):
+    """The CaMN/Trimodal sequence discriminator, with the reference's crash fixed.
+
+    ``Conv1d(D, 16, 3) -> BN -> LReLU(0.1) -> Conv1d(16, 8, 3) -> BN -> LReLU -> Conv1d(8, 8, 3)``
+    (T -> T - 6 frames), a bidirectional LSTM whose two directions are summed
+    (the reference passed an undefined ``decoder_hidden``; here the LSTM starts from
+    zeros), ``Linear(hidden, 1)`` per frame and ``Linear(T - 6, 1)`` over time.
+
+    Returns a **logit**; ``sigmoid(logit)`` is the reference's probability. The NS-GAN
+    losses use ``logsigmoid`` of the logit, which equals ``log(sigmoid)`` but never
+    produces ``log(0)``.
+
+    Shapes
+    ------
+    (B, T, D) -> (B, 1) logits; ``n_frames`` = T must be given at construction.
+    """
+
+    def __init__(
+        self, input_dim: int, *, hidden: int = 64, n_layers: int = 4, n_frames: int = 34, slope: float = 0.1
+    ) -> None:
+        super().__init__()
+        if n_frames < 7:
+            raise ValueError(f"ConvDiscriminator: n_frames must be >= 7, got {n_frames}")
+        self.convs = nn.Sequential(
+            nn.Conv1d(input_dim, 16, 3),
+            nn.BatchNorm1d(16),
+            nn.LeakyReLU(slope),
+            nn.Conv1d(16, 8, 3),
+            nn.BatchNorm1d(8),
+            nn.LeakyReLU(slope),
+            nn.Conv1d(8, 8, 3),
+        )
+        self.hidden = hidden
+        self.lstm = nn.LSTM(
+            8,
+            hidden,
+            num_layers=n_layers,
+            bidirectional=True,
+            batch_first=True,
+            dropout=0.3 if n_layers > 1 else 0,
+        )
+        self.out = nn.Linear(hidden, 1)
+        self.out2 = nn.Linear(n_frames - 6, 1)
+        self.n_frames = n_frames
+
+    def forward(self, pose: torch.Tensor) -> torch.Tensor:
+        if pose.ndim != 3 or pose.shape[1] != self.n_frames:
+            raise ValueError(
+                f"ConvDiscriminator: pose must be (B, {self.n_frames}, D), got shape {tuple(pose.shape)}"
+            )
+        feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
+        seq, _ = self.lstm(feat)
+        seq = seq[..., : self.hidden] + seq[..., self.hidden :]
+        return self.out2(self.out(seq).squeeze(-1))
+
+
+def mlp(sizes: Sequence[int], slope: float = 0.1, *, last_act: bool = True) -> nn.Sequential:
+    """``Linear -> LeakyReLU(slope)`` for each consecutive pair of ``sizes`` (no act after the last if asked)."""
+    layers: list[nn.Module] = []
+    for i in range(len(sizes) - 1):
+        layers.append(nn.Linear(sizes[i], sizes[i + 1]))
+        if last_act or i < len(sizes) - 2:
+            layers.append(nn.LeakyReLU(slope))
+    return nn.Sequential(*layers)
+
+
+def sum_directions(seq: torch.Tensor, hidden: int) -> torch.Tensor:
+    """Sum the forward and backward halves of a bidirectional RNN output ``(B, T, 2H) -> (B, T, H)``."""
+    return seq[..., :hidden] + seq[..., hidden:]
+
+
+def match_length(x: torch.Tensor, n: int) -> torch.Tensor:
+    """Crop or repeat-last-frame pad ``(B, T, C)`` to ``(B, n, C)`` (the reference's length fix-ups)."""
+    t = x.shape[1]
+    if t == n:
+        return x
+    if t > n:
+        return x[:, :n]
+    if t == 0:
+        raise ValueError("match_length: cannot pad an empty sequence")
+    return torch.cat([x, x[:, -1:].expand(-1, n - t, -1)], dim=1)
+
+
+def ns_gan_d_loss(real_logit: torch.Tensor, fake_logit: torch.Tensor) -> torch.Tensor:
+    """Discriminator NS-GAN loss ``-mean(log D(real) + log(1 - D(fake)))`` from logits."""
+    return -(nn.functional.logsigmoid(real_logit) + nn.functional.logsigmoid(-fake_logit)).mean()
+
+
+def ns_gan_g_loss(fake_logit: torch.Tensor) -> torch.Tensor:
+    """Generator non-saturating loss ``-mean(log D(fake))`` from logits."""
+    return -nn.functional.logsigmoid(fake_logit).mean()

@@ -1,0 +1,165 @@
+"""Per-take streams used by the dataset statistics (motion energy, audio energy, face activity).
+
+:func:`load_corpus` loads every usable take of an index once at 15 fps and keeps
+only what the statistics need, so all figures/tables share one pass over the data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeIndex, TakeRecord
+
+#: Joints whose speed measures gesture energy: CaMN's 9 body joints plus both wrists.
+ENERGY_JOINTS = (
+    "Spine",
+    "Neck",
+    "Neck1",
+    "RightShoulder",
+    "RightArm",
+    "RightForeArm",
+    "RightHand",
+    "LeftShoulder",
+    "LeftArm",
+    "LeftForeArm",
+    "LeftHand",
+)
+
+
+@dataclass
+class CorpusTake:
+    """What the statistics need from one take, aligned at ``fps``.
+
+    Attributes
+    ----------
+    stem, split, language : str
+    speaker_id : int
+    emotion : int
+        Take-level emotion id 0..7 (from the name).
+    fps : float
+    rotations : (T, 141) float32, degrees
+        ``spine_neck_141`` Euler angles.
+    speed : (T,) float32, cm/s
+        Gesture energy: mean speed of :data:`ENERGY_JOINTS`, root fixed at the origin
+        (root translation and rotation removed), first frame copies the second.
+    audio_rms : (T,) float32
+        RMS of the waveform over each frame's samples.
+    face_activity : (T,) float32 or None, 1/s
+        Mean absolute rate of change of the 51 blendshape weights (None without JSON).
+    emotion_frames : (T,) int64
+    semantic : (T,) float32, score in [0, 1]
+    semantic_scores : (S,) float32
+        Score of every annotated semantic segment.
+    word_starts, word_ends : (W,) float64 seconds; words : tuple of str
+    """
+
+    stem: str
+    split: str | None
+    language: str | None
+    speaker_id: int
+    emotion: int
+    fps: float
+    rotations: np.ndarray
+    speed: np.ndarray
+    audio_rms: np.ndarray
+    face_activity: np.ndarray | None
+    emotion_frames: np.ndarray
+    semantic: np.ndarray
+    semantic_scores: np.ndarray
+    word_starts: np.ndarray
+    word_ends: np.ndarray
+    words: tuple[str, ...]
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.rotations.shape[0])
+
+
+def joint_speed(positions: np.ndarray, fps: float) -> np.ndarray:
+    """Mean joint speed per frame, (T,) float64 in cm/s, from (T, J, 3) cm positions.
+
+    Backward differences; frame 0 repeats frame 1 (0 for a single frame).
+
+    >>> p = np.zeros((3, 1, 3)); p[:, 0, 0] = [0.0, 1.0, 3.0]
+    >>> joint_speed(p, fps=10).tolist()
+    [10.0, 10.0, 20.0]
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    if pos.ndim != 3 or pos.shape[2] != 3:
+        raise ValueError(f"joint_speed: positions must be (T, J, 3), got {pos.shape}")
+    if pos.shape[0] < 2:
+        return np.zeros(pos.shape[0])
+    v = np.linalg.norm(np.diff(pos, axis=0), axis=2).mean(axis=1) * fps
+    return np.concatenate([v[:1], v])
+
+
+def frame_rms(audio: np.ndarray, n_frames: int, fps: float, sr: int) -> np.ndarray:
+    """RMS of ``audio`` over the samples ``[floor(i*sr/fps), floor((i+1)*sr/fps))`` of each frame, (T,).
+
+    Frames beyond the audio get 0.
+    """
+    y = np.asarray(audio, dtype=np.float64)
+    edges = np.floor(np.arange(n_frames + 1) * sr / fps + 1e-9).astype(np.int64)
+    edges = np.minimum(edges, len(y))
+    csum = np.concatenate([[0.0], np.cumsum(y * y)])
+    counts = np.diff(edges)
+    energy = np.diff(csum[edges])
+    return np.sqrt(np.divide(energy, counts, out=np.zeros(n_frames), where=counts > 0))
+
+
+def corpus_take(record: TakeRecord, *, fps: float = 15, sr: int = 16000) -> CorpusTake:
+    """Load one take (:func:`beatlite.io.load_take`) and compute its :class:`CorpusTake` streams."""
+    from beatlite.io import load_take
+    from beatlite.skeleton import forward_kinematics, subset_columns
+
+    take = load_take(record.path("motion"), fps=fps, audio_sr=sr)
+    motion = take.motion
+    audio = np.asarray(take.audio)
+    n = take.n_frames  # load_take already cut every modality to the shortest one
+    skel = motion.skeleton
+    channels = motion.channels[:n].copy()
+    root = skel.channel_starts[0]
+    channels[:, root : root + len(skel.channels[0])] = 0.0  # gestures relative to the body
+    world = forward_kinematics(skel, channels)[:, skel.indices(ENERGY_JOINTS)]
+    face_activity = None
+    if take.face is not None:
+        face = np.asarray(take.face, dtype=np.float64)[:n]
+        if n >= 2:
+            rate = np.abs(np.diff(face, axis=0)).mean(axis=1) * fps
+            face_activity = np.concatenate([rate[:1], rate]).astype(np.float32)
+        else:
+            face_activity = np.zeros(n, np.float32)
+    words = take.words
+    segments = take.semantic_segments or []
+    return CorpusTake(
+        stem=record.stem,
+        split=record.split,
+        language=record.language,
+        speaker_id=int(record.speaker_id),
+        emotion=int(record.emotion or 0),
+        fps=float(fps),
+        rotations=motion.channels[:n, subset_columns(skel, "spine_neck_141")].astype(np.float32),
+        speed=joint_speed(world, fps).astype(np.float32),
+        audio_rms=frame_rms(audio, n, fps, sr).astype(np.float32),
+        face_activity=face_activity,
+        emotion_frames=np.asarray(take.emotion, dtype=np.int64)[:n],
+        semantic=np.asarray(take.semantic, dtype=np.float32)[:n],
+        semantic_scores=np.array([s.score for s in segments], dtype=np.float32),
+        word_starts=np.zeros(0) if words is None else np.asarray(words.starts, dtype=np.float64),
+        word_ends=np.zeros(0) if words is None else np.asarray(words.ends, dtype=np.float64),
+        words=() if words is None else tuple(words.words),
+    )
+
+
+def load_corpus(
+    index: TakeIndex, *, fps: float = 15, sr: int = 16000, splits: tuple[str, ...] | None = None
+) -> list[CorpusTake]:
+    """:func:`corpus_take` of every usable take of ``index`` (optionally only some splits), in order."""
+    records = [r for r in index if r.usable and (splits is None or r.split in splits)]
+    if not records:
+        raise ValueError(f"load_corpus: no usable takes in the index ({len(index)} takes, splits={splits})")
+    return [corpus_take(r, fps=fps, sr=sr) for r in records]

@@ -1,0 +1,316 @@
+"""The paper's correlation claims as numbers with significance tests.
+
+BEAT (Sec. 3.3) states that gestures correlate with audio, facial expression,
+emotion and speaker identity. Here *gesture energy* is the mean speed of the
+arm/spine joints (:data:`beatlite.stats.corpus.ENERGY_JOINTS`, cm/s), averaged
+over non-overlapping windows (2 s by default) to tame autocorrelation.
+
+- continuous modalities (audio RMS, facial activity): Spearman's rho over windows,
+  scipy's p-value (assumes independent windows, optimistic) **and** a permutation
+  p-value from circularly shifting the other signal within each take, which keeps
+  each signal's autocorrelation (the honest baseline);
+- categorical factors (emotion, speaker): one-way ANOVA of the take-mean energy
+  across groups (one value per take, so takes are the independent units), its
+  effect size eta^2, and a permutation p-value from shuffling the take labels.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from beatlite.stats.corpus import CorpusTake
+from beatlite.stats.distributions import EMOTION_NAMES
+
+
+@dataclass
+class CorrelationResult:
+    """Spearman correlation with parametric and permutation p-values.
+
+    Attributes
+    ----------
+    rho : float
+    p_value : float
+        scipy.stats.spearmanr (independence assumed).
+    p_permutation : float
+        ``(1 + #{|rho_null| >= |rho|}) / (1 + n_permutations)``.
+    null_mean, null_std : float
+        Mean and spread of rho under the permutation null.
+    n : int
+        Number of windows.
+    """
+
+    rho: float
+    p_value: float
+    p_permutation: float
+    null_mean: float
+    null_std: float
+    n: int
+
+
+@dataclass
+class GroupEffectResult:
+    """Effect of a categorical factor on per-take values.
+
+    Attributes
+    ----------
+    f_stat, p_value : float
+        One-way ANOVA (scipy.stats.f_oneway) across groups of take means.
+    eta2 : float
+        Between-group sum of squares / total sum of squares (0..1).
+    p_permutation : float
+        Permutation p-value of eta^2 under shuffled take labels.
+    group_means : dict
+        Label -> mean of the take values.
+    n_takes : int
+    """
+
+    f_stat: float
+    p_value: float
+    eta2: float
+    p_permutation: float
+    group_means: dict
+    n_takes: int
+
+
+def _rank(x: np.ndarray) -> np.ndarray:
+    from scipy.stats import rankdata
+
+    return rankdata(x).astype(np.float64)
+
+
+def _pearson(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Pearson r of ``a`` (N,) with every row of ``b`` (..., N)."""
+    a = a - a.mean()
+    b = b - b.mean(axis=-1, keepdims=True)
+    den = np.sqrt((a * a).sum() * (b * b).sum(axis=-1))
+    return np.divide((b * a).sum(axis=-1), den, out=np.zeros(den.shape), where=den > 0)
+
+
+def correlation_test(
+    x: np.ndarray,
+    y: np.ndarray,
+    *,
+    groups: np.ndarray | None = None,
+    n_permutations: int = 1000,
+    seed: int = 0,
+) -> CorrelationResult:
+    """Spearman correlation of ``x`` and ``y`` with a within-group circular-shift permutation test.
+
+    Parameters
+    ----------
+    x, y : (N,) float
+        Paired values (e.g. window means), in time order within each group.
+    groups : (N,) int, optional
+        Group (take) of each value; ``y`` is rolled by a random offset inside each group.
+        Default: one group.
+    n_permutations : int
+        Number of shifted copies.
+    seed : int
+    """
+    from scipy.stats import spearmanr
+
+    x = np.asarray(x, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64)
+    if x.ndim != 1 or x.shape != y.shape or len(x) < 3:
+        raise ValueError(
+            f"correlation_test: x and y must be equal (N,) with N >= 3, got {x.shape} and {y.shape}"
+        )
+    g = np.zeros(len(x), np.int64) if groups is None else np.asarray(groups)
+    if g.shape != x.shape:
+        raise ValueError(f"correlation_test: groups must be {x.shape}, got {g.shape}")
+    res = spearmanr(x, y)
+    rho = float(res.statistic)
+    rx, ry = _rank(x), _rank(y)
+    rng = np.random.default_rng(seed)
+    perm = np.empty((n_permutations, len(x)), dtype=np.int64)
+    for gid in np.unique(g):
+        idx = np.flatnonzero(g == gid)
+        m = len(idx)
+        shifts = rng.integers(1, m, size=n_permutations) if m > 1 else np.zeros(n_permutations, np.int64)
+        perm[:, idx] = idx[(np.arange(m)[None, :] + shifts[:, None]) % m]
+    null = _pearson(rx, ry[perm])
+    p_perm = (1 + int(np.sum(np.abs(null) >= abs(rho) - 1e-12))) / (1 + n_permutations)
+    return CorrelationResult(
+        rho=rho,
+        p_value=float(res.pvalue),
+        p_permutation=float(p_perm),
+        null_mean=float(null.mean()),
+        null_std=float(null.std()),
+        n=len(x),
+    )
+
+
+def _eta2(values: np.ndarray, labels: np.ndarray) -> float:
+    total = ((values - values.mean()) ** 2).sum()
+    if total == 0:
+        return 0.0
+    between = sum(
+        (labels == c).sum() * (values[labels == c].mean() - values.mean()) ** 2 for c in np.unique(labels)
+    )
+    return float(between / total)
+
+
+def group_effect_test(
+    values: np.ndarray, labels: np.ndarray, *, n_permutations: int = 1000, seed: int = 0
+) -> GroupEffectResult:
+    """One-way ANOVA + eta^2 + label-permutation p-value of per-take ``values`` (N,) by ``labels`` (N,)."""
+    from scipy.stats import f_oneway
+
+    v = np.asarray(values, dtype=np.float64)
+    lab = np.asarray(labels)
+    if v.ndim != 1 or lab.shape != v.shape:
+        raise ValueError(
+            f"group_effect_test: values and labels must be equal (N,), got {v.shape} and {lab.shape}"
+        )
+    classes = np.unique(lab)
+    if len(classes) < 2 or len(classes) == len(v):
+        raise ValueError(f"group_effect_test: need >= 2 groups and a group with >= 2 takes ({len(v)} takes)")
+    res = f_oneway(*[v[lab == c] for c in classes])
+    eta = _eta2(v, lab)
+    rng = np.random.default_rng(seed)
+    null = np.array([_eta2(v, rng.permutation(lab)) for _ in range(n_permutations)])
+    p_perm = (1 + int(np.sum(null >= eta - 1e-12))) / (1 + n_permutations)
+    return GroupEffectResult(
+        f_stat=float(res.statistic),
+        p_value=float(res.pvalue),
+        eta2=eta,
+        p_permutation=float(p_perm),
+        group_means={c.item(): float(v[lab == c].mean()) for c in classes},
+        n_takes=len(v),
+    )
+
+
+def window_means(takes: Sequence[CorpusTake], *, seconds: float = 2.0) -> dict[str, np.ndarray]:
+    """Means of gesture speed, audio RMS and face activity over non-overlapping windows.
+
+    Returns
+    -------
+    dict with (N,) arrays ``speed`` (cm/s), ``audio`` (RMS), ``face`` (1/s, NaN without JSON),
+    ``take`` (index into ``takes``), ``emotion``, ``speaker``.
+    """
+    out: dict[str, list] = {k: [] for k in ("speed", "audio", "face", "take", "emotion", "speaker")}
+    for i, t in enumerate(takes):
+        length = max(1, int(round(seconds * t.fps)))
+        n = t.n_frames // length
+        if n == 0:
+            continue
+        cut = n * length
+        out["speed"].append(t.speed[:cut].reshape(n, length).mean(axis=1))
+        out["audio"].append(t.audio_rms[:cut].reshape(n, length).mean(axis=1))
+        face = (
+            np.full(n, np.nan)
+            if t.face_activity is None
+            else t.face_activity[:cut].reshape(n, length).mean(axis=1)
+        )
+        out["face"].append(face)
+        out["take"].append(np.full(n, i))
+        out["emotion"].append(np.full(n, t.emotion))
+        out["speaker"].append(np.full(n, t.speaker_id))
+    if not out["take"]:
+        raise ValueError(f"window_means: no take is at least {seconds} s long")
+    return {k: np.concatenate(v) for k, v in out.items()}
+
+
+def speed_by_emotion(takes: Sequence[CorpusTake]) -> dict[str, float]:
+    """Mean gesture speed (cm/s, frame-weighted) per emotion name present in the takes."""
+    sums: dict[int, float] = {}
+    counts: dict[int, int] = {}
+    for t in takes:
+        sums[t.emotion] = sums.get(t.emotion, 0.0) + float(np.sum(t.speed))
+        counts[t.emotion] = counts.get(t.emotion, 0) + t.n_frames
+    return {EMOTION_NAMES[e]: sums[e] / counts[e] for e in sorted(sums) if counts[e] > 0}
+
+
+def gesture_correlations(
+    takes: Sequence[CorpusTake], *, seconds: float = 2.0, n_permutations: int = 1000, seed: int = 0
+) -> dict[str, CorrelationResult | GroupEffectResult]:
+    """Gesture energy vs audio energy, facial activity, emotion and speaker.
+
+    Returns
+    -------
+    dict
+        ``"audio"``, ``"face"``: :class:`CorrelationResult` over windows (face only when every
+        take has a JSON); ``"emotion"``, ``"speaker"``: :class:`GroupEffectResult` over takes
+        (speaker only with >= 2 speakers; emotion over self-talk takes).
+    """
+    wm = window_means(takes, seconds=seconds)
+    out: dict[str, CorrelationResult | GroupEffectResult] = {
+        "audio": correlation_test(
+            wm["speed"], wm["audio"], groups=wm["take"], n_permutations=n_permutations, seed=seed
+        )
+    }
+    if not np.any(np.isnan(wm["face"])):
+        out["face"] = correlation_test(
+            wm["speed"], wm["face"], groups=wm["take"], n_permutations=n_permutations, seed=seed
+        )
+    take_speed = np.array([float(np.mean(t.speed)) for t in takes])
+    emotions = np.array([t.emotion for t in takes])
+    speakers = np.array([t.speaker_id for t in takes])
+    if len(np.unique(emotions)) >= 2:
+        out["emotion"] = group_effect_test(take_speed, emotions, n_permutations=n_permutations, seed=seed)
+    if len(np.unique(speakers)) >= 2:
+        out["speaker"] = group_effect_test(take_speed, speakers, n_permutations=n_permutations, seed=seed)
+    return out
+
+
+def correlations_markdown(results: dict[str, CorrelationResult | GroupEffectResult]) -> str:
+    """A Markdown table of :func:`gesture_correlations` results."""
+    lines = [
+        "| gesture energy vs | statistic | p (parametric) | p (permutation) | null |",
+        "|---|---|---|---|---|",
+    ]
+    for name, r in results.items():
+        if isinstance(r, CorrelationResult):
+            lines.append(
+                f"| {name} | Spearman rho = {r.rho:.3f} (n={r.n} windows) | {r.p_value:.2g} | "
+                f"{r.p_permutation:.3g} | rho {r.null_mean:+.3f} +- {r.null_std:.3f} |"
+            )
+        else:
+            lines.append(
+                f"| {name} | eta^2 = {r.eta2:.3f}, F = {r.f_stat:.2f} (n={r.n_takes} takes) | {r.p_value:.2g} | "
+                f"{r.p_permutation:.3g} | shuffled take labels |"
+            )
+    return "\n".join(lines)
+
+
+def plot_correlations(
+    takes: Sequence[CorpusTake],
+    *,
+    seconds: float = 2.0,
+    out: str | Path | None = None,
+    formats: tuple[str, ...] = ("png", "svg"),
+):
+    """Three panels: gesture energy vs audio energy, vs facial activity (windows), and per emotion (takes).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    from beatlite.viz.style import figure_style, save_figure
+
+    wm = window_means(takes, seconds=seconds)
+    speeds = speed_by_emotion(takes)
+    with figure_style():
+        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+        axes[0].scatter(wm["audio"], wm["speed"], s=5, alpha=0.5)
+        axes[0].set_xlabel(f"audio RMS ({seconds:g}-s window mean)")
+        axes[0].set_ylabel("gesture speed, cm/s")
+        axes[0].set_title("gesture vs audio energy")
+        if not np.any(np.isnan(wm["face"])):
+            axes[1].scatter(wm["face"], wm["speed"], s=5, alpha=0.5)
+        axes[1].set_xlabel("facial activity, 1/s")
+        axes[1].set_title("gesture vs facial activity")
+        axes[2].bar(list(speeds), list(speeds.values()))
+        axes[2].set_ylabel("mean gesture speed, cm/s")
+        axes[2].set_title("gesture energy per emotion")
+        axes[2].tick_params(axis="x", rotation=45)
+        fig.tight_layout()
+        if out is not None:
+            save_figure(fig, out, formats)
+    return fig

@@ -1,0 +1,118 @@
+"""Figure 2 analogs: emotion proportions, language share, per-speaker duration (from the index only).
+
+Shares are fractions of the summed take durations (seconds of motion), not of take counts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeIndex, TakeRecord
+
+EMOTION_NAMES = ("neutral", "happiness", "anger", "sadness", "contempt", "surprise", "fear", "disgust")
+
+#: BEAT paper Sec. 3.1 / Fig. 2c: of the 120 self-talk questions 64 are neutral and each of the
+#: other seven emotions has 8, i.e. the designed emotion shares of the self-talk session.
+PAPER_EMOTION_SHARES: dict[str, float] = {
+    name: (64 / 120 if name == "neutral" else 8 / 120) for name in EMOTION_NAMES
+}
+#: BEAT paper Sec. 3.1 / Fig. 2d: hours per language (60 h English = 81 %).
+PAPER_LANGUAGE_HOURS: dict[str, float] = {"english": 60.0, "chinese": 12.0, "spanish": 2.0, "japanese": 2.0}
+
+
+def _shares(index: TakeIndex, key: Callable[[TakeRecord], Any], *, normalise: bool) -> dict[Any, float]:
+    totals: dict[Any, float] = {}
+    for r in index:
+        if not r.usable:
+            continue
+        k = key(r)
+        totals[k] = totals.get(k, 0.0) + r.duration
+    if not normalise:
+        return totals
+    total = sum(totals.values())
+    if total <= 0:
+        raise ValueError(f"no usable take with a positive duration in the index ({len(index)} takes)")
+    return {k: v / total for k, v in totals.items()}
+
+
+def emotion_shares(index: TakeIndex, *, speech_only: bool = True) -> dict[str, float]:
+    """Fraction of the duration per emotion, all 8 emotions in id order (0 for absent ones).
+
+    Parameters
+    ----------
+    index : TakeIndex
+    speech_only : bool
+        Count self-talk (speech) takes only, as the paper's Fig. 2c does (conversations are
+        all neutral).
+    """
+    chosen = index.where(conversation=False) if speech_only else index
+    shares = _shares(chosen, lambda r: r.emotion, normalise=True)
+    return {name: shares.get(i, 0.0) for i, name in enumerate(EMOTION_NAMES)}
+
+
+def language_shares(index: TakeIndex) -> dict[str, float]:
+    """Fraction of the duration per language (languages present only)."""
+    return dict(sorted(_shares(index, lambda r: r.language, normalise=True).items(), key=lambda kv: -kv[1]))
+
+
+def speaker_durations(index: TakeIndex) -> dict[str, float]:
+    """Seconds of usable takes per speaker, keyed ``"{id}_{name}"``, in speaker id order."""
+    totals = _shares(index, lambda r: (r.speaker_id, r.speaker), normalise=False)
+    return {f"{sid}_{name}": v for (sid, name), v in sorted(totals.items())}
+
+
+def plot_figure2(
+    index: TakeIndex, *, out: str | Path | None = None, formats: tuple[str, ...] = ("png", "svg")
+):
+    """Three panels: emotion shares (corpus vs the paper's design), language share, minutes per speaker.
+
+    Parameters
+    ----------
+    index : TakeIndex
+    out : str or Path, optional
+        Path stem to save the figure to (``out.png``, ``out.svg``) with
+        :func:`beatlite.viz.style.save_figure`.
+    formats : tuple of str
+        Formats to save.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from beatlite.viz.style import figure_style, save_figure
+
+    emo = emotion_shares(index)
+    lang = language_shares(index)
+    spk = speaker_durations(index)
+    with figure_style():
+        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+        x = np.arange(len(EMOTION_NAMES))
+        axes[0].bar(x - 0.2, [emo[n] * 100 for n in EMOTION_NAMES], 0.4, label="this corpus")
+        axes[0].bar(x + 0.2, [PAPER_EMOTION_SHARES[n] * 100 for n in EMOTION_NAMES], 0.4, label="BEAT design")
+        axes[0].set_xticks(x, EMOTION_NAMES, rotation=45, ha="right")
+        axes[0].set_ylabel("% of self-talk duration")
+        axes[0].set_title("(c) emotions")
+        axes[0].legend()
+        paper_total = sum(PAPER_LANGUAGE_HOURS.values())
+        names = list(PAPER_LANGUAGE_HOURS)
+        xl = np.arange(len(names))
+        axes[1].bar(xl - 0.2, [lang.get(n, 0.0) * 100 for n in names], 0.4, label="this corpus")
+        axes[1].bar(xl + 0.2, [PAPER_LANGUAGE_HOURS[n] / paper_total * 100 for n in names], 0.4, label="BEAT")
+        axes[1].set_xticks(xl, names)
+        axes[1].set_ylabel("% of duration")
+        axes[1].set_title("(d) languages")
+        axes[1].legend()
+        axes[2].bar(list(spk), [v / 60 for v in spk.values()])
+        axes[2].set_ylabel("minutes")
+        axes[2].set_title("(e) duration per speaker")
+        axes[2].tick_params(axis="x", rotation=45)
+        fig.tight_layout()
+        if out is not None:
+            save_figure(fig, out, formats)
+    return fig

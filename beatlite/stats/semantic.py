@@ -1,0 +1,133 @@
+"""Figure 4 analogs: distribution of semantic-relevance scores, per frequent word, per speaker."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from beatlite.stats.corpus import CorpusTake
+
+#: BEAT paper Sec. 3.3 / Fig. 4b: "83% of the gestures have low semantic scores (<= 0.2)".
+PAPER_LOW_SCORE_SHARE = 0.83
+LOW_SCORE = 0.2
+
+
+@dataclass
+class ScoreHistogram:
+    """Histogram of segment scores.
+
+    Attributes
+    ----------
+    counts : (B,) int64
+    edges : (B+1,) float64, score bin edges in [0, 1]
+    share_low : float
+        Fraction of segments with score <= 0.2 (the paper's 83 % statistic).
+    n : int
+        Number of segments.
+    """
+
+    counts: np.ndarray
+    edges: np.ndarray
+    share_low: float
+    n: int
+
+
+def score_histogram(takes: Sequence[CorpusTake], *, bins: int = 10) -> ScoreHistogram:
+    """Histogram of the scores of all annotated semantic segments (one count per gesture)."""
+    scores = np.concatenate([t.semantic_scores for t in takes]) if takes else np.zeros(0)
+    if scores.size == 0:
+        raise ValueError("score_histogram: no semantic segments in the takes")
+    counts, edges = np.histogram(scores, bins=bins, range=(0.0, 1.0))
+    share = float(np.mean(scores <= LOW_SCORE + 1e-9))
+    return ScoreHistogram(counts.astype(np.int64), edges, share, int(scores.size))
+
+
+def word_scores(takes: Sequence[CorpusTake], *, top: int = 9) -> list[tuple[str, int, float]]:
+    """Mean semantic score of the ``top`` most frequent words.
+
+    A word occurrence's score is the mean per-frame semantic score over the frames its
+    interval covers (frames ``i`` with ``start <= i / fps < end``; at least the frame of
+    its start).
+
+    Returns
+    -------
+    list of (word, count, mean score), by decreasing count then alphabetically.
+    """
+    scores: dict[str, list[float]] = defaultdict(list)
+    for t in takes:
+        for start, end, word in zip(t.word_starts, t.word_ends, t.words):
+            w = word.strip().lower()
+            if not w:
+                continue
+            a = int(np.floor(start * t.fps))
+            b = max(a + 1, int(np.ceil(end * t.fps)))
+            seg = t.semantic[a:b]
+            if seg.size:
+                scores[w].append(float(seg.mean()))
+    ranked = sorted(scores, key=lambda w: (-len(scores[w]), w))[:top]
+    return [(w, len(scores[w]), float(np.mean(scores[w]))) for w in ranked]
+
+
+def speaker_scores(takes: Sequence[CorpusTake]) -> dict[int, dict[str, float]]:
+    """Per speaker id: ``mean`` segment score, ``share_low`` (<= 0.2) and ``n`` segments."""
+    by: dict[int, list[np.ndarray]] = defaultdict(list)
+    for t in takes:
+        by[t.speaker_id].append(t.semantic_scores)
+    out = {}
+    for sid in sorted(by):
+        s = np.concatenate(by[sid])
+        if s.size:
+            out[sid] = {
+                "mean": float(s.mean()),
+                "share_low": float(np.mean(s <= LOW_SCORE + 1e-9)),
+                "n": int(s.size),
+            }
+    return out
+
+
+def plot_figure4(
+    takes: Sequence[CorpusTake],
+    *,
+    top: int = 9,
+    out: str | Path | None = None,
+    formats: tuple[str, ...] = ("png", "svg"),
+):
+    """Three panels: score histogram with the share <= 0.2, mean score of frequent words, per speaker.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    from beatlite.viz.style import figure_style, save_figure
+
+    hist = score_histogram(takes)
+    words = word_scores(takes, top=top)
+    spk = speaker_scores(takes)
+    with figure_style():
+        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+        centers = (hist.edges[:-1] + hist.edges[1:]) / 2
+        axes[0].bar(centers, hist.counts / max(hist.n, 1) * 100, width=np.diff(hist.edges) * 0.9)
+        axes[0].axvline(LOW_SCORE, color="k", ls="--", lw=1)
+        axes[0].set_xlabel("semantic score")
+        axes[0].set_ylabel("% of gestures")
+        axes[0].set_title(
+            f"(b) {hist.share_low * 100:.0f}% <= {LOW_SCORE} (paper {PAPER_LOW_SCORE_SHARE * 100:.0f}%)"
+        )
+        axes[1].bar([w for w, _, _ in words], [s for _, _, s in words])
+        axes[1].set_ylabel("mean score")
+        axes[1].set_title(f"(c) {len(words)} most frequent words")
+        axes[1].tick_params(axis="x", rotation=45)
+        axes[2].bar([str(s) for s in spk], [v["mean"] for v in spk.values()])
+        axes[2].set_xlabel("speaker id")
+        axes[2].set_ylabel("mean score")
+        axes[2].set_title("(a) per speaker")
+        fig.tight_layout()
+        if out is not None:
+            save_figure(fig, out, formats)
+    return fig

@@ -1,0 +1,151 @@
+"""Table 1 analog: one row describing the indexed corpus, beside the BEAT paper's rows.
+
+The paper's rows are copied from Table 1 of Liu et al., "BEAT: A Large-Scale
+Semantic and Emotional Multi-Modal Dataset for Conversational Gestures
+Synthesis", ECCV 2022 (``/work/shared/papers/beat_camn_eccv2022.txt``).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeIndex
+
+#: Columns of Table 1, in the paper's order.
+TABLE1_COLUMNS = (
+    "dataset",
+    "quality",
+    "body",
+    "hand",
+    "face",
+    "audio",
+    "text",
+    "speakers",
+    "emotions",
+    "semantic",
+    "sequences",
+    "duration",
+)
+
+#: BEAT paper, Table 1 ("Comparison of Datasets"), as published. "-" = not available.
+PAPER_TABLE1: tuple[dict[str, Any], ...] = (
+    {"dataset": "TED [52]", "quality": "pseudo label", "body": "9", "hand": "-", "face": "-", "audio": "En",
+     "text": "yes", "speakers": ">100", "emotions": "-", "semantic": "-", "sequences": "1400", "duration": "97h"},
+    {"dataset": "S2G [20,21]", "quality": "pseudo label", "body": "14", "hand": "42", "face": "2D LM",
+     "audio": "En", "text": "-", "speakers": "6", "emotions": "-", "semantic": "-", "sequences": "N/A",
+     "duration": "33h"},
+    {"dataset": "MPI [47]", "quality": "mo-cap", "body": "23", "hand": "-", "face": "-", "audio": "-",
+     "text": "yes", "speakers": "1", "emotions": "11", "semantic": "-", "sequences": "1408", "duration": "1.5h"},
+    {"dataset": "VOCA [16]", "quality": "mo-cap", "body": "-", "hand": "-", "face": "3D Mesh", "audio": "En",
+     "text": "-", "speakers": "12", "emotions": "-", "semantic": "-", "sequences": "480", "duration": "0.5h"},
+    {"dataset": "Takechi [46]", "quality": "mo-cap", "body": "24", "hand": "38", "face": "-", "audio": "Jp",
+     "text": "-", "speakers": "2", "emotions": "-", "semantic": "-", "sequences": "1049", "duration": "5h"},
+    {"dataset": "Trinity [17]", "quality": "mo-cap", "body": "24", "hand": "38", "face": "-", "audio": "En",
+     "text": "yes", "speakers": "1", "emotions": "-", "semantic": "-", "sequences": "23", "duration": "4h"},
+    {"dataset": "BEAT (Ours)", "quality": "mo-cap", "body": "27", "hand": "48", "face": "3D BSW",
+     "audio": "E/C/S/J", "text": "yes", "speakers": "30", "emotions": "8", "semantic": "yes",
+     "sequences": "2508", "duration": "76h"},
+)  # fmt: skip
+
+_LANGUAGE_CODES = {"english": "E", "chinese": "C", "spanish": "S", "japanese": "J"}
+
+
+def _face_dims(index: TakeIndex) -> int | None:
+    from beatlite.io.textfile import open_text
+
+    for r in index:
+        if r.usable and "face" in r.files:
+            try:
+                with open_text(r.files["face"]) as f:
+                    return len(json.load(f)["names"])
+            except (OSError, ValueError, KeyError, TypeError):
+                continue
+    return None
+
+
+def _joint_counts(index: TakeIndex) -> tuple[int, int] | None:
+    """(body, hand) joint counts of the first readable BVH header; hand = joints named ``*Hand*``."""
+    from beatlite.io import read_bvh_header
+
+    for r in index:
+        if r.usable:
+            try:
+                skeleton, _, _ = read_bvh_header(r.files["motion"])
+            except (OSError, ValueError):
+                continue
+            hand = sum("Hand" in name for name in skeleton.names)
+            return skeleton.n_joints - hand, hand
+    return None
+
+
+def corpus_row(
+    index: TakeIndex, *, name: str = "beatlite corpus", quality: str = "synthetic"
+) -> dict[str, Any]:
+    """The Table 1 row of the usable takes of ``index``.
+
+    Counts joints as the paper does (BEAT: 27 body + 48 hand = 75; "hand" = joints whose
+    name contains ``Hand``), face dims from the first JSON's ``names``, emotions from the
+    take names, duration = sum of motion durations in hours.
+
+    Parameters
+    ----------
+    index : TakeIndex
+    name : str
+        Row label.
+    quality : str
+        The "quality" cell ("synthetic" for ``data_samples/``, "mo-cap" for real BEAT).
+
+    Returns
+    -------
+    dict with the keys of :data:`TABLE1_COLUMNS` (strings, as in the paper's table) plus
+    numeric ``n_speakers``, ``n_sequences``, ``hours``, ``n_body``, ``n_hand``, ``n_face``,
+    ``n_emotions``, ``languages`` (list).
+    """
+    usable = index.where(usable=True)
+    joints = _joint_counts(usable)
+    face = _face_dims(usable)
+    languages = sorted({r.language for r in usable if r.language}, key=list(_LANGUAGE_CODES).index)
+    emotions = sorted({r.emotion for r in usable if r.emotion is not None})
+    has_text = any("text" in r.files for r in usable)
+    has_sem = any("semantic" in r.files for r in usable)
+    hours = usable.total_duration / 3600.0
+    return {
+        "dataset": name,
+        "quality": quality,
+        "body": "-" if joints is None else str(joints[0]),
+        "hand": "-" if joints is None else str(joints[1]),
+        "face": "-" if face is None else f"{face} BSW",
+        "audio": "/".join(_LANGUAGE_CODES[lang] for lang in languages) or "-",
+        "text": "yes" if has_text else "-",
+        "speakers": str(len(usable.speaker_ids())),
+        "emotions": str(len(emotions)) if emotions else "-",
+        "semantic": "yes" if has_sem else "-",
+        "sequences": str(len(usable)),
+        "duration": f"{hours:.2f}h",
+        "n_speakers": len(usable.speaker_ids()),
+        "n_sequences": len(usable),
+        "hours": hours,
+        "n_body": None if joints is None else joints[0],
+        "n_hand": None if joints is None else joints[1],
+        "n_face": face,
+        "n_emotions": len(emotions),
+        "languages": languages,
+    }
+
+
+def table1(
+    index: TakeIndex, *, name: str = "beatlite corpus", quality: str = "synthetic"
+) -> list[dict[str, Any]]:
+    """The paper's Table 1 rows followed by the corpus row (string cells of :data:`TABLE1_COLUMNS`)."""
+    row = corpus_row(index, name=name, quality=quality)
+    return [dict(r) for r in PAPER_TABLE1] + [{k: row[k] for k in TABLE1_COLUMNS}]
+
+
+def table1_markdown(index: TakeIndex, *, name: str = "beatlite corpus", quality: str = "synthetic") -> str:
+    """:func:`table1` as a Markdown table (the last row is the corpus)."""
+    rows = table1(index, name=name, quality=quality)
+    lines = ["| " + " | ".join(TABLE1_COLUMNS) + " |", "|" + "|".join("---" for _ in TABLE1_COLUMNS) + "|"]
+    lines += ["| " + " | ".join(str(r[c]) for c in TABLE1_COLUMNS) + " |" for r in rows]
+    return "\n".join(lines)

@@ -1,0 +1,503 @@
+"""Procedural body motion on the BEAT skeleton: wrist paths, two-bone IK, fingers, spine and head.
+
+The wrists follow targets written in the chest frame (the ``Spine3`` joint's frame, centimetres,
+Y up, +Z forward, the character's right at -X):
+
+``wrist = rest + a(t) (centre - rest) - A_k L_k(t) d + sum_g w_g(t) (target_g - ...) + drift (+ tremor)``
+
+- ``a(t)`` is the phrase envelope (1 while talking, 0 in long pauses; minimum-jerk ramps);
+- each beat ``k`` lifts the hand by ``A_k`` against the stroke direction ``d`` during its
+  preparation and brings it back with a minimum-jerk stroke that ends, with zero velocity, at
+  the word onset (``L_k`` goes 0 -> 1 -> 0);
+- each semantic gesture ``g`` blends the wrist towards its scripted target with weight ``w_g``
+  (minimum-jerk preparation that completes at the word onset, hold, retraction).
+
+Arm joint angles come from an analytic two-bone IK (the elbow swivels towards a fixed pole
+below, behind and outside the shoulder), fingers from blended hand shapes (open, relaxed, fist,
+point, pinch), and the spine, neck and head from small sinusoids (breathing, sway), beat nods and
+the emotion's head pitch. Everything is a smooth function of time evaluated at the frame times.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from beatlite.skeleton.core import Skeleton
+from beatlite.skeleton.rotations import axis_angle_to_matrix, euler_to_matrix, matrix_to_euler, unwrap_degrees
+from beatlite.synth.plan import Plan
+from beatlite.synth.styles import EMOTION_STYLES, SpeakerStyle
+
+HAND_SHAPES: dict[str, tuple[float, float, float, float, float]] = {
+    # curl of (index, middle, ring, pinky, thumb), 0 = straight, 1 = fully flexed
+    "open": (0.02, 0.02, 0.04, 0.06, 0.0),
+    "relaxed": (0.25, 0.32, 0.38, 0.45, 0.2),
+    "fist": (0.95, 0.95, 0.95, 0.95, 0.75),
+    "point": (0.0, 0.92, 0.95, 0.95, 0.6),
+    "pinch": (0.55, 0.3, 0.35, 0.42, 0.55),
+}
+"""Hand shape -> finger curls."""
+
+# Maximum flexion (degrees) of the knuckle, middle and distal joints, and the carpal joint.
+_CURL_DEG = (75.0, 95.0, 65.0)
+_CARPAL_DEG = 6.0
+_THUMB_DEG = (30.0, 35.0, 45.0)
+
+# Scripted semantic gestures: right-wrist target (chest frame, cm), hands used, hand shape, wrist roll.
+# hands: "dominant" or "both".
+GESTURE_TARGETS: dict[str, tuple[tuple[float, float, float], str, str, float]] = {
+    "chest": ((-4.0, -8.0, 17.0), "dominant", "open", 0.0),
+    "point_forward": ((-14.0, -2.0, 46.0), "dominant", "point", 0.0),
+    "point_down": ((-14.0, -26.0, 34.0), "dominant", "point", -20.0),
+    "big": ((-50.0, -12.0, 24.0), "both", "open", 30.0),
+    "small": ((-3.5, -22.0, 30.0), "both", "pinch", 20.0),
+    "circle": ((-16.0, -14.0, 32.0), "dominant", "point", 0.0),
+    "up": ((-26.0, 22.0, 16.0), "both", "open", 40.0),
+    "idea": ((-15.0, 20.0, 14.0), "dominant", "point", 0.0),
+    "future": ((-14.0, -8.0, 50.0), "dominant", "open", 60.0),
+    "everything": ((-40.0, -16.0, 32.0), "both", "open", 0.0),
+    "love": ((-5.0, -6.0, 16.0), "both", "open", 0.0),
+}
+"""Gesture kind -> (right-wrist target cm, hands, hand shape, wrist roll degrees)."""
+
+LOOP = 1.0
+"""Sideways bulge of a beat's preparation, as a fraction of the beat amplitude."""
+
+CIRCLE_RADIUS_CM = 12.0
+"""Radius of the ``circle`` gesture's path (frontal plane)."""
+
+_FAVOURITE_SHAPE = {"palm_up": "open", "chop": "open", "flick": "relaxed", "pinch": "pinch"}
+_FAVOURITE_ROLL = {"palm_up": 70.0, "chop": 85.0, "flick": 20.0, "pinch": 10.0}
+_FAVOURITE_FLEX = {"palm_up": 6.0, "chop": 4.0, "flick": 30.0, "pinch": 8.0}
+_ELBOW_POLE = np.array([-0.45, -1.0, -0.35])
+
+
+# ----------------------------------------------------------------------------- time profiles
+def min_jerk(x: np.ndarray) -> np.ndarray:
+    """Minimum-jerk ramp ``10x^3 - 15x^4 + 6x^5`` of ``x`` clipped to [0, 1] (zero speed at both ends)."""
+    x = np.clip(x, 0.0, 1.0)
+    return x**3 * (10.0 - 15.0 * x + 6.0 * x**2)
+
+
+def smooth_box(t: np.ndarray, start: float, end: float, ramp_in: float, ramp_out: float) -> np.ndarray:
+    """1 on ``[start, end]``, minimum-jerk ramps on ``[start - ramp_in, start]`` and ``[end, end + ramp_out]``.
+
+    Parameters
+    ----------
+    t : (T,) float, seconds
+    start, end : float, seconds
+    ramp_in, ramp_out : float, seconds (> 0)
+
+    Returns
+    -------
+    (T,) float64 in [0, 1]
+    """
+    rise = min_jerk((t - (start - ramp_in)) / ramp_in)
+    fall = 1.0 - min_jerk((t - end) / ramp_out)
+    return rise * fall
+
+
+def beat_lift(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+    """Beat displacement along the stroke direction and across it, centimetres.
+
+    Between consecutive beats the hand first holds (0.08 s), then rises (minimum jerk) to
+    ``A_k`` and strikes back (minimum jerk, ``stroke_k`` s) to reach 0 with zero velocity at
+    the beat time. The preparation also bulges sideways (``loop``, a ``sin^2`` bump of height
+    ``LOOP * A_k`` that returns to 0 before the stroke ends), so the path is a loop and the hand
+    does not stop at the top: the speed minimum of a beat is its stroke end.
+
+    Returns
+    -------
+    lift : (T,) float64
+        ``sum_k A_k L_k(t)`` (0 at every beat time).
+    loop : (T,) float64
+        Sideways bulge of the preparation.
+    """
+    lift = np.zeros_like(t)
+    loop = np.zeros_like(t)
+    previous = -np.inf
+    for b in plan.beats:
+        peak = b.time - b.stroke
+        rise_start = max(peak - b.prep, previous + 0.08)
+        rise_len = peak - rise_start
+        if rise_len < 0.06:
+            previous = b.time
+            continue
+        amp = b.amplitude * min(1.0, rise_len / b.prep)
+        up = (t >= rise_start) & (t < peak)
+        lift[up] += amp * min_jerk((t[up] - rise_start) / rise_len)
+        down = (t >= peak) & (t <= b.time)
+        lift[down] += amp * (1.0 - min_jerk((t[down] - peak) / b.stroke))
+        loop_end = b.time - 0.35 * b.stroke
+        side = (t >= rise_start) & (t < loop_end)
+        loop[side] += LOOP * amp * np.sin(np.pi * (t[side] - rise_start) / (loop_end - rise_start)) ** 2
+        previous = b.time
+    return lift, loop
+
+
+def emotion_track(t: np.ndarray, plan: Plan, field: str) -> np.ndarray:
+    """Per-frame value of an :class:`EmotionStyle` field, following the words' emotions.
+
+    Each word's emotion holds from its start until the next word; before the first word the
+    first emotion holds. Changes are smoothed over 0.5 s.
+
+    Returns
+    -------
+    (T,) float64
+    """
+    if not plan.words:
+        return np.full_like(t, getattr(EMOTION_STYLES[0], field))
+    starts = np.array([w.start for w in plan.words])
+    values = np.array([getattr(EMOTION_STYLES[w.emotion], field) for w in plan.words], dtype=np.float64)
+    idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
+    raw = values[idx]
+    dt = float(t[1] - t[0]) if t.size > 1 else 1.0
+    half = max(int(round(0.25 / dt)), 1)
+    kernel = np.hanning(2 * half + 1)
+    kernel /= kernel.sum()
+    padded = np.pad(raw, half, mode="edge")
+    return np.convolve(padded, kernel, mode="valid")
+
+
+# ----------------------------------------------------------------------------- wrists
+def _mirror(v: np.ndarray, side: str) -> np.ndarray:
+    v = np.array(v, dtype=np.float64)
+    if side == "left":
+        v[..., 0] = -v[..., 0]
+    return v
+
+
+def _hand_role(speaker: SpeakerStyle, side: str) -> float:
+    """Share of beats and gesture-space excursion of this hand (1 = dominant)."""
+    if speaker.handedness == "both" or speaker.handedness == side:
+        return 1.0
+    return 0.35
+
+
+def wrist_paths(
+    t: np.ndarray, plan: Plan, speaker: SpeakerStyle, rng: np.random.Generator
+) -> dict[str, dict[str, np.ndarray]]:
+    """Wrist targets, hand shapes and wrist roll of both hands.
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    plan : Plan
+    speaker : SpeakerStyle
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    dict side -> {"wrist": (T, 3) cm chest frame, "curl": (T, 5) in [0, 1], "roll": (T,) degrees,
+    "flex": (T,) degrees}, sides ``"right"``, ``"left"``.
+    """
+    amp_e = emotion_track(t, plan, "amplitude")
+    tremor_e = emotion_track(t, plan, "tremor")
+    env = np.zeros_like(t)
+    for start, end in plan.phrases:
+        env = np.maximum(env, smooth_box(t, start - 0.1, end + 0.25, 0.6, 0.8))
+    lift, loop = beat_lift(t, plan)
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for side in ("right", "left"):
+        role = _hand_role(speaker, side)
+        rest = _mirror(speaker.rest, side)
+        centre = _mirror(speaker.gesture_center, side)
+        # gesture space follows the emotion amplitude: sad speakers stay low and near the body
+        reach = role * np.clip(0.55 + 0.45 * amp_e, 0.5, 1.3)
+        wrist = rest[None, :] + (env * reach)[:, None] * (centre - rest)[None, :]
+        direction = _mirror(speaker.beat_direction, side)
+        direction = direction / np.linalg.norm(direction)
+        across = np.cross(direction, np.array([1.0, 0.0, 0.0]))
+        across = across / max(float(np.linalg.norm(across)), 1e-9)
+        wrist = wrist - (role * lift)[:, None] * direction[None, :] + (role * loop)[:, None] * across[None, :]
+        # slow drift and the favourite movement
+        for _ in range(3):
+            f = rng.uniform(0.08, 0.35)
+            phase = rng.uniform(0, 2 * np.pi, size=3)
+            wrist += 0.8 * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
+        shape_fav = np.array(HAND_SHAPES[_FAVOURITE_SHAPE[speaker.favourite]])
+        curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[:, None] * shape_fav
+        roll = env * role * _FAVOURITE_ROLL[speaker.favourite]
+        flex = 8.0 + _FAVOURITE_FLEX[speaker.favourite] * lift * role / 5.0
+        # semantic gestures
+        weight_sum = np.zeros_like(t)
+        g_wrist = np.zeros_like(wrist)
+        g_curl = np.zeros_like(curl)
+        g_roll = np.zeros_like(roll)
+        for g in plan.gestures:
+            target, hands, shape, g_roll_deg = GESTURE_TARGETS[g.kind]
+            if hands == "dominant" and role < 1.0:
+                continue
+            if hands == "dominant" and speaker.handedness == "both" and side == "left":
+                continue
+            w = smooth_box(t, g.onset, g.hold_end, g.ramp_in, g.ramp_out)
+            tgt = centre + g.amplitude * (_mirror(target, side) - centre)
+            path = np.broadcast_to(tgt, wrist.shape).copy()
+            if g.kind == "circle":
+                dur = g.hold_end - g.onset
+                phi = 2 * np.pi * min_jerk((t - g.onset) / dur)
+                sign = -1.0 if side == "left" else 1.0
+                path[:, 0] += sign * CIRCLE_RADIUS_CM * np.sin(phi)
+                path[:, 1] += CIRCLE_RADIUS_CM * (np.cos(phi) - 1.0)
+            weight_sum += w
+            g_wrist += w[:, None] * path
+            g_curl += w[:, None] * np.array(HAND_SHAPES[shape])
+            g_roll += w * g_roll_deg
+        norm = np.maximum(weight_sum, 1.0)
+        ws = np.clip(weight_sum, 0.0, 1.0)
+        wrist = (1 - ws)[:, None] * wrist + g_wrist / norm[:, None]
+        curl = (1 - ws)[:, None] * curl + g_curl / norm[:, None]
+        roll = (1 - ws) * roll + g_roll / norm
+        if np.any(tremor_e > 0):
+            for axis in range(3):
+                f = rng.uniform(8.0, 11.0)
+                wrist[:, axis] += tremor_e * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+        out[side] = {"wrist": wrist, "curl": np.clip(curl, 0.0, 1.0), "roll": roll, "flex": flex}
+    return out
+
+
+# ----------------------------------------------------------------------------- IK
+def _normalize(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
+def two_bone_ik(
+    target: np.ndarray,
+    root: np.ndarray,
+    upper: np.ndarray,
+    lower: np.ndarray,
+    pole: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Analytic two-bone IK (shoulder-elbow-wrist) in the parent's frame.
+
+    Parameters
+    ----------
+    target : (T, 3) float, centimetres
+        Wrist targets in the frame of the shoulder joint's parent (the clavicle).
+    root : (3,) float
+        The shoulder joint's offset in that frame.
+    upper, lower : (3,) float
+        Elbow offset (in the shoulder's frame) and wrist offset (in the elbow's frame) at rest.
+    pole : (T, 3) or (3,) float
+        Direction the elbow should point to, same frame as ``target``.
+
+    Returns
+    -------
+    shoulder : (T, 3, 3) float64
+        Local rotation of the shoulder joint.
+    elbow : (T, 3, 3) float64
+        Local rotation of the elbow joint (a pure rotation about the flexion axis).
+
+    Notes
+    -----
+    Targets closer than ``|l1 - l2| + 2`` cm or farther than ``0.97 (l1 + l2)`` are clamped to
+    that range along their direction, so the elbow always keeps some flexion.
+    """
+    target = np.asarray(target, dtype=np.float64)
+    if target.ndim != 2 or target.shape[1] != 3:
+        raise ValueError(f"two_bone_ik: target must be (T, 3), got {target.shape}")
+    l1, l2 = float(np.linalg.norm(upper)), float(np.linalg.norm(lower))
+    u1, u2 = _normalize(np.asarray(upper, float)), _normalize(np.asarray(lower, float))
+    v = target - root[None, :]
+    d = np.clip(np.linalg.norm(v, axis=1), abs(l1 - l2) + 2.0, 0.97 * (l1 + l2))
+    vh = _normalize(v)
+    cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
+    sin_a = np.sqrt(1.0 - cos_a**2)
+    pole = np.broadcast_to(np.asarray(pole, dtype=np.float64), v.shape)
+    n = _normalize(pole - np.sum(pole * vh, axis=1, keepdims=True) * vh)
+    a_dir = cos_a[:, None] * vh + sin_a[:, None] * n
+    wrist = d[:, None] * vh
+    f_dir = _normalize(wrist - l1 * a_dir)
+    b_world = _normalize(np.cross(a_dir, f_dir))
+    b_local = _normalize(np.cross(u1, np.array([0.0, 0.0, 1.0])))
+    local = np.stack([u1, b_local, np.cross(u1, b_local)], axis=1)  # columns
+    world = np.stack([a_dir, b_world, np.cross(a_dir, b_world)], axis=2)
+    shoulder = world @ local.T[None, :, :]
+    f_local = np.einsum("tji,tj->ti", shoulder, f_dir)
+    cross = np.cross(u2[None, :], f_local)
+    beta = np.arctan2(np.sum(cross * b_local[None, :], axis=1), f_local @ u2)
+    elbow = axis_angle_to_matrix(beta[:, None] * b_local[None, :])
+    return shoulder, elbow
+
+
+# ----------------------------------------------------------------------------- whole body
+def continuous_euler(angles: np.ndarray) -> np.ndarray:
+    """Make an Euler-angle track continuous across the middle angle's ±90° (gimbal) boundary.
+
+    ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)`` give the same rotation for every
+    Tait-Bryan order; frame by frame the one closer to the previous frame is kept, then 360°
+    jumps are unwrapped. Only needed when a joint passes through ``|b| = 90°`` (e.g. an elbow
+    flexing beyond 90° about its middle axis).
+
+    Parameters
+    ----------
+    angles : (T, 3) float, degrees
+
+    Returns
+    -------
+    (T, 3) float64, degrees
+    """
+    out = unwrap_degrees(np.asarray(angles, dtype=np.float64))
+    if out.shape[0] < 2 or np.abs(np.diff(out, axis=0)).max() < 90.0:
+        return out
+    fixed = out.copy()
+    for i in range(1, fixed.shape[0]):
+        prev = fixed[i - 1]
+        a, b, c = out[i]
+        cands = (out[i], np.array([a + 180.0, 180.0 - b, c + 180.0]))
+        best = None
+        for cand in cands:
+            cand = cand - 360.0 * np.round((cand - prev) / 360.0)
+            if best is None or np.abs(cand - prev).sum() < np.abs(best - prev).sum():
+                best = cand
+        fixed[i] = best
+    return fixed
+
+
+def _put(channels: np.ndarray, skeleton: Skeleton, name: str, rot: np.ndarray) -> None:
+    j = skeleton.index(name)
+    angles = matrix_to_euler(rot, skeleton.rotation_order(j))
+    channels[:, skeleton.rotation_channel_indices(j)] = continuous_euler(angles)
+
+
+def _euler(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    return euler_to_matrix(np.stack([x, y, z], axis=-1), "XYZ")
+
+
+def _sines(t: np.ndarray, rng: np.random.Generator, amp: float, fmin: float, fmax: float, n: int = 2) -> np.ndarray:
+    out = np.zeros_like(t)
+    for _ in range(n):
+        out += amp / n * np.sin(2 * np.pi * rng.uniform(fmin, fmax) * t + rng.uniform(0, 2 * np.pi))
+    return out
+
+
+def body_channels(
+    skeleton: Skeleton, t: np.ndarray, plan: Plan, speaker: SpeakerStyle, rng: np.random.Generator
+) -> np.ndarray:
+    """BVH channel rows of a whole take.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        The BEAT skeleton (:func:`beatlite.skeleton.beat.beat_skeleton`).
+    t : (T,) float64
+        Frame times, seconds.
+    plan : Plan
+    speaker : SpeakerStyle
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    (T, 228) float64
+        Hips position in centimetres, rotations in degrees (each joint's CHANNELS order),
+        unwrapped along time.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    n = t.size
+    ch = np.zeros((n, skeleton.n_channels))
+    zero = np.zeros_like(t)
+    head_pitch = emotion_track(t, plan, "head_pitch")
+    amp_e = emotion_track(t, plan, "amplitude")
+    lift, _ = beat_lift(t, plan)
+    nod = lift / 5.0  # ~1 at a typical beat
+
+    # hips: small translation sway and weight shift; legs counter-rotate so they stay vertical
+    hips_pos = np.stack(
+        [_sines(t, rng, 1.6, 0.05, 0.2), _sines(t, rng, 0.4, 0.1, 0.3), _sines(t, rng, 1.0, 0.05, 0.2)], axis=1
+    )
+    ch[:, skeleton.position_channel_indices(0)] = hips_pos
+    hips_rot = _euler(_sines(t, rng, 1.2, 0.05, 0.2), _sines(t, rng, 2.5, 0.04, 0.15), _sines(t, rng, 1.2, 0.05, 0.2))
+    _put(ch, skeleton, "Hips", hips_rot)
+    hips_inv = np.swapaxes(hips_rot, 1, 2)
+    for side in ("Right", "Left"):
+        _put(ch, skeleton, f"{side}UpLeg", hips_inv)
+        _put(ch, skeleton, f"{side}Leg", _euler(zero + 2.0, zero, zero))
+        _put(ch, skeleton, f"{side}Foot", _euler(zero - 2.0, zero, zero))
+
+    # spine: lean, breathing, beat emphasis, a little twist
+    breath = np.sin(2 * np.pi * 0.25 * t + rng.uniform(0, 2 * np.pi))
+    lean = speaker.lean + 1.5 * np.clip(head_pitch, 0, None) / 14.0 * 4.0
+    twist = _sines(t, rng, 3.0, 0.05, 0.15)
+    spine_rot = _euler((lean + 0.6 * breath + 0.6 * nod * amp_e) / 4.0, twist / 4.0, _sines(t, rng, 1.0, 0.05, 0.2) / 4.0)
+    for name in ("Spine", "Spine1", "Spine2", "Spine3"):
+        _put(ch, skeleton, name, spine_rot)
+
+    # neck and head: emotion head pitch, nods at beats, slow looking around
+    look = _sines(t, rng, 10.0, 0.03, 0.1)
+    tilt = _sines(t, rng, 3.0, 0.04, 0.12)
+    head_x = head_pitch + 2.5 * nod * amp_e + _sines(t, rng, 1.5, 0.1, 0.3) - 0.3 * breath
+    neck_rot = _euler(head_x * 0.3, look * 0.3, tilt * 0.3)
+    _put(ch, skeleton, "Neck", neck_rot)
+    _put(ch, skeleton, "Neck1", _euler(head_x * 0.2, look * 0.2, tilt * 0.2))
+    _put(ch, skeleton, "Head", _euler(head_x * 0.5, look * 0.5, tilt * 0.5))
+
+    # arms
+    paths = wrist_paths(t, plan, speaker, rng)
+    for side, cap in (("right", "Right"), ("left", "Left")):
+        sgn = 1.0 if side == "right" else -1.0
+        p = paths[side]
+        shrug = -sgn * (1.5 + 0.8 * breath + 1.5 * nod * amp_e)
+        clav = _euler(zero, zero, shrug)
+        _put(ch, skeleton, f"{cap}Shoulder", clav)
+        j_sh = skeleton.index(f"{cap}Shoulder")
+        j_arm = skeleton.index(f"{cap}Arm")
+        j_fore = skeleton.index(f"{cap}ForeArm")
+        j_hand = skeleton.index(f"{cap}Hand")
+        # wrist target (chest frame) -> clavicle frame
+        local_target = np.einsum("tji,tj->ti", clav, p["wrist"] - skeleton.offsets[j_sh][None, :])
+        pole = np.einsum("tji,j->ti", clav, _mirror(_ELBOW_POLE, side))
+        shoulder, elbow = two_bone_ik(
+            local_target, skeleton.offsets[j_arm], skeleton.offsets[j_fore], skeleton.offsets[j_hand], pole
+        )
+        _put(ch, skeleton, f"{cap}Arm", shoulder)
+        _put(ch, skeleton, f"{cap}ForeArm", elbow)
+        # wrist: roll about the forearm axis (supination), flexion towards the palm
+        axis = _normalize(skeleton.offsets[skeleton.index(f"{cap}HandMiddle1")])
+        palm_normal = np.array([0.0, -1.0, 0.0])
+        flex_axis = _normalize(np.cross(axis, palm_normal))
+        roll = axis_angle_to_matrix(np.deg2rad(sgn * p["roll"])[:, None] * axis[None, :])
+        flex = axis_angle_to_matrix(np.deg2rad(p["flex"])[:, None] * flex_axis[None, :])
+        _put(ch, skeleton, f"{cap}Hand", roll @ flex)
+        _fingers(ch, skeleton, cap, p["curl"], palm_normal)
+    return ch
+
+
+def _fingers(ch: np.ndarray, skeleton: Skeleton, cap: str, curl: np.ndarray, palm_normal: np.ndarray) -> None:
+    """Write finger joint rotations from per-finger curls (T, 5): index, middle, ring, pinky, thumb."""
+    names = {0: "Index", 1: "Middle", 2: "Ring", 3: "Pinky"}
+    for k, finger in names.items():
+        for level in (1, 2, 3):
+            j = skeleton.index(f"{cap}Hand{finger}{level}")
+            axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
+            angle = np.deg2rad(_CURL_DEG[level - 1]) * curl[:, k]
+            _put(ch, skeleton, f"{cap}Hand{finger}{level}", axis_angle_to_matrix(angle[:, None] * axis[None, :]))
+        if finger != "Middle":
+            j = skeleton.index(f"{cap}Hand{finger}")
+            axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
+            angle = np.deg2rad(_CARPAL_DEG) * curl[:, k]
+            _put(ch, skeleton, f"{cap}Hand{finger}", axis_angle_to_matrix(angle[:, None] * axis[None, :]))
+    for level in (1, 2, 3):
+        j = skeleton.index(f"{cap}HandThumb{level}")
+        axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
+        angle = np.deg2rad(_THUMB_DEG[level - 1]) * curl[:, 4]
+        _put(ch, skeleton, f"{cap}HandThumb{level}", axis_angle_to_matrix(angle[:, None] * axis[None, :]))
+
+
+def emotion_ids(t: np.ndarray, plan: Plan) -> np.ndarray:
+    """Emotion id of each time: that of the last word started (the first word's before it).
+
+    Parameters
+    ----------
+    t : (T,) float, seconds
+    plan : Plan
+
+    Returns
+    -------
+    (T,) int64
+    """
+    t = np.asarray(t, dtype=np.float64)
+    if not plan.words:
+        return np.zeros(t.shape, dtype=np.int64)
+    starts = np.array([w.start for w in plan.words])
+    values = np.array([w.emotion for w in plan.words], dtype=np.int64)
+    idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
+    return values[idx]

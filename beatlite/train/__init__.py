@@ -1,0 +1,43 @@
+"""One training harness and whole-take generation for every gesture model (torch, imported lazily).
+
+- :class:`TrainConfig` (``beatlite.train.config``), :func:`fit` (``beatlite.train.training``),
+- :func:`save_checkpoint`, :func:`load_checkpoint`, :func:`load_model`, :func:`export_checkpoint`
+  (``beatlite.train.checkpoint``),
+- :func:`generate`, :func:`generate_sequence` (``beatlite.train.generation``).
+
+``import beatlite.train`` does not import torch; the names above import their module on
+first access. Command line: ``python -m beatlite.train {retrain-all,results}``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_NAMES = {
+    "TrainConfig": "beatlite.train.config",
+    "fit": "beatlite.train.training",
+    "FitResult": "beatlite.train.training",
+    "data_fingerprint": "beatlite.train.training",
+    "save_checkpoint": "beatlite.train.checkpoint",
+    "load_checkpoint": "beatlite.train.checkpoint",
+    "load_model": "beatlite.train.checkpoint",
+    "export_checkpoint": "beatlite.train.checkpoint",
+    "generate": "beatlite.train.generation",
+    "generate_sequence": "beatlite.train.generation",
+    "GeneratedTake": "beatlite.train.generation",
+}
+
+__all__ = sorted(_NAMES)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _NAMES:
+        value = getattr(importlib.import_module(_NAMES[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'beatlite.train' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

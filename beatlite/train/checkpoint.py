@@ -1,0 +1,129 @@
+"""Atomic, resumable checkpoints of gesture models (torch).
+
+A checkpoint is a ``torch.save`` dict::
+
+    {"format": "beatlite-checkpoint/1",
+     "model": model.to_config(),           # {"name": ..., **config fields}
+     "state": model.state_dict(),          # float32 (float16 in exported files)
+     "epoch": completed epochs, "history": [per-epoch loss dicts],
+     "fingerprint": data fingerprint (str), "train_config": TrainConfig.to_dict(),
+     "meta": {...}                          # e.g. normalisation statistics for generation
+     # training checkpoints only:
+     "optimizer", "d_optimizer", "rng": torch RNG state}
+
+Files are written to a temporary file in the same folder and moved into place with
+:func:`os.replace`, so a crash never leaves a half-written checkpoint.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import torch
+
+from beatlite.models.base import GestureModel
+
+FORMAT = "beatlite-checkpoint/1"
+
+
+def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
+    """``torch.save(payload)`` atomically (temp file in the same folder + ``os.replace``).
+
+    Returns
+    -------
+    Path
+        The written path.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            torch.save(dict(payload), fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    """Read a checkpoint dict (on CPU; ``weights_only=False`` because of numpy metadata).
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at ``path``.
+    beatlite.io.FormatError
+        The file is not a beatlite checkpoint.
+    """
+    from beatlite.io.errors import FormatError
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"checkpoint not found: {path}")
+    try:
+        data = torch.load(path, map_location="cpu", weights_only=False)
+    except Exception as exc:  # noqa: BLE001 - any unpickling failure is a format problem
+        raise FormatError(path, f"not a torch checkpoint ({type(exc).__name__}: {exc})") from exc
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise FormatError(path, f"not a beatlite checkpoint (missing format {FORMAT!r})", field="format")
+    for key in ("model", "state"):
+        if key not in data:
+            raise FormatError(path, f"checkpoint has no {key!r}", field=key)
+    return data
+
+
+def model_from_checkpoint(data: Mapping[str, Any]) -> GestureModel:
+    """Rebuild the model of a checkpoint dict and load its (float32) weights, in eval mode."""
+    model = GestureModel.from_config(data["model"])
+    state = {
+        k: v.float() if torch.is_tensor(v) and v.is_floating_point() else v for k, v in data["state"].items()
+    }
+    model.load_state_dict(state)
+    return model.eval()
+
+
+def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
+    """Load a model from a checkpoint file or a shipped checkpoint name.
+
+    Parameters
+    ----------
+    path_or_name : str or Path
+        A ``.pt`` path, or a name such as ``"camn_tiny"`` looked up as
+        ``beatlite.paths.checkpoints_dir() / "<name>.pt"``.
+
+    Returns
+    -------
+    (GestureModel in eval mode, checkpoint dict)
+    """
+    from beatlite.paths import checkpoints_dir
+
+    path = Path(path_or_name)
+    if path.suffix != ".pt" and not path.is_file():
+        path = checkpoints_dir() / f"{path_or_name}.pt"
+    data = load_checkpoint(path)
+    return model_from_checkpoint(data), data
+
+
+def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True) -> Path:
+    """Write a small inference-only copy of a training checkpoint.
+
+    Drops the optimiser and RNG states; stores floating-point weights as float16 when
+    ``half`` (:func:`model_from_checkpoint` converts them back to float32).
+    """
+    data = load_checkpoint(src)
+    keep = {k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng")}
+    if half:
+        keep["state"] = {
+            k: v.half() if torch.is_tensor(v) and v.is_floating_point() else v
+            for k, v in data["state"].items()
+        }
+    return save_checkpoint(dst, keep)

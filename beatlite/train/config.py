@@ -1,0 +1,76 @@
+"""The training configuration :class:`TrainConfig` (no torch import)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+
+@dataclasses.dataclass
+class TrainConfig:
+    """Settings of :func:`beatlite.train.fit` (defaults follow CaMN's reference, facts B.6).
+
+    Attributes
+    ----------
+    epochs : int
+        Number of epochs (total, also when resuming).
+    batch_size : int
+        Windows per step. A last batch of a single window is dropped (BatchNorm needs 2).
+    lr : float or None
+        Generator learning rate; ``None`` = ``5e-4 * batch_size / 256`` (the reference's
+        ``lr_base * batch / 128`` with ``lr_base = 2.5e-4``).
+    betas : (float, float)
+        Adam betas (0.5, 0.999).
+    d_lr_weight : float
+        Discriminator learning rate = ``d_lr_weight * lr`` (0.2).
+    seed : int
+        Seeds torch (weights, dropout) and the per-epoch shuffles.
+    threads : int or None
+        Torch CPU threads; ``None`` = :func:`beatlite.paths.n_threads` (``$BEATLITE_THREADS``).
+    no_adv_epochs : int or None
+        If set, overrides the model's ``config.no_adv_epochs`` (first adversarial epoch, 0-based).
+    grad_clip : float
+        Gradient-norm clip of each optimiser step (reference 200).
+    checkpoint : str or Path or None
+        Where to save (atomically, after every epoch); ``None`` = do not save.
+    resume : bool
+        Continue from ``checkpoint`` if it exists (same data fingerprint required).
+    progress : bool
+        Show a tqdm bar.
+    """
+
+    epochs: int = 30
+    batch_size: int = 64
+    lr: float | None = None
+    betas: tuple[float, float] = (0.5, 0.999)
+    d_lr_weight: float = 0.2
+    seed: int = 2021
+    threads: int | None = None
+    no_adv_epochs: int | None = None
+    grad_clip: float = 200.0
+    checkpoint: str | Path | None = None
+    resume: bool = False
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        if self.epochs < 0:
+            raise ValueError(f"TrainConfig: epochs must be >= 0, got {self.epochs}")
+        if self.batch_size < 2:
+            raise ValueError(f"TrainConfig: batch_size must be >= 2 (BatchNorm), got {self.batch_size}")
+        if self.lr is not None and not self.lr > 0:
+            raise ValueError(f"TrainConfig: lr must be positive, got {self.lr}")
+        if self.threads is not None and self.threads < 1:
+            raise ValueError(f"TrainConfig: threads must be >= 1, got {self.threads}")
+        self.betas = (float(self.betas[0]), float(self.betas[1]))
+
+    @property
+    def learning_rate(self) -> float:
+        """The generator learning rate actually used (``lr`` or ``5e-4 * batch_size / 256``)."""
+        return float(self.lr) if self.lr is not None else 5e-4 * self.batch_size / 256
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly dict (paths as strings)."""
+        d = dataclasses.asdict(self)
+        d["checkpoint"] = None if self.checkpoint is None else str(self.checkpoint)
+        return d

@@ -1,0 +1,214 @@
+"""Generation of whole takes of any length with any :class:`~beatlite.models.base.GestureModel`.
+
+The take is cut into 34-frame units with stride 30 (facts C.7 "Inference"): unit ``k``
+covers frames ``[30 k, 30 k + 34)``; its seed (first ``n_pre = 4`` frames) is the
+ground-truth seed for ``k = 0`` and the previous unit's last 4 output frames
+afterwards; the 4 overlapping frames are linearly cross-faded
+(weights ``linspace(0, 1, 4)`` for the new unit). Audio and mel slices follow the
+unit's *time* axis (the reference sliced the spectrogram along its mel axis, a bug).
+The last unit is padded (edge frames, silent audio) and the result cropped to T frames.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import torch
+
+from beatlite.io.motion import Motion
+from beatlite.models.base import GestureModel
+
+FPS = 15
+SR = 16000
+UNIT = 34
+STRIDE = 30
+MEL_HOP = 512
+MEL_FRAMES = 70
+
+
+@dataclasses.dataclass(eq=False)
+class GeneratedTake:
+    """The result of :func:`generate` for one take.
+
+    Attributes
+    ----------
+    pose : (T, D) float32
+        Output in the model's normalised representation (D = 141 or 126).
+    representation : str
+        ``"euler141"`` or ``"dirvec126"``.
+    motion : Motion or None
+        Euler models: a 228-channel BEAT :class:`Motion` at 15 fps (the 141 predicted
+        channels denormalised to degrees, every other channel 0 = rest pose, root at the
+        origin). ``None`` for direction models (no IK).
+    positions : (T, J, 3) float64 or None, centimetres
+        Direction models: TED-43 joint positions from the denormalised unit directions
+        and the training-mean bone lengths (root at the origin). Euler models: ``None``
+        (use ``motion.positions()``).
+    fps : float
+        15.
+    """
+
+    pose: np.ndarray
+    representation: str
+    motion: Motion | None
+    positions: np.ndarray | None
+    fps: float = float(FPS)
+
+
+def _unit_slice(a: np.ndarray, start: int, length: int) -> np.ndarray:
+    """Frames ``[start, start + length)`` of ``a`` (axis 0), edge-padded past the end."""
+    part = a[start : start + length]
+    if part.shape[0] < length:
+        if part.shape[0] == 0:
+            raise ValueError(f"unit start {start} is past the end ({a.shape[0]} frames)")
+        pad = np.repeat(part[-1:], length - part.shape[0], axis=0)
+        part = np.concatenate([part, pad], axis=0)
+    return part
+
+
+def _zero_padded(a: np.ndarray, start: int, length: int) -> np.ndarray:
+    part = a[start : start + length]
+    if part.shape[0] < length:
+        part = np.concatenate([part, np.zeros((length - part.shape[0], *a.shape[1:]), dtype=a.dtype)], axis=0)
+    return part
+
+
+def unit_batch(
+    streams: Mapping[str, np.ndarray], start: int, keys: tuple[str, ...]
+) -> dict[str, torch.Tensor]:
+    """The one-window batch (B = 1) of the unit starting at frame ``start``.
+
+    Frame streams are sliced ``[start, start + 34)`` (edge-padded), audio samples
+    ``[floor(start * 16000 / 15), + floor(34 / 15 * 16000))`` (zero-padded), mel frames
+    ``[floor(a0 / 512), + 70)`` with ``a0`` the unit's first audio sample (edge-padded, as
+    :mod:`beatlite.data.windows` slices the whole-take log-mel), ``speaker`` is copied.
+    """
+    batch: dict[str, torch.Tensor] = {}
+    for key in keys:
+        a = np.asarray(streams[key])
+        if key == "speaker":
+            part = np.asarray(a, dtype=np.int64).reshape(1)
+            batch[key] = torch.from_numpy(part)
+            continue
+        if key == "audio":
+            part = _zero_padded(a, int(start * SR // FPS), int(np.floor(UNIT / FPS * SR)))
+        elif key == "mel":
+            part = _unit_slice(a, int(start * SR // FPS) // MEL_HOP, MEL_FRAMES)
+        else:
+            part = _unit_slice(a, start, UNIT)
+        dtype = np.int64 if part.dtype.kind in "iu" else np.float32
+        batch[key] = torch.from_numpy(np.ascontiguousarray(part.astype(dtype))[None])
+    return batch
+
+
+def generate_sequence(
+    model: GestureModel, streams: Mapping[str, np.ndarray], *, stride: int = STRIDE
+) -> np.ndarray:
+    """Generate a whole sequence in the model's normalised representation.
+
+    Parameters
+    ----------
+    model : GestureModel
+        Any trained model (put in eval mode for the call).
+    streams : mapping
+        Whole-take inputs: ``model.target_key`` (T, D) float (only frames 0..3 are read,
+        the seed), per-frame ``"face"`` (T, 51), ``"word"``/``"emotion"`` (T,) int,
+        ``"semantic"`` (T,), ``"audio"`` (S,) 16 kHz, ``"mel"`` (M, 128) log-mel of the
+        whole take (hop 512), ``"speaker"`` int — those the model reads.
+    stride : int
+        Frames between unit starts (30; must be in [1, 34 - n_pre]).
+
+    Returns
+    -------
+    (T, D) float32
+    """
+    keys = tuple(dict.fromkeys((*model.input_keys, model.target_key)))
+    missing = [k for k in keys if k not in streams]
+    if missing:
+        raise KeyError(f"generate_sequence: streams lack {missing} needed by {type(model).__name__}")
+    target = np.asarray(streams[model.target_key], dtype=np.float32)
+    if target.ndim != 2 or target.shape[1] != model.pose_dim:
+        raise ValueError(f"streams[{model.target_key!r}] must be (T, {model.pose_dim}), got {target.shape}")
+    n_pre = model.n_pre
+    if not 1 <= stride <= UNIT - n_pre:
+        raise ValueError(f"stride must be in [1, {UNIT - n_pre}], got {stride}")
+    t = target.shape[0]
+    if t < n_pre:
+        raise ValueError(f"the take has {t} frames, fewer than the {n_pre} seed frames")
+    starts = [0]
+    while starts[-1] + UNIT < t:
+        starts.append(starts[-1] + stride)
+    out = np.zeros((starts[-1] + UNIT, model.pose_dim), dtype=np.float32)
+    fade = np.linspace(0.0, 1.0, n_pre, dtype=np.float32)[:, None]
+    seed = target[:n_pre]
+    work = dict(streams)
+    for i, start in enumerate(starts):
+        work[model.target_key] = np.concatenate([np.zeros((start, model.pose_dim), np.float32), seed], 0)
+        unit = model.generate(unit_batch(work, start, keys))[0].numpy()
+        if i == 0:
+            out[:UNIT] = unit
+        else:
+            out[start : start + n_pre] = (1 - fade) * out[start : start + n_pre] + fade * unit[:n_pre]
+            out[start + n_pre : start + UNIT] = unit[n_pre:]
+        seed = unit[stride : stride + n_pre]
+    return out[:t]
+
+
+def denormalise(pose: np.ndarray, representation: str, norm: Mapping[str, Any]) -> np.ndarray:
+    """Undo the window normalisation.
+
+    euler141: ``pose * norm["pose_std"] + norm["pose_mean"]`` (degrees);
+    dirvec126: ``pose + norm["dirvec_mean"]`` reshaped to (T, 42, 3) and re-normalised to
+    unit length (HA2G adds the mean back, facts C.5).
+    """
+    pose = np.asarray(pose, dtype=np.float64)
+    if representation == "euler141":
+        return pose * np.asarray(norm["pose_std"], np.float64) + np.asarray(norm["pose_mean"], np.float64)
+    if representation == "dirvec126":
+        dirs = (pose + np.asarray(norm["dirvec_mean"], np.float64)).reshape(pose.shape[0], -1, 3)
+        length = np.linalg.norm(dirs, axis=-1, keepdims=True)
+        return np.divide(dirs, length, out=np.zeros_like(dirs), where=length > 1e-9)
+    raise ValueError(f"representation must be 'euler141' or 'dirvec126', got {representation!r}")
+
+
+def generate(
+    model: GestureModel, take: Mapping[str, np.ndarray], *, norm: Mapping[str, Any] | None = None
+) -> GeneratedTake:
+    """Generate a whole take of any length and return it as motion / positions.
+
+    Parameters
+    ----------
+    model : GestureModel
+        A trained model.
+    take : mapping
+        Whole-take streams as for :func:`generate_sequence` (the per-take arrays that
+        the window builder cuts windows from).
+    norm : mapping, optional
+        Normalisation statistics: ``pose_mean``/``pose_std`` (141,) degrees for euler
+        models; ``dirvec_mean`` (126,) and ``bone_lengths`` (42,) cm for direction models.
+        Without it only :attr:`GeneratedTake.pose` is filled.
+
+    Returns
+    -------
+    GeneratedTake
+    """
+    pose = generate_sequence(model, take)
+    motion = positions = None
+    if norm is not None:
+        values = denormalise(pose, model.representation, norm)
+        if model.representation == "euler141":
+            from beatlite.skeleton.beat import beat_skeleton, expand_subset
+
+            skeleton = beat_skeleton()
+            motion = Motion(skeleton, expand_subset(values, "spine_neck_141", skeleton), FPS)
+        else:
+            from beatlite.skeleton.directions import directions_to_positions
+            from beatlite.skeleton.ted import TED_BONES
+
+            positions = directions_to_positions(
+                values, np.asarray(TED_BONES), np.asarray(norm["bone_lengths"], np.float64), np.zeros(3)
+            )
+    return GeneratedTake(pose=pose, representation=model.representation, motion=motion, positions=positions)

@@ -1,0 +1,229 @@
+"""Input checks and skeleton helpers shared by the viz modules (no matplotlib, no pyvista here)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from beatlite.skeleton.core import Skeleton
+
+GROUPS: tuple[str, ...] = ("body", "hands", "head")
+
+
+@dataclass(frozen=True)
+class Bones:
+    """The drawable bones of a skeleton, split by joint group.
+
+    Attributes
+    ----------
+    n_joints : int
+        Number of joints J the positions must have.
+    pairs : dict str -> (B_g, 2) int64
+        For each group in :data:`GROUPS`, the (parent, child) joint indices of its
+        bones; a bone belongs to its child's group.
+    joints : dict str -> (J_g,) int64
+        The joint indices of each group.
+    """
+
+    n_joints: int
+    pairs: dict[str, np.ndarray]
+    joints: dict[str, np.ndarray]
+
+
+def joint_group(name: str) -> str:
+    """The plot group of a joint from its name: ``"hands"`` if it contains "Hand", ``"head"`` for Head/Neck.
+
+    Parameters
+    ----------
+    name : str
+        Joint name, e.g. ``"RightHandIndex2"`` (hands), ``"Neck1"`` (head), ``"Spine"`` (body).
+
+    Returns
+    -------
+    str
+        One of ``"body"``, ``"hands"``, ``"head"``.
+    """
+    low = name.lower()
+    if "hand" in low:
+        return "hands"
+    if "head" in low or "neck" in low:
+        return "head"
+    return "body"
+
+
+def skeleton_bones(
+    skeleton: Skeleton | Sequence[int] | np.ndarray, names: Sequence[str] | None = None
+) -> Bones:
+    """Bones and joint groups of a :class:`Skeleton` or of a parents array.
+
+    Parameters
+    ----------
+    skeleton : Skeleton or (J,) int array
+        The hierarchy; a parents array has ``-1`` at roots and ``0 <= parents[j] < J`` elsewhere.
+    names : sequence of str, optional
+        Joint names used to colour groups when ``skeleton`` is a parents array (else all joints are body).
+
+    Returns
+    -------
+    Bones
+    """
+    if isinstance(skeleton, Skeleton):
+        parents = skeleton.parents
+        names = skeleton.names
+    else:
+        parents = np.asarray(skeleton)
+        if parents.ndim != 1 or parents.size == 0 or not np.issubdtype(parents.dtype, np.integer):
+            raise TypeError(
+                "skeleton must be a beatlite Skeleton or a (J,) integer parents array, "
+                f"got {type(skeleton).__name__} with shape {getattr(parents, 'shape', None)} "
+                f"and dtype {getattr(parents, 'dtype', None)}"
+            )
+        parents = parents.astype(np.int64)
+        bad = np.flatnonzero(
+            (parents < -1) | (parents >= parents.size) | (parents == np.arange(parents.size))
+        )
+        if bad.size:
+            raise ValueError(
+                f"skeleton: parents[{bad[0]}] = {parents[bad[0]]} is not -1 or another joint index"
+            )
+    n = int(parents.size)
+    if names is None:
+        groups = np.array(["body"] * n)
+    else:
+        if len(names) != n:
+            raise ValueError(f"names: {len(names)} names for {n} joints")
+        groups = np.array([joint_group(str(nm)) for nm in names])
+    child = np.flatnonzero(parents >= 0)
+    pairs = np.stack([parents[child], child], axis=1) if child.size else np.zeros((0, 2), np.int64)
+    return Bones(
+        n_joints=n,
+        pairs={g: pairs[groups[pairs[:, 1]] == g] for g in GROUPS},
+        joints={g: np.flatnonzero(groups == g) for g in GROUPS},
+    )
+
+
+def check_positions(positions: Any, n_joints: int | None = None, name: str = "positions") -> np.ndarray:
+    """Validate joint positions and return them as ``(T, J, 3) float64``.
+
+    Parameters
+    ----------
+    positions : array-like, (T, J, 3) or (J, 3)
+        Joint positions in centimetres; a single ``(J, 3)`` frame becomes ``(1, J, 3)``.
+    n_joints : int, optional
+        Required J (from the skeleton).
+    name : str
+        Argument name used in error messages.
+
+    Returns
+    -------
+    (T, J, 3) float64 ndarray, centimetres
+    """
+    try:
+        arr = np.asarray(positions, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a numeric (T, J, 3) array, got {type(positions).__name__}") from exc
+    if arr.ndim == 2:
+        arr = arr[None]
+    if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] == 0:
+        raise ValueError(f"{name} must have shape (T, J, 3) with T >= 1, got {arr.shape}")
+    if n_joints is not None and arr.shape[1] != n_joints:
+        raise ValueError(
+            f"{name} has {arr.shape[1]} joints but the skeleton has {n_joints}: shape {arr.shape}"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or infinite values (shape {arr.shape})")
+    return arr
+
+
+def check_fps(fps: Any, name: str = "fps") -> float:
+    """A positive finite frame rate as float (frames per second)."""
+    try:
+        value = float(fps)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a positive number, got {fps!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a positive number, got {fps!r}")
+    return value
+
+
+def frame_indices(n_frames: int, fps: float, out_fps: float | None) -> np.ndarray:
+    """Frame indices that play ``n_frames`` recorded at ``fps`` at ``out_fps`` (never faster than recorded).
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames available T.
+    fps : float
+        Frame rate of the data.
+    out_fps : float or None
+        Wanted playback rate; ``None`` or ``>= fps`` keeps every frame.
+
+    Returns
+    -------
+    (K,) int64
+        ``round(k * fps / out_fps)`` for every k whose time lies inside the clip.
+    """
+    if out_fps is None or out_fps >= fps:
+        return np.arange(n_frames, dtype=np.int64)
+    step = fps / out_fps
+    idx = np.round(np.arange(0.0, n_frames - 0.5, step)).astype(np.int64)
+    return np.unique(np.clip(idx, 0, n_frames - 1))
+
+
+def check_words(words: Any) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Word timings as ``(starts (W,) float64 s, ends (W,) float64 s, words tuple of str)``.
+
+    Accepts a 3-tuple or a ``beatlite.io`` ``WordIntervals`` (anything with
+    ``starts``, ``ends`` and ``words`` attributes).
+    """
+    if all(hasattr(words, a) for a in ("starts", "ends", "words")):
+        starts, ends, texts = words.starts, words.ends, words.words
+    else:
+        try:
+            starts, ends, texts = words
+        except (TypeError, ValueError):
+            raise TypeError(
+                f"words must be (starts, ends, words) or a WordIntervals, got {type(words).__name__}"
+            ) from None
+    starts = np.asarray(starts, dtype=np.float64).reshape(-1)
+    ends = np.asarray(ends, dtype=np.float64).reshape(-1)
+    texts = tuple(str(w) for w in texts)
+    if not (starts.shape == ends.shape == (len(texts),)):
+        raise ValueError(
+            f"words: starts {starts.shape}, ends {ends.shape} and {len(texts)} words must have the same length"
+        )
+    if np.any(ends < starts):
+        k = int(np.flatnonzero(ends < starts)[0])
+        raise ValueError(
+            f"words: word {k} ({texts[k]!r}) ends at {ends[k]} s before it starts at {starts[k]} s"
+        )
+    return starts, ends, texts
+
+
+def word_at(t: float, starts: np.ndarray, ends: np.ndarray, texts: Sequence[str]) -> str:
+    """The word spoken at time ``t`` seconds (``starts[k] <= t < ends[k]``), or ``""``."""
+    k = int(np.searchsorted(starts, t, side="right")) - 1
+    if 0 <= k < len(texts) and starts[k] <= t < ends[k]:
+        return texts[k]
+    hit = np.flatnonzero((starts <= t) & (t < ends))  # unsorted input
+    return texts[int(hit[0])] if hit.size else ""
+
+
+def to_plot_coords(positions: np.ndarray) -> np.ndarray:
+    """Map Y-up data coordinates ``(x, y, z)`` to matplotlib's Z-up ``(x, -z, y)`` (a proper rotation).
+
+    Parameters
+    ----------
+    positions : (..., 3) float64
+        Positions with Y up, the character facing +Z.
+
+    Returns
+    -------
+    (..., 3) float64
+        Same points in plot axes: height on the plot's Z axis, the character facing
+        the plot's -Y, so matplotlib's default front view (azim=-90) looks at its face.
+    """
+    return np.stack([positions[..., 0], -positions[..., 2], positions[..., 1]], axis=-1)

@@ -1,0 +1,388 @@
+"""pyvista renders of skeletons: bones as tubes, joints as spheres; screenshots, GIF/MP4, notebook view.
+
+Each function first asks :func:`beatlite.viz.probe.use_pyvista` whether VTK can
+render off-screen here (a subprocess probe, cached per process). When it
+cannot, the function warns once (``UserWarning``, saying why and how to fix
+it) and returns the same kind of result drawn with matplotlib, so a notebook
+kernel never crashes. Pass ``backend="matplotlib"`` to skip pyvista.
+
+Headless machines: see :mod:`beatlite.viz.probe` (EGL first, then OSMesa,
+then X/Xvfb) and ``scripts/system_deps.sh``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import subprocess
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from beatlite.viz._files import atomic_target
+from beatlite.viz._inputs import GROUPS, Bones, check_fps, check_positions, frame_indices, skeleton_bones
+from beatlite.viz.animation import ffmpeg_available
+from beatlite.viz.plot3d import SkeletonLike
+from beatlite.viz.probe import use_pyvista
+from beatlite.viz.style import GROUP_COLOURS
+
+#: Unit vectors from the scene centre to the camera, and the camera's up vector, of the named views.
+CAMERAS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    "front": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
+    "side": ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    "top": ((0.0, 1.0, 0.0), (0.0, 0.0, -1.0)),
+    "default": ((0.5, 0.25, 0.83), (0.0, 1.0, 0.0)),
+}
+
+
+def _check_size(size: Any) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise TypeError(f"size must be (width, height) in pixels, got {size!r}") from None
+    if w < 16 or h < 16:
+        raise ValueError(f"size must be at least (16, 16) pixels, got {size!r}")
+    return w, h
+
+
+class _PyvistaSkeleton:
+    """Tubes and spheres of one skeleton in a pyvista Plotter, updated in place."""
+
+    def __init__(self, plotter: Any, bones: Bones, first: np.ndarray, radius: float) -> None:
+        import pyvista as pv
+
+        self.bones = bones
+        self.radius = radius
+        self._sphere = pv.Sphere(radius=radius * 1.6, theta_resolution=10, phi_resolution=10)
+        self._meshes: dict[str, tuple[Any, Any]] = {}
+        for g in GROUPS:
+            tubes, balls = self._build(first, g)
+            if tubes is not None:
+                plotter.add_mesh(tubes, color=GROUP_COLOURS[g], smooth_shading=True)
+            if balls is not None:
+                plotter.add_mesh(balls, color=GROUP_COLOURS[g], smooth_shading=True)
+            self._meshes[g] = (tubes, balls)
+
+    def _build(self, pts: np.ndarray, g: str) -> tuple[Any, Any]:
+        import pyvista as pv
+
+        pairs = self.bones.pairs[g]
+        joints = self.bones.joints[g]
+        scale = 0.6 if g == "hands" else 1.0
+        tubes = balls = None
+        if len(pairs):
+            cells = np.column_stack([np.full(len(pairs), 2), pairs]).ravel()
+            tubes = pv.PolyData(pts.copy(), lines=cells).tube(radius=self.radius * scale, n_sides=10)
+        if len(joints):
+            geom = self._sphere.scale(scale, inplace=False)
+            balls = pv.PolyData(pts[joints].copy()).glyph(geom=geom, scale=False, orient=False)
+        return tubes, balls
+
+    def update(self, pts: np.ndarray) -> None:
+        for g in GROUPS:
+            new = self._build(pts, g)
+            for old, fresh in zip(self._meshes[g], new):
+                if old is not None:
+                    old.copy_from(fresh)
+
+
+def _scene(
+    positions: np.ndarray, bones: Bones, size: tuple[int, int], view: str, floor: bool, radius: float | None
+) -> tuple[Any, _PyvistaSkeleton]:
+    import pyvista as pv
+
+    pts = positions.reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    extent = float(np.max(hi - lo)) or 1.0
+    r = radius if radius is not None else max(extent / 120.0, 0.2)
+    plotter = pv.Plotter(off_screen=True, window_size=size)
+    plotter.set_background("white")
+    if floor:
+        centre = (lo + hi) / 2
+        plane = pv.Plane(
+            center=(centre[0], lo[1] - r, centre[2]),
+            direction=(0, 1, 0),
+            i_size=extent * 1.2,
+            j_size=extent * 1.2,
+            i_resolution=6,
+            j_resolution=6,
+        )
+        plotter.add_mesh(plane, color="#f0f0f0", show_edges=True, edge_color="#c8c8c8", lighting=False)
+    skel = _PyvistaSkeleton(plotter, bones, positions[0], r)
+    if view not in CAMERAS:
+        raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
+    direction, up = CAMERAS[view]
+    centre = (lo + hi) / 2
+    d = np.asarray(direction) / np.linalg.norm(direction)
+    dist = 1.25 * extent / (2 * np.tan(np.radians(plotter.camera.view_angle) / 2))
+    plotter.camera.focal_point = tuple(centre)
+    plotter.camera.position = tuple(centre + d * dist)
+    plotter.camera.up = up
+    return plotter, skel
+
+
+def _mpl_frame_image(
+    positions: np.ndarray, skeleton: SkeletonLike, frame: int, size: tuple[int, int], view: str
+) -> np.ndarray:
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from beatlite.viz.plot3d import SkeletonArtist, setup_axes
+    from beatlite.viz.style import STYLE
+
+    w, h = size
+    with plt.rc_context(dict(STYLE)):
+        fig = Figure(figsize=(w / 100, h / 100), dpi=100)
+        canvas = FigureCanvasAgg(fig)
+        ax = fig.add_axes((0, 0, 1, 1), projection="3d")
+        setup_axes(ax, positions, view=view)
+        SkeletonArtist(ax, skeleton_bones(skeleton)).update(positions[frame])
+        canvas.draw()
+        img = np.asarray(canvas.buffer_rgba())[..., :3].copy()
+    return img
+
+
+def render_frame(
+    positions: Any,
+    skeleton: SkeletonLike,
+    frame: int = 0,
+    *,
+    size: Sequence[int] = (640, 480),
+    view: str = "default",
+    floor: bool = True,
+    radius: float | None = None,
+    path: str | Path | None = None,
+    backend: str = "auto",
+) -> np.ndarray:
+    """Render one frame off-screen (pyvista tubes and spheres; matplotlib when pyvista cannot render).
+
+    Parameters
+    ----------
+    positions : (T, J, 3) or (J, 3) float, centimetres, Y up
+        Joint positions.
+    skeleton : Skeleton or (J,) int parents array
+        Hierarchy (a Skeleton's names colour body, hands and head).
+    frame : int
+        Frame to render.
+    size : (width, height)
+        Image size in pixels.
+    view : {"default", "front", "side", "top"}
+        Camera.
+    floor : bool
+        Draw a floor plane under the lowest joint.
+    radius : float, optional
+        Bone tube radius, centimetres (default: 1/120 of the scene size).
+    path : str or Path, optional
+        Also write the image there (PNG), atomically.
+    backend : {"auto", "pyvista", "matplotlib"}
+        Renderer; ``"auto"``/``"pyvista"`` fall back to matplotlib with one warning.
+
+    Returns
+    -------
+    (height, width, 3) uint8 ndarray
+        The RGB image.
+    """
+    bones = skeleton_bones(skeleton)
+    pos = check_positions(positions, bones.n_joints)
+    if (
+        isinstance(frame, bool)
+        or not isinstance(frame, int | np.integer)
+        or not -len(pos) <= frame < len(pos)
+    ):
+        raise ValueError(f"frame={frame!r} is not a frame index for {len(pos)} frames")
+    frame = int(frame) % len(pos)
+    w, h = _check_size(size)
+    if use_pyvista(backend):
+        plotter, skel = _scene(pos[frame : frame + 1], bones, (w, h), view, floor, radius)
+        try:
+            img = np.asarray(plotter.screenshot(return_img=True))[..., :3].copy()
+        finally:
+            plotter.close()
+    else:
+        img = _mpl_frame_image(pos, skeleton, frame, (w, h), view)
+    if path is not None:
+        from matplotlib.image import imsave
+
+        with atomic_target(path) as tmp:
+            imsave(tmp, img, format="png")
+    return img
+
+
+def _pipe_to_ffmpeg(frames: Any, path: Path, fps: float, size: tuple[int, int]) -> None:
+    w, h = size
+    cmd = [
+        "ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}",
+        "-r", f"{fps:g}", "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+        "-pix_fmt", "yuv420p", str(path),
+    ]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdin is not None
+    try:
+        for img in frames:
+            proc.stdin.write(np.ascontiguousarray(img[..., :3], dtype=np.uint8).tobytes())
+    finally:
+        proc.stdin.close()
+        err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+        rc = proc.wait()
+    if rc != 0:
+        raise RuntimeError(f"ffmpeg failed writing {path} (exit code {rc}): {err.strip()[-300:]}")
+
+
+def render_animation(
+    positions: Any,
+    skeleton: SkeletonLike,
+    path: str | Path,
+    *,
+    fps: float,
+    out_fps: float | None = 15.0,
+    size: Sequence[int] = (480, 480),
+    view: str = "default",
+    floor: bool = True,
+    radius: float | None = None,
+    backend: str = "auto",
+) -> Path:
+    """Render a clip to ``.gif`` (``plotter.open_gif``) or ``.mp4`` (ffmpeg), atomically.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) float, centimetres, Y up
+        Joint positions at ``fps``.
+    skeleton : Skeleton or (J,) int parents array
+        Hierarchy.
+    path : str or Path
+        Output file, ``.gif`` or ``.mp4``.
+    fps : float
+        Frame rate of ``positions``.
+    out_fps : float or None
+        Playback rate; frames are subsampled to it (``None``: all frames).
+    size : (width, height)
+        Frame size in pixels.
+    view : {"default", "front", "side", "top"}
+        Camera (fixed for the whole clip).
+    floor : bool
+        Draw a floor plane.
+    radius : float, optional
+        Bone radius, centimetres.
+    backend : {"auto", "pyvista", "matplotlib"}
+        Renderer; ``"auto"``/``"pyvista"`` fall back to matplotlib with one warning.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    bones = skeleton_bones(skeleton)
+    pos = check_positions(positions, bones.n_joints)
+    fps = check_fps(fps)
+    w, h = _check_size(size)
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".gif", ".mp4"):
+        raise ValueError(f"path must end in .gif or .mp4, got {path.name!r}")
+    if suffix == ".mp4" and not ffmpeg_available():
+        raise RuntimeError(
+            f"cannot write {path}: MP4 export needs the ffmpeg program on PATH "
+            "(Debian/Ubuntu: `sudo apt-get install ffmpeg`), or save as .gif"
+        )
+    idx = frame_indices(len(pos), fps, out_fps)
+    play_fps = fps if len(idx) < 2 else fps / float(np.mean(np.diff(idx)))
+    if not use_pyvista(backend):
+        from beatlite.viz.animation import animate_skeletons
+
+        anim = animate_skeletons(pos, skeleton, fps, out_fps=out_fps, view=view, panel_size=w / 100, dpi=100)
+        anim.figure.set_size_inches(w / 100, h / 100)
+        return anim.save_as(path)
+    plotter, skel = _scene(pos, bones, (w, h), view, floor, radius)
+    try:
+        with atomic_target(path) as tmp:
+            if suffix == ".gif":
+                plotter.open_gif(str(tmp), fps=play_fps)
+                for k in idx:
+                    skel.update(pos[k])
+                    plotter.write_frame()
+            else:
+
+                def frames() -> Any:
+                    for k in idx:
+                        skel.update(pos[k])
+                        plotter.render()
+                        yield plotter.screenshot(return_img=True)
+
+                _pipe_to_ffmpeg(frames(), tmp, play_fps, (w, h))
+            plotter.close()
+    finally:
+        plotter.close()
+    return path
+
+
+def notebook_backend() -> str:
+    """The pyvista Jupyter backend to use: ``"trame"`` (interactive) when trame is installed, else ``"static"``."""
+    if importlib.util.find_spec("trame") is not None and importlib.util.find_spec("trame_vtk") is not None:
+        return "trame"
+    return "static"
+
+
+def show_skeleton(
+    positions: Any,
+    skeleton: SkeletonLike,
+    frame: int = 0,
+    *,
+    size: Sequence[int] = (600, 500),
+    view: str = "default",
+    jupyter_backend: str | None = None,
+    backend: str = "auto",
+) -> Any:
+    """Show one frame in a notebook: interactive (trame) when installed, a static image otherwise.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) or (J, 3) float, centimetres, Y up
+        Joint positions.
+    skeleton : Skeleton or (J,) int parents array
+        Hierarchy.
+    frame : int
+        Frame to show.
+    size : (width, height)
+        Pixels.
+    view : {"default", "front", "side", "top"}
+        Initial camera.
+    jupyter_backend : str, optional
+        pyvista's Jupyter backend (default :func:`notebook_backend`: ``"trame"`` or ``"static"``).
+    backend : {"auto", "pyvista", "matplotlib"}
+        ``"matplotlib"`` (or a failed probe, with one warning) returns a matplotlib figure.
+
+    Returns
+    -------
+    object
+        In a notebook, what ``Plotter.show`` returns (it displays a trame widget or a
+        static image); outside a notebook the ``(H, W, 3) uint8`` image; a matplotlib
+        Figure when pyvista cannot render.
+    """
+    bones = skeleton_bones(skeleton)
+    pos = check_positions(positions, bones.n_joints)
+    w, h = _check_size(size)
+    if not -len(pos) <= int(frame) < len(pos):
+        raise ValueError(f"frame={frame!r} is not a frame index for {len(pos)} frames")
+    if not use_pyvista(backend):
+        from beatlite.viz.plot3d import plot_frame
+
+        return plot_frame(pos, skeleton, int(frame), view=view, figsize=(w / 100, h / 100))
+    k = int(frame) % len(pos)
+    plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, True, None)
+    if not _in_notebook():
+        try:
+            return np.asarray(plotter.screenshot(return_img=True))[..., :3].copy()
+        finally:
+            plotter.close()
+    return plotter.show(jupyter_backend=jupyter_backend or notebook_backend())
+
+
+def _in_notebook() -> bool:
+    """True inside a Jupyter kernel (IPython's ZMQ shell)."""
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return shell is not None and type(shell).__name__ == "ZMQInteractiveShell"

@@ -1,0 +1,176 @@
+"""beatlite.data.index on a tiny hand-made corpus with known answers."""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_data_fixtures import make_tiny_take, write_tiny_bvh, write_wav
+
+from beatlite.data.index import MAX_DURATION_GAP, TakeIndex, TakeRecord, index_folder
+
+# stem -> seconds; splits by BEAT's rule for the 4-hour speakers 2 and 4 (facts A.8):
+# speech 1-8 test, 9-56 train, 57-64 val; 74 lies inside the anger block 73-80 -> train.
+GOOD = {
+    "2_scott_0_1_1": 4.0,  # test, neutral
+    "2_scott_0_9_9": 6.0,  # train
+    "2_scott_0_57_57": 3.0,  # val
+    "2_scott_0_74_74": 2.0,  # train, anger
+    "4_lawrence_0_9_9": 5.0,  # train
+}
+
+
+def _gzip_all(folder: Path, stem: str) -> None:
+    for p in list(folder.glob(f"{stem}.*")):
+        with open(p, "rb") as src, gzip.open(p.with_name(p.name + ".gz"), "wb") as dst:
+            shutil.copyfileobj(src, dst)
+        p.unlink()
+
+
+@pytest.fixture()
+def corpus(tmp_path: Path) -> Path:
+    root = tmp_path / "beat_english_v0.2.1"
+    for stem, seconds in GOOD.items():
+        make_tiny_take(root / stem.split("_")[0], stem, seconds)
+    # a gzipped take (every file .gz): 5 s, train
+    make_tiny_take(root / "2", "2_scott_0_10_10", 5.0)
+    _gzip_all(root / "2", "2_scott_0_10_10")
+    # problem takes in a flat side folder
+    bad = root / "extra"
+    make_tiny_take(bad, "2_scott_0_11_11", 4.0, modalities=("wav",))  # wav without bvh
+    make_tiny_take(bad, "hello_world", 4.0)  # a bad name
+    make_tiny_take(bad, "2_scott_0_12_12", 5.0, wav_seconds=8.0)  # 3 s disagreement
+    make_tiny_take(bad, "2_scott_0_13_13", 4.0)
+    (bad / "2_scott_0_13_13.json").write_text("{not json", encoding="utf-8")  # unreadable
+    (bad / "README.md").write_text("not a take\n", encoding="utf-8")  # ignored
+    return tmp_path
+
+
+def test_counts_durations_and_splits(corpus: Path) -> None:
+    idx = index_folder(corpus)
+    assert len(idx) == 5 + 1 + 4  # 5 good, 1 gzipped, 4 flagged; README ignored
+    ok = idx.where(ok=True)
+    assert sorted(ok.stems) == sorted([*GOOD, "2_scott_0_10_10"])
+    # durations from headers: BVH frames/15, WAV samples/16000, JSON frames/60, TextGrid xmax
+    for r in ok:
+        expected = GOOD.get(r.stem, 5.0)
+        for modality in ("motion", "audio", "face", "text"):
+            assert r.durations[modality] == pytest.approx(expected, abs=1e-3), (r.stem, modality)
+    # split membership: train = 9, 74, lawrence 9 and the gzipped 10 -> 6 + 2 + 5 + 5 = 18 s
+    train = ok.where(split="train")
+    assert sorted(train.stems) == sorted(
+        ["2_scott_0_9_9", "2_scott_0_10_10", "2_scott_0_74_74", "4_lawrence_0_9_9"]
+    )
+    assert train.total_duration == pytest.approx(18.0, abs=1e-3)
+    assert ok.where(split="val").stems == ["2_scott_0_57_57"]
+    assert ok.where(split="test").stems == ["2_scott_0_1_1"]
+    assert ok.speaker_ids() == [2, 4]
+    # name fields
+    r = idx["2_scott_0_74_74"]
+    assert (r.speaker_id, r.speaker, r.session_type, r.sequence, r.emotion) == (2, "scott", 0, 74, 2)
+    assert r.language == "english" and r.conversation is False
+
+
+def test_gz_variants_are_found(corpus: Path) -> None:
+    r = index_folder(corpus)["2_scott_0_10_10"]
+    assert all(p.name.endswith(".gz") for p in r.files.values())
+    assert len(r.files) == 6 and r.ok
+
+
+def test_problem_takes_are_flagged_not_crashing(corpus: Path) -> None:
+    idx = index_folder(corpus)
+    problems = idx.problems()
+    assert set(problems) == {"2_scott_0_11_11", "hello_world", "2_scott_0_12_12", "2_scott_0_13_13"}
+    wav_only = idx["2_scott_0_11_11"]
+    assert any("missing motion (.bvh)" in p for p in wav_only.problems)
+    assert not wav_only.usable and wav_only.has("audio") and not wav_only.has("motion")
+    bad_name = idx["hello_world"]
+    assert bad_name.speaker_id is None and bad_name.split is None
+    assert any(p.startswith("bad name") for p in bad_name.problems) and not bad_name.usable
+    gap = idx["2_scott_0_12_12"]
+    assert any("durations disagree" in p and "audio 8.00 s" in p for p in gap.problems)
+    assert not gap.usable and 8.0 - 5.0 > MAX_DURATION_GAP
+    broken = idx["2_scott_0_13_13"]
+    assert any(p.startswith("unreadable face file 2_scott_0_13_13.json") for p in broken.problems)
+    assert "face" not in broken.durations and broken.usable  # face is optional for training
+    # bad-name takes sort last
+    assert idx.stems[-1] == "hello_world"
+
+
+def test_missing_optional_files_are_listed(tmp_path: Path) -> None:
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0, modalities=("bvh", "wav"))
+    r = index_folder(tmp_path)["2_scott_0_9_9"]
+    assert r.usable and not r.ok
+    assert {p.split(" (")[0] for p in r.problems} == {
+        "missing face",
+        "missing text",
+        "missing semantic",
+        "missing emotion",
+    }
+
+
+def test_flat_folder_non_recursive(tmp_path: Path) -> None:
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
+    make_tiny_take(tmp_path / "sub", "2_scott_0_1_1", 3.0)
+    assert index_folder(tmp_path, recursive=False).stems == ["2_scott_0_9_9"]
+    assert sorted(index_folder(tmp_path).stems) == ["2_scott_0_1_1", "2_scott_0_9_9"]
+
+
+def test_duplicate_files_flagged(tmp_path: Path) -> None:
+    make_tiny_take(tmp_path / "a", "2_scott_0_9_9", 3.0)
+    (tmp_path / "b").mkdir()
+    write_tiny_bvh(tmp_path / "b" / "2_scott_0_9_9.bvh", 45)
+    r = index_folder(tmp_path)["2_scott_0_9_9"]
+    assert any(p.startswith("duplicate motion files") for p in r.problems)
+    assert r.files["motion"].parent.name == "a"  # sorted path order: a/ before b/
+
+
+def test_read_durations_false_lists_files_only(tmp_path: Path) -> None:
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
+    r = index_folder(tmp_path, read_durations=False)["2_scott_0_9_9"]
+    assert r.durations == {} and len(r.files) == 6 and r.duration == 0.0
+
+
+def test_where_variants_and_errors(corpus: Path) -> None:
+    idx = index_folder(corpus)
+    assert len(idx.where(speaker_id=[2, 4], ok=True)) == 6
+    assert len(idx.where(sequence=lambda s: s is not None and s >= 57, ok=True)) == 2  # 57 and 74
+    assert len(idx.where(split={"val", "test"}, ok=True)) == 2
+    with pytest.raises(ValueError, match="unknown field 'splitt'"):
+        idx.where(splitt="train")
+    with pytest.raises(KeyError, match="no take '2_scott_0_99_99'"):
+        idx["2_scott_0_99_99"]
+
+
+def test_rows_and_markdown(corpus: Path) -> None:
+    idx = index_folder(corpus).where(ok=True)
+    rows = idx.to_rows()
+    assert len(rows) == 6
+    assert {"stem", "speaker_id", "split", "duration", "has_motion", "dur_audio", "problems"} <= set(rows[0])
+    md = idx.to_markdown().splitlines()
+    assert md[0].startswith("| stem | speaker |") and len(md) == 2 + 6
+    assert "| 2_scott_0_1_1 | scott | english | neutral | test | 4.0 | bvh wav json textgrid txt csv |  |" in md
+    short = idx.to_markdown(["stem", "split"], max_rows=2).splitlines()
+    assert short[-1] == "... (4 more)" and short[0] == "| stem | split |"
+    with pytest.raises(ValueError, match="unknown columns"):
+        idx.to_markdown(["nope"])
+
+
+def test_wrong_frame_time_shows_as_disagreement(tmp_path: Path) -> None:
+    # a BEAT quirk (facts A.3): 120-fps data with 'Frame Time: 0.041667' -> 5x too long
+    write_tiny_bvh(tmp_path / "2_scott_0_9_9.bvh", 120 * 2, frame_time=0.041667)
+    write_wav(tmp_path / "2_scott_0_9_9.wav", np.zeros(2 * 16000, np.float32))
+    r = index_folder(tmp_path)["2_scott_0_9_9"]
+    assert r.durations["motion"] == pytest.approx(240 * 0.041667)
+    assert any("durations disagree" in p for p in r.problems)
+
+
+def test_not_a_folder(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError, match="is not a folder"):
+        index_folder(tmp_path / "missing")
+    with pytest.raises(TypeError, match="TakeRecord"):
+        TakeIndex(["x"])  # type: ignore[list-item]
+    assert TakeRecord("x").duration == 0.0

@@ -1,0 +1,216 @@
+"""Tests of load_take (every modality on one timeline, resampling phases, truncation) and a check that
+no reader modifies its input."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beatlite.io import (
+    AlignmentWarning,
+    EmotionSegment,
+    FormatError,
+    Interval,
+    Motion,
+    SemanticSegment,
+    load_take,
+    read_audio,
+    read_bvh,
+    read_bvh_header,
+    read_emotion,
+    read_facial,
+    read_semantic,
+    read_textgrid,
+    read_words,
+    write_bvh,
+    write_emotion,
+    write_facial,
+    write_semantic,
+    write_textgrid,
+    write_wav,
+)
+from beatlite.io.take import resample_frames
+from beatlite.skeleton.core import Skeleton
+
+
+def skeleton() -> Skeleton:
+    return Skeleton(
+        names=("Hips", "Spine"),
+        parents=np.array([-1, 0]),
+        offsets=np.array([[0.0, 0, 0], [0, 10, 0]]),
+        channels=(
+            ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation"),
+            ("Xrotation", "Yrotation", "Zrotation"),
+        ),
+    )
+
+
+def make_take(
+    folder: Path,
+    stem: str = "2_scott_0_65_65",
+    *,
+    bvh_fps: int = 120,
+    seconds: float = 2.0,
+    audio_seconds: float | None = None,
+    face_seconds: float | None = None,
+) -> Path:
+    n = int(round(bvh_fps * seconds))
+    # every channel of frame k holds k (+ column offset), so decimation is visible in the values
+    channels = np.arange(n, dtype=np.float64)[:, None] + np.arange(9)[None, :] * 1000
+    write_bvh(folder / f"{stem}.bvh.gz", Motion(skeleton(), channels, bvh_fps))
+    a_sec = seconds if audio_seconds is None else audio_seconds
+    write_wav(folder / f"{stem}.wav", 0.1 * np.sin(np.arange(int(48000 * a_sec)) / 10), 48000)
+    f_sec = seconds if face_seconds is None else face_seconds
+    nf = int(round(60 * f_sec))
+    face = np.repeat(np.arange(nf, dtype=np.float64)[:, None] / 1000, 51, axis=1)
+    write_facial(folder / f"{stem}.json", [f"s{i}" for i in range(51)], face, fps=60)
+    write_textgrid(
+        folder / f"{stem}.TextGrid",
+        {"words": [Interval(0.2, 0.6, "hello"), Interval(0.6, 1.0, "world")]},
+        seconds,
+    )
+    write_semantic(folder / f"{stem}.txt", [SemanticSegment("01_beat_align", 0.5, 1.0, 0.5, 0.25)])
+    write_emotion(folder / f"{stem}.csv", [EmotionSegment(stem, 1.0, 1.5, 0.5, 5)])
+    return folder / stem
+
+
+def test_load_take_start_phase(tmp_path: Path) -> None:
+    stem = make_take(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # equal lengths: no warning
+        take = load_take(stem)
+    assert take.name == "2_scott_0_65_65" and take.fps == 15.0 and take.n_frames == 30
+    # 120 -> 15 fps: frames 0, 8, 16, ... (exact decimation from frame 0)
+    np.testing.assert_array_equal(take.motion.channels[:, 0], np.arange(30) * 8)
+    np.testing.assert_array_equal(take.motion.channels[:, 8], np.arange(30) * 8 + 8000)
+    # face 60 -> 15 fps: frames 0, 4, 8, ...
+    assert take.face is not None and take.face.shape == (30, 51)
+    np.testing.assert_allclose(take.face[:, 0], np.arange(30) * 4 / 1000, rtol=1e-6)
+    assert take.audio is not None and take.sr == 16000 and take.audio.shape == (32000,)
+    assert take.words is not None and take.words.words == ("hello", "world")
+    # semantic [0.5, 1.0] -> frames 8..15 (t = 0.533 .. 1.0); emotion [1.0, 1.5] -> frames 15..22
+    assert np.flatnonzero(take.semantic).tolist() == list(range(8, 16))
+    assert np.flatnonzero(take.emotion == 5).tolist() == list(range(15, 23))
+    assert take.info is not None and take.info.emotion_name == "happiness"
+    assert set(take.paths) == {".bvh", ".wav", ".json", ".TextGrid", ".txt", ".csv"}
+
+
+def test_load_take_beat_phase_and_path_argument(tmp_path: Path) -> None:
+    stem = make_take(tmp_path)
+    take = load_take(str(stem) + ".bvh.gz", phase="beat")
+    # BEAT keeps 120-fps frames 1, 9, 17, ... (facts A.3): 239 source frames after frame 0 -> 30 frames
+    np.testing.assert_array_equal(take.motion.channels[:, 0], 1 + np.arange(30) * 8)
+    assert take.face is not None
+    np.testing.assert_allclose(take.face[:, 0], np.arange(30) * 4 / 1000, rtol=1e-6)  # face from frame 0
+
+
+def test_truncation_warns_with_lengths(tmp_path: Path) -> None:
+    stem = make_take(tmp_path, audio_seconds=1.5)
+    with pytest.warns(AlignmentWarning, match=r"motion 2\.000 s.*audio 1\.500 s.*face 2\.000 s"):
+        take = load_take(stem)
+    assert take.n_frames == 22  # floor(1.5 * 15)
+    assert take.face is not None and take.face.shape[0] == 22
+    assert take.audio is not None and take.audio.shape[0] == 23466  # floor(22 * 16000 / 15)
+    assert take.semantic.shape == (22,) and take.emotion.shape == (22,)
+
+
+def test_no_warning_within_one_frame(tmp_path: Path) -> None:
+    stem = make_take(tmp_path, face_seconds=2.0 - 1 / 60)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        take = load_take(stem)
+    assert take.n_frames == 30  # 119 face frames still give 30 frames at 15 fps (0, 4, ..., 116)
+
+
+def test_missing_optional_files(tmp_path: Path) -> None:
+    stem = make_take(tmp_path, stem="5_stewart_0_3_3")
+    for ext in (".wav", ".json", ".TextGrid", ".txt", ".csv"):
+        (tmp_path / f"5_stewart_0_3_3{ext}").unlink()
+    take = load_take(stem)
+    assert take.audio is None and take.face is None and take.words is None
+    assert take.n_frames == 30 and (take.semantic == 0).all() and (take.emotion == 0).all()
+    with pytest.raises(FileNotFoundError):
+        load_take(tmp_path / "2_scott_0_9_9")
+
+
+def test_non_integer_ratio_interpolates() -> None:
+    # 50 -> 15 fps: output frame i is source position i * 10/3; a linear ramp stays a linear ramp
+    values = np.arange(100, dtype=np.float64)[:, None] * np.array([[1.0, 2.0]])
+    out = resample_frames(values, 50, 15)
+    n = int(np.floor(99 * 15 / 50)) + 1  # 30 output frames inside the 99 source intervals
+    np.testing.assert_allclose(out, (np.arange(n) * 10 / 3)[:, None] * np.array([[1.0, 2.0]]), atol=1e-9)
+
+
+def test_angles_interpolate_the_short_way() -> None:
+    # 2 -> 4 fps: source positions 0, 0.5, 1. Column 0 is an angle: 170 -> -170 is +20 deg across 180,
+    # so halfway is 180 (mod 360), not 0; column 1 is a position and is interpolated linearly.
+    values = np.array([[170.0, 170.0], [-170.0, -170.0]])
+    out = resample_frames(values, 2.0, 4.0, angle_columns=np.array([0]))
+    assert out.shape == (3, 2)
+    assert out[0].tolist() == [170.0, 170.0] and out[2, 1] == -170.0
+    assert abs((out[1, 0] % 360.0) - 180.0) < 1e-9
+    assert out[1, 1] == 0.0
+    assert abs(((out[2, 0] + 170.0) + 180.0) % 360.0 - 180.0) < 1e-9  # -170 (mod 360)
+
+
+# ----------------------------------------------------------------------------- readers never write
+
+
+def _snapshot(folder: Path) -> dict[str, tuple[bytes, int, int]]:
+    return {
+        p.name: (p.read_bytes(), p.stat().st_mtime_ns, p.stat().st_mode) for p in sorted(folder.iterdir())
+    }
+
+
+def test_readers_do_not_modify_generated_files(tmp_path: Path) -> None:
+    stem = make_take(tmp_path)
+    before = _snapshot(tmp_path)
+    name = stem.name
+    readers: list[tuple[Callable[..., object], str]] = [
+        (read_bvh, ".bvh.gz"),
+        (read_bvh_header, ".bvh.gz"),
+        (read_audio, ".wav"),
+        (read_facial, ".json"),
+        (read_textgrid, ".TextGrid"),
+        (read_words, ".TextGrid"),
+        (read_semantic, ".txt"),
+        (read_emotion, ".csv"),
+    ]
+    for reader, ext in readers:
+        reader(tmp_path / f"{name}{ext}")
+    load_take(stem)
+    assert _snapshot(tmp_path) == before  # same files, bytes, mtimes and permissions; no temp files
+
+
+def test_failing_readers_do_not_modify(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.bvh"
+    bad.write_text("HIERARCHY\nROOT a\n{\n")
+    for ext in (".wav", ".json", ".TextGrid", ".txt", ".csv"):
+        (tmp_path / f"bad{ext}").write_text("version https://git-lfs.github.com/spec/v1\n")
+    before = _snapshot(tmp_path)
+    for reader, ext in [
+        (read_bvh, ".bvh"),
+        (read_audio, ".wav"),
+        (read_facial, ".json"),
+        (read_textgrid, ".TextGrid"),
+        (read_semantic, ".txt"),
+        (read_emotion, ".csv"),
+    ]:
+        with pytest.raises(FormatError):
+            reader(tmp_path / f"bad{ext}")
+    assert _snapshot(tmp_path) == before
+
+
+def test_real_files_untouched(real_samples: Path) -> None:
+    before = {p.name: (p.read_bytes(), os.stat(p).st_mtime_ns) for p in real_samples.iterdir()}
+    read_bvh(real_samples / "beat_skeleton_2_scott_0_1_1_frame0.bvh")
+    read_bvh(real_samples / "dataset-1_bye_normal_001.bvh")
+    read_audio(real_samples / "2_scott_0_2_2.wav")
+    read_textgrid(real_samples / "2_scott_0_2_2.TextGrid")
+    after = {p.name: (p.read_bytes(), os.stat(p).st_mtime_ns) for p in real_samples.iterdir()}
+    assert after == before

@@ -1,0 +1,331 @@
+"""Tests of beatlite.metrics: FGD, SRGR, diversity, extras, evaluate (numpy only, fast)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy import linalg
+
+from beatlite.metrics import (
+    diversity,
+    evaluate,
+    fgd,
+    fit_gaussian,
+    frechet_distance,
+    jerk_stats,
+    l1_diversity,
+    mae,
+    mpjpe,
+    pck,
+    srgr,
+    velocity_stats,
+)
+from beatlite.metrics._checks import sliding_windows
+from beatlite.metrics.srgr import srgr_per_frame
+
+
+def test_import_does_not_import_torch():
+    code = "import sys, beatlite.metrics; assert 'torch' not in sys.modules, 'torch imported'"
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# ----------------------------------------------------------------------------- FGD
+def test_fgd_of_a_set_with_itself_is_zero():
+    x = np.random.default_rng(0).normal(size=(300, 20))
+    assert fgd(x, x) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_fgd_symmetric_and_nonnegative():
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        x = rng.normal(size=(100, 8)) @ rng.normal(size=(8, 8))
+        y = rng.normal(size=(150, 8)) * rng.uniform(0.1, 3, 8) + rng.normal(size=8)
+        assert fgd(x, y) >= 0
+        assert fgd(x, y) == pytest.approx(fgd(y, x), rel=1e-9)
+
+
+def test_frechet_closed_form_diagonal():
+    # Commuting diagonal covariances: d = |mu1 - mu2|^2 + sum_i (s1_i - s2_i)^2 (s = standard deviations).
+    mu1, mu2 = np.array([0.0, 1.0, 2.0]), np.array([1.0, 1.0, 0.0])
+    s1, s2 = np.array([1.0, 2.0, 3.0]), np.array([2.0, 2.0, 1.0])
+    expected = (1 + 0 + 4) + (1 + 0 + 4)  # 10
+    d = frechet_distance(mu1, np.diag(s1**2), mu2, np.diag(s2**2))
+    assert d == pytest.approx(expected, rel=1e-12)
+
+
+def test_frechet_two_d_written_out():
+    # sigma1 = I, sigma2 = [[2,1],[1,2]] (eigenvalues 3 and 1), mu2 - mu1 = (1, 2):
+    # d = 5 + tr(I) + tr(sigma2) - 2 tr(sigma2^1/2) = 5 + 2 + 4 - 2 (sqrt 3 + 1) = 9 - 2 sqrt 3.
+    s2 = np.array([[2.0, 1.0], [1.0, 2.0]])
+    d = frechet_distance(np.zeros(2), np.eye(2), np.array([1.0, 2.0]), s2)
+    assert d == pytest.approx(9 - 2 * math.sqrt(3), rel=1e-12)
+
+
+def test_frechet_non_commuting_two_d():
+    # sigma1 = diag(4, 1), sigma2 = [[2,1],[1,2]]: M = sigma1^1/2 sigma2 sigma1^1/2 = [[8,2],[2,2]];
+    # for a 2x2 PSD M, tr sqrt(M) = sqrt(tr M + 2 sqrt(det M)) = sqrt(10 + 2 sqrt 12).
+    # d = 0 + 5 + 4 - 2 sqrt(10 + 2 sqrt 12)
+    s1, s2 = np.diag([4.0, 1.0]), np.array([[2.0, 1.0], [1.0, 2.0]])
+    expected = 9 - 2 * math.sqrt(10 + 2 * math.sqrt(12))
+    assert frechet_distance(np.zeros(2), s1, np.zeros(2), s2) == pytest.approx(expected, rel=1e-12)
+    assert frechet_distance(np.zeros(2), s1, np.zeros(2), s2, reference=True) == pytest.approx(
+        expected, rel=1e-9
+    )
+
+
+def test_stable_matches_scipy_sqrtm_oracle():
+    rng = np.random.default_rng(2)
+    a, b = rng.normal(size=(400, 30)), rng.normal(size=(500, 30)) @ rng.normal(size=(30, 30)) * 0.3
+    mu1, s1 = a.mean(0), np.cov(a, rowvar=False)
+    mu2, s2 = b.mean(0), np.cov(b, rowvar=False)
+    oracle = ((mu1 - mu2) ** 2).sum() + np.trace(s1 + s2) - 2 * np.trace(linalg.sqrtm(s1 @ s2).real)
+    assert frechet_distance(mu1, s1, mu2, s2) == pytest.approx(oracle, rel=1e-7)
+    assert fgd(a, b, reference=True) == pytest.approx(oracle, rel=1e-7)
+
+
+def test_frechet_rank_deficient_covariance_is_finite():
+    # 5 samples in 20 dims: singular covariances; tiny negative eigenvalues must be clipped.
+    rng = np.random.default_rng(3)
+    x, y = rng.normal(size=(5, 20)), rng.normal(size=(6, 20))
+    d = fgd(x, y)
+    assert np.isfinite(d) and d >= 0
+
+
+def test_fit_gaussian_equals_numpy_cov():
+    x = np.random.default_rng(4).normal(size=(50, 4))
+    mu, s = fit_gaussian(x)
+    np.testing.assert_allclose(mu, x.mean(0))
+    np.testing.assert_allclose(s, np.cov(x, rowvar=False))
+
+
+def test_fgd_errors_name_the_argument():
+    with pytest.raises(ValueError, match="generated needs at least 2 samples"):
+        fgd(np.zeros((1, 3)), np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="real needs at least 2"):
+        fgd(np.zeros((4, 3)), np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="real must be 2-D"):
+        fgd(np.zeros((4, 3)), np.zeros(5))
+    with pytest.raises(ValueError, match="width"):
+        fgd(np.ones((4, 3)), np.ones((4, 2)))
+    with pytest.raises(ValueError, match="sigma2"):
+        frechet_distance(np.zeros(2), np.eye(2), np.zeros(2), np.eye(3))
+
+
+def test_fgd_with_a_pluggable_extractor():
+    # Extractor = mean over time; windows with equal time-means have FGD 0.
+    rng = np.random.default_rng(5)
+    w = rng.normal(size=(40, 34, 3))
+    flipped = w[:, ::-1]  # same per-window mean over time
+
+    def extractor(x):
+        return x.mean(axis=1)
+
+    assert fgd(w, flipped, extractor=extractor) == pytest.approx(0.0, abs=1e-9)
+    with pytest.raises(ValueError, match="extractor must map"):
+        fgd(w, w, extractor=lambda x: x.mean(axis=(1, 2)))
+
+
+# ----------------------------------------------------------------------------- SRGR
+def _positions(t=6, j=4, seed=0):
+    return np.random.default_rng(seed).normal(scale=20, size=(t, j, 3))
+
+
+def test_srgr_paper_perfect_prediction_is_mean_semantic():
+    p = _positions()
+    sem = np.array([0.0, 0.1, 0.8, 0.5, 1.0, 0.2])
+    assert srgr(p, p, sem) == pytest.approx(sem.mean())
+
+
+def test_srgr_paper_all_miss_is_zero():
+    p = _positions()
+    assert srgr(p + np.array([0, 0, 10.5]), p, np.ones(6), delta=10.0) == 0.0  # every error 10.5 cm >= 10
+
+
+def test_srgr_paper_hand_computed():
+    # T = 2, J = 2, delta = 10 cm, semantic [0.5, 1.0]:
+    # frame 0 errors [0, 20] -> hits [1, 0]; frame 1 errors [5, 12] -> hits [1, 0]
+    # SRGR = (0.5 * 1 + 1.0 * 1) / (2 * 2) = 0.375
+    gt = np.zeros((2, 2, 3))
+    gen = gt.copy()
+    gen[0, 1, 0] = 20.0
+    gen[1, 0, 1] = 5.0
+    gen[1, 1, 2] = 12.0
+    assert srgr(gen, gt, np.array([0.5, 1.0]), delta=10.0) == pytest.approx(0.375)
+    np.testing.assert_allclose(srgr_per_frame(gen, gt, np.array([0.5, 1.0]), delta=10.0), [0.25, 0.5])
+
+
+def test_srgr_reference_hand_computed():
+    # Euler degrees, T = 2, C = 6 (J = 2), threshold 4 on the summed |diff|, weight sem / 0.165:
+    # frame 0: joint 0 |1|+|1|+|1| = 3 < 4 hit; joint 1 2+2+0 = 4 miss; weight 0.33/0.165 = 2 -> 2
+    # frame 1: joint 0 0 hit; joint 1 1 hit;                   weight 0.165/0.165 = 1 -> 2
+    # SRGR = (2 + 2) / (2 * 2) = 1.0
+    gt = np.zeros((2, 6))
+    gen = np.array([[1, -1, 1, 2, 2, 0], [0, 0, 0, 0, 0, 1.0]])
+    assert srgr(gen, gt, np.array([0.33, 0.165]), variant="reference") == pytest.approx(1.0)
+
+
+def test_srgr_takes_are_frame_weighted():
+    # take A: T = 1, perfect, sem 1 -> 1.0; take B: T = 3, all miss -> 0. Pooled: (1*1 + 3*0) / 4 = 0.25
+    a = np.zeros((1, 2, 3))
+    b = np.zeros((3, 2, 3))
+    value = srgr([a, b + 100.0], [a, b], [np.ones(1), np.ones(3)])
+    assert value == pytest.approx(0.25)
+
+
+def test_srgr_errors():
+    p = _positions()
+    with pytest.raises(ValueError, match="semantic must have one value per frame"):
+        srgr(p, p, np.ones(5))
+    with pytest.raises(ValueError, match="same shape"):
+        srgr(p, p[:, :3], np.ones(6))
+    with pytest.raises(ValueError, match="variant"):
+        srgr(p, p, np.ones(6), variant="paperish")
+    with pytest.raises(ValueError, match="generated must be 2-D"):
+        srgr(p, p, np.ones(6), variant="reference")
+
+
+# ----------------------------------------------------------------------------- diversity
+def test_l1_diversity_hand_computed():
+    # one take [0, 2, 4]: mean 2, sum |x - 2| = 4, / 3 frames
+    assert l1_diversity(np.array([[0.0], [2.0], [4.0]])) == pytest.approx(4 / 3)
+    # two takes: [0, 2] (mean 1, sum 2) and four frames of 1 (sum 0): 2 / 6 frames
+    assert l1_diversity([np.array([[0.0], [2.0]]), np.ones((4, 1))]) == pytest.approx(2 / 6)
+
+
+def test_l1_diversity_windowed_quirk_hand_computed():
+    # x = 0..4, windows of 3 every 1: [0,1,2] [1,2,3] [2,3,4] -> 9 frames, mean 2,
+    # sum |x - 2| = 2+1+0 + 1+0+1 + 0+1+2 = 8 -> 8 / 9; without windows: 6 / 5.
+    x = np.arange(5.0)[:, None]
+    assert l1_diversity(x, windowed=True, length=3, stride=1) == pytest.approx(8 / 9)
+    assert l1_diversity(x) == pytest.approx(6 / 5)
+
+
+def test_diversity_of_identical_clips_is_zero():
+    assert l1_diversity(np.ones((10, 5))) == 0.0
+    assert diversity(np.ones((10, 4))) == 0.0
+
+
+def test_diversity_hand_computed_and_deterministic():
+    # two clips [0, 0] and [1, 3]: every pair of distinct clips is at L1 distance 4
+    f = np.array([[0.0, 0.0], [1.0, 3.0]])
+    assert diversity(f, n_pairs=37, seed=5) == pytest.approx(4.0)
+    g = np.random.default_rng(0).normal(size=(20, 6))
+    assert diversity(g, seed=3) == diversity(g, seed=3)
+
+
+def test_diversity_matches_the_mean_over_all_pairs():
+    # uniform random pairs of distinct clips -> expectation = mean over all ordered distinct pairs
+    g = np.random.default_rng(1).normal(size=(12, 5))
+    d = np.abs(g[:, None] - g[None]).sum(-1)
+    exact = d.sum() / (12 * 11)
+    assert diversity(g, n_pairs=200_000, seed=0) == pytest.approx(exact, rel=0.01)
+
+
+def test_diversity_batch_pairing_quirk():
+    # one batch: the permutation can only pair it with itself -> all rows meet themselves -> 0
+    b = np.random.default_rng(2).normal(size=(8, 3))
+    assert diversity([b], batch_pairing=True) == 0.0
+    # loop oracle with the same permutation
+    batches = [np.random.default_rng(k).normal(size=(4, 3)) for k in range(6)]
+    perm = np.random.default_rng(7).permutation(6)[:3]
+    rows = [np.abs(batches[i][r] - batches[perm[i]][r]).sum() for i in range(3) for r in range(4)]
+    assert diversity(batches, n_pairs=3, seed=7, batch_pairing=True) == pytest.approx(np.mean(rows))
+
+
+def test_diversity_errors():
+    with pytest.raises(ValueError, match="at least 2 clips"):
+        diversity(np.ones((1, 3)))
+    with pytest.raises(TypeError, match="list of batches"):
+        diversity(np.ones((4, 3)), batch_pairing=True)
+
+
+# ----------------------------------------------------------------------------- extras
+def test_pck_mae_mpjpe_hand_computed():
+    gt = np.zeros((1, 4, 3))
+    gen = np.zeros((1, 4, 3))
+    gen[0, :, 0] = [0.0, 3.0, 12.0, 4.0]  # errors 0, 3, 12, 4
+    assert pck(gen, gt, delta=5.0) == pytest.approx(3 / 4)
+    assert mpjpe(gen, gt) == pytest.approx(19 / 4)
+    assert mae(gen, gt) == pytest.approx(19 / 12)
+
+
+def test_velocity_and_jerk_closed_forms():
+    fps = 15.0
+    t = np.arange(10.0)
+    lin = np.zeros((10, 1, 3))
+    lin[:, 0, 0] = 2 * t  # 2 cm per frame -> 30 cm/s
+    v = velocity_stats(lin, fps)
+    assert v["mean"] == pytest.approx(30.0) and v["std"] == pytest.approx(0.0, abs=1e-9)
+    cubic = np.zeros((10, 1, 3))
+    cubic[:, 0, 1] = t**3  # third difference of t^3 is 6 -> 6 fps^3
+    assert jerk_stats(cubic, fps)["mean"] == pytest.approx(6 * fps**3)
+
+
+def test_sliding_windows():
+    x = np.arange(10)
+    w = sliding_windows(x, 4, 3)  # starts 0, 3, 6
+    np.testing.assert_array_equal(w, [[0, 1, 2, 3], [3, 4, 5, 6], [6, 7, 8, 9]])
+    assert sliding_windows(x, 11, 1).shape == (0, 11)
+
+
+# ----------------------------------------------------------------------------- evaluate
+def test_evaluate_ground_truth_against_itself():
+    rng = np.random.default_rng(0)
+    pos = np.cumsum(rng.normal(size=(60, 5, 3)), axis=0)
+    sem = rng.uniform(0, 1, 60)
+    windows = sliding_windows(pos.reshape(60, -1), 34, 2)
+    rep = evaluate(
+        pos,
+        pos,
+        semantic=sem,
+        extractor=lambda w: w.mean(axis=1),
+        generated_windows=windows,
+        real_windows=windows,
+    )
+    assert rep.get("FGD", "stable").value == pytest.approx(0.0, abs=1e-9)
+    assert rep.get("SRGR", "paper").value == pytest.approx(sem.mean())
+    assert rep.get("PCK").value == 1.0
+    assert rep.get("MPJPE").value == 0.0
+    assert "BeatAlign" in rep.skipped and "BC" in rep.skipped
+    md = rep.to_markdown()
+    assert md.splitlines()[0].startswith("| metric | variant | value")
+    assert "| SRGR | paper |" in md and "skipped" in md
+    with pytest.raises(KeyError, match="no metric"):
+        rep.get("nonsense")
+
+
+def test_evaluate_rejects_mismatched_takes():
+    p = np.zeros((10, 3, 3))
+    with pytest.raises(ValueError, match="differ"):
+        evaluate(p, p[:5])
+
+
+def test_evaluate_on_beat_skeleton_motion_with_audio():
+    from beatlite.skeleton.beat import beat_skeleton
+    from beatlite.skeleton.kinematics import forward_kinematics
+
+    sk = beat_skeleton()
+    rng = np.random.default_rng(0)
+    t = np.arange(90) / 15.0
+    channels = np.zeros((90, sk.n_channels))
+    channels[:, 6:] = 15 * np.sin(2 * np.pi * 0.7 * t[:, None] + rng.uniform(0, 6, sk.n_channels - 6))
+    pos = forward_kinematics(sk, channels)
+    audio = np.zeros(6 * 16000, np.float32)
+    audio[16000 * np.arange(1, 6)] = 0.9  # one-sample clicks every second
+    rep = evaluate(
+        pos,
+        pos,
+        audio=audio,
+        semantic=np.full(90, 0.5),
+        generated_euler=channels,
+        ground_truth_euler=channels,
+    )
+    ba, ba_gt = rep.get("BeatAlign", "positions").value, rep.get("BeatAlign", "positions, ground truth").value
+    assert ba == ba_gt and 0 <= ba <= 1
+    assert 0 <= rep.get("BC").value <= 1
+    assert rep.get("SRGR", "reference").value == pytest.approx(0.5 / 0.165)
+    assert rep.get("L1div", "reference (windowed)").value > 0

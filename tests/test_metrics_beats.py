@@ -1,0 +1,292 @@
+"""Tests of BeatAlign (BEAT) and Beat Consistency (HA2G) on synthetic click tracks and sinusoids."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from beatlite.metrics import audio_beats, beat_align, beat_consistency, gaussian_alignment
+from beatlite.metrics.beat_align import REFERENCE_COLUMNS_141, motion_beat_times
+from beatlite.metrics.beats import (
+    alignment_score,
+    angle_change_beats,
+    angle_change_curve,
+    append_palm_normals,
+    euler_speed,
+    local_minima,
+    mean_angle_change,
+    nearest_distance,
+)
+
+SR = 16000
+FPS = 15.0
+PERIOD = 0.8  # s = 12 frames = 25 hops of 512 samples
+HOP_S = 512 / SR  # 0.032 s
+# onset_strength peaks up to ~1.25 hop after a click (librosa's framing); beats are never early.
+LATE = 0.04
+
+
+def click_track(times, duration, sr=SR):
+    """Short 1 kHz clicks (10 ms, decaying) at ``times`` seconds."""
+    y = np.zeros(int(duration * sr), np.float32)
+    n = int(0.01 * sr)
+    click = (np.hanning(2 * n)[n:] * np.sin(2 * np.pi * 1000 * np.arange(n) / sr) * 0.8).astype(np.float32)
+    for t in times:
+        i = int(round(t * sr))
+        y[i : i + n] += click[: len(y) - i]
+    return y
+
+
+CLICKS = np.arange(1, 13) * PERIOD  # 0.8 .. 9.6 s
+AUDIO = click_track(CLICKS, 10.0)
+
+
+def swinging_joint(shift_s=0.0, duration=11.0):
+    """(T, 1, 3) positions: x = 10 cos(pi (t - shift) / P) cm -> speed minima at t = k P + shift."""
+    t = np.arange(int(duration * FPS)) / FPS
+    p = np.zeros((len(t), 1, 3))
+    p[:, 0, 0] = 10 * np.cos(np.pi * (t - shift_s) / PERIOD)
+    return p
+
+
+# ----------------------------------------------------------------------------- pieces
+def test_gaussian_alignment_hand_computed():
+    # audio [1.0, 2.0], motion [1.1, 2.5]: distances 0.1 and 0.5, sigma 0.3
+    expected = (math.exp(-0.01 / 0.18) + math.exp(-0.25 / 0.18)) / 2
+    assert gaussian_alignment([1.0, 2.0], [1.1, 2.5], 0.3) == pytest.approx(expected)
+    assert gaussian_alignment([1.0, 2.0], [2.0, 1.0], 0.3) == 1.0  # coinciding beats
+    assert gaussian_alignment([1.0], [], 0.3) == 0.0
+    assert math.isnan(gaussian_alignment([], [1.0], 0.3))
+
+
+def test_nearest_distance_matches_a_loop():
+    rng = np.random.default_rng(0)
+    q, r = rng.uniform(0, 100, 300), rng.uniform(0, 100, 77)
+    loop = np.array([min(abs(a - b) for b in r) for a in q])
+    np.testing.assert_allclose(nearest_distance(q, r), loop)
+
+
+def test_alignment_directions():
+    a, m = np.array([1.0]), np.array([1.0, 5.0])
+    assert alignment_score(a, m, 0.3, "audio_to_motion") == 1.0  # extra motion beat ignored
+    # motion -> audio: (1 + exp(-16 / 0.18)) / 2
+    assert alignment_score(a, m, 0.3, "motion_to_audio") == pytest.approx((1 + math.exp(-16 / 0.18)) / 2)
+    with pytest.raises(ValueError, match="direction"):
+        alignment_score(a, m, 0.3, "both")
+
+
+def test_local_minima_matches_scipy_argrelextrema():
+    from scipy.signal import argrelextrema
+
+    x = np.random.default_rng(1).normal(size=500)
+    for order in (1, 2, 7):
+        np.testing.assert_array_equal(local_minima(x, order), argrelextrema(x, np.less, order=order)[0])
+
+
+def test_audio_beats_find_the_clicks():
+    a = audio_beats(AUDIO, SR)
+    assert len(a) == len(CLICKS)
+    assert np.all(a - CLICKS >= -1e-9) and np.all(a - CLICKS <= LATE)
+
+
+def test_audio_beats_legacy_sr_scales_times():
+    # librosa's default 22050 Hz used for 16 kHz audio: times x 16000 / 22050 = 0.7256
+    a = audio_beats(AUDIO, SR, legacy_sr=True)
+    assert len(a) == len(CLICKS)
+    np.testing.assert_allclose(a * 22050 / 16000, CLICKS, atol=LATE * 22050 / 16000 + 1e-9)
+
+
+def test_audio_beats_backtrack_moves_earlier():
+    plain = audio_beats(AUDIO, SR)
+    for mode in ("rms", "onset"):
+        back = audio_beats(AUDIO, SR, backtrack=mode)
+        assert len(back) == len(plain) and np.all(back <= plain)
+
+
+# ----------------------------------------------------------------------------- BeatAlign
+def test_motion_beats_of_a_swinging_joint():
+    m = motion_beat_times(swinging_joint(), FPS)[0]
+    np.testing.assert_allclose(m, np.arange(1, 14) * PERIOD, atol=1e-9)  # 11 s of motion
+
+
+def test_beat_align_is_one_when_beats_coincide():
+    score = beat_align(AUDIO, SR, swinging_joint(), FPS)
+    assert score >= math.exp(-(LATE**2) / (2 * 0.3**2)) and score <= 1.0
+
+
+def test_beat_align_decreases_with_offset_as_the_gaussian():
+    scores = []
+    for n in range(0, 6):  # motion beats n frames *early*: distance d + (detection delay in [0, LATE])
+        d = n / FPS
+        s = beat_align(AUDIO, SR, swinging_joint(-d), FPS)
+        assert math.exp(-((d + LATE) ** 2) / 0.18) - 1e-9 <= s <= math.exp(-(d**2) / 0.18) + 1e-9
+        scores.append(s)
+    assert all(a > b for a, b in zip(scores, scores[1:]))
+
+
+def test_beat_align_exact_value_with_onset_backtracking():
+    # clicks on hop boundaries (0.8 s = 25 hops) are found exactly when backtracked to the envelope minimum;
+    # motion 2 frames early: d = 2/15 s -> exp(-d^2 / (2 * 0.3^2)) = exp(-0.017778 / 0.18) = 0.90596
+    a = audio_beats(AUDIO, SR, backtrack="onset")
+    np.testing.assert_allclose(a, CLICKS, atol=1e-9)
+    s = beat_align(AUDIO, SR, swinging_joint(-2 / FPS), FPS, backtrack="onset")
+    assert s == pytest.approx(math.exp(-((2 / 15) ** 2) / 0.18), rel=1e-9)
+
+
+def test_beat_align_frozen_pose_scores_zero_and_lists_average():
+    frozen = np.repeat(swinging_joint()[:1], 165, axis=0)
+    assert beat_align(AUDIO, SR, frozen, FPS) == 0.0
+    both = beat_align([AUDIO, AUDIO], SR, [swinging_joint(), frozen], FPS)
+    assert both == pytest.approx(beat_align(AUDIO, SR, swinging_joint(), FPS) / 2)
+
+
+def test_euler_motion_beats_hand_computed():
+    # column 36 = [0, 3, 5, 6, 8, 11, 15]: forward differences 3, 2, 1, 2, 3, 4 (x 15 fps);
+    # index 2 is below its 2 neighbours on each side -> one beat at 2/15 s
+    ch = np.zeros((7, 141))
+    ch[:, 36] = [0, 3, 5, 6, 8, 11, 15]
+    np.testing.assert_allclose(euler_speed(ch, [36, 37, 38], 15)[:, 0], np.array([3, 2, 1, 2, 3, 4]) * 15.0)
+    beats = motion_beat_times(ch, 15, motion_kind="euler")
+    assert len(beats) == 1
+    np.testing.assert_allclose(beats[0], [2 / 15])
+
+
+def test_reference_columns_are_the_ring_finger_triplet_of_the_30_39_slice():
+    assert REFERENCE_COLUMNS_141 == (36, 37, 38)  # 30:39[6:9], "beat_right_wrist" in the reference
+    t = np.arange(165) / FPS
+    wave = 10 * np.cos(np.pi * t / PERIOD)
+    in_slice = np.zeros((165, 141))
+    in_slice[:, 36] = wave
+    arm_only = np.zeros((165, 141))
+    arm_only[:, 9:18] = wave[:, None]  # the real right shoulder/arm/forearm of spine_neck_141
+    assert motion_beat_times(in_slice, FPS, motion_kind="euler")[0].size > 0
+    assert motion_beat_times(arm_only, FPS, motion_kind="euler")[0].size == 0
+    assert beat_align(AUDIO, SR, arm_only, FPS, legacy=True, window=(0.0, 500.0)) == 0.0
+
+
+def test_window_makes_times_relative_to_its_start():
+    full = motion_beat_times(swinging_joint(), FPS)[0]
+    cut = motion_beat_times(swinging_joint(), FPS, window=(1.6, 8.0))[0]
+    inside = full[(full > 1.6 + 1e-9) & (full < 8.0 - 1e-9)] - 1.6
+    # frames [24, 120) are searched; 1.6 s itself is the first sample (never a minimum): beats 2.4 .. 7.2 s
+    np.testing.assert_allclose(cut, inside, atol=1e-9)
+    np.testing.assert_allclose(cut, np.arange(1, 8) * PERIOD, atol=1e-9)
+
+
+def test_beat_align_errors():
+    with pytest.raises(ValueError, match="motion_kind"):
+        beat_align(AUDIO, SR, swinging_joint(), FPS, motion_kind="quaternions")
+    with pytest.raises(ValueError, match=r"motion must be 3-D, got shape \(10, 4\)"):
+        beat_align(AUDIO, SR, np.zeros((10, 4)), FPS)
+    with pytest.raises(ValueError, match="lists of equal length"):
+        beat_align([AUDIO], SR, swinging_joint(), FPS)
+
+
+# ----------------------------------------------------------------------------- HA2G BC
+def test_angle_change_curve_hand_computed():
+    # two vectors, angle 90, 45, 45, 90 deg -> theta/pi = .5, .25, .25, .5; |diffs| .25, 0, .25;
+    # MAAC = 0.5 / 3 = 1/6; c = [0, 1.5, 0, 1.5]
+    ang = np.radians([90, 45, 45, 90])
+    d = np.zeros((4, 2, 3))
+    d[:, 0, 0] = 1
+    d[:, 1, 0], d[:, 1, 1] = np.cos(ang), np.sin(ang)
+    pairs = np.array([[0, 1]])
+    ca = mean_angle_change(d, pairs)
+    np.testing.assert_allclose(ca, [1 / 6])
+    np.testing.assert_allclose(angle_change_curve(d, pairs, ca), [0, 1.5, 0, 1.5], atol=1e-12)
+
+
+def test_angle_change_beats_hand_computed():
+    # t in [2, 7]: t=3 (0.49 between 0.5 and 0.51) drops only 0.01/0.02 < 0.03 -> no beat;
+    # t=6 (0.3 between 0.9 and 0.8) -> beat at 6/15 = 0.4 s
+    c = np.array([0, 1, 0.5, 0.49, 0.51, 0.9, 0.3, 0.8, 1.0])
+    np.testing.assert_allclose(angle_change_beats(c, 15), [0.4])
+
+
+def test_palm_normals():
+    d = np.zeros((1, 42, 3))
+    d[0, :, 0] = 1
+    d[0, 11], d[0, 17] = [1, 0, 0], [0, 2, 0]  # left palm = cross(v11, v17) -> +z
+    d[0, 28], d[0, 34] = [0, 1, 0], [1, 0, 0]  # right palm = cross(v28, v34) -> -z
+    out = append_palm_normals(d)
+    assert out.shape == (1, 44, 3)
+    np.testing.assert_allclose(out[0, 42:], [[0, 0, 1], [0, 0, -1]])
+
+
+def rotating_bone(shift_s=0.0, duration=11.0):
+    """(T, 2, 3) vectors whose included angle is pi/4 + 0.5 cos(pi (t - t0) / P), with its turning
+    points half a frame before k P + shift, so the backward-difference angle change has strict
+    minima exactly at frames k P + shift."""
+    t = np.arange(int(duration * FPS)) / FPS
+    theta = np.pi / 4 + 0.5 * np.cos(np.pi * (t - shift_s + 0.5 / FPS) / PERIOD)
+    d = np.zeros((len(t), 2, 3))
+    d[:, 0, 0] = 1
+    d[:, 1, 0], d[:, 1, 1] = np.cos(theta), np.sin(theta)
+    return d
+
+
+def _bc(audio, dirs, **kw):
+    return beat_consistency(audio, SR, dirs, FPS, pairs=np.array([[0, 1]]), palm_normals=False, **kw)
+
+
+def test_bc_is_one_when_beats_coincide_and_decreases_with_offset():
+    aligned = _bc(AUDIO, rotating_bone())
+    assert aligned >= math.exp(-(LATE**2) / (2 * 0.1**2))
+    scores = [aligned]
+    for n in range(1, 4):
+        d = n / FPS
+        s = _bc(AUDIO, rotating_bone(-d))
+        assert math.exp(-((d + LATE) ** 2) / 0.02) - 1e-9 <= s <= math.exp(-(d**2) / 0.02) + 1e-9
+        scores.append(s)
+    assert all(a > b for a, b in zip(scores, scores[1:]))
+
+
+def test_bc_exact_value_with_onset_backtracking():
+    # motion beats 1 frame early: d = 1/15 s, sigma 0.1 -> exp(-d^2 / 0.02) = exp(-0.22222) = 0.80074
+    s = _bc(AUDIO, rotating_bone(-1 / FPS), backtrack="onset")
+    assert s == pytest.approx(math.exp(-((1 / 15) ** 2) / 0.02), rel=1e-9)
+
+
+def test_bc_clip_protocol_runs_and_stays_high_when_aligned():
+    s = _bc(AUDIO, rotating_bone(), clip_length=34, clip_stride=10)
+    assert s >= math.exp(-(LATE**2) / 0.02)
+    frozen = np.repeat(rotating_bone()[:1], 165, axis=0)
+    maac = mean_angle_change(rotating_bone(), np.array([[0, 1]]))  # "training" statistics
+    assert math.isnan(_bc(AUDIO, frozen, change_angle=maac))  # no motion beat anywhere: nothing to score
+
+
+def test_bc_default_pairs_come_from_the_ted_skeleton():
+    from beatlite.metrics.beat_consistency import default_angle_pairs
+    from beatlite.metrics.beats import included_angles
+    from beatlite.skeleton import ted
+
+    pairs = default_angle_pairs()
+    assert pairs.shape == (41, 2)  # HA2G's 41 pairs
+    assert pairs.min() >= 0 and pairs.max() == 43  # 42 bones + 2 palm normals
+    d = np.random.default_rng(0).normal(size=(5, 42, 3))
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    np.testing.assert_allclose(included_angles(append_palm_normals(d), pairs), ted.pair_angles(d) / np.pi)
+
+
+# ----------------------------------------------------------------------------- librosa oracles
+def test_stft_magnitude_equals_librosa():
+    import librosa
+
+    from beatlite.metrics.beats import stft_magnitude
+
+    y = np.random.default_rng(0).normal(scale=0.1, size=50_001).astype(np.float32)
+    ours = stft_magnitude(y, chunk=7)  # several chunks
+    ref = np.abs(librosa.stft(y, n_fft=2048, hop_length=512))
+    assert ours.shape == ref.shape
+    np.testing.assert_allclose(ours, ref, atol=1e-4 * ref.max())
+
+
+def test_audio_beats_librosa_peak_picking_equals_onset_detect():
+    # HA2G's call: librosa.onset.onset_detect(y=clip, sr=16000, units="time")
+    import librosa
+
+    y = AUDIO + np.random.default_rng(1).normal(scale=0.003, size=AUDIO.shape).astype(np.float32)
+    ref = librosa.onset.onset_detect(y=y, sr=SR, units="time")
+    np.testing.assert_allclose(audio_beats(y, SR, peak_pick="librosa"), ref, atol=1e-9)

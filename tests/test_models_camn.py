@@ -1,0 +1,265 @@
+"""CaMN: module shapes, output assembly, losses, switches, gradients (tiny/paper presets)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.models import build_model  # noqa: E402
+from beatlite.models.base import huber, seed_input  # noqa: E402
+from beatlite.models.camn import CaMN, EmotionEncoder, FaceEncoder, SpeakerEncoder  # noqa: E402
+from beatlite.models.layers import ConvDiscriminator, TextEncoderTCN, WavEncoder, ns_gan_d_loss  # noqa: E402
+from beatlite.models.testing import fake_batch  # noqa: E402
+
+V = 50  # vocabulary of the fake batches
+
+
+def tiny(**kw) -> CaMN:
+    torch.manual_seed(0)
+    return build_model("camn", preset="tiny", vocab_size=V, **kw)
+
+
+@pytest.fixture(scope="module")
+def batch():
+    return fake_batch(3, vocab_size=V)
+
+
+def test_wav_encoder_maps_36266_samples_to_34_frames():
+    # (36266 + 2*1600 - 15)//5 + 1 = 7891; (7891-15)//6+1 = 1313; (1313-15)//6+1 = 217; (217-15)//6+1 = 34
+    enc = WavEncoder((32, 32, 32, 64, 64, 128))
+    out = enc(torch.zeros(2, 36266))
+    assert out.shape == (2, 34, 128)
+
+
+def test_wav_encoder_length_formula_for_other_lengths():
+    enc = WavEncoder((4, 4, 4, 4, 4, 4))
+    s = 16000 * 5
+    n = (s + 3200 - 15) // 5 + 1
+    for _ in range(3):
+        n = (n - 15) // 6 + 1
+    assert enc(torch.zeros(1, s)).shape == (1, n, 4)
+
+
+def test_encoder_shapes_paper_sizes():
+    b = 2
+    assert FaceEncoder((16, 16, 16, 32))(torch.zeros(b, 34, 51)).shape == (b, 34, 32)
+    assert EmotionEncoder(8, 8)(torch.zeros(b, 34, dtype=torch.long)).shape == (b, 34, 8)
+    assert SpeakerEncoder(30, 8)(torch.tensor([0, 29])).shape == (b, 8)
+    text = TextEncoderTCN(100, 300, 256, 4, 128, 0.3)
+    assert text(torch.zeros(b, 34, dtype=torch.long)).shape == (b, 34, 128)
+    d = ConvDiscriminator(141)
+    assert d(torch.zeros(b, 34, 141)).shape == (b, 1)
+
+
+def test_paper_preset_builds_with_reference_sizes_and_runs(batch):
+    torch.manual_seed(0)
+    model = build_model("camn", preset="paper", vocab_size=V)
+    # decoder input 446 = 142 pre_seq + 8 spk + 8 emo + 128 text + 128 audio + 32 face; hands 446 + 27 = 473
+    assert model.decoder_in == 446
+    assert model.body_decoder.lstm.input_size == 446
+    assert model.hands_decoder.lstm.input_size == 473
+    assert model.body_decoder.lstm.num_layers == 4 and model.body_decoder.lstm.hidden_size == 256
+    out = model(batch)
+    assert out["pose"].shape == (3, 34, 141)
+    assert out["body"].shape == (3, 34, 27) and out["hands"].shape == (3, 34, 114)
+
+
+def test_output_assembly_follows_reference_layout(batch):
+    out = tiny()(batch)
+    pose, body, hands = out["pose"], out["body"], out["hands"]
+    assert torch.equal(pose[..., 0:18], body[..., 0:18])
+    assert torch.equal(pose[..., 18:75], hands[..., 0:57])
+    assert torch.equal(pose[..., 75:84], body[..., 18:27])
+    assert torch.equal(pose[..., 84:141], hands[..., 57:114])
+
+
+def test_seed_input_holds_four_frames_and_indicator():
+    pose = torch.arange(2 * 34 * 3, dtype=torch.float32).reshape(2, 34, 3)
+    pre = seed_input(pose, 4)
+    assert pre.shape == (2, 34, 4)
+    assert torch.equal(pre[:, :4, :3], pose[:, :4])
+    assert torch.all(pre[:, :4, 3] == 1) and torch.all(pre[:, 4:] == 0)
+
+
+def test_generate_reads_only_the_seed_frames(batch):
+    model = tiny()
+    other = dict(batch)
+    other["pose"] = batch["pose"].clone()
+    other["pose"][:, 4:] += 5.0
+    assert torch.equal(model.generate(batch), model.generate(other))
+    other["pose"][:, :4] += 1.0
+    assert not torch.equal(model.generate(batch), model.generate(other))
+
+
+def test_huber_matches_hand_values():
+    # |d| < beta: 0.5 d^2 / beta = 0.5 * 0.0025 / 0.1 = 0.0125 ; |d| >= beta: |d| - beta/2 = 0.95
+    assert float(huber(torch.tensor([0.05]), torch.tensor([0.0]))) == pytest.approx(0.0125)
+    assert float(huber(torch.tensor([1.0]), torch.tensor([0.0]))) == pytest.approx(0.95)
+
+
+def test_reconstruction_loss_zero_on_target_and_semantic_weighting(batch):
+    model = tiny()
+    assert float(model.reconstruction_loss(batch, batch["pose"].clone())) == 0.0
+    b = dict(batch)
+    b["semantic"] = torch.ones_like(batch["semantic"])
+    # (1+1)*(target+1) - (1+1)*target = 2 -> Huber = 2 - 0.05
+    assert float(model.reconstruction_loss(b, batch["pose"] + 1.0)) == pytest.approx(1.95, rel=1e-5)
+    plain = tiny(semantic_weighting=False)
+    assert float(plain.reconstruction_loss(b, batch["pose"] + 1.0)) == pytest.approx(0.95, rel=1e-5)
+
+
+def test_adversarial_term_off_before_no_adv_epochs_and_ns_gan_after(batch):
+    model = tiny(no_adv_epochs=3, rec_weight=1.0, adv_weight=1.0)
+    model.eval()
+    torch.set_grad_enabled(False)
+    try:
+        _check_schedule(model, batch)
+    finally:
+        torch.set_grad_enabled(True)
+
+
+def _check_schedule(model, batch):
+    out = model(batch)
+    early = model.losses(batch, out, epoch=2)
+    assert float(early["adv"]) == 0.0 and not model.adversarial_active(2)
+    late = model.losses(batch, out, epoch=3)
+    logit = model.discriminator(out["pose"])
+    expected = float(torch.mean(-torch.log(torch.sigmoid(logit))))
+    assert float(late["adv"]) == pytest.approx(expected, rel=1e-5)
+    assert float(late["total"]) == pytest.approx(float(late["rec"]) + expected, rel=1e-5)
+
+
+def test_squared_generator_quirk_option(batch):
+    model = tiny(no_adv_epochs=0, squared_adv_loss=True)
+    model.eval()
+    with torch.no_grad():
+        out = model(batch)
+        logit = model.discriminator(out["pose"])
+        adv = model.losses(batch, out, epoch=0)["adv"]
+    assert float(adv) == pytest.approx(float(torch.mean(torch.sigmoid(logit) ** 2)), rel=1e-5)
+
+
+def test_discriminator_loss_values():
+    zero = torch.zeros(4, 1)
+    # D = 0.5 everywhere: -(log .5 + log .5) = 2 log 2
+    assert float(ns_gan_d_loss(zero, zero)) == pytest.approx(2 * math.log(2), rel=1e-6)
+    # a perfect discriminator has (almost) zero loss
+    assert float(ns_gan_d_loss(zero + 30, zero - 30)) < 1e-10
+
+
+def test_discriminator_step_trains(batch):
+    model = tiny(no_adv_epochs=0)
+    out = model(batch)
+    d_loss = model.discriminator_losses(batch, out)["total"]
+    d_loss.backward()
+    grads = [p.grad for p in model.discriminator.parameters()]
+    assert all(g is not None and float(g.abs().sum()) > 0 for g in grads)
+
+
+SWITCHES = {
+    "use_audio": ("audio_encoder", "audio_fusion"),
+    "use_text": ("text_encoder",),
+    "use_face": ("face_encoder", "face_fusion"),
+    "use_emotion": ("emotion_encoder",),
+    "use_speaker": ("speaker_encoder",),
+}
+
+
+@pytest.mark.parametrize("switch", [None, *SWITCHES, "cascade"])
+def test_every_switched_on_component_gets_gradient(batch, switch):
+    kw = {} if switch is None else {switch: False}
+    model = tiny(no_adv_epochs=0, **kw)
+    out = model(batch)
+    model.losses(batch, out, epoch=0)["total"].backward()
+    d_ids = {id(p) for p in model.discriminator.parameters()}
+    for name, p in model.named_parameters():
+        if id(p) in d_ids:
+            continue
+        assert p.grad is not None and float(p.grad.abs().sum()) > 0, name
+    if switch in SWITCHES:
+        for module in SWITCHES[switch]:
+            assert getattr(model, module) is None
+            assert not any(n.startswith(module + ".") for n, _ in model.named_parameters())
+    if switch == "cascade":
+        assert model.audio_fusion is None and model.face_fusion is None and model.hands_decoder is None
+        assert out["pose"].shape == (3, 34, 141)
+
+
+def test_switches_shrink_decoder_input():
+    full = tiny()
+    cfg = full.config
+    assert (
+        full.decoder_in
+        == 142
+        + cfg.speaker_features
+        + cfg.emotion_features
+        + cfg.text_features
+        + cfg.audio_fused
+        + cfg.face_fused
+    )
+    assert tiny(use_text=False).decoder_in == full.decoder_in - cfg.text_features
+    assert tiny(use_face=False).decoder_in == full.decoder_in - cfg.face_fused
+    # without the cascade the raw encoder features go to the decoder
+    assert tiny(cascade=False).decoder_in == (
+        142
+        + cfg.speaker_features
+        + cfg.emotion_features
+        + cfg.text_features
+        + cfg.audio_channels[-1]
+        + cfg.face_channels[-1]
+    )
+
+
+def test_switched_off_modality_is_not_read(batch):
+    model = tiny(use_audio=False)
+    other = dict(batch)
+    other["audio"] = torch.randn_like(batch["audio"])
+    assert torch.equal(model.generate(batch), model.generate(other))
+    del other["audio"]
+    assert model.generate(other).shape == (3, 34, 141)
+
+
+def test_leaky_relu_slopes_are_corrected():
+    model = tiny()
+    fusion_slopes = {
+        m.negative_slope for m in model.audio_fusion.modules() if isinstance(m, torch.nn.LeakyReLU)
+    }
+    assert fusion_slopes == {0.1}
+
+
+def test_bad_inputs_raise_clear_errors(batch):
+    model = tiny()
+    bad = dict(batch)
+    bad["audio"] = batch["audio"][:, None]
+    with pytest.raises(ValueError, match="audio"):
+        model(bad)
+    missing = {k: v for k, v in batch.items() if k != "face"}
+    with pytest.raises(KeyError, match="face"):
+        model(missing)
+    wrong = dict(batch)
+    wrong["word"] = batch["word"] + V
+    with pytest.raises(ValueError, match="word ids"):
+        model(wrong)
+
+
+def test_config_round_trip_rebuilds_identical_model(batch):
+    model = tiny(use_face=False)
+    model.eval()
+    clone = CaMN.from_config(model.to_config())
+    clone.load_state_dict(model.state_dict())
+    clone.eval()
+    assert clone.config == model.config
+    assert torch.equal(clone(batch)["pose"], model(batch)["pose"])
+
+
+def test_word_vectors_are_loaded():
+    model = tiny()
+    vectors = np.random.default_rng(0).standard_normal((V, model.config.word_dim)).astype(np.float32)
+    model.set_word_vectors(vectors)
+    assert np.array_equal(model.text_encoder.embedding.weight.detach().numpy(), vectors)
+    with pytest.raises(ValueError, match="vectors"):
+        model.set_word_vectors(vectors[:, :3])

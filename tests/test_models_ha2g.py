@@ -1,0 +1,336 @@
+"""HA2G model (beatlite.models.ha2g): shapes of every module, switches, gradients, determinism."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.models import build_model  # noqa: E402
+from beatlite.models.ha2g import (  # noqa: E402
+    ABLATIONS,
+    CHECKPOINTS,
+    HA2G,
+    PRESETS,
+    HA2GDiscriminator,
+    build_ha2g,
+    recover_dirvec_mean,
+)
+from beatlite.models.ha2g_audio import HierarchicalAudioEncoder, StyleCoordinator, blend_audio  # noqa: E402
+from beatlite.models.testing import fake_batch, fake_windows  # noqa: E402
+
+PAPER_LEVEL_DIMS = (24, 30, 36, 66, 96, 126)  # facts C.7: 8/10/12/22/32/42 bones x 3
+
+
+@pytest.fixture(autouse=True)
+def _one_thread() -> None:
+    torch.set_num_threads(1)
+
+
+def _unit_windows(n: int, seed: int = 0) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Fake windows whose "dirvec" are real mean-subtracted unit vectors; returns (windows, mean)."""
+    w = fake_windows(n, seed=seed)
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal((n, 34, 42, 3)) + np.array([0.0, 2.0, 0.0])  # mostly "up", varied
+    u /= np.linalg.norm(u, axis=-1, keepdims=True)
+    u = u.reshape(n, 34, 126)
+    mean = u.reshape(-1, 126).mean(axis=0)
+    w["dirvec"] = (u - mean).astype(np.float32)
+    return w, mean
+
+
+def _model(seed: int = 0, **overrides: object) -> HA2G:
+    torch.manual_seed(seed)
+    model = build_model("ha2g", preset="tiny", **overrides)
+    w, mean = _unit_windows(8)
+    model.prepare({**w, "dirvec_mean": mean})
+    return model
+
+
+# ----------------------------------------------------------------------------- audio learner
+@pytest.mark.parametrize(
+    ("channels", "blocks", "feat"),
+    [((4, 8, 16, 32), (1, 1, 1, 1), 16), ((32, 64, 128, 256), (1, 1, 1, 1), 32)],
+)
+def test_audio_encoder_maps_mel_to_three_levels_of_34_frames(channels, blocks, feat) -> None:
+    enc = HierarchicalAudioEncoder(channels, blocks, reduction=4, out_features=feat)
+    out = enc(torch.randn(2, 70, 128) * 20 - 40)
+    assert sorted(out) == ["high", "low", "mid"]
+    for level in ("low", "mid", "high"):
+        assert tuple(out[level].shape) == (2, 34, feat)
+
+
+def test_audio_encoder_builds_only_requested_levels_and_validates() -> None:
+    enc = HierarchicalAudioEncoder((4, 8, 16, 32), (1, 1, 1, 1), 4, 8, levels=("low",))
+    assert enc.layer3 is None and enc.layer4 is None
+    assert list(enc(torch.zeros(1, 70, 128))) == ["low"]
+    with pytest.raises(ValueError, match=r"mel must be \(B, M >= 8, 128\).*\(2, 70, 80\)"):
+        enc(torch.zeros(2, 70, 80))
+    with pytest.raises(ValueError, match="pixel-shuffled"):
+        HierarchicalAudioEncoder((4, 8, 16, 24), (1, 1, 1, 1))
+
+
+def test_style_coordinator_weights_are_a_softmax_over_audio_levels() -> None:
+    coord = StyleCoordinator(8, 16, 6)
+    w = coord(torch.randn(5, 8))
+    assert tuple(w.shape) == (5, 3, 6)
+    np.testing.assert_allclose(w.sum(dim=1).detach().numpy(), 1.0, atol=1e-6)
+    assert float(w.detach().min()) > 0.0
+
+
+def test_blend_audio_is_the_weighted_sum_of_eq3() -> None:
+    g = torch.Generator().manual_seed(0)
+    feats = {lv: torch.randn(2, 34, 4, generator=g) for lv in ("low", "mid", "high")}
+    w = torch.zeros(2, 3, 2)
+    w[:, 0, 0] = 1.0  # body level 0 <- low only
+    w[:, 1, 1] = 0.25  # body level 1 <- 0.25 mid + 0.75 high
+    w[:, 2, 1] = 0.75
+    out = blend_audio(feats, w)
+    assert tuple(out.shape) == (2, 2, 34, 4)
+    torch.testing.assert_close(out[:, 0], feats["low"])
+    torch.testing.assert_close(out[:, 1], 0.25 * feats["mid"] + 0.75 * feats["high"])
+
+
+# ----------------------------------------------------------------------------- pose inferer
+def test_level_outputs_have_the_paper_dimensions() -> None:
+    from beatlite.skeleton import ted
+
+    model = _model()
+    assert model.level_dims == PAPER_LEVEL_DIMS
+    assert model.level_dims == tuple(3 * len(lv) for lv in ted.HA2G_LEVELS)
+    out = model(fake_batch(3))
+    for k, d in enumerate(PAPER_LEVEL_DIMS):
+        assert tuple(out[f"level{k}"].shape) == (3, 34, d)
+    assert tuple(out["pose"].shape) == (3, 34, 126)
+    assert tuple(out["style_weights"].shape) == (3, 3, 6)
+    for level in ("low", "mid", "high"):
+        assert tuple(out[f"audio_{level}"].shape) == (3, 34, 16)
+    # the 126-d output is the last level's prediction (all 42 bones, in bone order)
+    torch.testing.assert_close(out["pose"], out["level5"])
+
+
+def test_holistic_switch_has_one_level_with_all_bones() -> None:
+    model = _model(**ABLATIONS["holistic"])
+    out = model(fake_batch(2))
+    assert model.level_dims == (126,)
+    assert "level1" not in out and tuple(out["level0"].shape) == (2, 34, 126)
+    assert tuple(out["style_weights"].shape) == (2, 3, 1)
+
+
+def test_single_audio_and_same_audio_switches() -> None:
+    single = _model(**ABLATIONS["single_audio"])
+    assert single.coordinator is None
+    w = single(fake_batch(2))["style_weights"]
+    np.testing.assert_array_equal(w[:, 0].numpy(), 1.0)  # all body levels read the low level
+    np.testing.assert_array_equal(w[:, 1:].numpy(), 0.0)
+    same = _model(**ABLATIONS["same_audio"])
+    w = same(fake_batch(2))["style_weights"]
+    torch.testing.assert_close(w, w[:, :, :1].expand_as(w))
+
+
+def test_coarse_to_fine_level_k_reads_level_k_minus_1() -> None:
+    # Changing level 0's output weights changes level 1's prediction (cascade), and the seed
+    # frames of the target are the only part of "dirvec" the model reads.
+    model = _model().eval()
+    batch = fake_batch(2)
+    before = model(batch)
+    with torch.no_grad():
+        model.generators[0].head[-1].bias += 1.0
+    after = model(batch)
+    assert not torch.allclose(before["level1"], after["level1"])
+    future = dict(batch)
+    future["dirvec"] = batch["dirvec"].clone()
+    future["dirvec"][:, model.n_pre :] += 5.0
+    torch.testing.assert_close(model(future)["pose"], after["pose"])
+
+
+def test_generate_uses_only_the_seed_frames() -> None:
+    model = _model()
+    batch = fake_batch(2)
+    other = dict(batch)
+    other["dirvec"] = batch["dirvec"].clone()
+    other["dirvec"][:, 4:] = torch.randn(2, 30, 126)
+    a, b = model.generate(batch), model.generate(other)
+    assert tuple(a.shape) == (2, 34, 126)
+    torch.testing.assert_close(a, b)
+    assert model.training  # generate restores the mode
+
+
+def test_discriminator_shape_and_losses() -> None:
+    d = HA2GDiscriminator(126, 16, 2, 34, 0.1)
+    assert tuple(d(torch.randn(3, 34, 126)).shape) == (3, 1)
+    with pytest.raises(ValueError, match=r"\(B, 34, 126\)"):
+        d(torch.randn(3, 33, 126))
+    model = _model()
+    batch = fake_batch(4)
+    out = model(batch)
+    d_loss = model.discriminator_losses(batch, out)["total"]
+    # log(4) when D outputs 1/2 for everything; an untrained D is near that
+    assert 0.5 < float(d_loss) < 3.0
+
+
+# ----------------------------------------------------------------------------- losses and gradients
+def test_loss_terms_follow_the_switches_and_warmup() -> None:
+    model = _model()
+    batch = fake_batch(4)
+    out = model(batch)
+    early = model.losses(batch, out, epoch=0)
+    assert "adv" not in early  # warm-up
+    late = model.losses(batch, out, epoch=model.config.no_adv_epochs)
+    assert {"huber", "kld", "adv", "style", "contrastive_pos", "contrastive_neg", "physical", "total"} <= set(
+        late
+    )
+    c = model.config
+    torch.manual_seed(5)
+    again = model.losses(batch, out, epoch=0)
+    torch.manual_seed(5)
+    ref = model.losses(batch, out, epoch=0)
+    expected = (
+        c.huber_weight * ref["huber"]
+        + c.kld_weight * ref["kld"]
+        + c.style_weight * ref["style"]
+        + c.contrastive_pos_weight * ref["contrastive_pos"]
+        - c.contrastive_neg_weight * ref["contrastive_neg"]
+        + c.physical_weight * ref["physical"]
+    )
+    torch.testing.assert_close(again["total"], expected)
+    bare = _model(use_contrastive=False, use_physical=False, adversarial=False, use_style_loss=False)
+    terms = bare.losses(batch, bare(batch), epoch=100)
+    assert set(terms) == {"huber", "kld", "total"}
+    assert bare.discriminator is None and bare.contrastive_text is None
+
+
+@pytest.mark.parametrize("ablation", sorted(ABLATIONS))
+def test_every_switched_on_component_receives_gradient(ablation: str) -> None:
+    model = _model(**ABLATIONS[ablation])
+    batch = fake_batch(4)
+    out = model(batch)
+    losses = model.losses(batch, out, epoch=model.config.no_adv_epochs)
+    losses["total"].backward()
+    g_ids = {id(p) for p in model.generator_parameters()}
+    dead = [
+        name
+        for name, p in model.named_parameters()
+        if id(p) in g_ids and (p.grad is None or not torch.any(p.grad != 0))
+    ]
+    assert dead == []
+    # the discriminator learns from its own loss
+    model.zero_grad()
+    model.discriminator_losses(batch, model(batch))["total"].backward()
+    dead_d = [
+        n for n, p in model.discriminator.named_parameters() if p.grad is None or not torch.any(p.grad != 0)
+    ]
+    assert dead_d == []
+
+
+def test_physical_statistics_come_from_prepare() -> None:
+    torch.manual_seed(0)
+    model = build_model("ha2g", preset="tiny")
+    batch = fake_batch(2)
+    with pytest.raises(RuntimeError, match="prepare"):
+        model.losses(batch, model(batch), epoch=0)
+    w, mean = _unit_windows(6)
+    model.prepare(w)  # no mean given: recovered from the unit-norm constraint
+    np.testing.assert_allclose(model.mean_dirvec.numpy(), mean, atol=1e-5)
+    assert bool(model.statistics_ready)
+    assert model.angle_mean.shape == model.angle_var.shape == (len(model.angle_pairs),)
+    assert float(model.angle_var.min()) >= model.config.angle_var_floor
+
+
+def test_prepare_reads_the_mean_from_a_windows_object_and_sets_word_vectors() -> None:
+    class FakeWindows(dict):
+        pass
+
+    w, mean = _unit_windows(4)
+    obj = FakeWindows(w)
+    obj.dir_norm = type("Norm", (), {"mean": mean})()
+    torch.manual_seed(0)
+    model = build_model("ha2g", preset="tiny")
+    model.prepare(obj)
+    np.testing.assert_allclose(model.mean_dirvec.numpy(), mean, rtol=0, atol=1e-7)
+    vectors = np.random.default_rng(0).standard_normal((1000, 16)).astype(np.float32)
+    model.set_word_vectors(vectors)
+    for enc in [*model.text_encoders, model.contrastive_text]:
+        np.testing.assert_array_equal(enc.embedding.weight.detach().numpy(), vectors)
+    with pytest.raises(ValueError, match="vocab_size, word_dim"):
+        model.set_word_vectors(vectors[:, :8])
+
+
+def test_recover_dirvec_mean_round_trip_and_failure() -> None:
+    _, mean = _unit_windows(3, seed=7)
+    w, _ = _unit_windows(3, seed=7)
+    np.testing.assert_allclose(recover_dirvec_mean(w["dirvec"]), mean, atol=1e-5)
+    with pytest.raises(ValueError, match="not mean-subtracted unit vectors"):
+        recover_dirvec_mean(fake_windows(3)["dirvec"])
+
+
+# ----------------------------------------------------------------------------- registry, config, errors
+def test_registry_presets_ablations_and_config_round_trip() -> None:
+    assert set(PRESETS) == {"tiny", "paper"}
+    assert {"full", "holistic", "single_audio", "no_contrastive", "no_physical"} <= set(ABLATIONS)
+    assert all(name.startswith("ha2g") for name in CHECKPOINTS)
+    model = _model(**ABLATIONS["holistic"])
+    assert model.representation == "dirvec126" and model.target_key == "dirvec"
+    config = json.loads(json.dumps(model.to_config()))
+    clone = HA2G.from_config(config)
+    clone.load_state_dict(model.state_dict())
+    model.eval()
+    clone.eval()
+    batch = fake_batch(2)
+    torch.testing.assert_close(clone(batch)["pose"], model(batch)["pose"])
+    assert build_ha2g("tiny", "no_physical").config.use_physical is False
+    with pytest.raises(ValueError, match="ablation must be one of"):
+        build_ha2g("tiny", "no_such_thing")
+    with pytest.raises(ValueError, match="audio_mode"):
+        build_model("ha2g", audio_mode="loud")
+
+
+def test_bad_inputs_raise_clear_errors() -> None:
+    model = _model()
+    batch = fake_batch(2)
+    bad = dict(batch, mel=torch.zeros(2, 70, 64))
+    with pytest.raises(ValueError, match=r"batch\['mel'\] must be \(2, M, 128\)"):
+        model(bad)
+    bad = dict(batch, speaker=torch.tensor([0, 99]))
+    with pytest.raises(ValueError, match=r"speaker ids must be in \[0, 30\)"):
+        model(bad)
+    bad = dict(batch, dirvec=torch.zeros(2, 34, 141))
+    with pytest.raises(ValueError, match=r"batch\['dirvec'\] must have shape \(2, 34, 126\)"):
+        model(bad)
+    with pytest.raises(KeyError, match="word"):
+        model({k: v for k, v in batch.items() if k != "word"})
+
+
+# ----------------------------------------------------------------------------- training
+@pytest.mark.slow
+def test_two_short_runs_with_one_seed_give_identical_losses() -> None:
+    from beatlite.train import TrainConfig, fit
+
+    w, mean = _unit_windows(12)
+    w["dirvec_mean"] = mean
+    histories = []
+    for _ in range(2):
+        torch.manual_seed(123)
+        model = build_model("ha2g", preset="tiny", no_adv_epochs=1)
+        cfg = TrainConfig(epochs=2, batch_size=6, seed=3, progress=False, threads=1)
+        histories.append(fit(model, w, cfg).history)
+    assert histories[0] == histories[1]
+    assert "adv" in histories[0][1]["train"] and "adv" not in histories[0][0]["train"]
+    assert all(np.isfinite(v) for e in histories[0] for v in e["train"].values())
+
+
+@pytest.mark.slow
+def test_paper_preset_builds_and_runs_one_forward() -> None:
+    torch.manual_seed(0)
+    model = build_model("ha2g", preset="paper")
+    assert model.config.hidden == 300 and model.config.n_layers == 4
+    assert model.level_dims == PAPER_LEVEL_DIMS
+    assert len(model.text_encoders) == 6 and model.config.audio_channels == (32, 64, 128, 256)
+    model.eval()
+    with torch.no_grad():
+        out = model(fake_batch(2, vocab_size=100))
+    assert tuple(out["pose"].shape) == (2, 34, 126)
+    assert tuple(out["audio_high"].shape) == (2, 34, 32)

@@ -1,0 +1,205 @@
+"""The training harness: determinism, resume, checkpoints, whole-take generation."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.models import build_model  # noqa: E402
+from beatlite.models.base import GestureModel, ModelConfig  # noqa: E402
+from beatlite.models.testing import fake_windows  # noqa: E402
+from beatlite.train import TrainConfig, data_fingerprint, export_checkpoint, fit, generate, load_model  # noqa: E402
+from beatlite.train.generation import generate_sequence  # noqa: E402
+
+V = 50
+
+
+@pytest.fixture(scope="module")
+def windows():
+    return fake_windows(24, seed=0, vocab_size=V), fake_windows(8, seed=1, vocab_size=V)
+
+
+def camn():
+    torch.manual_seed(0)
+    return build_model("camn", preset="tiny", vocab_size=V, no_adv_epochs=1)
+
+
+def cfg(**kw):
+    return TrainConfig(**{"epochs": 2, "batch_size": 8, "lr": 1e-3, "seed": 3, "progress": False, **kw})
+
+
+def test_two_runs_with_one_seed_give_identical_losses(windows):
+    train, val = windows
+    a = fit(camn(), train, cfg(), val)
+    b = fit(camn(), train, cfg(), val)
+    assert a.history == b.history
+    assert set(a.history[-1]["train"]) >= {"rec", "adv", "total", "D_d"}  # epoch 1 is adversarial
+    assert a.history[-1]["val"]["total"] > 0
+    c = fit(camn(), train, cfg(seed=4), val)
+    assert c.history != a.history
+
+
+def test_resume_reproduces_an_uninterrupted_run(windows, tmp_path):
+    train, val = windows
+    full = fit(camn(), train, cfg(epochs=3, checkpoint=tmp_path / "full.pt"), val)
+    fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt"), val)
+    resumed = fit(camn(), train, cfg(epochs=3, checkpoint=tmp_path / "part.pt", resume=True), val)
+    assert resumed.history == full.history
+    a, _ = load_model(tmp_path / "full.pt")
+    b, _ = load_model(tmp_path / "part.pt")
+    for (name, p), q in zip(a.state_dict().items(), b.state_dict().values(), strict=True):
+        assert torch.equal(p, q), name
+    assert not list(tmp_path.glob("*.tmp"))  # atomic writes leave no temp file
+
+
+def test_resume_refuses_other_data(windows, tmp_path):
+    train, val = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "a.pt"))
+    other = dict(train)
+    other["pose"] = train["pose"] + 1
+    with pytest.raises(ValueError, match="cannot resume"):
+        fit(camn(), other, cfg(epochs=2, checkpoint=tmp_path / "a.pt", resume=True))
+
+
+def test_data_fingerprint_sees_values_and_shapes(windows):
+    train, _ = windows
+    copy = {k: v.copy() for k, v in train.items()}
+    assert data_fingerprint(copy) == data_fingerprint(train)
+    copy["pose"][0, 0, 0] += 1.0  # window 0 is always in the sample
+    assert data_fingerprint(copy) != data_fingerprint(train)
+    fewer = {k: v[:-1] for k, v in train.items()}
+    assert data_fingerprint(fewer) != data_fingerprint(train)
+
+
+def test_fit_checks_keys_and_config(windows):
+    train, _ = windows
+    with pytest.raises(KeyError, match="face"):
+        fit(camn(), {k: v for k, v in train.items() if k != "face"}, cfg())
+    with pytest.raises(ValueError, match="batch_size"):
+        TrainConfig(batch_size=1)
+    assert TrainConfig(batch_size=256).learning_rate == pytest.approx(5e-4)
+
+
+def test_export_is_small_and_equivalent(windows, tmp_path):
+    train, _ = windows
+    model = camn()
+    fit(model, train, cfg(epochs=1, checkpoint=tmp_path / "t.pt"))
+    export_checkpoint(tmp_path / "t.pt", tmp_path / "s.pt")
+    assert (tmp_path / "s.pt").stat().st_size < 0.4 * (tmp_path / "t.pt").stat().st_size
+    small, data = load_model(tmp_path / "s.pt")
+    assert "optimizer" not in data
+    batch = {k: torch.from_numpy(v[:2]) for k, v in train.items()}
+    model.eval()
+    np.testing.assert_allclose(small.generate(batch).numpy(), model.generate(batch).numpy(), atol=0.05)
+
+
+def test_untrained_baselines_fit_saves_and_loads(windows, tmp_path):
+    train, _ = windows
+    model = build_model("mean_pose")
+    fit(model, train, cfg(checkpoint=tmp_path / "m.pt"))
+    loaded, _ = load_model(tmp_path / "m.pt")
+    np.testing.assert_allclose(loaded.mean.numpy(), train["pose"].mean(axis=(0, 1)), atol=1e-5)
+
+
+# --------------------------------------------------------------------------- whole-take generation
+@dataclasses.dataclass
+class _StubConfig(ModelConfig):
+    pass
+
+
+class _Counter(GestureModel):
+    """Returns the constant k on call k (k = 0, 1, ...): exposes the cross-fade."""
+
+    name = "stub"
+    config_class = _StubConfig
+    input_keys = ("pose",)
+
+    def __init__(self) -> None:
+        super().__init__(_StubConfig())
+        self.calls = 0
+
+    def forward(self, batch):
+        self.calls += 1
+        return {"pose": torch.full_like(batch["pose"], float(self.calls - 1))}
+
+
+class _SeedPlusOne(_Counter):
+    """Every output frame = seed frame 0 + 1: exposes how seeds propagate between units."""
+
+    def forward(self, batch):
+        return {"pose": (batch["pose"][:, :1] + 1).expand_as(batch["pose"]).clone()}
+
+
+def _streams(t: int) -> dict[str, np.ndarray]:
+    return {"pose": np.zeros((t, 141), np.float32)}
+
+
+@pytest.mark.parametrize("t", [4, 33, 34, 35, 64, 65, 100])
+def test_generate_sequence_length_and_unit_count(t):
+    model = _Counter()
+    out = generate_sequence(model, _streams(t))
+    assert out.shape == (t, 141)
+    # units start at 0, 30, 60, ... until one reaches frame t: 1 + ceil(max(t - 34, 0) / 30) units
+    assert model.calls == 1 + -(-max(t - 34, 0) // 30)
+
+
+def test_cross_fade_is_linear_over_the_overlap():
+    out = generate_sequence(_Counter(), _streams(64))[:, 0]
+    np.testing.assert_array_equal(out[:30], 0.0)
+    # frames 30..33: (1 - w) * unit0 + w * unit1 with w = 0, 1/3, 2/3, 1 and unit0 = 0, unit1 = 1
+    np.testing.assert_allclose(out[30:34], [0.0, 1 / 3, 2 / 3, 1.0], atol=1e-6)
+    np.testing.assert_array_equal(out[34:], 1.0)
+
+
+def test_units_are_seeded_by_the_previous_output():
+    streams = _streams(94)
+    streams["pose"][:4] = 5.0
+    out = generate_sequence(_SeedPlusOne(), streams)[:, 0]
+    # unit 0 = 5 + 1; unit 1 is seeded with unit 0's frames 30..33 -> 7; unit 2 -> 8
+    np.testing.assert_allclose(out[:30], 6.0)
+    np.testing.assert_allclose(out[34:60], 7.0)
+    np.testing.assert_allclose(out[64:], 8.0)
+
+
+def test_generate_returns_denormalised_full_motion():
+    from beatlite.skeleton.beat import beat_skeleton, subset_columns
+
+    t = 50
+    rng = np.random.default_rng(0)
+    windows = fake_windows(6)
+    model = build_model("mean_pose")
+    model.prepare(windows)
+    mean, std = rng.normal(size=141), rng.uniform(1, 20, size=141)
+    result = generate(model, _streams(t), norm={"pose_mean": mean, "pose_std": std})
+    assert result.motion.channels.shape == (t, 228) and result.motion.fps == 15
+    expected = windows["pose"].astype(np.float64).mean(axis=(0, 1)) * std + mean
+    cols = subset_columns(beat_skeleton(), "spine_neck_141")
+    np.testing.assert_allclose(
+        result.motion.channels[:, cols], np.broadcast_to(expected, (t, 141)), atol=1e-3
+    )
+    others = np.setdiff1d(np.arange(228), cols)
+    np.testing.assert_array_equal(result.motion.channels[:, others], 0.0)
+
+
+def test_generate_camn_on_a_take_of_odd_length():
+    t = 77
+    model = camn().eval()
+    take = {k: v[0] for k, v in fake_windows(1, n_frames=t, vocab_size=V).items()}
+    take["speaker"] = 1
+    out = generate_sequence(model, take)
+    assert out.shape == (t, 141) and np.all(np.isfinite(out))
+    # the first unit is exactly the model's output on the first window
+    first = {
+        k: torch.from_numpy(
+            np.asarray(v)[None, :34] if k not in ("audio", "speaker") else np.asarray(v)[None]
+        )
+        for k, v in take.items()
+        if k != "mel"
+    }
+    first["audio"] = first["audio"][:, :36266]
+    first["speaker"] = torch.tensor([1])
+    np.testing.assert_allclose(out[:30], model.generate(first)[0, :30].numpy(), atol=1e-6)

@@ -1,0 +1,385 @@
+"""Tests of beatlite.viz: style, input checks, matplotlib plots and animations (Agg, headless)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from PIL import Image  # noqa: E402
+
+from beatlite.skeleton.core import Skeleton  # noqa: E402
+from beatlite.viz import _inputs, animation, face, plot3d, style  # noqa: E402
+
+ROT = ("Xrotation", "Yrotation", "Zrotation")
+NAMES = [
+    "Hips",
+    "Spine",
+    "Neck",
+    "Head",
+    "RightArm",
+    "RightHand",
+    "LeftArm",
+    "LeftHand",
+    "RightFoot",
+    "LeftFoot",
+]
+PARENTS = [-1, 0, 1, 2, 1, 4, 1, 6, 0, 0]
+OFFSETS = [
+    [0, 95, 0],
+    [0, 30, 0],
+    [0, 25, 0],
+    [0, 12, 0],
+    [-15, 0, 0],
+    [-30, 0, 0],
+    [15, 0, 0],
+    [30, 0, 0],
+    [-10, -95, 0],
+    [10, -95, 0],
+]
+
+
+def tiny_skeleton() -> Skeleton:
+    return Skeleton(NAMES, PARENTS, OFFSETS, [("Xposition", "Yposition", "Zposition", *ROT)] + [ROT] * 9)
+
+
+def rest_positions() -> np.ndarray:
+    pos = np.zeros((len(NAMES), 3))
+    for j, p in enumerate(PARENTS):
+        pos[j] = np.array(OFFSETS[j], float) + (pos[p] if p >= 0 else 0.0)
+    return pos
+
+
+def wave_motion(n_frames: int = 30) -> np.ndarray:
+    """(T, 10, 3) cm: the rest pose with the right hand waving up and down by up to 25 cm."""
+    pos = np.repeat(rest_positions()[None], n_frames, axis=0)
+    pos[:, 5, 1] += 25 * np.sin(np.linspace(0, 2 * np.pi, n_frames))
+    return pos
+
+
+def fig_image(fig) -> np.ndarray:
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+
+
+pytestmark = pytest.mark.filterwarnings("ignore:Animation was deleted without rendering:UserWarning")
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
+
+
+# ----------------------------------------------------------------------------------------- style
+def test_figure_style_applies_and_restores_rcparams():
+    before = plt.rcParams["axes.spines.top"]
+    with style.figure_style(**{"font.size": 17}):
+        assert plt.rcParams["font.size"] == 17
+        assert plt.rcParams["axes.spines.top"] is False
+    assert plt.rcParams["axes.spines.top"] == before
+    assert plt.rcParams["font.size"] != 17
+
+
+def test_save_figure_writes_each_format_atomically(tmp_path):
+    fig = plt.figure(figsize=(2, 1))
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.imshow(np.arange(6.0).reshape(2, 3), aspect="auto")
+    ax.set_axis_off()
+    out = style.save_figure(fig, tmp_path / "sub" / "line.png", formats=("png", "svg"), pad_inches=0)
+    assert out == [tmp_path / "sub" / "line.png", tmp_path / "sub" / "line.svg"]
+    # the style's savefig.dpi = 150 applies outside figure_style too: 2 x 1 inches -> 300 x 150 pixels
+    w, h = Image.open(out[0]).size
+    assert abs(w - 300) <= 1 and abs(h - 150) <= 1
+    assert out[1].read_text().lstrip().startswith("<?xml")
+    assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == ["line.png", "line.svg"]  # no temp files
+
+
+def test_save_figure_rejects_bad_arguments(tmp_path):
+    with pytest.raises(TypeError, match="Figure"):
+        style.save_figure("not a figure", tmp_path / "x")
+    fig = plt.figure()
+    with pytest.raises(ValueError, match="formats"):
+        style.save_figure(fig, tmp_path / "x", formats=())
+
+
+# ---------------------------------------------------------------------------------------- inputs
+@pytest.mark.parametrize(
+    ("name", "group"),
+    [
+        ("RightHandIndex2", "hands"),
+        ("LeftHand", "hands"),
+        ("Head", "head"),
+        ("HeadEnd", "head"),
+        ("Neck1", "head"),
+        ("Spine3", "body"),
+        ("LeftForeArm", "body"),
+        ("RightToeBase", "body"),
+    ],
+)
+def test_joint_group_by_name(name, group):
+    assert _inputs.joint_group(name) == group
+
+
+def test_skeleton_bones_partition_joints_and_bones():
+    bones = _inputs.skeleton_bones(tiny_skeleton())
+    # joints: hands = {RightHand, LeftHand}; head = {Neck, Head}; body = the other 6
+    assert bones.joints["hands"].tolist() == [5, 7]
+    assert bones.joints["head"].tolist() == [2, 3]
+    assert len(bones.joints["body"]) == 6
+    # every non-root joint owns exactly one bone, coloured by the child
+    all_pairs = np.concatenate([bones.pairs[g] for g in _inputs.GROUPS])
+    assert sorted(all_pairs[:, 1].tolist()) == list(range(1, 10))
+    assert all(PARENTS[c] == p for p, c in all_pairs)
+    # a parents array gives the same bones, all in the body group
+    plain = _inputs.skeleton_bones(np.array(PARENTS))
+    assert len(plain.pairs["body"]) == 9 and len(plain.pairs["hands"]) == 0
+
+
+def test_skeleton_bones_rejects_bad_parents():
+    with pytest.raises(ValueError, match="parents"):
+        _inputs.skeleton_bones(np.array([-1, 5, 0]))
+    with pytest.raises(TypeError, match="parents array"):
+        _inputs.skeleton_bones(np.zeros((2, 2), dtype=int))
+
+
+def test_check_positions_errors_name_the_shape():
+    with pytest.raises(ValueError, match=r"\(T, J, 3\).*\(4, 10, 2\)"):
+        _inputs.check_positions(np.zeros((4, 10, 2)))
+    with pytest.raises(ValueError, match="9 joints but the skeleton has 10"):
+        _inputs.check_positions(np.zeros((4, 9, 3)), 10)
+    bad = np.zeros((2, 10, 3))
+    bad[1, 3, 0] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        _inputs.check_positions(bad)
+    assert _inputs.check_positions(np.zeros((10, 3))).shape == (1, 10, 3)
+
+
+def test_frame_indices_subsample_to_the_asked_rate():
+    # 100 frames at 120 fps played at 15 fps: every 8th frame, 0, 8, ..., 96 -> 13 frames
+    assert _inputs.frame_indices(100, 120.0, 15.0).tolist() == list(range(0, 97, 8))
+    # 10 frames at 15 fps asked at 30 fps: never faster than recorded -> all frames
+    assert _inputs.frame_indices(10, 15.0, 30.0).tolist() == list(range(10))
+    assert _inputs.frame_indices(7, 15.0, None).tolist() == list(range(7))
+
+
+def test_word_at_and_check_words():
+    starts, ends, words = _inputs.check_words(([0.0, 1.0, 2.5], [0.8, 2.0, 3.0], ["so", "we", "go"]))
+    assert _inputs.word_at(0.5, starts, ends, words) == "so"
+    assert _inputs.word_at(0.9, starts, ends, words) == ""  # the gap 0.8-1.0 s
+    assert _inputs.word_at(2.0, starts, ends, words) == ""  # ends are exclusive
+    assert _inputs.word_at(2.7, starts, ends, words) == "go"
+    with pytest.raises(ValueError, match="same length"):
+        _inputs.check_words(([0.0], [1.0, 2.0], ["a"]))
+    with pytest.raises(ValueError, match="before it starts"):
+        _inputs.check_words(([1.0], [0.5], ["a"]))
+
+
+def test_plot_coords_are_a_rotation_with_height_on_z():
+    m = _inputs.to_plot_coords(np.eye(3))  # rows: images of the data x, y, z axes
+    assert np.isclose(np.linalg.det(m), 1.0)  # a rotation: no mirror image
+    assert m[1].tolist() == [0.0, 0.0, 1.0]  # data up (y) is plot up (z)
+
+
+# ------------------------------------------------------------------------------------ static plots
+def test_plot_frame_renders_expected_size_and_changes_with_the_frame():
+    pos = wave_motion()
+    fig = plot3d.plot_frame(pos, tiny_skeleton(), 0, figsize=(3, 2), dpi=100)
+    img0 = fig_image(fig)
+    assert img0.shape == (200, 300, 3)  # 3 x 2 inches at 100 dpi
+    assert img0.std() > 5  # not blank
+    img1 = fig_image(plot3d.plot_frame(pos, tiny_skeleton(), 7, figsize=(3, 2), dpi=100))
+    assert np.abs(img0.astype(int) - img1).sum() > 0
+
+
+def test_plot_frame_front_view_shows_the_right_hand_on_the_viewers_left():
+    from mpl_toolkits.mplot3d import proj3d
+
+    pos = rest_positions()  # right hand at x = -45 cm, left hand at x = +45 cm, both facing +Z
+    fig = plot3d.plot_frame(pos, tiny_skeleton(), view="front", figsize=(3, 3), dpi=100)
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    screen_x = []
+    for j in (5, 7):
+        x, y, z = _inputs.to_plot_coords(pos[j])
+        px, py, _ = proj3d.proj_transform(x, y, z, ax.get_proj())
+        screen_x.append(ax.transData.transform((px, py))[0])
+    assert screen_x[0] < fig.bbox.width / 2 < screen_x[1]
+
+
+def test_plot_frame_accepts_a_parents_array_and_checks_inputs():
+    fig = plot3d.plot_frame(wave_motion(), np.array(PARENTS), 2, figsize=(2, 2), dpi=50)
+    assert fig_image(fig).std() > 0
+    with pytest.raises(ValueError, match="out of range"):
+        plot3d.plot_frame(wave_motion(5), tiny_skeleton(), 5)
+    with pytest.raises(ValueError, match="view"):
+        plot3d.plot_frame(wave_motion(5), tiny_skeleton(), view="below")
+
+
+def test_filmstrip_views_and_trajectories_layouts():
+    pos, sk = wave_motion(), tiny_skeleton()
+    strip = plot3d.plot_filmstrip(pos, sk, n=4, fps=15)
+    assert len(strip.axes) == 4
+    # frames evenly spaced over 0..29: round(linspace(0, 29, 4)) = 0, 10, 19, 29 -> t = k / 15 s
+    assert [ax.get_title() for ax in strip.axes] == ["t = 0.00 s", "t = 0.67 s", "t = 1.27 s", "t = 1.93 s"]
+    views = plot3d.plot_views(pos, sk, 3)
+    assert [ax.get_title() for ax in views.axes] == ["front", "side", "top"]
+    assert [(ax.elev, ax.azim) for ax in views.axes] == [(0, -90), (0, 0), (90, -90)]
+    traj = plot3d.plot_trajectories(pos, sk)
+    labels = [t.get_text() for t in traj.axes[0].get_legend().get_texts()]
+    assert labels == ["RightHand", "LeftHand", "Head"]
+    with pytest.raises(KeyError, match="Nose"):
+        plot3d.plot_trajectories(pos, sk, joints=["Nose"])
+
+
+def test_beat_skeleton_joint_groups():
+    beat = pytest.importorskip("beatlite.skeleton.beat")
+    bones = _inputs.skeleton_bones(beat.beat_skeleton())
+    # reference table: per side RightHand + 23 finger joints (M1-4, R..R4, P..P4, I..I4, T1-4) = 24;
+    # head = Neck, Neck1, Head, HeadEnd; body = the other 75 - 48 - 4 = 23
+    assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
+
+
+# ------------------------------------------------------------------------------------ animations
+def _animation(**kwargs):
+    pos = wave_motion(30)
+    sr = 1000
+    audio = np.sin(2 * np.pi * 5 * np.arange(2 * sr) / sr)
+    return animation.animate_skeletons(
+        {"ground truth": pos, "CaMN": pos[::-1]},
+        tiny_skeleton(),
+        fps=15,
+        audio=audio,
+        sr=sr,
+        audio_beats=[0.2, 0.9],
+        motion_beats=[0.5],
+        words=([0.0, 1.0], [0.5, 1.5], ["hello", "world"]),
+        panel_size=2.0,
+        dpi=50,
+        **kwargs,
+    )
+
+
+def test_animation_frames_are_in_sync_and_differ():
+    anim = _animation(out_fps=5)
+    # 30 frames at 15 fps played at 5 fps: frames 0, 3, ..., 27 -> 10 frames, times k * 0.2 s
+    assert np.allclose(anim.times, np.arange(10) * 0.2)
+    assert anim.fps == pytest.approx(5.0)
+    img0, img3 = anim.frame_image(0), anim.frame_image(3)
+    # two 2-inch panels at 50 dpi, but the timeline panel widens the figure to 6 inches -> 300 px
+    assert img0.shape[1] == 300
+    assert img0.std() > 5
+    assert np.abs(img0.astype(int) - img3).sum() > 0
+    caption = anim.figure.texts[-1]
+    anim.frame_image(6)  # t = 1.2 s, inside "world" (1.0-1.5 s)
+    assert caption.get_text() == "world"
+    timeline = anim.figure.axes[2]
+    assert np.allclose(timeline.lines[-1].get_xdata(), [1.2, 1.2])  # the cursor follows the clock
+    beats = [c for c in timeline.collections if type(c).__name__ == "LineCollection"]
+    assert [len(c.get_segments()) for c in beats] == [2, 1]  # 2 audio beats, 1 motion beat
+    anim.frame_image(3)  # t = 0.6 s, between words
+    assert caption.get_text() == ""
+
+
+def test_animation_size_is_panels_times_dpi():
+    anim = animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, panel_size=2.0, dpi=50)
+    assert anim.frame_image(0).shape == (100, 100, 3)  # one 2 x 2 inch panel at 50 dpi
+
+
+def test_animation_gif_round_trip(tmp_path):
+    anim = _animation(out_fps=5, max_frames=4)
+    path = anim.save_as(tmp_path / "clip.gif")
+    with Image.open(path) as gif:
+        assert gif.n_frames == 4
+        assert gif.info["duration"] == pytest.approx(200, abs=10)  # 1000 ms / 5 fps
+        w, h = gif.size
+    assert (h, w) == anim.frame_image(0).shape[:2]
+    assert [p.name for p in tmp_path.iterdir()] == ["clip.gif"]
+
+
+def test_animation_mp4_and_html(tmp_path):
+    anim = _animation(out_fps=5, max_frames=3)
+    if animation.ffmpeg_available():
+        data = anim.save_as(tmp_path / "clip.mp4").read_bytes()
+        assert data[4:8] == b"ftyp"  # an ISO media file
+    html = anim.to_html()
+    assert "<script" in html and html == anim._repr_html_()
+    assert anim.save_as(tmp_path / "clip.html").read_text().count("<script") >= 1
+
+
+def test_mp4_without_ffmpeg_says_how_to_fix(tmp_path, monkeypatch):
+    monkeypatch.setattr(animation.shutil, "which", lambda name: None)
+    anim = _animation(max_frames=2)
+    with pytest.raises(RuntimeError, match="ffmpeg"):
+        anim.save_as(tmp_path / "clip.mp4")
+    with pytest.raises(ValueError, match=r"\.gif"):
+        anim.save_as(tmp_path / "clip.avi")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_animation_face_panels_follow_the_clock():
+    rng = np.random.default_rng(0)
+    weights = rng.random((120, 51))  # 2 s at 60 fps
+    anim = animation.animate_skeletons(
+        wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, out_fps=15, dpi=40
+    )
+    ax_face = anim.figure.axes[-1]
+    anim.frame_image(10)  # t = 10 / 15 s -> face frame round(40.0) = 40
+    heights = [r.get_height() for r in ax_face.patches]
+    assert np.allclose(heights, weights[40])
+    heat = animation.animate_skeletons(
+        wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, face_panel="heatmap", dpi=40
+    )
+    assert heat.frame_image(5).std() > 0
+    with pytest.raises(ValueError, match="face_panel"):
+        animation.animate_skeletons(wave_motion(3), tiny_skeleton(), 15, face=weights, face_panel="pie")
+
+
+def test_animation_rejects_mismatched_inputs():
+    with pytest.raises(ValueError, match="labels"):
+        animation.animate_skeletons([wave_motion(3)], tiny_skeleton(), 15, labels=["a", "b"])
+    with pytest.raises(ValueError, match="audio"):
+        animation.animate_skeletons(wave_motion(3), tiny_skeleton(), 15, audio=np.zeros((2, 5)))
+    with pytest.raises(ValueError, match=r"positions\[0\]"):
+        animation.animate_skeletons(np.zeros((3, 4, 3)), tiny_skeleton(), 15)
+
+
+# ------------------------------------------------------------------------------------------ face
+def test_plot_blendshapes_heatmap_and_bars():
+    w = np.linspace(0, 1, 60 * 51).reshape(60, 51)
+    names = [f"shape{i}" for i in range(51)]
+    heat = face.plot_blendshapes(w, names, fps=60, frame=30)
+    ax = heat.axes[0]
+    assert ax.images[0].get_extent() == [0.0, 1.0, -0.5, 50.5]  # 60 frames / 60 fps = 1 s
+    assert ax.get_yticklabels()[3].get_text() == "shape3"
+    bars = face.plot_blendshapes(w, names, fps=60, kind="bars", frame=2)
+    assert np.allclose([r.get_height() for r in bars.axes[0].patches], w[2])
+    with pytest.raises(ValueError, match="50 names for 51"):
+        face.plot_blendshapes(w, names[:50])
+    with pytest.raises(ValueError, match=r"\(T, K\)"):
+        face.plot_blendshapes(np.zeros(51))
+
+
+def test_real_beat_skeleton_file_plots_with_expected_groups(real_samples):
+    from beatlite.io import read_bvh
+
+    motion = read_bvh(real_samples / "beat_skeleton_2_scott_0_1_1_frame0.bvh")
+    bones = _inputs.skeleton_bones(motion.skeleton)
+    assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
+    img = fig_image(plot3d.plot_frame(motion.positions(), motion.skeleton, figsize=(2, 3), dpi=60))
+    assert img.shape == (180, 120, 3) and img.std() > 5
+
+
+def test_animation_takes_one_skeleton_per_sequence_or_a_parents_list():
+    small = np.array([[0.0, 0.0, 0.0], [0.0, 10.0, 0.0], [5.0, 15.0, 0.0]])  # a 3-joint chain
+    anim = animation.animate_skeletons(
+        [wave_motion(4), np.repeat(small[None], 4, axis=0)], [tiny_skeleton(), [-1, 0, 1]], 15, dpi=30
+    )
+    assert anim.frame_image(1).std() > 0
+    parents_list = animation.animate_skeletons(wave_motion(4), PARENTS, 15, dpi=30)
+    assert parents_list.frame_image(0).std() > 0
+    with pytest.raises(ValueError, match="skeleton: 3 given for 2"):
+        animation.animate_skeletons([wave_motion(2)] * 2, [tiny_skeleton()] * 3, 15)
