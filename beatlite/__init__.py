@@ -26,7 +26,21 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-_SUBMODULES = ("io", "skeleton", "synth", "data", "stats", "metrics", "models", "train", "viz", "paths")
+_SUBMODULES = (
+    "io",
+    "skeleton",
+    "synth",
+    "data",
+    "stats",
+    "metrics",
+    "models",
+    "train",
+    "viz",
+    "paths",
+    "report",
+    "exercise",
+    "notebook",
+)
 
 __all__ = ["__version__", *_SUBMODULES]
 
@@ -44,4 +58,18 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
-    from beatlite import data, io, metrics, models, paths, skeleton, stats, synth, train, viz  # noqa: F401
+    from beatlite import (  # noqa: F401
+        data,
+        exercise,
+        io,
+        metrics,
+        models,
+        notebook,
+        paths,
+        report,
+        skeleton,
+        stats,
+        synth,
+        train,
+        viz,
+    )

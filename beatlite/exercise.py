@@ -71,7 +71,9 @@ def check(
             return None
         want = reference_fn(*args, **kwargs)
         try:
-            ok = bool(np.allclose(np.asarray(got, dtype=float), np.asarray(want, dtype=float), rtol=rtol, atol=atol))
+            ok = bool(
+                np.allclose(np.asarray(got, dtype=float), np.asarray(want, dtype=float), rtol=rtol, atol=atol)
+            )
         except (TypeError, ValueError):
             ok = got == want
         if not ok:

@@ -24,8 +24,22 @@ def require(version: str) -> None:
         )
 
 
+def _inline_figures() -> None:
+    """Inside a Jupyter kernel, show matplotlib figures inline even when ``MPLBACKEND=Agg`` is set."""
+    try:
+        from IPython import get_ipython
+    except ImportError:  # plain Python: nothing to do
+        return
+    shell = get_ipython()
+    if shell is not None and getattr(shell, "kernel", None) is not None:
+        shell.run_line_magic("matplotlib", "inline")
+
+
 def setup(seed: int = 0, *, verbose: bool = True) -> dict[str, str]:
     """Prepare a notebook: seed numpy/random (and torch if it is imported), set torch threads.
+
+    Inside Jupyter it also switches matplotlib to inline figures, so executed
+    notebooks keep their figures even when the environment says ``MPLBACKEND=Agg``.
 
     Parameters
     ----------
@@ -48,6 +62,7 @@ def setup(seed: int = 0, *, verbose: bool = True) -> dict[str, str]:
         torch.manual_seed(seed)
         torch.set_num_threads(paths.n_threads())
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    _inline_figures()
     info = {
         "version": __version__,
         "mode": paths.mode(),

@@ -8,6 +8,7 @@ Every function reads the environment at call time (no global state):
   (train live).
 - ``BEATLITE_THREADS``: torch CPU threads (default 1; see :func:`n_threads`).
 - ``BEATLITE_BUILD``: output folder of the main job (default ``build/``).
+- ``BEATLITE_PYVISTA``: ``off`` forces matplotlib instead of pyvista (see :mod:`beatlite.viz.probe`).
 """
 
 from __future__ import annotations

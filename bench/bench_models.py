@@ -1,12 +1,15 @@
-"""Speed of the tiny models: one training epoch and generating a 60 s take.
+"""Speed of the tiny models: one training epoch, the full shipped training, generating a 60 s take.
 
-Run: ``BEATLITE_THREADS=1 .venv/bin/python bench/bench_models.py [--windows N] [--epochs E]``.
+Run: ``BEATLITE_THREADS=1 .venv/bin/python bench/bench_models.py [--windows N] [--seconds S]``.
 
-Prints, per model, seconds per training epoch on N windows (fake data with the real
-shapes unless ``data_samples/`` windows can be built) and the extrapolated time for E
-epochs (target: <= 180 s), and the time to generate a 60 s take with the harness
-(34-frame units, stride 30; target <= 2 s) next to one single forward pass over the
-whole take (the straightforward alternative, no seeding between units).
+Per model it prints the seconds of one training epoch on the ``data_samples/`` train windows
+(fake windows with the real shapes when the folder is missing; ``--windows`` keeps the first
+N), the extrapolated time of the shipped training (``beatlite.train.__main__.TRAINING``:
+target <= 180 s per model), and the time to generate a 60 s take with the harness (34-frame
+units, stride 30; target <= 2 s) next to one single forward pass over the whole take (the
+straightforward alternative, no seeding between units). CaMN tiny is also timed with the
+previous tiny audio widths ``(8, 8, 8, 16, 16, 32)`` (the straightforward alternative of the
+narrower ``(4, 8, 8, 16, 16, 32)``), measured in the same run.
 Timings on a shared machine are noisy: repeat when idle.
 """
 
@@ -20,34 +23,65 @@ import torch
 
 from beatlite.models import build_model
 from beatlite.models.testing import fake_windows
-from beatlite.paths import n_threads
+from beatlite.paths import data_dir, n_threads
 from beatlite.train import TrainConfig, fit
+from beatlite.train.__main__ import TRAINING
 from beatlite.train.generation import generate_sequence
 
-MODELS = (("camn", {}), ("s2g", {}), ("trimodal", {}))
+MODELS = (
+    ("camn", "camn tiny", {}),
+    ("camn", "camn old-audio", {"audio_channels": (8, 8, 8, 16, 16, 32)}),
+    ("s2g", "s2g tiny", {}),
+    ("trimodal", "trimodal tiny", {}),
+)
+
+
+def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str]:
+    try:
+        from beatlite.data.index import index_folder
+        from beatlite.data.vocab import build_vocab
+        from beatlite.data.windows import build_windows
+
+        index = index_folder(data_dir())
+        vocab = build_vocab(index)
+        w = build_windows(index, split="train", vocab=vocab)
+        arrays = {k: w[k] for k in w.keys()}
+        source = f"{data_dir().name} train windows"
+        n_vocab = len(vocab)
+    except (OSError, ValueError) as exc:
+        print(f"(no data: {exc}; using fake windows)")
+        n_vocab = 200
+        arrays = fake_windows(limit or 658, vocab_size=n_vocab)
+        source = "fake windows"
+    if limit is not None:
+        arrays = {k: v[:limit] for k, v in arrays.items()}
+    return arrays, n_vocab, source
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("--windows", type=int, default=512)
-    parser.add_argument("--epochs", type=int, default=30)
+    parser.add_argument("--windows", type=int, default=None, help="use only the first N train windows")
     parser.add_argument("--seconds", type=float, default=60.0)
     args = parser.parse_args()
     torch.set_num_threads(n_threads())
-    vocab = 200
-    train = fake_windows(args.windows, vocab_size=vocab)
+    train, vocab, source = _train_windows(args.windows)
+    n = len(train["pose"])
     t = int(args.seconds * 15)
     take = {k: v[0] for k, v in fake_windows(1, n_frames=t, vocab_size=vocab).items()}
     take["speaker"] = 1
-    print(f"threads={torch.get_num_threads()} windows={args.windows} take={args.seconds:g}s ({t} frames)")
-    for name, kw in MODELS:
+    epochs = TRAINING["epochs"]
+    print(f"threads={torch.get_num_threads()} {source}: {n} windows; take={args.seconds:g}s ({t} frames)")
+    epoch_times = {}
+    for name, label, kw in MODELS:
         if name != "s2g":
             kw = {**kw, "vocab_size": vocab}
         torch.manual_seed(0)
-        model = build_model(name, preset="tiny", no_adv_epochs=0, **kw)
+        model = build_model(name, preset="tiny", no_adv_epochs=0, **kw)  # adversarial: the costlier epoch
+        config = TrainConfig(epochs=1, batch_size=TRAINING["batch_size"], lr=TRAINING["lr"], progress=False)
         start = time.perf_counter()
-        fit(model, train, TrainConfig(epochs=1, batch_size=32, progress=False))
+        fit(model, train, config)
         epoch_s = time.perf_counter() - start
+        epoch_times[label] = epoch_s
         model.eval()
         start = time.perf_counter()
         generate_sequence(model, take)
@@ -59,11 +93,13 @@ def main() -> None:
             model(whole)
         one_s = time.perf_counter() - start
         print(
-            f"{name:9s} params={model.n_parameters():7d}  epoch={epoch_s:6.2f}s  "
-            f"x{args.epochs} epochs={epoch_s * args.epochs:7.1f}s (target <= 180)  "
+            f"{label:15s} params={model.n_parameters():7d}  epoch={epoch_s:6.2f}s  "
+            f"x{epochs} epochs={epoch_s * epochs:6.1f}s (target <= 180)  "
             f"generate {args.seconds:g}s take={gen_s:5.2f}s (target <= 2)  "
             f"single pass={one_s:5.2f}s  ratio={gen_s / one_s:4.1f}x"
         )
+    ratio = epoch_times["camn old-audio"] / epoch_times["camn tiny"]
+    print(f"camn tiny epoch speed-up from the narrower audio encoder: {ratio:.2f}x")
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ Writes, for each ``notebooks/NN_name.ipynb``:
 
 - ``build/notebooks/NN_name.ipynb`` (executed, with outputs) and ``.html``;
 - the tables the notebook saved with :func:`beatlite.report.save_table` (``build/tables/``);
+- ``build/student/NN_name.ipynb``: the student copy, without the cells tagged ``solution``;
 - ``build/results.md``: per-notebook status and wall time, then every table.
 
 Exit status is non-zero when any notebook fails (the others still run).
@@ -42,8 +43,20 @@ def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     return ok, seconds, message
 
 
+def write_student_copy(path: Path, out_dir: Path) -> None:
+    """Write ``path`` without its ``solution``-tagged cells (the exercise stubs stay)."""
+    import nbformat
+
+    nb = nbformat.read(path, as_version=4)
+    nb.cells = [c for c in nb.cells if "solution" not in c.get("metadata", {}).get("tags", [])]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    nbformat.write(nb, out_dir / path.name)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--out", type=Path, default=REPO / "build", help="output folder (default build/)")
     parser.add_argument("--timeout", type=int, default=900, help="per-cell timeout in seconds")
     parser.add_argument("notebooks", nargs="*", type=Path, help="notebooks to run (default: all, in order)")
@@ -64,6 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     for path in paths:
         print(f"[run] {path.name} ...", flush=True)
         ok, seconds, message = execute(path.resolve(), out / "notebooks", args.timeout)
+        write_student_copy(path, out / "student")
         failed += not ok
         rows.append((path.stem, ok, seconds, message))
         print(f"[run] {path.name}: {'ok' if ok else 'FAILED'} in {seconds:.1f} s {message}", flush=True)
@@ -78,7 +92,9 @@ def main(argv: list[str] | None = None) -> int:
         "| notebook | status | wall time (s) |",
         "|---|---|---:|",
     ]
-    lines += [f"| [{s}](notebooks/{s}.html) | {'ok' if ok else 'FAILED: ' + m} | {t:.1f} |" for s, ok, t, m in rows]
+    lines += [
+        f"| [{s}](notebooks/{s}.html) | {'ok' if ok else 'FAILED: ' + m} | {t:.1f} |" for s, ok, t, m in rows
+    ]
     lines += [f"| **total** | {len(rows) - failed}/{len(rows)} ok | {total:.1f} |", ""]
     for table in sorted((out / "tables").glob("*.md")):
         lines += [table.read_text(encoding="utf-8").rstrip(), ""]

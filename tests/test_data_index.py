@@ -93,6 +93,11 @@ def test_problem_takes_are_flagged_not_crashing(corpus: Path) -> None:
     gap = idx["2_scott_0_12_12"]
     assert any("durations disagree" in p and "audio 8.00 s" in p for p in gap.problems)
     assert not gap.usable and 8.0 - 5.0 > MAX_DURATION_GAP
+    (corpus / "beat_english_v0.2.1" / "extra" / "2_scott_0_11_11.bvh").write_text(
+        "HIERARCHY\n", encoding="utf-8"
+    )
+    no_header = index_folder(corpus)["2_scott_0_11_11"]  # now a BVH without a readable header
+    assert any(p.startswith("unreadable motion file") for p in no_header.problems) and not no_header.usable
     broken = idx["2_scott_0_13_13"]
     assert any(p.startswith("unreadable face file 2_scott_0_13_13.json") for p in broken.problems)
     assert "face" not in broken.durations and broken.usable  # face is optional for training
@@ -131,7 +136,7 @@ def test_duplicate_files_flagged(tmp_path: Path) -> None:
 def test_read_durations_false_lists_files_only(tmp_path: Path) -> None:
     make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
     r = index_folder(tmp_path, read_durations=False)["2_scott_0_9_9"]
-    assert r.durations == {} and len(r.files) == 6 and r.duration == 0.0
+    assert r.durations == {} and len(r.files) == 6 and r.duration == 0.0 and r.usable
 
 
 def test_where_variants_and_errors(corpus: Path) -> None:
@@ -152,7 +157,9 @@ def test_rows_and_markdown(corpus: Path) -> None:
     assert {"stem", "speaker_id", "split", "duration", "has_motion", "dur_audio", "problems"} <= set(rows[0])
     md = idx.to_markdown().splitlines()
     assert md[0].startswith("| stem | speaker |") and len(md) == 2 + 6
-    assert "| 2_scott_0_1_1 | scott | english | neutral | test | 4.0 | bvh wav json textgrid txt csv |  |" in md
+    assert (
+        "| 2_scott_0_1_1 | scott | english | neutral | test | 4.0 | bvh wav json textgrid txt csv |  |" in md
+    )
     short = idx.to_markdown(["stem", "split"], max_rows=2).splitlines()
     assert short[-1] == "... (4 more)" and short[0] == "| stem | split |"
     with pytest.raises(ValueError, match="unknown columns"):
@@ -174,3 +181,21 @@ def test_not_a_folder(tmp_path: Path) -> None:
     with pytest.raises(TypeError, match="TakeRecord"):
         TakeIndex(["x"])  # type: ignore[list-item]
     assert TakeRecord("x").duration == 0.0
+
+
+def test_real_beat_files(real_samples: Path) -> None:
+    # the real folder holds a BEAT wav + TextGrid without their BVH, and two BVHs with non-BEAT names
+    idx = index_folder(real_samples)
+    take = idx["2_scott_0_2_2"]
+    assert take.durations["audio"] == pytest.approx(62.0, abs=0.01)  # README: 62.0 s of 16 kHz speech
+    assert take.durations["text"] == 62.0  # README: integer xmax = 62
+    assert take.split == "test" and take.speaker == "scott"  # speech 1-8 of a 4-hour speaker
+    assert any("missing motion" in p for p in take.problems) and not take.usable
+    others = {r.stem: r for r in idx if r.stem != "2_scott_0_2_2"}
+    assert set(others) == {"beat_skeleton_2_scott_0_1_1_frame0", "dataset-1_bye_normal_001"}
+    for r in others.values():
+        assert any(p.startswith("bad name") for p in r.problems)
+    # the one-frame BEAT BVH header: Frames 1 x 1/120 s
+    assert others["beat_skeleton_2_scott_0_1_1_frame0"].durations["motion"] == pytest.approx(
+        1 / 120, rel=1e-3
+    )

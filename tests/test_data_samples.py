@@ -101,7 +101,7 @@ def test_skeleton_equals_real_beat_header(data_samples: Path, real_samples: Path
         assert np.array_equal(ours.parents, real.parents)
         assert ours.channels == real.channels
         assert sorted(ours.end_sites) == sorted(real.end_sites)
-        assert fps == pytest.approx(30.0)
+        assert 1.0 / fps == pytest.approx(30.0, rel=1e-4)  # read_bvh_header gives the frame time
 
 
 def test_textgrid_tiers_as_mfa_writes_them(takes: dict[str, dict]) -> None:
@@ -131,7 +131,9 @@ def test_face_is_51_arkit_at_60fps_with_blinks(takes: dict[str, dict]) -> None:
         blink = face.weights[:, ARKIT_51.index("eyeBlinkLeft")]
         closed = np.flatnonzero(blink > 0.8) / 60.0
         assert closed.size > 0, stem
-        gaps = np.diff(np.concatenate([[0.0], closed[np.diff(closed, prepend=-1.0) > 0.5], [face.n_frames / 60]]))
+        gaps = np.diff(
+            np.concatenate([[0.0], closed[np.diff(closed, prepend=-1.0) > 0.5], [face.n_frames / 60]])
+        )
         assert gaps.max() < 6.5, (stem, gaps.max())  # a blink every 3-5 s (first within 3 s)
 
 
@@ -163,7 +165,7 @@ def test_corpus_content_and_splits(takes: dict[str, dict], data_samples: Path) -
     for split in ("train", "test"):
         assert {n.emotion for n in speech if n.split == split} == set(range(8)), split
     size = sum(p.stat().st_size for p in data_samples.iterdir() if p.is_file())
-    assert size <= 40 * 2**20, size
+    assert size <= 40_000_000, size  # hard limit 40 MB
 
 
 def test_emotion_annotations(takes: dict[str, dict]) -> None:
@@ -200,7 +202,9 @@ def test_motion_is_smooth_and_within_limits(takes: dict[str, dict]) -> None:
         m = tk["motion"]
         sk = m.skeleton
         step = np.abs(np.diff(m.channels, axis=0)).max()
-        assert step < 20.0, (stem, step)  # < 600 deg/s (or 600 cm/s) at 30 fps: no jumps
+        assert step < 30.0, (stem, step)  # < 900 deg/s at 30 fps: no jumps or Euler flips
+        for hand in ("RightHand", "LeftHand"):
+            assert _wrist_speed(tk, hand).max() < 350.0, (stem, hand)  # cm/s
         for side in ("Right", "Left"):
             upper = _joint(tk, f"{side}ForeArm") - _joint(tk, f"{side}Arm")
             lower = _joint(tk, f"{side}Hand") - _joint(tk, f"{side}ForeArm")
@@ -241,6 +245,7 @@ def _alignment(motion_beats: np.ndarray, onsets: np.ndarray, sigma: float = 0.05
     return float(np.mean(np.exp(-(d**2) / (2 * sigma**2))))
 
 
+@pytest.mark.slow  # librosa's first onset detection JIT-compiles (~8 s); then ~0.1 s per take
 def test_motion_beats_align_with_audio_onsets(takes: dict[str, dict]) -> None:
     import librosa
 
@@ -249,7 +254,7 @@ def test_motion_beats_align_with_audio_onsets(takes: dict[str, dict]) -> None:
     for tk in takes.values():
         if tk["name"].session_type != 0:
             continue
-        onsets = librosa.onset.onset_detect(y=tk["audio"], sr=tk["sr"], units="time", hop_length=160)
+        onsets = librosa.onset.onset_detect(y=tk["audio"], sr=tk["sr"], units="time", hop_length=256)
         for hand in ("RightHand", "LeftHand"):
             beats = _stroke_ends(_wrist_speed(tk, hand), tk["motion"].fps)
             if beats.size < 5:
@@ -278,8 +283,8 @@ def test_speed_and_amplitude_order_by_emotion(takes: dict[str, dict]) -> None:
             continue
         v = (_wrist_speed(tk, "RightHand") + _wrist_speed(tk, "LeftHand")) / 2
         speed[n.speaker_id][n.emotion].append(float(v.mean()))
-        w = _chest_frame_wrists(tk)
-        amplitude[n.speaker_id][n.emotion].append(float(np.linalg.norm(w.std(axis=0), axis=-1).mean()))
+        w = _chest_frame_wrists(tk)  # amplitude: mean distance of the wrists from the rest pose (frame 0)
+        amplitude[n.speaker_id][n.emotion].append(float(np.linalg.norm(w - w[:1], axis=-1).mean()))
     for sid in (2, 4, 6, 8):
         s = {e: np.mean(v) for e, v in speed[sid].items()}
         a = {e: np.mean(v) for e, v in amplitude[sid].items()}
@@ -327,7 +332,13 @@ def test_big_gestures_spread_the_hands_more_than_small_ones(takes: dict[str, dic
         gap = np.linalg.norm(w[:, 0] - w[:, 1], axis=1)
         t = np.arange(gap.size) / tk["motion"].fps
         for s in tk["semantic"]:
-            kind = "big" if s.keywords in ("big", "huge", "large") else "small" if s.keywords in ("small", "little", "tiny") else None
+            kind = (
+                "big"
+                if s.keywords in ("big", "huge", "large")
+                else "small"
+                if s.keywords in ("small", "little", "tiny")
+                else None
+            )
             if kind:
                 gaps[kind].append(gap[(t >= s.start) & (t <= s.end)])
     big, small = np.concatenate(gaps["big"]), np.concatenate(gaps["small"])

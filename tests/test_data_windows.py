@@ -123,6 +123,8 @@ def test_counts_shapes_dtypes(train: Windows) -> None:
         "start",
     ]
     assert np.all(train["speaker"] == 1)  # speaker id 2 -> index 1
+    assert train[3]["start"] == 30 and train[-1]["take"] == "2_scott_0_10_10"  # int -> one item
+    assert list(train) == train.keys() and train.get("positions") is None and "dirvec_mean" not in train
 
 
 def test_pose_values_and_train_normalisation(train: Windows) -> None:
@@ -264,3 +266,18 @@ def test_import_does_not_load_torch() -> None:
     code = "import sys, beatlite.data, beatlite.data.windows, beatlite.stats; print('torch' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_b_half_words_use_the_sequence_offset(tmp_path: Path) -> None:
+    # 1-hour speaker 10 (kieks): "_b" halves keep the whole sequence's TextGrid times; speech -> 30 s offset
+    stem = "10_kieks_0_65_65_b"
+    write_take(tmp_path, stem, 40)
+    write_textgrid(tmp_path / f"{stem}.TextGrid", [(30.5, 31.0, "hello")], 62.0)
+    idx = index_folder(tmp_path)
+    assert idx[stem].half == "b" and idx[stem].split == "val"
+    fake = (Normalizer(np.zeros(141), np.ones(141)), Normalizer(np.zeros(126), np.ones(126)))
+    w = build_windows(idx, split="val", vocab=VOCAB, stats=fake, whole_takes=True, cache=False)
+    # frame i at 30 + i / 15 s: [30.5, 31.0) -> frames 8..14
+    expected = np.zeros(40, np.int64)
+    expected[8:15] = VOCAB["hello"]
+    assert w.item(0)["word"].tolist() == expected.tolist()

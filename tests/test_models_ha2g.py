@@ -167,9 +167,10 @@ def test_discriminator_shape_and_losses() -> None:
     model = _model()
     batch = fake_batch(4)
     out = model(batch)
-    d_loss = model.discriminator_losses(batch, out)["total"]
+    d_losses = model.discriminator_losses(batch, out)
     # log(4) when D outputs 1/2 for everything; an untrained D is near that
-    assert 0.5 < float(d_loss) < 3.0
+    assert 0.5 < float(d_losses["total"].detach()) < 3.0
+    torch.testing.assert_close(d_losses["total"].detach(), d_losses["real"] + d_losses["fake"])
 
 
 # ----------------------------------------------------------------------------- losses and gradients
@@ -334,3 +335,31 @@ def test_paper_preset_builds_and_runs_one_forward() -> None:
         out = model(fake_batch(2, vocab_size=100))
     assert tuple(out["pose"].shape) == (2, 34, 126)
     assert tuple(out["audio_high"].shape) == (2, 34, 32)
+
+
+def test_retrain_rejects_unknown_checkpoint_names_before_loading_data() -> None:
+    from beatlite.models.ha2g import retrain
+
+    with pytest.raises(ValueError, match="unknown HA2G checkpoint"):
+        retrain(["ha2g_tiny_typo"])
+
+
+@pytest.mark.parametrize("name", sorted(CHECKPOINTS))
+def test_shipped_checkpoint_loads_and_generates(name: str) -> None:
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train import load_model
+
+    path = checkpoints_dir() / f"{name}.pt"
+    if not path.is_file():
+        pytest.skip(f"{path} not trained yet (python -m beatlite.models.ha2g_train)")
+    model, data = load_model(path)
+    assert isinstance(model, HA2G) and model.config.preset == "tiny"
+    for field, value in CHECKPOINTS[name].items():
+        assert getattr(model.config, field) == value
+    assert bool(model.statistics_ready)
+    np.testing.assert_allclose(model.mean_dirvec.numpy(), data["meta"]["dirvec_mean"], atol=1e-3)  # float16
+    assert path.stat().st_size < 2_000_000
+    batch = fake_batch(2, vocab_size=model.config.vocab_size)
+    pose = model.generate(batch)
+    assert tuple(pose.shape) == (2, 34, 126) and bool(torch.isfinite(pose).all())
+    assert float(pose[:, 4:].std(dim=1).mean()) > 0.0  # not a frozen pose

@@ -198,16 +198,18 @@ def test_emotion_classifier_per_class_accuracy() -> None:
     test = np.concatenate([_speed_windows(rng, c, 20) for c in range(3)])
     y_train, y_test = np.repeat([0, 2, 3], 40), np.repeat([0, 2, 3], 20)
     for model in ("logistic", "forest"):
-        clf = EmotionClassifier(model=model).fit(train, y_train)
+        clf = EmotionClassifier(model=model, joints=None).fit(train, y_train)
         acc = clf.per_class_accuracy(test, y_test)
         assert set(acc) == {"neutral", "anger", "sadness", "avg", "overall"}
         assert acc["avg"] > 0.9, (model, acc)
         assert clf.classes.tolist() == [0, 2, 3]
         assert clf.predict_proba(test).shape == (60, 3)
     with pytest.raises(RuntimeError, match="fit"):
-        EmotionClassifier().predict(test)
+        EmotionClassifier(joints=None).predict(test)
+    with pytest.raises(ValueError, match="joints=None"):
+        EmotionClassifier().fit(train, y_train)  # 4-d windows: no body27 subset
     with pytest.raises(ValueError, match="labels must be"):
-        EmotionClassifier().fit(train, y_train[:-1])
+        EmotionClassifier(joints=None).fit(train, y_train[:-1])
     with pytest.raises(ValueError, match="model"):
         EmotionClassifier(model="svm")
 
@@ -245,6 +247,7 @@ def test_word_and_speaker_scores() -> None:
 # ------------------------------------------------------------------ distributions (records only)
 def _record(stem: str, seconds: float, **fields) -> TakeRecord:
     r = TakeRecord(stem, **fields)
+    r.files = {"motion": Path(f"{stem}.bvh"), "audio": Path(f"{stem}.wav")}  # never opened
     r.durations = {"motion": seconds, "audio": seconds}
     return r
 
@@ -318,3 +321,64 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
     for stem in ("fig2", "fig3a", "fig4", "corr", "table6"):
         for ext in ("png", "svg"):
             assert (tmp_path / f"{stem}.{ext}").stat().st_size > 1000
+
+
+def test_subset_dims_body27_matches_reference_layout() -> None:
+    from beatlite.stats.emotion_clusters import subset_dims
+
+    # facts A.3: spine/neck = dims 0-8, right shoulder/arm/forearm = 9-17, left ones = 75-83
+    assert subset_dims("body27").tolist() == list(range(18)) + list(range(75, 84))
+    assert subset_dims("spine_neck_141").tolist() == list(range(141))
+    with pytest.raises(ValueError, match="joints must be one of"):
+        subset_dims("nope")
+
+
+def test_knn_vote_matches_scikit_learn() -> None:
+    from scipy.spatial.distance import cdist
+    from sklearn.neighbors import KNeighborsClassifier
+
+    from beatlite.stats.emotion_clusters import _knn_predict
+
+    rng = np.random.default_rng(3)
+    xtr, xte = rng.normal(size=(60, 3)), rng.normal(size=(25, 3))
+    ytr = rng.integers(0, 4, size=60)
+    ours = _knn_predict(cdist(xte, xtr, "sqeuclidean"), ytr, 5)
+    ref = KNeighborsClassifier(n_neighbors=5).fit(xtr, ytr).predict(xte)
+    assert ours.tolist() == ref.tolist()
+
+
+def test_separability_permutation_p_value() -> None:
+    rng = np.random.default_rng(0)
+    groups = np.repeat(np.arange(16), 8)  # 16 takes of 8 windows
+    labels = np.repeat(np.arange(16) % 4, 8)
+    planted = rng.normal(size=(128, 5)) + 4.0 * np.eye(5)[labels]
+    good = separability(planted, labels, groups=groups, n_permutations=99)
+    assert good.balanced_accuracy > 0.8 and good.p_permutation == pytest.approx(0.01)  # (1 + 0) / (1 + 99)
+    noise = separability(rng.normal(size=(128, 5)), labels, groups=groups, n_permutations=99)
+    assert noise.p_permutation > 0.05
+
+
+def test_load_corpus_streams_and_skips_broken_takes(tmp_path: Path) -> None:
+    from test_data_windows import ramp, write_take
+
+    from beatlite.data.index import index_folder
+    from beatlite.stats.corpus import load_corpus
+
+    write_take(tmp_path, "2_scott_0_9_9", 40)
+    write_take(tmp_path, "2_scott_0_10_10", 40)
+    bvh = tmp_path / "2_scott_0_10_10.bvh"
+    lines = bvh.read_text(encoding="utf-8").splitlines()
+    bvh.write_text("\n".join([*lines[:-1], "abc"]) + "\n", encoding="utf-8")  # header fine, last row broken
+    idx = index_folder(tmp_path)
+    assert idx["2_scott_0_10_10"].usable  # only the header is checked by the index
+    with pytest.warns(UserWarning, match="skipped 1 unreadable takes: .*2_scott_0_10_10.bvh, line 471"):
+        takes = load_corpus(idx)
+    (t,) = takes
+    assert t.stem == "2_scott_0_9_9" and t.n_frames == 40 and t.emotion == 0 and t.speaker_id == 2
+    assert t.rotations.shape == (40, 141) and t.speed.shape == (40,) and np.all(t.speed > 0)
+    y = ramp(40 * 16000 // 15).astype(np.float64)
+    # frame 0 covers samples [0, 1066): RMS of the ramp there, computed directly
+    assert t.audio_rms[0] == pytest.approx(np.sqrt(np.mean(y[:1066] ** 2)), rel=1e-5)
+    assert t.face_activity is not None and np.allclose(t.face_activity, 0.0)  # constant weights
+    assert np.all(t.emotion_frames == 2)  # from the .csv
+    assert t.semantic_scores.tolist() == [0.5] and t.words == ("Hello", "world,", "zebra")

@@ -203,3 +203,81 @@ def test_generate_camn_on_a_take_of_odd_length():
     first["audio"] = first["audio"][:, :36266]
     first["speaker"] = torch.tensor([1])
     np.testing.assert_allclose(out[:30], model.generate(first)[0, :30].numpy(), atol=1e-6)
+
+
+# --------------------------------------------------------------------------- windows per epoch
+@dataclasses.dataclass
+class _ScaleConfig(ModelConfig):
+    pass
+
+
+class _Scale(GestureModel):
+    """One trainable scalar; records how many windows each training forward pass sees."""
+
+    name = "scale"
+    config_class = _ScaleConfig
+    input_keys = ("pose",)
+
+    def __init__(self) -> None:
+        super().__init__(_ScaleConfig())
+        self.w = torch.nn.Parameter(torch.zeros(()))
+        self.seen: list[int] = []
+
+    def forward(self, batch):
+        if self.training:
+            self.seen.append(int(batch["pose"].shape[0]))
+        return {"pose": batch["pose"] * self.w}
+
+    def losses(self, batch, out, *, epoch):
+        return {"total": ((out["pose"] - batch["pose"]) ** 2).mean()}
+
+
+def test_windows_per_epoch_limits_each_epoch(windows):
+    train, _ = windows  # 24 windows
+    model = _Scale()
+    fit(model, train, cfg(epochs=3, batch_size=4, windows_per_epoch=10))
+    # 10 windows per epoch in batches of 4: 4 + 4 + 2, three epochs
+    assert model.seen == [4, 4, 2] * 3
+    full = _Scale()
+    fit(full, train, cfg(epochs=1, batch_size=4))
+    assert full.seen == [4] * 6
+    with pytest.raises(ValueError, match="windows_per_epoch"):
+        TrainConfig(windows_per_epoch=1)
+
+
+def test_windows_per_epoch_draws_a_new_subset_each_epoch(windows):
+    train, _ = windows
+    marked = dict(train)
+    marked["pose"] = np.broadcast_to(
+        np.arange(24, dtype=np.float32)[:, None, None], train["pose"].shape
+    ).copy()  # window i is filled with the value i
+
+    class _Ids(_Scale):
+        def forward(self, batch):
+            if self.training:
+                self.ids.append(sorted(int(v) for v in batch["pose"][:, 0, 0]))
+            return {"pose": batch["pose"] * self.w}
+
+    model = _Ids()
+    model.ids = []
+    fit(model, marked, cfg(epochs=2, batch_size=8, windows_per_epoch=8))
+    first, second = model.ids
+    assert len(set(first)) == 8 and len(set(second)) == 8  # no window twice within an epoch
+    assert first != second
+
+
+def test_fit_accepts_a_windows_like_object(windows):
+    train, _ = windows
+
+    class _WindowsLike:
+        whole_takes = False
+
+        def keys(self):
+            return list(train)
+
+        def __getitem__(self, key):
+            return train[key]
+
+    a = fit(camn(), train, cfg(epochs=1))
+    b = fit(camn(), _WindowsLike(), cfg(epochs=1))
+    assert a.history == b.history

@@ -131,3 +131,20 @@ def test_read_vec_file(tmp_path: Path) -> None:
     (tmp_path / "bad.vec").write_text("hello 1 2\nworld 3\n", encoding="utf-8")
     with pytest.raises(ValueError, match="line 2"):
         read_vec_file(tmp_path / "bad.vec", v)
+
+
+def test_randomized_svd_branch(monkeypatch: pytest.MonkeyPatch) -> None:
+    import beatlite.data.vocab as vocab_module
+
+    sentences = [
+        ["the", "cat", "sat"],
+        ["the", "dog", "sat"],
+        ["a", "sun", "rose"],
+        ["a", "moon", "rose"],
+    ] * 5
+    v = vocab_from_sentences(sentences)
+    monkeypatch.setattr(vocab_module, "DENSE_SVD_MAX", 0)  # force scikit-learn's TruncatedSVD
+    vec = word_vectors(v, sentences, dim=4, window=1)
+    cos = vec @ vec.T
+    assert cos[v["cat"], v["dog"]] > 0.99 and cos[v["cat"], v["sun"]] < 0.5
+    assert np.array_equal(vec, word_vectors(v, sentences, dim=4, window=1))  # seeded: deterministic

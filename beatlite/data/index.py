@@ -5,8 +5,9 @@ A *take* is every file sharing one stem, e.g. ``2_scott_0_1_1.bvh``, ``.wav``,
 index works on real BEAT's layout (``{speaker_id}/{stem}.*``, also nested as
 ``beat_english_v0.2.1/2/...``) and on a flat folder. Problems (a ``.wav``
 without ``.bvh``, a name that does not parse, an unreadable file, modalities
-whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds) are
-recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
+whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds -- the
+TextGrid of an ``_a``/``_b`` half is not compared, it spans the whole sequence)
+are recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
 
 >>> from beatlite.data.index import index_folder
 >>> idx = index_folder("data_samples")  # doctest: +SKIP
@@ -113,14 +114,16 @@ class TakeRecord:
     def usable(self) -> bool:
         """True when the take can feed training windows.
 
-        The name parsed, motion and audio exist and were readable, and the timed
-        modalities agree within :data:`MAX_DURATION_GAP`. Missing optional files
-        (face, text, annotations) are problems but do not make a take unusable.
+        The name parsed, motion and audio files exist and their headers were readable
+        (or not read: ``read_durations=False``), and the timed modalities agree within
+        :data:`MAX_DURATION_GAP`. Missing optional files (face, text, annotations) are
+        problems but do not make a take unusable.
         """
+        blocking = ("durations disagree", "unreadable motion", "unreadable audio")
         return (
             self.speaker_id is not None
-            and all(m in self.durations for m in REQUIRED)
-            and not any(p.startswith("durations disagree") for p in self.problems)
+            and all(m in self.files for m in REQUIRED)
+            and not any(p.startswith(blocking) for p in self.problems)
         )
 
     def has(self, modality: str) -> bool:
@@ -494,11 +497,13 @@ def index_take(stem: str, files: dict[str, list[Path]], *, read_durations: bool 
                 record.durations[modality] = float(_DURATION_READERS[modality](record.files[modality]))
             except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
                 record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
-        if len(record.durations) >= 2:
-            lo = min(record.durations, key=record.durations.__getitem__)
-            hi = max(record.durations, key=record.durations.__getitem__)
-            if record.durations[hi] - record.durations[lo] > MAX_DURATION_GAP:
-                listing = ", ".join(f"{m} {d:.2f} s" for m, d in record.durations.items())
+        # the TextGrid of an "_a"/"_b" half spans the whole sequence (facts A.5): not compared
+        compared = {m: d for m, d in record.durations.items() if not (m == "text" and record.half)}
+        if len(compared) >= 2:
+            lo = min(compared, key=compared.__getitem__)
+            hi = max(compared, key=compared.__getitem__)
+            if compared[hi] - compared[lo] > MAX_DURATION_GAP:
+                listing = ", ".join(f"{m} {d:.2f} s" for m, d in compared.items())
                 record.problems.append(f"durations disagree by more than {MAX_DURATION_GAP:g} s: {listing}")
     return record
 

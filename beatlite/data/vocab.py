@@ -29,6 +29,8 @@ if TYPE_CHECKING:
 PAD, SOS, EOS, UNK = 0, 1, 2, 3
 SPECIAL_TOKENS = ("<pad>", "<sos>", "<eos>", "<unk>")
 _STRIP = ' \t,.?!;:"()[]{}'
+#: Vocabularies up to this size use an exact dense SVD; larger ones scikit-learn's randomized one.
+DENSE_SVD_MAX = 3000
 
 
 def normalize_word(word: str) -> str:
@@ -271,7 +273,8 @@ def word_vectors(
     """Offline word vectors: truncated SVD of the corpus PPMI matrix.
 
     Row ``i`` is the vector of token ``vocab.itos[i]``. Ordinary words get
-    ``U_k * sqrt(S_k)`` from the SVD, scaled to unit L2 norm (signs fixed so that each
+    ``U_k * sqrt(S_k)`` from the SVD (exact numpy SVD up to :data:`DENSE_SVD_MAX` tokens,
+    scikit-learn's seeded randomized ``TruncatedSVD`` beyond), scaled to unit L2 norm (signs fixed so that each
     column's largest-magnitude entry is positive; deterministic). If the corpus has
     rank < ``dim`` the remaining columns are zero. PAD is the zero vector; SOS, EOS
     and UNK get fixed random N(0, 1/dim) vectors from ``seed`` (as the reference gives
@@ -295,18 +298,21 @@ def word_vectors(
     -------
     (len(vocab), dim) float32
     """
-    from sklearn.decomposition import TruncatedSVD
-
     if not isinstance(dim, int | np.integer) or dim < 1:
         raise ValueError(f"word_vectors: dim must be a positive int, got {dim!r}")
     matrix = ppmi(cooccurrence(sentences, vocab, window=window))
     out = np.zeros((len(vocab), dim), dtype=np.float64)
     rank = min(dim, len(vocab) - 5, matrix.nnz)
     if rank >= 1:
-        svd = TruncatedSVD(n_components=rank, algorithm="randomized", n_iter=10, random_state=seed)
-        u = svd.fit_transform(matrix)  # = U * S
-        s = np.maximum(svd.singular_values_, 1e-12)
-        u = u / np.sqrt(s)  # U * sqrt(S)
+        if len(vocab) <= DENSE_SVD_MAX:  # exact and fast for small vocabularies
+            u_full, s_full, _ = np.linalg.svd(matrix.toarray(), full_matrices=False)
+            u, s = u_full[:, :rank] * s_full[:rank], s_full[:rank]
+        else:
+            from sklearn.decomposition import TruncatedSVD
+
+            svd = TruncatedSVD(n_components=rank, algorithm="randomized", n_iter=10, random_state=seed)
+            u, s = svd.fit_transform(matrix), svd.singular_values_  # u = U * S
+        u = u / np.sqrt(np.maximum(s, 1e-12))  # U * sqrt(S)
         signs = np.sign(u[np.argmax(np.abs(u), axis=0), np.arange(u.shape[1])])
         u = u * np.where(signs == 0, 1.0, signs)
         norms = np.linalg.norm(u, axis=1, keepdims=True)

@@ -42,7 +42,7 @@ from __future__ import annotations
 import hashlib
 import json
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -182,8 +182,11 @@ def take_features(
     vocab: Mapping | None = None,
     word_rule: str = "span",
     positions: bool = False,
+    mel: bool = True,
 ) -> TakeFeatures:
     """Load one take and compute its aligned per-frame streams (see :class:`TakeFeatures`).
+
+    ``mel=False`` skips the log-mel (``mel`` is then (0, 128)); ``vocab=None`` gives PAD words.
 
     The frame count is the one :func:`beatlite.io.load_take` aligned every modality to: the
     smallest of the motion frames, ``floor(audio seconds * fps)`` and the face frames (BEAT:
@@ -221,7 +224,7 @@ def take_features(
         dirs=dirs,
         positions=pos,
         audio=audio,
-        mel=log_mel(audio, sr),
+        mel=log_mel(audio, sr) if mel else np.zeros((0, MEL_SETTINGS["n_mels"]), np.float32),
         face=face,
         word=word,
         emotion=np.asarray(take.emotion, dtype=np.int64)[:n],
@@ -301,6 +304,14 @@ class Windows:
     def __len__(self) -> int:
         return int(len(self._arrays["take"]))
 
+    def __iter__(self) -> Iterator[str]:
+        """Iterate over the keys, like a dict (``len`` however counts items)."""
+        return iter(self.keys())
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """``self[key]`` if the key is present, else ``default`` (dict-like)."""
+        return self[key] if key in self.keys() else default
+
     def __contains__(self, key: object) -> bool:
         return key in self.keys()
 
@@ -309,7 +320,10 @@ class Windows:
         off = self._offsets[kind]
         return slice(int(off[i]), int(off[i + 1]))
 
-    def __getitem__(self, key: str) -> np.ndarray | list[np.ndarray]:
+    def __getitem__(self, key: str | int) -> np.ndarray | list[np.ndarray] | dict[str, np.ndarray]:
+        """``w["pose"]``: the array of a key (a list in whole-take mode); ``w[i]``: item ``i`` (a dict)."""
+        if isinstance(key, int | np.integer):
+            return self.item(int(key))
         if key not in self.keys():
             raise KeyError(f"Windows has no key {key!r}; keys: {self.keys()}")
         arr = self._arrays[key]
@@ -460,7 +474,7 @@ def train_statistics(
     path = _stats_path(records, fps, sr, cache)
     stats = _load_stats(path)
     if stats is None:
-        stats = _fit_stats([take_features(r, fps=fps, sr=sr) for r in records], path)
+        stats = _fit_stats([take_features(r, fps=fps, sr=sr, mel=False) for r in records], path)
     return stats
 
 
@@ -569,7 +583,9 @@ def build_windows(
                 loaded = {r.stem: take_features(r, **feature_args) for r in train_records}
                 stats = _fit_stats(list(loaded.values()), stats_path)
             else:
-                stats = _fit_stats([take_features(r, fps=fps, sr=sr) for r in train_records], stats_path)
+                stats = _fit_stats(
+                    [take_features(r, fps=fps, sr=sr, mel=False) for r in train_records], stats_path
+                )
     pose_norm, dir_norm = stats
     params: dict[str, Any] = {
         "split": split,

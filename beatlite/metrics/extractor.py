@@ -60,7 +60,7 @@ class ExtractorConfig:
     input_dim: int
     latent_dim: int = 32
     channels: int = 32
-    epochs: int = 40
+    epochs: int = 100
     batch_size: int = 64
     lr: float = 1e-3
     velocity_weight: float = 0.1
@@ -358,7 +358,7 @@ def _train_command(args: argparse.Namespace) -> int:
         "takes": takes,
         "window_key": key,
         "seconds": round(float(info["seconds"]), 1),
-        "torch": torch.__version__,
+        "torch": str(torch.__version__),
     }
     out = Path(args.out) if args.out else checkpoints_dir() / fname
     save_extractor(out, model, info, space=args.space, meta=meta)
@@ -389,7 +389,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     t.add_argument("--out", help="checkpoint path (default checkpoints/fgd_<space>.pt)")
     t.add_argument("--latent", type=int, default=32)
     t.add_argument("--channels", type=int, default=32)
-    t.add_argument("--epochs", type=int, default=40)
+    t.add_argument("--epochs", type=int, default=100)
     t.add_argument("--batch-size", type=int, default=64)
     t.add_argument("--lr", type=float, default=1e-3)
     t.add_argument("--seed", type=int, default=0)

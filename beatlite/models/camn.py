@@ -116,7 +116,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "text_layers": 2,
         "text_features": 32,
         "n_speakers": 30,
-        "audio_channels": (8, 8, 8, 16, 16, 32),
+        "audio_channels": (4, 8, 8, 16, 16, 32),
         "audio_fused": 32,
         "face_channels": (8, 8, 8, 16),
         "face_fused": 16,

@@ -113,7 +113,7 @@ class HA2GConfig(ModelConfig):
     contrastive_neg_weight: float = 0.005
     contrastive_min_distance: float = 1e-2
     physical_weight: float = 0.01
-    angle_var_floor: float = 1e-5
+    angle_var_floor: float = 1e-4
     d_hidden: int = 64
     d_layers: int = 4
     d_lr_scale: float = 0.2
@@ -586,12 +586,20 @@ class HA2G(GestureModel):
         )
 
     def discriminator_losses(self, batch: Batch, out: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
-        """NS-GAN discriminator loss on real ``dirvec`` vs the detached generated pose."""
+        """NS-GAN discriminator loss on real ``dirvec`` vs the detached generated pose.
+
+        ``"total" = "real" + "fake"`` with ``"real" = -mean log D(real)`` and
+        ``"fake" = -mean log(1 - D(fake))`` (the last two detached, for logging).
+        """
         if self.discriminator is None:
             raise RuntimeError("HA2G: adversarial is off, there is no discriminator")
         real = self.discriminator(batch["dirvec"])
         fake = self.discriminator(out["pose"].detach())
-        return {"total": ns_gan_d_loss(real, fake)}
+        return {
+            "total": ns_gan_d_loss(real, fake),
+            "real": -nn.functional.logsigmoid(real).mean().detach(),
+            "fake": -nn.functional.logsigmoid(-fake).mean().detach(),
+        }
 
 
 def _find_dirvec_mean(windows: Mapping[str, Any]) -> np.ndarray:

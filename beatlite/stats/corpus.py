@@ -6,6 +6,7 @@ only what the statistics need, so all figures/tables share one pass over the dat
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -158,8 +159,22 @@ def corpus_take(record: TakeRecord, *, fps: float = 15, sr: int = 16000) -> Corp
 def load_corpus(
     index: TakeIndex, *, fps: float = 15, sr: int = 16000, splits: tuple[str, ...] | None = None
 ) -> list[CorpusTake]:
-    """:func:`corpus_take` of every usable take of ``index`` (optionally only some splits), in order."""
+    """:func:`corpus_take` of every usable take of ``index`` (optionally only some splits), in order.
+
+    A take that fails to load (e.g. a broken motion row the header check could not see) is
+    skipped with a warning naming it; ``ValueError`` if no take is left.
+    """
     records = [r for r in index if r.usable and (splits is None or r.split in splits)]
-    if not records:
-        raise ValueError(f"load_corpus: no usable takes in the index ({len(index)} takes, splits={splits})")
-    return [corpus_take(r, fps=fps, sr=sr) for r in records]
+    takes, failed = [], []
+    for r in records:
+        try:
+            takes.append(corpus_take(r, fps=fps, sr=sr))
+        except (OSError, ValueError) as e:  # FormatError is a ValueError and names the file
+            failed.append(f"{r.stem}: {e}")
+    if failed:
+        warnings.warn(f"load_corpus: skipped {len(failed)} unreadable takes: {failed[:3]}", stacklevel=2)
+    if not takes:
+        raise ValueError(
+            f"load_corpus: no readable usable takes in the index ({len(index)} takes, splits={splits})"
+        )
+    return takes

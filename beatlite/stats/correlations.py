@@ -8,7 +8,9 @@ over non-overlapping windows (2 s by default) to tame autocorrelation.
 - continuous modalities (audio RMS, facial activity): Spearman's rho over windows,
   scipy's p-value (assumes independent windows, optimistic) **and** a permutation
   p-value from circularly shifting the other signal within each take, which keeps
-  each signal's autocorrelation (the honest baseline);
+  each signal's autocorrelation and each take's level (the honest baseline: it asks
+  whether the moment-to-moment coupling is real, beyond takes that are louder *and*
+  livelier overall; its null rho can therefore be well above 0);
 - categorical factors (emotion, speaker): one-way ANOVA of the take-mean energy
   across groups (one value per take, so takes are the independent units), its
   effect size eta^2, and a permutation p-value from shuffling the take labels.

@@ -4,7 +4,8 @@ The paper shows a t-SNE plot and says emotions are "basically distinguished into
 different groups". A 2-D embedding can look clustered or not depending on
 perplexity, so beatlite also *measures* separability on the high-dimensional
 features: the silhouette score of the emotion labels and the cross-validated
-k-NN accuracy, next to chance (the majority-class share). Folds are grouped by
+k-NN accuracy and balanced accuracy, next to their chance levels (majority-class
+share; 1 / number of classes), with a permutation test. Folds are grouped by
 take (windows of one take never sit in both train and test), otherwise
 neighbouring windows of the same take would inflate the accuracy.
 """
@@ -84,6 +85,30 @@ def rotation_windows(
     )
 
 
+def subset_dims(joints: str) -> np.ndarray:
+    """Positions, inside the 141-d ``spine_neck_141`` vector, of the rotation dims of a joint subset.
+
+    Parameters
+    ----------
+    joints : str
+        A key of :data:`beatlite.skeleton.JOINT_SUBSETS` whose joints all lie in ``spine_neck_141``
+        (``"body27"``, ``"hands114"``, ``"spine_neck_141"``).
+
+    Returns
+    -------
+    (3K,) int64, e.g. 27 dims for ``"body27"`` (0-17 and 75-83).
+    """
+    from beatlite.skeleton import JOINT_SUBSETS
+
+    if joints not in JOINT_SUBSETS:
+        raise ValueError(f"subset_dims: joints must be one of {sorted(JOINT_SUBSETS)}, got {joints!r}")
+    order = {name: i for i, name in enumerate(JOINT_SUBSETS["spine_neck_141"])}
+    missing = [n for n in JOINT_SUBSETS[joints] if n not in order]
+    if missing:
+        raise ValueError(f"subset_dims: joints of {joints!r} not in spine_neck_141: {missing[:3]}")
+    return np.array([3 * order[n] + c for n in JOINT_SUBSETS[joints] for c in range(3)], dtype=np.int64)
+
+
 def window_features(windows: np.ndarray, *, kind: str = "stats") -> np.ndarray:
     """High-dimensional features of motion windows.
 
@@ -119,29 +144,75 @@ class Separability:
         Silhouette score of the labels on the standardised features (-1..1; 0 = overlapping).
     knn_accuracy : float
         Mean cross-validated k-NN accuracy (take-grouped folds when groups were given).
+    balanced_accuracy : float
+        Mean cross-validated k-NN balanced accuracy (mean per-class recall); its chance
+        level is ``uniform_chance`` whatever the class sizes.
     fold_accuracies : (F,) float64
     chance : float
-        Accuracy of always predicting the most frequent class.
+        Accuracy of always predicting the most frequent class (the chance level of
+        ``knn_accuracy``).
     uniform_chance : float
-        1 / number of classes.
+        1 / number of classes (the chance level of ``balanced_accuracy``).
+    p_permutation : float or None
+        Permutation p-value of ``balanced_accuracy``: labels shuffled between groups
+        (takes), ``(1 + #{null >= observed}) / (1 + n_permutations)``; None if not run.
     n : int
         Number of windows; ``k`` neighbours, ``n_classes``.
     """
 
     silhouette: float
     knn_accuracy: float
+    balanced_accuracy: float
     fold_accuracies: np.ndarray
     chance: float
     uniform_chance: float
+    p_permutation: float | None
     n: int
     k: int
     n_classes: int
 
     def summary(self) -> str:
+        p = "" if self.p_permutation is None else f", permutation p {self.p_permutation:.3g}"
         return (
             f"{self.n} windows, {self.n_classes} classes: {self.k}-NN accuracy {self.knn_accuracy:.3f} "
-            f"(chance {self.chance:.3f}, uniform {self.uniform_chance:.3f}), silhouette {self.silhouette:.3f}"
+            f"(majority chance {self.chance:.3f}), balanced accuracy {self.balanced_accuracy:.3f} "
+            f"(chance {self.uniform_chance:.3f}{p}), silhouette {self.silhouette:.3f}"
         )
+
+
+def _knn_predict(dist: np.ndarray, train_labels: np.ndarray, k: int) -> np.ndarray:
+    """Majority vote of the ``k`` nearest training rows (ties -> smallest label, as scikit-learn).
+
+    ``dist`` is (n_test, n_train); ``train_labels`` (n_train,) int64 in 0..C-1.
+    """
+    k = min(k, dist.shape[1])
+    nearest = np.argpartition(dist, k - 1, axis=1)[:, :k]
+    votes = train_labels[nearest]
+    n_classes = int(train_labels.max()) + 1
+    counts = np.zeros((len(dist), n_classes), dtype=np.int64)
+    np.add.at(counts, (np.repeat(np.arange(len(dist)), k), votes.ravel()), 1)
+    return counts.argmax(axis=1)
+
+
+def _cv_knn(dist: np.ndarray, y: np.ndarray, groups: np.ndarray | None, k: int, folds: int, seed: int):
+    """(accuracies, balanced accuracies) of k-NN over stratified (group) folds, from a distance matrix."""
+    from sklearn.model_selection import StratifiedGroupKFold, StratifiedKFold
+
+    _, counts = np.unique(y, return_counts=True)
+    if groups is not None:
+        n_folds = max(2, min(folds, len(np.unique(groups))))
+        splits = StratifiedGroupKFold(n_splits=n_folds, shuffle=True, random_state=seed).split(
+            dist, y, groups
+        )
+    else:
+        n_folds = max(2, min(folds, int(counts.min())))
+        splits = StratifiedKFold(n_splits=n_folds, shuffle=True, random_state=seed).split(dist, y)
+    accs, bals = [], []
+    for train, test in splits:
+        pred = _knn_predict(dist[np.ix_(test, train)], y[train], k)
+        accs.append(float(np.mean(pred == y[test])))
+        bals.append(float(np.mean([np.mean(pred[y[test] == c] == c) for c in np.unique(y[test])])))
+    return np.array(accs), np.array(bals)
 
 
 def separability(
@@ -151,74 +222,134 @@ def separability(
     groups: np.ndarray | None = None,
     k: int = 5,
     folds: int = 5,
+    n_permutations: int = 0,
     seed: int = 0,
 ) -> Separability:
-    """Silhouette and cross-validated k-NN accuracy of ``labels`` on ``features``.
+    """Silhouette and cross-validated k-NN (balanced) accuracy of ``labels`` on ``features``.
+
+    Features are standardised once over all rows (no labels involved); k-NN uses Euclidean
+    distance with a majority vote (ties to the smallest label, like scikit-learn's
+    ``KNeighborsClassifier``), so one distance matrix serves every fold and permutation.
 
     Parameters
     ----------
     features : (N, F) float
     labels : (N,) int
     groups : (N,) int, optional
-        Group of each row (e.g. take); folds never split a group (StratifiedGroupKFold).
+        Group of each row (e.g. take); folds never split a group (StratifiedGroupKFold), and
+        the permutation test shuffles labels between groups (each group keeps one label
+        when it had one).
     k : int
         Neighbours.
     folds : int
-        Number of folds (reduced to the smallest class's group count if needed, at least 2).
+        Number of folds (at most the number of groups; without groups, at most the smallest
+        class size; at least 2). A class with fewer groups than folds is absent from some
+        test folds; balanced accuracy averages the classes present in each fold.
+    n_permutations : int
+        Label shuffles for :attr:`Separability.p_permutation` (0: skip).
     seed : int
-        Shuffling seed of the folds.
+        Seed of the folds and the shuffles.
     """
+    from scipy.spatial.distance import cdist
     from sklearn.metrics import silhouette_score
-    from sklearn.model_selection import StratifiedGroupKFold, StratifiedKFold
-    from sklearn.neighbors import KNeighborsClassifier
-    from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
     x = np.asarray(features, dtype=np.float64)
-    y = np.asarray(labels)
-    if x.ndim != 2 or y.shape != (x.shape[0],):
+    y_in = np.asarray(labels)
+    if x.ndim != 2 or y_in.shape != (x.shape[0],):
         raise ValueError(
-            f"separability: features must be (N, F) and labels (N,), got {x.shape} and {y.shape}"
+            f"separability: features must be (N, F) and labels (N,), got {x.shape} and {y_in.shape}"
         )
-    classes, counts = np.unique(y, return_counts=True)
+    classes, y = np.unique(y_in, return_inverse=True)
+    counts = np.bincount(y)
     if len(classes) < 2:
         raise ValueError(f"separability: need at least 2 classes, got {classes.tolist()}")
-    xs = StandardScaler().fit_transform(x)
-    sil = float(silhouette_score(xs, y, metric="euclidean"))
+    g = None
     if groups is not None:
         g = np.asarray(groups)
         if g.shape != y.shape:
             raise ValueError(f"separability: groups must be (N,) like labels, got {g.shape}")
-        per_class = min(len(np.unique(g[y == c])) for c in classes)
-        n_folds = max(2, min(folds, per_class))
-        splitter = StratifiedGroupKFold(n_splits=n_folds, shuffle=True, random_state=seed)
-        splits = list(splitter.split(x, y, g))
-    else:
-        n_folds = max(2, min(folds, int(counts.min())))
-        splits = list(StratifiedKFold(n_splits=n_folds, shuffle=True, random_state=seed).split(x, y))
-    accs = []
-    for train, test in splits:
-        model = make_pipeline(StandardScaler(), KNeighborsClassifier(n_neighbors=min(k, len(train))))
-        model.fit(x[train], y[train])
-        accs.append(float(np.mean(model.predict(x[test]) == y[test])))
+    xs = StandardScaler().fit_transform(x)  # label-free, so standardising all rows at once leaks nothing
+    sil = float(silhouette_score(xs, y, metric="euclidean"))
+    dist = cdist(xs, xs, "sqeuclidean")
+    accs, bals = _cv_knn(dist, y, g, k, folds, seed)
+    p_perm = None
+    if n_permutations > 0:
+        rng = np.random.default_rng(seed)
+        observed = float(bals.mean())
+        unit = np.arange(len(y)) if g is None else g
+        _, first, inverse = np.unique(unit, return_index=True, return_inverse=True)
+        unit_labels = y[first]
+        hits = 0
+        for _ in range(n_permutations):
+            y_perm = rng.permutation(unit_labels)[inverse]
+            hits += _cv_knn(dist, y_perm, g, k, folds, seed)[1].mean() >= observed - 1e-12
+        p_perm = (1 + hits) / (1 + n_permutations)
     return Separability(
         silhouette=sil,
-        knn_accuracy=float(np.mean(accs)),
-        fold_accuracies=np.array(accs),
+        knn_accuracy=float(accs.mean()),
+        balanced_accuracy=float(bals.mean()),
+        fold_accuracies=accs,
         chance=float(counts.max() / counts.sum()),
         uniform_chance=1.0 / len(classes),
+        p_permutation=p_perm,
         n=int(len(y)),
         k=int(k),
         n_classes=int(len(classes)),
     )
 
 
+def per_group_standardize(features: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """z-score ``features`` (N, F) within each group (e.g. speaker); constant columns become 0.
+
+    Removes each speaker's overall style (mean pose, typical speed) so that what remains is
+    the within-speaker variation, e.g. by emotion. Uses no labels.
+    """
+    x = np.asarray(features, dtype=np.float64).copy()
+    g = np.asarray(groups)
+    for gid in np.unique(g):
+        m = g == gid
+        mu, sd = x[m].mean(axis=0), x[m].std(axis=0)
+        x[m] = (x[m] - mu) / np.where(sd > 1e-12, sd, 1.0)
+    return x
+
+
 def emotion_separability(
-    takes: Sequence[CorpusTake], *, seconds: float = 2.0, kind: str = "stats", k: int = 5, seed: int = 0
+    takes: Sequence[CorpusTake],
+    *,
+    seconds: float = 2.0,
+    kind: str = "stats",
+    joints: str = "body27",
+    per_speaker: bool = True,
+    k: int = 5,
+    n_permutations: int = 0,
+    seed: int = 0,
 ) -> Separability:
-    """:func:`separability` of the emotion labels of 2-s rotation windows, folds grouped by take."""
+    """:func:`separability` of the emotion labels of 2-s rotation windows, folds grouped by take.
+
+    Parameters
+    ----------
+    takes : sequence of CorpusTake
+    seconds : float
+        Window length.
+    kind : {"stats", "flat"}
+        Features (:func:`window_features`).
+    joints : str
+        Joints whose rotations enter the features (:func:`subset_dims`): ``"body27"`` (default;
+        the 9 spine/arm joints that carry the gesture -- with all 47 joints the 38 hand joints
+        make up 114 of 141 dimensions and dominate the distances) or ``"spine_neck_141"``.
+    per_speaker : bool
+        Standardise the features within each speaker first (:func:`per_group_standardize`),
+        so that speaker style does not mask emotion (the paper's Fig. 3b compares emotions
+        within one speaker).
+    k, n_permutations, seed
+        See :func:`separability`.
+    """
     rw = rotation_windows(takes, seconds=seconds)
-    return separability(window_features(rw.windows, kind=kind), rw.emotion, groups=rw.take, k=k, seed=seed)
+    feats = window_features(rw.windows[:, :, subset_dims(joints)], kind=kind)
+    if per_speaker:
+        feats = per_group_standardize(feats, rw.speaker)
+    return separability(feats, rw.emotion, groups=rw.take, k=k, n_permutations=n_permutations, seed=seed)
 
 
 def tsne_embedding(features: np.ndarray, *, perplexity: float = 30.0, seed: int = 0) -> np.ndarray:
@@ -240,11 +371,15 @@ def plot_emotion_tsne(
     *,
     seconds: float = 2.0,
     kind: str = "stats",
+    joints: str = "body27",
+    per_speaker: bool = True,
     seed: int = 0,
     out: str | Path | None = None,
     formats: tuple[str, ...] = ("png", "svg"),
 ):
     """Figure 3a: t-SNE of 2-s rotation windows coloured by emotion, separability in the title.
+
+    Features as in :func:`emotion_separability` (per-speaker standardised by default).
 
     Returns
     -------
@@ -255,7 +390,9 @@ def plot_emotion_tsne(
     from beatlite.viz.style import figure_style, save_figure
 
     rw = rotation_windows(takes, seconds=seconds)
-    feats = window_features(rw.windows, kind=kind)
+    feats = window_features(rw.windows[:, :, subset_dims(joints)], kind=kind)
+    if per_speaker:
+        feats = per_group_standardize(feats, rw.speaker)
     sep = separability(feats, rw.emotion, groups=rw.take, seed=seed)
     emb = tsne_embedding(feats, seed=seed)
     with figure_style():
@@ -267,8 +404,8 @@ def plot_emotion_tsne(
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_title(
-            f"t-SNE of {seconds:g}-s rotation windows\n{sep.k}-NN acc {sep.knn_accuracy:.2f} "
-            f"(chance {sep.chance:.2f}), silhouette {sep.silhouette:.2f}"
+            f"t-SNE of {seconds:g}-s rotation windows\n{sep.k}-NN balanced acc {sep.balanced_accuracy:.2f} "
+            f"(chance {sep.uniform_chance:.2f}), silhouette {sep.silhouette:.2f}"
         )
         ax.legend(markerscale=2, loc="best", fontsize=8)
         fig.tight_layout()

@@ -20,7 +20,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--out", default="data_samples", help="output folder (created if missing)")
     parser.add_argument("--seed", type=int, default=0, help="corpus seed (default 0)")
-    parser.add_argument("--fps", type=int, default=30, help="BVH frame rate of the compact corpus (default 30)")
+    parser.add_argument(
+        "--fps", type=int, default=30, help="BVH frame rate of the compact corpus (default 30)"
+    )
     parser.add_argument(
         "--full-rate",
         action="store_true",
@@ -40,13 +42,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         results = generate_corpus(
             args.out, args.seed, fps=args.fps, full_rate=args.full_rate, workers=args.workers, specs=specs
         )
-    except EspeakNotFoundError as exc:
+    except (EspeakNotFoundError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     wall = time.perf_counter() - tic
     total = sum(r.duration for r in results)
     splits = Counter(s.split for s in specs)
-    print(f"wrote {len(results)} takes, {total:.1f} s ({total / 60:.2f} min) of data to {args.out} in {wall:.1f} s")
+    print(
+        f"wrote {len(results)} takes, {total:.1f} s ({total / 60:.2f} min) of data to {args.out} in {wall:.1f} s"
+    )
     print("takes per split: " + ", ".join(f"{k} {v}" for k, v in sorted(splits.items())))
     return 0
 

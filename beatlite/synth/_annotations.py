@@ -18,7 +18,9 @@ def write_textgrid(
     _write_textgrid(path, {k: [Interval(*iv) for iv in v] for k, v in tiers.items()}, xmax)
 
 
-def write_semantic(path: str | os.PathLike[str], rows: Sequence[tuple[str, float, float, float, str]]) -> None:
+def write_semantic(
+    path: str | os.PathLike[str], rows: Sequence[tuple[str, float, float, float, str]]
+) -> None:
     """BEAT semantic ``.txt`` from rows ``(type, start s, end s, score, keyword or "")``."""
     _write_semantic(path, [SemanticSegment(t, s, e, round(e - s, 3), sc, kw) for t, s, e, sc, kw in rows])
 

@@ -13,7 +13,15 @@ import numpy as np
 
 from beatlite.io.names import emotion_of, split_of
 from beatlite.synth.plan import TimedWord, make_plan, semantic_segments
-from beatlite.synth.speech import ESPEAK_SR, OUTPUT_SR, SpokenWord, Voice, espeak_path, resample_to_output, speak_words
+from beatlite.synth.speech import (
+    ESPEAK_SR,
+    OUTPUT_SR,
+    SpokenWord,
+    Voice,
+    espeak_path,
+    resample_to_output,
+    speak_words,
+)
 from beatlite.synth.styles import EMOTION_NAMES, EMOTION_STYLES, SPEAKERS, SpeakerStyle
 from beatlite.synth.transcripts import sentence_order
 
@@ -276,7 +284,7 @@ def generate_take(
     out = Path(out_dir)
     if not out.is_dir():
         raise FileNotFoundError(f"generate_take: output folder {out} does not exist")
-    if not isinstance(fps, int) or fps <= 0 or (DURATION_STEP_S * fps) % 1:
+    if not isinstance(fps, int) or isinstance(fps, bool) or fps <= 0 or fps % 5:
         raise ValueError(f"generate_take: fps must be a positive integer multiple of 5, got {fps!r}")
     tic = time.perf_counter()
     streams = [np.random.default_rng([seed, spec.speaker_id, spec.session, spec.seq, k]) for k in range(4)]
@@ -292,7 +300,14 @@ def generate_take(
     n_face = int(round(speech.duration * FACE_FPS))
     t_face = np.arange(n_face) / FACE_FPS
     face = face_weights(
-        ARKIT_51, n_face, FACE_FPS, speech.audio, OUTPUT_SR, speech.phones, emotion_ids(t_face, plan), streams[3]
+        ARKIT_51,
+        n_face,
+        FACE_FPS,
+        speech.audio,
+        OUTPUT_SR,
+        speech.phones,
+        emotion_ids(t_face, plan),
+        streams[3],
     )
     stem = out / spec.name
     paths = (
@@ -349,6 +364,8 @@ def generate_corpus(
     -------
     list of TakeResult, in the order of ``specs``.
     """
+    if not isinstance(fps, int) or isinstance(fps, bool) or fps <= 0 or fps % 5:
+        raise ValueError(f"generate_corpus: fps must be a positive integer multiple of 5, got {fps!r}")
     espeak_path()  # fail early with the install hint
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -3,12 +3,13 @@
 The wrists follow targets written in the chest frame (the ``Spine3`` joint's frame, centimetres,
 Y up, +Z forward, the character's right at -X):
 
-``wrist = rest + a(t) (centre - rest) - A_k L_k(t) d + sum_g w_g(t) (target_g - ...) + drift (+ tremor)``
+``wrist = rest + a(t) reach (centre - rest) - lift(t) d + loop(t) n``, then blended towards
+``target_g`` with weight ``w_g(t)`` for each semantic gesture, plus drift (and tremor in fear)
 
 - ``a(t)`` is the phrase envelope (1 while talking, 0 in long pauses; minimum-jerk ramps);
-- each beat ``k`` lifts the hand by ``A_k`` against the stroke direction ``d`` during its
-  preparation and brings it back with a minimum-jerk stroke that ends, with zero velocity, at
-  the word onset (``L_k`` goes 0 -> 1 -> 0);
+- each beat lifts the hand by its amplitude against the stroke direction ``d`` during its
+  preparation (bulging sideways along ``n``, so the path loops) and brings it back with a
+  minimum-jerk stroke that ends, with zero velocity, at the word onset (:func:`beat_lift`);
 - each semantic gesture ``g`` blends the wrist towards its scripted target with weight ``w_g``
   (minimum-jerk preparation that completes at the word onset, hold, retraction).
 
@@ -51,13 +52,16 @@ GESTURE_TARGETS: dict[str, tuple[tuple[float, float, float], str, str, float]] =
     "big": ((-50.0, -12.0, 24.0), "both", "open", 30.0),
     "small": ((-3.5, -22.0, 30.0), "both", "pinch", 20.0),
     "circle": ((-16.0, -14.0, 32.0), "dominant", "point", 0.0),
-    "up": ((-26.0, 22.0, 16.0), "both", "open", 40.0),
-    "idea": ((-15.0, 20.0, 14.0), "dominant", "point", 0.0),
+    "up": ((-30.0, 18.0, 24.0), "both", "open", 40.0),
+    "idea": ((-22.0, 16.0, 26.0), "dominant", "point", 0.0),
     "future": ((-14.0, -8.0, 50.0), "dominant", "open", 60.0),
     "everything": ((-40.0, -16.0, 32.0), "both", "open", 0.0),
     "love": ((-5.0, -6.0, 16.0), "both", "open", 0.0),
 }
 """Gesture kind -> (right-wrist target cm, hands, hand shape, wrist roll degrees)."""
+
+MAX_ELBOW_FLEX_DEG = 145.0
+"""Largest elbow flexion the IK produces (human range is about 0-150 degrees)."""
 
 LOOP = 1.0
 """Sideways bulge of a beat's preparation, as a fraction of the beat amplitude."""
@@ -149,7 +153,32 @@ def emotion_track(t: np.ndarray, plan: Plan, field: str) -> np.ndarray:
     starts = np.array([w.start for w in plan.words])
     values = np.array([getattr(EMOTION_STYLES[w.emotion], field) for w in plan.words], dtype=np.float64)
     idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
-    raw = values[idx]
+    return _smooth_track(t, values[idx])
+
+
+def emotion_ids(t: np.ndarray, plan: Plan) -> np.ndarray:
+    """Emotion id of each time: that of the last word started (the first word's before it).
+
+    Parameters
+    ----------
+    t : (T,) float, seconds
+    plan : Plan
+
+    Returns
+    -------
+    (T,) int64
+    """
+    t = np.asarray(t, dtype=np.float64)
+    if not plan.words:
+        return np.zeros(t.shape, dtype=np.int64)
+    starts = np.array([w.start for w in plan.words])
+    values = np.array([w.emotion for w in plan.words], dtype=np.int64)
+    idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
+    return values[idx]
+
+
+def _smooth_track(t: np.ndarray, raw: np.ndarray) -> np.ndarray:
+    """``raw`` (T,) smoothed with a 0.5-s Hann window (edges held)."""
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
     half = max(int(round(0.25 / dt)), 1)
     kernel = np.hanning(2 * half + 1)
@@ -196,13 +225,14 @@ def wrist_paths(
     for start, end in plan.phrases:
         env = np.maximum(env, smooth_box(t, start - 0.1, end + 0.25, 0.6, 0.8))
     lift, loop = beat_lift(t, plan)
+    angry = _smooth_track(t, (emotion_ids(t, plan) == 2).astype(np.float64))
     out: dict[str, dict[str, np.ndarray]] = {}
     for side in ("right", "left"):
         role = _hand_role(speaker, side)
         rest = _mirror(speaker.rest, side)
         centre = _mirror(speaker.gesture_center, side)
         # gesture space follows the emotion amplitude: sad speakers stay low and near the body
-        reach = role * np.clip(0.55 + 0.45 * amp_e, 0.5, 1.3)
+        reach = role * np.clip(0.4 + 0.6 * amp_e, 0.5, 1.4)
         wrist = rest[None, :] + (env * reach)[:, None] * (centre - rest)[None, :]
         direction = _mirror(speaker.beat_direction, side)
         direction = direction / np.linalg.norm(direction)
@@ -215,7 +245,12 @@ def wrist_paths(
             phase = rng.uniform(0, 2 * np.pi, size=3)
             wrist += 0.8 * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
         shape_fav = np.array(HAND_SHAPES[_FAVOURITE_SHAPE[speaker.favourite]])
-        curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[:, None] * shape_fav
+        curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[
+            :, None
+        ] * shape_fav
+        # anger clenches the gesturing hand towards a fist
+        fist = (0.6 * env * role * angry)[:, None]
+        curl = (1 - fist) * curl + fist * np.array(HAND_SHAPES["fist"])
         roll = env * role * _FAVOURITE_ROLL[speaker.favourite]
         flex = 8.0 + _FAVOURITE_FLEX[speaker.favourite] * lift * role / 5.0
         # semantic gestures
@@ -289,8 +324,9 @@ def two_bone_ik(
 
     Notes
     -----
-    Targets closer than ``|l1 - l2| + 2`` cm or farther than ``0.97 (l1 + l2)`` are clamped to
-    that range along their direction, so the elbow always keeps some flexion.
+    The shoulder-wrist distance saturates smoothly (``tanh``): beyond ``0.85 (l1 + l2)``
+    towards ``0.97 (l1 + l2)`` (the elbow keeps ~28 degrees of flexion and never snaps straight)
+    and below the distance of :data:`MAX_ELBOW_FLEX_DEG` flexion (+ 4 cm) towards that distance.
     """
     target = np.asarray(target, dtype=np.float64)
     if target.ndim != 2 or target.shape[1] != 3:
@@ -298,7 +334,15 @@ def two_bone_ik(
     l1, l2 = float(np.linalg.norm(upper)), float(np.linalg.norm(lower))
     u1, u2 = _normalize(np.asarray(upper, float)), _normalize(np.asarray(lower, float))
     v = target - root[None, :]
-    d = np.clip(np.linalg.norm(v, axis=1), abs(l1 - l2) + 2.0, 0.97 * (l1 + l2))
+    d = np.linalg.norm(v, axis=1)
+    # soft limits (smooth, C1): the elbow flexion stays within about [28, 145] degrees
+    d0, dmax = 0.85 * (l1 + l2), 0.97 * (l1 + l2)
+    far = d > d0
+    d[far] = d0 + (dmax - d0) * np.tanh((d[far] - d0) / (dmax - d0))
+    dmin = np.sqrt(l1**2 + l2**2 - 2 * l1 * l2 * np.cos(np.deg2rad(180.0 - MAX_ELBOW_FLEX_DEG)))
+    d1 = dmin + 4.0
+    near = d < d1
+    d[near] = d1 - 4.0 * np.tanh((d1 - d[near]) / 4.0)
     vh = _normalize(v)
     cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
     sin_a = np.sqrt(1.0 - cos_a**2)
@@ -363,7 +407,9 @@ def _euler(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     return euler_to_matrix(np.stack([x, y, z], axis=-1), "XYZ")
 
 
-def _sines(t: np.ndarray, rng: np.random.Generator, amp: float, fmin: float, fmax: float, n: int = 2) -> np.ndarray:
+def _sines(
+    t: np.ndarray, rng: np.random.Generator, amp: float, fmin: float, fmax: float, n: int = 2
+) -> np.ndarray:
     out = np.zeros_like(t)
     for _ in range(n):
         out += amp / n * np.sin(2 * np.pi * rng.uniform(fmin, fmax) * t + rng.uniform(0, 2 * np.pi))
@@ -402,10 +448,13 @@ def body_channels(
 
     # hips: small translation sway and weight shift; legs counter-rotate so they stay vertical
     hips_pos = np.stack(
-        [_sines(t, rng, 1.6, 0.05, 0.2), _sines(t, rng, 0.4, 0.1, 0.3), _sines(t, rng, 1.0, 0.05, 0.2)], axis=1
+        [_sines(t, rng, 1.6, 0.05, 0.2), _sines(t, rng, 0.4, 0.1, 0.3), _sines(t, rng, 1.0, 0.05, 0.2)],
+        axis=1,
     )
     ch[:, skeleton.position_channel_indices(0)] = hips_pos
-    hips_rot = _euler(_sines(t, rng, 1.2, 0.05, 0.2), _sines(t, rng, 2.5, 0.04, 0.15), _sines(t, rng, 1.2, 0.05, 0.2))
+    hips_rot = _euler(
+        _sines(t, rng, 1.2, 0.05, 0.2), _sines(t, rng, 2.5, 0.04, 0.15), _sines(t, rng, 1.2, 0.05, 0.2)
+    )
     _put(ch, skeleton, "Hips", hips_rot)
     hips_inv = np.swapaxes(hips_rot, 1, 2)
     for side in ("Right", "Left"):
@@ -417,7 +466,9 @@ def body_channels(
     breath = np.sin(2 * np.pi * 0.25 * t + rng.uniform(0, 2 * np.pi))
     lean = speaker.lean + 1.5 * np.clip(head_pitch, 0, None) / 14.0 * 4.0
     twist = _sines(t, rng, 3.0, 0.05, 0.15)
-    spine_rot = _euler((lean + 0.6 * breath + 0.6 * nod * amp_e) / 4.0, twist / 4.0, _sines(t, rng, 1.0, 0.05, 0.2) / 4.0)
+    spine_rot = _euler(
+        (lean + 0.6 * breath + 0.6 * nod * amp_e) / 4.0, twist / 4.0, _sines(t, rng, 1.0, 0.05, 0.2) / 4.0
+    )
     for name in ("Spine", "Spine1", "Spine2", "Spine3"):
         _put(ch, skeleton, name, spine_rot)
 
@@ -469,7 +520,12 @@ def _fingers(ch: np.ndarray, skeleton: Skeleton, cap: str, curl: np.ndarray, pal
             j = skeleton.index(f"{cap}Hand{finger}{level}")
             axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
             angle = np.deg2rad(_CURL_DEG[level - 1]) * curl[:, k]
-            _put(ch, skeleton, f"{cap}Hand{finger}{level}", axis_angle_to_matrix(angle[:, None] * axis[None, :]))
+            _put(
+                ch,
+                skeleton,
+                f"{cap}Hand{finger}{level}",
+                axis_angle_to_matrix(angle[:, None] * axis[None, :]),
+            )
         if finger != "Middle":
             j = skeleton.index(f"{cap}Hand{finger}")
             axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
@@ -480,24 +536,3 @@ def _fingers(ch: np.ndarray, skeleton: Skeleton, cap: str, curl: np.ndarray, pal
         axis = _normalize(np.cross(_normalize(skeleton.offsets[j + 1]), palm_normal))
         angle = np.deg2rad(_THUMB_DEG[level - 1]) * curl[:, 4]
         _put(ch, skeleton, f"{cap}HandThumb{level}", axis_angle_to_matrix(angle[:, None] * axis[None, :]))
-
-
-def emotion_ids(t: np.ndarray, plan: Plan) -> np.ndarray:
-    """Emotion id of each time: that of the last word started (the first word's before it).
-
-    Parameters
-    ----------
-    t : (T,) float, seconds
-    plan : Plan
-
-    Returns
-    -------
-    (T,) int64
-    """
-    t = np.asarray(t, dtype=np.float64)
-    if not plan.words:
-        return np.zeros(t.shape, dtype=np.int64)
-    starts = np.array([w.start for w in plan.words])
-    values = np.array([w.emotion for w in plan.words], dtype=np.int64)
-    idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
-    return values[idx]

@@ -4,7 +4,8 @@ Rules (all times in seconds):
 
 - A *phrase* is a run of words whose gaps are all shorter than :data:`PHRASE_GAP_S`.
 - A keyword of :data:`beatlite.synth.transcripts.KEYWORDS` gets its scripted semantic gesture
-  when the gesture's preparation (``PREP_S / speed`` before the word onset) starts at least
+  when the gesture's preparation (``PREP_S / speed`` before the word onset, longer for the
+  far-travelling kinds of :data:`SLOW_KINDS`) starts at least
   ``0.15`` s after the previous semantic gesture ended; its stroke ends exactly at the word onset
   and it is held until ``max(word end, onset + MIN_HOLD_S)``.
 - Every other word starting at least ``0.3 / tempo`` s after the previous beat (and after any
@@ -27,8 +28,10 @@ PREP_S = 0.45
 """Preparation time of a semantic gesture at speed 1, seconds."""
 MIN_HOLD_S = 0.35
 """Shortest hold of a semantic gesture, seconds."""
-RETRACT_S = 0.5
+RETRACT_S = 0.6
 """Retraction time of a semantic gesture at speed 1, seconds."""
+SLOW_KINDS = {"up": 1.6, "big": 1.3, "everything": 1.3, "idea": 1.3}
+"""Gestures whose hands travel far: preparation and retraction take this much longer."""
 
 
 @dataclass(frozen=True)
@@ -169,7 +172,7 @@ def make_plan(
         speed = emo.speed * speaker.tempo
         kw = KEYWORDS.get(w.word)
         if kw is not None:
-            ramp_in = PREP_S / speed
+            ramp_in = PREP_S * SLOW_KINDS.get(kw[0], 1.0) / speed
             accept = w.start - ramp_in >= busy_until + 0.15 and w.start - ramp_in >= 0.05
             if kw[0] == "chest":  # "I" is frequent: not every one gets the gesture
                 accept = accept and rng.random() < 0.7
@@ -182,10 +185,10 @@ def make_plan(
                     onset=w.start,
                     hold_end=hold_end,
                     ramp_in=ramp_in,
-                    ramp_out=RETRACT_S / speed,
+                    ramp_out=RETRACT_S * SLOW_KINDS.get(kw[0], 1.0) / speed,
                     word=w.word,
                     label=kw[1],
-                    amplitude=float(np.clip(emo.amplitude * speaker.amplitude, 0.75, 1.25)),
+                    amplitude=float(np.clip(emo.amplitude * speaker.amplitude, 0.6, 1.3)),
                 )
                 gestures.append(g)
                 busy_until = g.end
@@ -241,6 +244,8 @@ def semantic_segments(plan: Plan) -> list[tuple[str, float, float, float, str]]:
             continue
         if start - t >= 0.01:
             out.append(("00_nogesture", t, start, 0.0, ""))
+        else:
+            start = t
         out.append((label, start, end, SEMANTIC_SCORES[label], word))
         t = end
     if plan.duration - t >= 0.01:

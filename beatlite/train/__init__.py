@@ -3,7 +3,9 @@
 - :class:`TrainConfig` (``beatlite.train.config``), :func:`fit` (``beatlite.train.training``),
 - :func:`save_checkpoint`, :func:`load_checkpoint`, :func:`load_model`, :func:`export_checkpoint`
   (``beatlite.train.checkpoint``),
-- :func:`generate`, :func:`generate_sequence` (``beatlite.train.generation``).
+- :func:`generate`, :func:`generate_sequence` (``beatlite.train.generation``),
+- :func:`evaluate_models`, :func:`load_test_set`, :func:`write_results`, :class:`ModelResults`
+  (``beatlite.train.evaluation``: the results table on whole test takes).
 
 ``import beatlite.train`` does not import torch; the names above import their module on
 first access. Command line: ``python -m beatlite.train {retrain-all,results}``.
@@ -26,6 +28,10 @@ _NAMES = {
     "generate": "beatlite.train.generation",
     "generate_sequence": "beatlite.train.generation",
     "GeneratedTake": "beatlite.train.generation",
+    "evaluate_models": "beatlite.train.evaluation",
+    "load_test_set": "beatlite.train.evaluation",
+    "write_results": "beatlite.train.evaluation",
+    "ModelResults": "beatlite.train.evaluation",
 }
 
 __all__ = sorted(_NAMES)

@@ -26,6 +26,9 @@ class TrainConfig:
         Discriminator learning rate = ``d_lr_weight * lr`` (0.2).
     seed : int
         Seeds torch (weights, dropout) and the per-epoch shuffles.
+    windows_per_epoch : int or None
+        If set, each epoch trains on this many windows drawn without replacement from the
+        epoch's shuffle (a different subset every epoch); ``None`` = all windows.
     threads : int or None
         Torch CPU threads; ``None`` = :func:`beatlite.paths.n_threads` (``$BEATLITE_THREADS``).
     no_adv_epochs : int or None
@@ -46,6 +49,7 @@ class TrainConfig:
     betas: tuple[float, float] = (0.5, 0.999)
     d_lr_weight: float = 0.2
     seed: int = 2021
+    windows_per_epoch: int | None = None
     threads: int | None = None
     no_adv_epochs: int | None = None
     grad_clip: float = 200.0
@@ -60,6 +64,8 @@ class TrainConfig:
             raise ValueError(f"TrainConfig: batch_size must be >= 2 (BatchNorm), got {self.batch_size}")
         if self.lr is not None and not self.lr > 0:
             raise ValueError(f"TrainConfig: lr must be positive, got {self.lr}")
+        if self.windows_per_epoch is not None and self.windows_per_epoch < 2:
+            raise ValueError(f"TrainConfig: windows_per_epoch must be >= 2, got {self.windows_per_epoch}")
         if self.threads is not None and self.threads < 1:
             raise ValueError(f"TrainConfig: threads must be >= 1, got {self.threads}")
         self.betas = (float(self.betas[0]), float(self.betas[1]))

@@ -40,12 +40,22 @@ class FitResult:
 
 
 def as_arrays(windows: Any) -> Mapping[str, np.ndarray]:
-    """The numpy dict of a window set: a Mapping itself, or an object's ``.arrays`` Mapping."""
+    """The numpy dict of a window set.
+
+    A Mapping itself, an object's ``.arrays`` Mapping, or a mapping-like object with
+    ``keys()`` and ``[key]`` (a :class:`beatlite.data.windows.Windows` in windowed mode).
+    """
     if isinstance(windows, Mapping):
         return windows
     arrays = getattr(windows, "arrays", None)
     if isinstance(arrays, Mapping):
         return arrays
+    if callable(getattr(windows, "keys", None)) and hasattr(windows, "__getitem__"):
+        if getattr(windows, "whole_takes", False):
+            raise TypeError(
+                "windows: whole-take items have different lengths; build windows with whole_takes=False"
+            )
+        return {k: windows[k] for k in windows.keys()}
     raise TypeError(
         f"windows must be a dict of arrays (or have an .arrays dict), got {type(windows).__name__}"
     )
@@ -185,7 +195,8 @@ def fit(
     discriminator step on ``model.discriminator_losses`` with its own Adam at
     ``d_lr_weight * lr``, then the generator step on ``model.losses(...)["total"]``.
     Both clip the gradient norm at ``grad_clip``. Shuffling uses
-    ``numpy.random.default_rng([seed, epoch])`` and the torch RNG state is checkpointed,
+    ``numpy.random.default_rng([seed, epoch])`` (an epoch keeps the first
+    ``windows_per_epoch`` windows of its shuffle when that is set) and the torch RNG state is checkpointed,
     so ``resume=True`` reproduces the losses of an uninterrupted run exactly.
     """
     if not isinstance(model, GestureModel):
@@ -262,9 +273,11 @@ def fit(
     for epoch in bar:
         model.train()
         order = np.random.default_rng([config.seed, epoch]).permutation(n)
+        if config.windows_per_epoch is not None:
+            order = order[: config.windows_per_epoch]
         sums: dict[str, float] = {}
         seen = 0
-        for start in range(0, n, config.batch_size):
+        for start in range(0, len(order), config.batch_size):
             idx = np.sort(order[start : start + config.batch_size])
             if len(idx) < 2:
                 continue

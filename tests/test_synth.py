@@ -1,0 +1,248 @@
+"""Unit tests of :mod:`beatlite.synth` (the generator of ``data_samples/``)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beatlite.io import parse_take_name, read_bvh, read_semantic, read_textgrid
+from beatlite.skeleton.beat import beat_skeleton
+from beatlite.skeleton.rotations import euler_to_matrix, matrix_to_euler
+from beatlite.synth import (
+    EMOTION_STYLES,
+    SEMANTIC_SCORES,
+    SPEAKERS,
+    EspeakNotFoundError,
+    TakeSpec,
+    corpus_specs,
+    generate_take,
+)
+from beatlite.synth.motion import continuous_euler, min_jerk, smooth_box, two_bone_ik
+from beatlite.synth.plan import Beat, Plan, TimedWord, make_plan, semantic_segments
+from beatlite.synth.speech import espeak_path, split_phonemes, trim_silence
+
+needs_espeak = pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng not installed")
+
+
+# ----------------------------------------------------------------------------- speech helpers
+@pytest.mark.parametrize(
+    ("text", "phones"),
+    [
+        ("s'3:k@L", ("s", "3:", "k", "@L")),  # circle
+        ("h@l'oU", ("h", "@", "l", "oU")),  # hello
+        ("t'2aIm", ("t", "aI", "m")),  # time: the stress digit is dropped
+        ("f'ju:tS3", ("f", "j", "u:", "tS", "3")),  # future
+    ],
+)
+def test_split_phonemes(text: str, phones: tuple[str, ...]) -> None:
+    assert split_phonemes(text) == phones
+
+
+def test_trim_silence_keeps_the_loud_part_plus_margins() -> None:
+    y = np.zeros(22050, dtype=np.float32)
+    y[1000:3000] = 0.5  # 2000 loud samples
+    out = trim_silence(y, threshold=0.02, margin_s=0.005)
+    margin = round(0.005 * 22050)  # 110 samples each side
+    assert out.size == 2000 + 2 * margin
+    with pytest.raises(ValueError, match="1-D"):
+        trim_silence(np.zeros((4, 2)))
+
+
+def test_missing_espeak_names_the_install_command(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PATH", "/nonexistent")
+    with pytest.raises(EspeakNotFoundError, match="apt-get install espeak-ng"):
+        espeak_path()
+
+
+# ----------------------------------------------------------------------------- time profiles
+def test_min_jerk_has_zero_speed_at_both_ends() -> None:
+    x = np.array([0.0, 0.5, 1.0])
+    assert np.allclose(min_jerk(x), [0.0, 0.5, 1.0])  # 10/8 - 15/16 + 6/32 = 0.5
+    h = 1e-4
+    assert abs((min_jerk(np.array([h]))[0] - 0.0) / h) < 1e-6  # derivative 30x^2(1-x)^2 -> 0
+    assert abs((1.0 - min_jerk(np.array([1 - h]))[0]) / h) < 1e-6
+    assert np.allclose(min_jerk(np.array([-1.0, 2.0])), [0.0, 1.0])  # clipped
+
+
+def test_smooth_box_is_one_inside_and_zero_outside() -> None:
+    t = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.25, 2.5, 3.0])
+    w = smooth_box(t, start=1.0, end=2.0, ramp_in=0.5, ramp_out=0.5)
+    assert np.allclose(w[[0, 1]], 0.0) and np.allclose(w[[2, 3, 4]], 1.0)
+    assert w[5] == pytest.approx(0.5)  # half-way down the minimum-jerk ramp
+    assert np.allclose(w[[6, 7]], 0.0)
+
+
+def test_beat_stroke_ends_with_zero_velocity_at_the_word_onset() -> None:
+    from beatlite.synth.motion import beat_lift
+
+    plan = Plan(
+        words=(),
+        phrases=(),
+        beats=(Beat(1.0, 5.0, 0.2, 0.3), Beat(1.6, 4.0, 0.2, 0.3)),
+        gestures=(),
+        duration=3.0,
+    )
+    t = np.arange(0, 3.0, 1 / 1200)
+    lift, loop = beat_lift(t, plan)
+    for b in plan.beats:
+        i = int(round(b.time * 1200))
+        assert lift[i] == pytest.approx(0.0, abs=1e-9) and loop[i] == pytest.approx(0.0, abs=1e-9)
+        speed = np.hypot(np.gradient(lift), np.gradient(loop)) * 1200
+        assert speed[i] < 0.01 * speed[i - 240 : i].max()  # a speed minimum at the beat
+    assert lift[int(0.8 * 1200)] == pytest.approx(5.0)  # top of the first stroke (t - stroke)
+
+
+# ----------------------------------------------------------------------------- IK and Euler
+def test_two_bone_ik_reaches_reachable_targets() -> None:
+    sk = beat_skeleton()
+    arm, fore, hand = (sk.offsets[sk.index(n)] for n in ("RightArm", "RightForeArm", "RightHand"))
+    rng = np.random.default_rng(0)
+    directions = rng.normal(size=(50, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    dist = rng.uniform(22.0, 45.0, size=50)  # inside the soft limits [20.4, 45.5] cm (arm 28.5 + 25 cm)
+    targets = arm + directions * dist[:, None]
+    shoulder, elbow = two_bone_ik(targets, arm, fore, hand, np.array([-0.45, -1.0, -0.35]))
+    # forward kinematics by hand: wrist = root + R_s (upper + R_e lower)
+    wrist = arm + np.einsum("tij,tj->ti", shoulder, fore + np.einsum("tij,j->ti", elbow, hand))
+    assert np.allclose(wrist, targets, atol=1e-6)
+    assert np.allclose(np.linalg.det(shoulder), 1.0) and np.allclose(np.linalg.det(elbow), 1.0)
+    with pytest.raises(ValueError, match=r"\(T, 3\)"):
+        two_bone_ik(np.zeros(3), arm, fore, hand, np.array([0.0, -1.0, 0.0]))
+
+
+def test_two_bone_ik_limits_elbow_flexion() -> None:
+    sk = beat_skeleton()
+    arm, fore, hand = (sk.offsets[sk.index(n)] for n in ("RightArm", "RightForeArm", "RightHand"))
+    targets = arm + np.array([[-200.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # far away / at the shoulder
+    shoulder, elbow = two_bone_ik(targets, arm, fore, hand, np.array([-0.45, -1.0, -0.35]))
+    u = -hand / np.linalg.norm(hand)
+    flex = np.degrees(
+        np.arccos(np.clip(np.einsum("tij,j->ti", elbow, hand) @ -u / np.linalg.norm(hand), -1, 1))
+    )
+    assert 20.0 <= flex[0] <= 35.0  # never fully straight
+    assert 135.0 <= flex[1] <= 145.0  # never beyond 145 degrees
+
+
+def test_continuous_euler_crosses_the_gimbal_boundary() -> None:
+    beta = np.linspace(0.0, 150.0, 61)  # an elbow flexing about its middle (Y) axis
+    rot = euler_to_matrix(np.stack([0 * beta, beta, 0 * beta], axis=1), "XYZ")
+    raw = matrix_to_euler(rot, "XYZ")
+    assert np.abs(np.diff(raw, axis=0)).max() > 90.0  # the plain decomposition flips at 90 degrees
+    fixed = continuous_euler(raw)
+    assert np.abs(np.diff(fixed, axis=0)).max() < 3.0
+    assert np.allclose(euler_to_matrix(fixed, "XYZ"), rot, atol=1e-9)
+
+
+# ----------------------------------------------------------------------------- planning
+def _words(items: list[tuple[float, float, str]], emotion: int = 0) -> list[TimedWord]:
+    return [TimedWord(s, e, w, emotion) for s, e, w in items]
+
+
+def test_plan_scripts_keywords_and_tiles_the_semantic_annotation() -> None:
+    words = _words(
+        [(1.0, 1.3, "we"), (1.4, 1.8, "bought"), (2.6, 3.0, "huge"), (3.1, 3.5, "table"), (5.0, 5.4, "small")]
+    )
+    plan = make_plan(words, SPEAKERS[2], 7.0, np.random.default_rng(0))
+    kinds = {g.word: (g.kind, g.label) for g in plan.gestures}
+    assert kinds == {"huge": ("big", "07_iconic_h"), "small": ("small", "06_iconic_m")}
+    assert all(g.onset in (2.6, 5.0) for g in plan.gestures)  # the stroke ends at the word onset
+    assert {b.time for b in plan.beats} <= {w.start for w in words}
+    segs = semantic_segments(plan)
+    assert segs[0][1] == 0.0 and segs[-1][2] == 7.0
+    assert all(a[2] == b[1] for a, b in zip(segs, segs[1:]))  # contiguous
+    assert all(score == SEMANTIC_SCORES[label] for label, _, _, score, _ in segs)
+    assert [s[4] for s in segs if s[4]] == ["huge", "small"]
+
+
+def test_emotion_table_orders_amplitude_and_speed() -> None:
+    amp = {e: s.amplitude for e, s in EMOTION_STYLES.items()}
+    speed = {e: s.speed for e, s in EMOTION_STYLES.items()}
+    assert amp[2] > amp[5] > amp[1] > amp[0] > amp[7] > amp[4] > amp[6] > amp[3]
+    assert speed[2] > speed[0] > speed[3]
+    assert EMOTION_STYLES[3].head_pitch > 0 and EMOTION_STYLES[6].tremor > 0
+
+
+# ----------------------------------------------------------------------------- corpus design
+def test_corpus_specs_follow_beat_names_and_splits() -> None:
+    specs = corpus_specs()
+    assert len({s.name for s in specs}) == len(specs) == 44
+    for s in specs:
+        name = parse_take_name(s.name)
+        assert (name.speaker_id, name.speaker, name.session_type) == (s.speaker_id, s.speaker.name, s.session)
+        assert name.split == s.split and name.emotion == s.emotion
+    assert {s.speaker_id for s in specs} == {2, 4, 6, 8}
+    for sid in (2, 4, 6, 8):
+        mine = [s for s in specs if s.speaker_id == sid]
+        assert {s.split for s in mine} == {"train", "val", "test"}
+        assert {0, 2, 3} <= {s.emotion for s in mine if s.session == 0}  # for the emotion ordering tests
+        assert any(s.session == 1 for s in mine)
+    for split in ("train", "test"):
+        assert {s.emotion for s in specs if s.session == 0 and s.split == split} == set(range(8))
+    counts = Counter(s.split for s in specs)
+    assert counts["val"] == counts["test"] == 8
+
+
+def test_speaker_styles_are_distinct() -> None:
+    styles = list(SPEAKERS.values())
+    assert [s.name for s in styles] == ["scott", "lawrence", "carla", "catherine"]
+    for attr in ("voice", "rest", "favourite"):
+        assert len({getattr(s, attr) for s in styles}) == 4, attr
+    assert {s.handedness for s in styles} == {"right", "left", "both"}
+
+
+def test_generate_take_rejects_bad_arguments(tmp_path: Path) -> None:
+    spec = TakeSpec(2, 0, 9, 2.0)
+    with pytest.raises(TypeError, match="TakeSpec"):
+        generate_take("2_scott_0_9_9", tmp_path)  # type: ignore[arg-type]
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        generate_take(spec, tmp_path / "missing")
+    with pytest.raises(ValueError, match="fps"):
+        generate_take(spec, tmp_path, fps=7)
+
+
+@needs_espeak
+def test_generate_take_is_byte_identical_for_a_seed(tmp_path: Path) -> None:
+    spec = TakeSpec(8, 0, 111, 2.5)  # a short disgust take
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "c").mkdir()
+    first = generate_take(spec, tmp_path / "a", seed=3)
+    second = generate_take(spec, tmp_path / "b", seed=3)
+    other = generate_take(spec, tmp_path / "c", seed=4)
+    assert [p.name for p in first.paths] == [p.name for p in second.paths]
+    assert len(first.paths) == 6
+    for p, q in zip(first.paths, second.paths):
+        assert p.read_bytes() == q.read_bytes(), p.name
+    assert any(p.read_bytes() != q.read_bytes() for p, q in zip(first.paths, other.paths))
+    # and it reads back
+    motion = read_bvh(first.paths[0])
+    assert motion.fps == 30.0 and motion.duration == pytest.approx(first.duration)
+    words = [iv.text for iv in read_textgrid(first.paths[3])["words"] if iv.text]
+    assert words and all(w.isalpha() for w in words)
+    assert read_semantic(first.paths[4])[-1].end == pytest.approx(first.duration)
+
+
+@needs_espeak
+def test_full_rate_take_is_the_same_motion_at_120fps(tmp_path: Path) -> None:
+    (tmp_path / "full").mkdir()
+    (tmp_path / "compact").mkdir()
+    spec = TakeSpec(6, 0, 13, 1.5)
+    result = generate_take(spec, tmp_path / "full", seed=0, full_rate=True)
+    compact = generate_take(spec, tmp_path / "compact", seed=0)
+    names = [p.name for p in result.paths]
+    assert names[0].endswith(".bvh") and names[2].endswith(".json")
+    motion = read_bvh(result.paths[0])
+    assert motion.fps == 120.0 and motion.n_frames == round(result.duration * 120)
+    small = read_bvh(compact.paths[0])
+    assert np.abs(motion.channels[::4] - small.channels).max() <= 0.0005 + 1e-9  # 3 vs 6 decimals
+
+
+def test_import_does_not_load_torch() -> None:
+    code = "import sys, beatlite.synth, beatlite.synth.corpus; assert 'torch' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)

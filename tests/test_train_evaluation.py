@@ -1,0 +1,208 @@
+"""The results evaluation (beatlite.train.evaluation) on a small synthetic test set."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.models import build_model  # noqa: E402
+from beatlite.skeleton.beat import beat_skeleton  # noqa: E402
+from beatlite.skeleton.directions import positions_to_directions  # noqa: E402
+from beatlite.skeleton.kinematics import rest_pose  # noqa: E402
+from beatlite.skeleton.ted import TED_BONES, TED_VECTOR_NAMES, beat_to_ted43  # noqa: E402
+from beatlite.train.evaluation import (  # noqa: E402
+    COLUMNS,
+    GROUND_TRUTH,
+    GROUND_TRUTH_141,
+    EvaluationSet,
+    _renormalised,
+    _windows,
+    directions_to_ted_positions,
+    euler_to_directions,
+    evaluate_models,
+    rest_bone_lengths,
+    write_results,
+)
+
+LENGTHS = (200, 150)
+
+
+def _rest_directions() -> np.ndarray:
+    """(42, 3) TED bone directions of the BEAT rest pose, straight from the rest positions."""
+    ted = beat_to_ted43(rest_pose(beat_skeleton())[None])
+    return positions_to_directions(ted, np.asarray(TED_BONES))[0]
+
+
+def _features(windows: np.ndarray) -> np.ndarray:
+    """A fixed stand-in extractor: per-window mean and std of the first 3 channels -> (N, 6)."""
+    w = np.asarray(windows, np.float64)
+    return np.concatenate([w[:, :, :3].mean(1), w[:, :, :3].std(1)], axis=1)
+
+
+@pytest.fixture(scope="module")
+def test_set() -> EvaluationSet:
+    rng = np.random.default_rng(0)
+    rest = _rest_directions()
+    mean = rest.reshape(-1)
+    streams, gt, gt141, sems, audios = [], [], [], [], []
+    for t in LENGTHS:
+        wobble = 0.3 * np.sin(np.arange(t) / 3.0)[:, None, None] * rng.normal(size=(1, 42, 3))
+        d = rest + wobble + 0.02 * rng.normal(size=(t, 42, 3))
+        d /= np.linalg.norm(d, axis=-1, keepdims=True)
+        n = int(t / 15 * 16000)
+        audio = (0.01 * rng.normal(size=n)).astype(np.float32)
+        audio[:: 16000 // 2] = 0.9  # a click every 0.5 s: audio onsets
+        streams.append(
+            {
+                "pose": np.zeros((t, 141), np.float32),
+                "dirvec": (d.reshape(t, -1) - mean).astype(np.float32),
+                "audio": audio,
+                "mel": np.zeros((n // 512 + 1, 128), np.float32),
+                "face": np.zeros((t, 51), np.float32),
+                "word": np.zeros(t, np.int64),
+                "emotion": np.zeros(t, np.int64),
+                "semantic": rng.uniform(size=t).astype(np.float32),
+                "speaker": 0,
+            }
+        )
+        gt.append(d)
+        gt141.append(d[::-1].copy())
+        sems.append(streams[-1]["semantic"].astype(np.float64))
+        audios.append(audio)
+    norm = {
+        "pose_mean": np.zeros(141),
+        "pose_std": np.ones(141),
+        "dirvec_mean": mean,
+        "bone_lengths": rest_bone_lengths(),
+    }
+    return EvaluationSet(
+        takes=["a", "b"],
+        streams=streams,
+        gt_directions=gt,
+        gt_directions_141=gt141,
+        semantic=sems,
+        audio=audios,
+        norm=norm,
+        change_angle=np.full(41, 0.01),
+        vocab=("<pad>", "<sos>", "<eos>", "<unk>"),
+    )
+
+
+@pytest.fixture(scope="module")
+def results(test_set):
+    mean_pose = build_model("mean_pose")
+    mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})  # mean 0 = pose_mean = rest pose
+    return evaluate_models([("Mean pose", mean_pose)], test=test_set, extractor=_features)
+
+
+def test_rows_are_ground_truth_then_models(results):
+    assert [r.label for r in results.rows] == [GROUND_TRUTH, GROUND_TRUTH_141, "Mean pose"]
+    assert set(results.rows[0].metrics) == {name for name, _ in COLUMNS}
+    assert results.get("Mean pose").representation == "euler141"
+    with pytest.raises(KeyError, match="no row"):
+        results.get("CaMN")
+
+
+def test_ground_truth_row_closed_forms(results, test_set):
+    gt = results.get(GROUND_TRUTH).metrics
+    assert gt["FGD"] == pytest.approx(0.0, abs=1e-6)  # identical features
+    # every frame is a hit, so paper SRGR = sum of semantic scores / frames
+    sem = np.concatenate(test_set.semantic)
+    assert gt["SRGR"] == pytest.approx(sem.sum() / sem.size, rel=1e-9)
+    assert gt["Diversity"] > 0 and gt["L1div"] > 0
+
+
+def test_mean_pose_row_closed_forms(results, test_set):
+    mp = results.get("Mean pose").metrics
+    assert mp["Diversity"] == pytest.approx(0.0, abs=1e-9)  # one constant window, repeated
+    assert mp["L1div"] == pytest.approx(0.0, abs=1e-6)  # every frame is the take's mean
+    assert mp["BeatAlign"] == 0.0  # a frozen pose has no motion beat
+    # the constant window's features: mean = rest - dirvec_mean = 0, std = 0 -> f = 0; FGD to the
+    # real features = |mu_real|^2 + tr(Sigma_real) (biased or unbiased covariance: take the max)
+    real = _features(_windows(test_set.gt_directions, test_set.norm["dirvec_mean"]))
+    low = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T, bias=True))
+    high = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T))
+    assert low - 1e-6 <= mp["FGD"] <= high + 1e-6
+
+
+def test_windows_are_stride_10_and_pooled(test_set):
+    w = _windows(test_set.gt_directions, test_set.norm["dirvec_mean"])
+    # (200 - 34) // 10 + 1 = 17 and (150 - 34) // 10 + 1 = 12 windows
+    assert w.shape == (29, 34, 126)
+    third = test_set.gt_directions[0][20:54].reshape(34, -1) - test_set.norm["dirvec_mean"]
+    np.testing.assert_allclose(w[2], third, atol=1e-6)
+    np.testing.assert_allclose(w[17], test_set.streams[1]["dirvec"][:34], atol=1e-6)
+
+
+def test_positions_round_trip_and_mirrored_lengths():
+    lengths = rest_bone_lengths()
+    assert lengths.shape == (42,) and np.all(lengths > 0)
+    names = list(TED_VECTOR_NAMES[:42])
+    for i, name in enumerate(names):  # the BEAT rest skeleton is left/right symmetric
+        if "left" in name:
+            j = names.index(name.replace("left", "right"))
+            assert lengths[i] == pytest.approx(lengths[j], rel=1e-9), name
+    rng = np.random.default_rng(1)
+    d = rng.normal(size=(5, 42, 3))
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    pos = directions_to_ted_positions(d, lengths)
+    assert pos.shape == (5, 43, 3)
+    np.testing.assert_allclose(pos[:, 0], 0.0)  # root at the origin
+    np.testing.assert_allclose(positions_to_directions(pos, np.asarray(TED_BONES)), d, atol=1e-9)
+    bones = np.asarray(TED_BONES)
+    np.testing.assert_allclose(
+        np.linalg.norm(pos[:, bones[:, 1]] - pos[:, bones[:, 0]], axis=-1), lengths[None].repeat(5, 0)
+    )
+
+
+def test_euler_to_directions_of_zero_angles_is_the_rest_pose():
+    d = euler_to_directions(np.zeros((3, 141)))
+    np.testing.assert_allclose(d, np.broadcast_to(_rest_directions(), (3, 42, 3)), atol=1e-9)
+    with pytest.raises(ValueError, match=r"\(T, 141\)"):
+        euler_to_directions(np.zeros((3, 140)))
+
+
+def test_seed_streams_are_renormalised_for_other_statistics(test_set):
+    stream = test_set.streams[0]
+    rng = np.random.default_rng(2)
+    have = {**test_set.norm, "pose_mean": rng.normal(size=141), "pose_std": rng.uniform(1, 3, 141)}
+    want = {**test_set.norm, "pose_mean": rng.normal(size=141), "pose_std": rng.uniform(1, 3, 141)}
+    want["dirvec_mean"] = have["dirvec_mean"] + 0.1
+    pose = rng.normal(size=(4, 141))
+    out = _renormalised({**stream, "pose": pose}, have, want)
+    # the same degrees in either normalisation
+    np.testing.assert_allclose(
+        out["pose"] * want["pose_std"] + want["pose_mean"],
+        pose * have["pose_std"] + have["pose_mean"],
+        atol=1e-4,
+    )
+    np.testing.assert_allclose(
+        out["dirvec"] + want["dirvec_mean"], stream["dirvec"] + have["dirvec_mean"], atol=1e-5
+    )
+    assert _renormalised(stream, have, have) is stream
+
+
+def test_written_markdown_and_json(results, tmp_path):
+    md, js = write_results(results, tmp_path / "res")
+    text = md.read_text()
+    table = [line for line in text.splitlines() if line.startswith("|")]
+    assert len(table) == 2 + len(results.rows)
+    header = table[0]
+    positions = [header.index(name) for name, _ in COLUMNS]
+    assert positions == sorted(positions)  # metric columns in COLUMNS order
+    data = json.loads(js.read_text())
+    assert [r["label"] for r in data["rows"]] == [r.label for r in results.rows]
+    for row, back in zip(results.rows, data["rows"], strict=True):
+        for k, v in row.metrics.items():
+            assert back["metrics"][k] is None if not math.isfinite(v) else back["metrics"][k] == v
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_bad_model_entries_are_rejected(test_set):
+    with pytest.raises(TypeError, match="models entries"):
+        evaluate_models([42], test=test_set, extractor=_features)
