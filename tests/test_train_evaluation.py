@@ -22,6 +22,8 @@ from beatlite.train.evaluation import (  # noqa: E402
     EvaluationSet,
     _renormalised,
     _windows,
+    beat_align_cached,
+    beat_consistency_cached,
     directions_to_ted_positions,
     euler_to_directions,
     evaluate_models,
@@ -206,3 +208,22 @@ def test_written_markdown_and_json(results, tmp_path):
 def test_bad_model_entries_are_rejected(test_set):
     with pytest.raises(TypeError, match="models entries"):
         evaluate_models([42], test=test_set, extractor=_features)
+
+
+def test_cached_beat_metrics_equal_the_metrics_functions(test_set, results):
+    from beatlite.metrics import beat_align, beat_consistency
+
+    dirs = test_set.gt_directions
+    pos = [directions_to_ted_positions(d, test_set.norm["bone_lengths"]) for d in dirs]
+    beats = test_set.beats()
+    expected_ba = beat_align(test_set.audio, 16000, pos, 15, sigma=0.3)
+    expected_bc = beat_consistency(
+        test_set.audio, 16000, dirs, 15, sigma=0.1, change_angle=test_set.change_angle
+    )
+    assert np.isfinite(expected_ba) and np.isfinite(expected_bc)
+    assert beat_align_cached(pos, beats) == pytest.approx(expected_ba, abs=1e-12)
+    assert beat_consistency_cached(dirs, beats, test_set.change_angle) == pytest.approx(
+        expected_bc, abs=1e-12
+    )
+    assert results.value(GROUND_TRUTH, "BeatAlign") == pytest.approx(expected_ba, abs=1e-12)
+    assert results.value(GROUND_TRUTH, "BC") == pytest.approx(expected_bc, abs=1e-12)

@@ -196,6 +196,10 @@ class EvaluationSet:
         HA2G's MAAC per angle pair from the train windows (for BC).
     vocab : tuple of str
         The vocabulary the word ids refer to.
+    audio_beats : list of (K,) float64
+        Onset times (s) of each take's audio (:func:`beatlite.metrics.audio_beats` defaults),
+        computed once and shared by BeatAlign and BC; filled by :func:`load_test_set` (or on
+        first use when empty).
     """
 
     takes: list[str]
@@ -208,6 +212,15 @@ class EvaluationSet:
     change_angle: np.ndarray
     vocab: tuple[str, ...]
     split: str = "test"
+    audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
+
+    def beats(self) -> list[np.ndarray]:
+        """:attr:`audio_beats`, computed now if empty."""
+        if len(self.audio_beats) != len(self.audio):
+            from beatlite.metrics import audio_beats
+
+            self.audio_beats = [audio_beats(np.asarray(y, np.float64), SR) for y in self.audio]
+        return self.audio_beats
 
     @property
     def n_frames(self) -> int:
@@ -314,7 +327,7 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         gt_dirs_141.append(euler_to_directions(item["pose_raw"]))
         sems.append(np.asarray(item["semantic"], np.float64))
         audios.append(np.asarray(item["audio"], np.float32))
-    return EvaluationSet(
+    test = EvaluationSet(
         takes=takes,
         streams=streams,
         gt_directions=gt_dirs,
@@ -326,6 +339,8 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         vocab=tuple(vocab.itos),
         split=split,
     )
+    test.beats()
+    return test
 
 
 # ------------------------------------------------------------------------------------ generation
@@ -400,7 +415,7 @@ def score_directions(
     directions: list[np.ndarray], test: EvaluationSet, extractor: Any, reference: _Reference, *, seed: int = 0
 ) -> dict[str, float]:
     """The metrics of :data:`COLUMNS` for one row's per-take directions (T, 42, 3)."""
-    from beatlite.metrics import beat_align, beat_consistency, diversity, fgd, l1_diversity, srgr
+    from beatlite.metrics import diversity, fgd, l1_diversity, srgr
 
     if len(directions) != len(test.takes):
         raise ValueError(f"directions has {len(directions)} takes, the test set {len(test.takes)}")
@@ -413,13 +428,70 @@ def score_directions(
     return {
         "FGD": float(fgd(feats, reference.features)),
         "SRGR": float(srgr(positions, reference.positions, test.semantic, variant="paper", delta=10.0)),
-        "BeatAlign": float(beat_align(test.audio, SR, positions, FPS, sigma=0.3)),
-        "BC": float(
-            beat_consistency(test.audio, SR, directions, FPS, sigma=0.1, change_angle=test.change_angle)
-        ),
+        "BeatAlign": beat_align_cached(positions, test.beats()),
+        "BC": beat_consistency_cached(directions, test.beats(), test.change_angle),
         "Diversity": float(diversity(feats, n_pairs=500, seed=seed)),
         "L1div": float(l1_diversity(positions)),
     }
+
+
+def beat_align_cached(positions: list[np.ndarray], beats: list[np.ndarray], sigma: float = 0.3) -> float:
+    """:func:`beatlite.metrics.beat_align` (positions, order 2, audio -> motion) with precomputed audio beats.
+
+    Parameters
+    ----------
+    positions : list of (T, J, 3) float, cm
+    beats : list of (K,) float, seconds
+        Audio onset times of each take (``audio_beats(y, 16000)``).
+
+    Returns
+    -------
+    float: mean over takes with audio beats; a take whose joints have no speed minimum scores 0.
+    """
+    from beatlite.metrics.beat_align import motion_beat_times
+    from beatlite.metrics.beats import alignment_score
+
+    scores = []
+    for p, a in zip(positions, beats, strict=True):
+        if a.size == 0:
+            continue
+        per_joint = [alignment_score(a, m, sigma) for m in motion_beat_times(p, FPS, order=2) if m.size]
+        per_joint = [v for v in per_joint if np.isfinite(v)]
+        scores.append(float(np.mean(per_joint)) if per_joint else 0.0)
+    return float(np.mean(scores)) if scores else math.nan
+
+
+def beat_consistency_cached(
+    directions: list[np.ndarray], beats: list[np.ndarray], change_angle: np.ndarray, sigma: float = 0.1
+) -> float:
+    """:func:`beatlite.metrics.beat_consistency` on whole takes (threshold 0.03) with precomputed audio beats.
+
+    Parameters
+    ----------
+    directions : list of (T, 42, 3) float unit vectors
+    beats : list of (K,) float, seconds
+    change_angle : (41,) float
+        MAAC per angle pair.
+
+    Returns
+    -------
+    float: mean over takes weighted by their number of audio beats, skipping takes without
+    motion beats; NaN when none has both.
+    """
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.beats import alignment_score, angle_change_beats, angle_change_curve
+
+    pairs = default_angle_pairs()
+    total, weight = 0.0, 0
+    for d, a in zip(directions, beats, strict=True):
+        m = angle_change_beats(
+            angle_change_curve(prepare_directions(d), pairs, change_angle), FPS, threshold=0.03
+        )
+        if a.size == 0 or m.size == 0:
+            continue
+        total += alignment_score(a, m, sigma) * a.size
+        weight += a.size
+    return total / weight if weight else math.nan
 
 
 def _as_entries(models: Sequence[Any] | None) -> list[tuple[str, str, Any, Mapping[str, Any] | None]]:
