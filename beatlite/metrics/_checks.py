@@ -10,8 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 
-def as_array(x: object, name: str, *, ndim: int | tuple[int, ...], last: int | None = None) -> np.ndarray:
-    """``x`` as a finite float64 array with ``ndim`` dimensions (and last axis ``last`` if given).
+def as_array(
+    x: object, name: str, *, ndim: int | tuple[int, ...], last: int | None = None, dtype: type = np.float64
+) -> np.ndarray:
+    """``x`` as a finite ``dtype`` (float64) array with ``ndim`` dimensions (and last axis ``last`` if given).
 
     Raises
     ------
@@ -21,7 +23,7 @@ def as_array(x: object, name: str, *, ndim: int | tuple[int, ...], last: int | N
         Wrong number of dimensions, wrong last axis, or non-finite values.
     """
     try:
-        arr = np.asarray(x, dtype=np.float64)
+        arr = np.asarray(x, dtype=dtype)
     except (TypeError, ValueError) as exc:
         raise TypeError(f"{name} must be an array of numbers, got {type(x).__name__}") from exc
     dims = (ndim,) if isinstance(ndim, int) else ndim

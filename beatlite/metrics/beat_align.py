@@ -182,7 +182,7 @@ def beat_align_take(
     _name: str = "take",
 ) -> float:
     """BeatAlign of a single take (see :func:`beat_align`); NaN when it has no audio beat."""
-    y = as_array(audio, "audio", ndim=1)
+    y = as_array(audio, "audio", ndim=1, dtype=np.float32)
     if window is not None:
         a, b = _window_indices(window, sr, y.shape[0])
         y = y[a:b]

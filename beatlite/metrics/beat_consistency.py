@@ -161,7 +161,7 @@ def beat_consistency(
     )
     total, weight = 0.0, 0
     for y, v in zip(audios, vecs):
-        y = as_array(y, "audio", ndim=1)
+        y = as_array(y, "audio", ndim=1, dtype=np.float32)
         pieces = [(y, v)] if clip_length is None else _clips(y, sr, v, fps, clip_length, clip_stride)
         for y_c, v_c in pieces:
             a_times = audio_beats(y_c, sr, hop_length=hop_length, backtrack=backtrack, peak_pick=peak_pick)

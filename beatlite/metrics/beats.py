@@ -72,7 +72,7 @@ def audio_beats(
     import librosa
     from scipy import sparse
 
-    y = as_array(audio, "audio", ndim=1).astype(np.float32)
+    y = as_array(audio, "audio", ndim=1, dtype=np.float32)
     sr = int(positive(sr, "sr"))
     if backtrack not in BACKTRACKS:
         raise ValueError(f"backtrack must be one of {BACKTRACKS}, got {backtrack!r}")

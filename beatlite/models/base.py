@@ -228,7 +228,8 @@ class GestureModel(nn.Module):
         """
         check_batch(batch, (self.target_key,), f"{type(self).__name__}.generate")
         was_training = self.training
-        self.eval()
+        if was_training:  # toggling walks every submodule: skip it in the usual eval-mode loop
+            self.eval()
         try:
             seeded = dict(batch)
             target = batch[self.target_key].clone()
@@ -236,7 +237,8 @@ class GestureModel(nn.Module):
             seeded[self.target_key] = target
             return self.forward(seeded)["pose"]
         finally:
-            self.train(was_training)
+            if was_training:
+                self.train()
 
     # ---------------------------------------------------------------- (de)serialisation
     def to_config(self) -> dict[str, Any]:

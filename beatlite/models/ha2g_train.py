@@ -14,7 +14,7 @@ import argparse
 import time
 from collections.abc import Sequence
 
-DEFAULT_EPOCHS = 10
+DEFAULT_EPOCHS = 20
 """Epochs of each shipped tiny checkpoint (sized for about 3 minutes on one CPU thread)."""
 DEFAULT_LR = 1e-3
 """Adam learning rate of the tiny checkpoints (the reference uses 5e-4 at batch 96 for 100 epochs)."""
@@ -27,6 +27,7 @@ def retrain(
     batch_size: int = 32,
     lr: float = DEFAULT_LR,
     seed: int = 2021,
+    resume: bool = False,
     progress: bool = True,
 ) -> dict[str, float]:
     """Train and export HA2G checkpoints.
@@ -39,6 +40,9 @@ def retrain(
         Harness settings (:class:`beatlite.train.TrainConfig`).
     lr : float
         Generator learning rate (the discriminator's is ``TrainConfig.d_lr_weight`` = 0.2 times it).
+    resume : bool
+        Continue each ``build/train/<name>.pt`` training checkpoint up to ``epochs`` (the losses
+        equal those of an uninterrupted run).
     progress : bool
         Show the tqdm bar.
 
@@ -83,7 +87,13 @@ def retrain(
         )
         full = build_dir() / "train" / f"{name}.pt"
         config = TrainConfig(
-            epochs=epochs, batch_size=batch_size, lr=lr, seed=seed, checkpoint=full, progress=progress
+            epochs=epochs,
+            batch_size=batch_size,
+            lr=lr,
+            seed=seed,
+            checkpoint=full,
+            resume=resume,
+            progress=progress,
         )
         start = time.perf_counter()
         fit(model, arrays, config, val_arrays, meta=meta)
@@ -102,8 +112,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--batch-size", type=int, default=32)
     parser.add_argument("--lr", type=float, default=DEFAULT_LR)
     parser.add_argument("--seed", type=int, default=2021)
+    parser.add_argument("--resume", action="store_true", help="continue build/train/<name>.pt")
     args = parser.parse_args(argv)
-    retrain(args.only or None, epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed)
+    retrain(
+        args.only or None,
+        epochs=args.epochs,
+        batch_size=args.batch_size,
+        lr=args.lr,
+        seed=args.seed,
+        resume=args.resume,
+    )
     return 0
 
 
