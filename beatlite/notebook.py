@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import platform
 import random
+import warnings
 
 import numpy as np
 
@@ -62,6 +63,8 @@ def setup(seed: int = 0, *, verbose: bool = True) -> dict[str, str]:
         torch.manual_seed(seed)
         torch.set_num_threads(paths.n_threads())
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    # tqdm.auto falls back to a text bar without ipywidgets (not a dependency); its warning is noise
+    warnings.filterwarnings("ignore", message="IProgress not found")
     _inline_figures()
     info = {
         "version": __version__,
