@@ -50,6 +50,7 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a table is an ordinary readable file
         os.replace(tmp, out)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
