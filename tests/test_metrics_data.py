@@ -61,17 +61,6 @@ def test_srgr_ground_truth_is_best_and_shuffle_is_worse(takes):
     assert shuffled < 0.7 * best
 
 
-# data_samples issue (reported to the lead): the synthetic wrists' speed minima fall ~0.25-0.3 s
-# *before* the planned beats (at the top of the preparation) and wander during the holds after the
-# strokes, while speech onsets come ~3 per second; ground truth then aligns with its audio no better
-# than shuffled motion (BeatAlign 0.76 vs 0.83, BC 0.55 vs 0.59 on the 8 test takes). strict=True:
-# the test starts failing (XPASS) as soon as the corpus carries audio-aligned motion beats.
-DATA_BEATS_XFAIL = pytest.mark.xfail(
-    strict=True, reason="data_samples motion beats are not aligned with audio onsets (see comment)"
-)
-
-
-@DATA_BEATS_XFAIL
 def test_beat_align_ground_truth_beats_shuffled(takes):
     sk = takes[0].motion.skeleton
     joints = sk.indices(list(ARM_JOINTS))
@@ -88,7 +77,6 @@ def test_beat_align_ground_truth_beats_shuffled(takes):
     assert shuffled < gt - 0.03
 
 
-@DATA_BEATS_XFAIL
 def test_beat_consistency_ground_truth_beats_shuffled(takes):
     audio = [t.audio for t in takes]
     dirs = [ted_directions(t) for t in takes]

@@ -13,7 +13,7 @@ from beatlite.models import build_model  # noqa: E402
 from beatlite.models.base import GestureModel, ModelConfig  # noqa: E402
 from beatlite.models.testing import fake_windows  # noqa: E402
 from beatlite.train import TrainConfig, data_fingerprint, export_checkpoint, fit, generate, load_model  # noqa: E402
-from beatlite.train.generation import generate_sequence  # noqa: E402
+from beatlite.train.generation import generate_sequence, generate_sequences  # noqa: E402
 
 V = 50
 
@@ -281,3 +281,19 @@ def test_fit_accepts_a_windows_like_object(windows):
     a = fit(camn(), train, cfg(epochs=1))
     b = fit(camn(), _WindowsLike(), cfg(epochs=1))
     assert a.history == b.history
+
+
+def test_batched_generation_equals_take_by_take():
+    model = camn().eval()
+    takes = []
+    for t, seed in ((77, 0), (40, 1), (130, 2)):
+        take = {k: v[0] for k, v in fake_windows(1, n_frames=t, vocab_size=V, seed=seed).items()}
+        take["speaker"] = seed
+        takes.append(take)
+    batched = generate_sequences(model, takes)
+    for take, out in zip(takes, batched, strict=True):
+        assert out.shape == (take["pose"].shape[0], 141)
+        np.testing.assert_allclose(out, generate_sequence(model, take), atol=1e-5)
+    counter = _Counter()
+    generate_sequences(counter, [_streams(34), _streams(94)])
+    assert counter.calls == 3  # units 0, 1, 2 of the longer take; unit 0 of both in one call

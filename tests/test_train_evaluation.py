@@ -227,3 +227,33 @@ def test_cached_beat_metrics_equal_the_metrics_functions(test_set, results):
     )
     assert results.value(GROUND_TRUTH, "BeatAlign") == pytest.approx(expected_ba, abs=1e-12)
     assert results.value(GROUND_TRUTH, "BC") == pytest.approx(expected_bc, abs=1e-12)
+
+
+def test_checkpoints_trained_on_other_data_are_flagged(test_set, tmp_path):
+    import dataclasses
+
+    from beatlite.models.testing import fake_windows
+    from beatlite.train import TrainConfig, fit
+
+    windows = fake_windows(4)
+    windows["pose"][:] = 0.0
+    # without statistics in its meta, a checkpoint is compared by data fingerprint
+    result = fit(build_model("mean_pose"), windows, TrainConfig(epochs=1, checkpoint=tmp_path / "mp.pt"))
+    same = dataclasses.replace(test_set, fingerprint=result.fingerprint)
+    res = evaluate_models([str(tmp_path / "mp.pt")], test=same, extractor=_features, ground_truth=False)
+    assert not res.rows[0].stale and "†" not in res.to_markdown()
+    other = dataclasses.replace(test_set, fingerprint="0000000000000000")
+    with pytest.warns(UserWarning, match="other data"):
+        res = evaluate_models([str(tmp_path / "mp.pt")], test=other, extractor=_features, ground_truth=False)
+    assert res.rows[0].stale and res.rows[0].fingerprint == result.fingerprint
+    assert "mp †" in res.to_markdown()
+    # with statistics, those decide (a trainer may fingerprint another window dict)
+    stats = {k: test_set.norm[k] for k in ("pose_mean", "pose_std", "dirvec_mean")}
+    fit(build_model("mean_pose"), windows, TrainConfig(epochs=1, checkpoint=tmp_path / "a.pt"), meta=stats)
+    res = evaluate_models([str(tmp_path / "a.pt")], test=other, extractor=_features, ground_truth=False)
+    assert not res.rows[0].stale
+    moved = {**stats, "pose_mean": stats["pose_mean"] + 1.0}
+    fit(build_model("mean_pose"), windows, TrainConfig(epochs=1, checkpoint=tmp_path / "b.pt"), meta=moved)
+    with pytest.warns(UserWarning, match="other data"):
+        res = evaluate_models([str(tmp_path / "b.pt")], test=same, extractor=_features, ground_truth=False)
+    assert res.rows[0].stale

@@ -39,14 +39,24 @@ def test_shipped_checkpoints_are_float16_inference_copies():
 
 
 @pytest.mark.slow
-def test_camn_beats_mean_pose_and_s2g_on_fgd():
-    if _missing():
-        pytest.skip(f"missing checkpoints: {_missing()}")
+def test_shipped_orderings_that_hold_across_seeds():
+    """Only orderings that held for every training seed tried (4 seeds of camn_tiny and s2g_tiny, 2 of the
+    ablation): FGD CaMN << mean pose (about 5.2-6.5 vs 25), SRGR CaMN > S2G (0.156-0.162 vs 0.139-0.146)
+    and SRGR CaMN > CaMN w/o speaker ID (vs 0.132-0.138). FGD CaMN < S2G holds for the shipped pair and
+    on 4-seed means but not seed by seed (5.2-6.5 vs 5.4-7.4), so it is not asserted."""
+    if _missing() or not (checkpoints_dir() / "camn_tiny_no_speaker.pt").is_file():
+        pytest.skip(f"missing checkpoints: {_missing() or ['camn_tiny_no_speaker']}")
     if not data_dir().is_dir():
         pytest.skip("no data folder")
     from beatlite.train.evaluation import evaluate_models
 
-    res = evaluate_models(["mean_pose", "s2g_tiny", "camn_tiny"], ground_truth=False)
+    res = evaluate_models(["mean_pose", "s2g_tiny", "camn_tiny", "camn_tiny_no_speaker"], ground_truth=False)
+    stale = [row.source for row in res.rows if row.stale]
+    assert not stale, (
+        f"{stale} were trained on another version of the data: python -m beatlite.train retrain-all"
+    )
     fgd = {row.source: row.metrics["FGD"] for row in res.rows}
-    assert fgd["camn_tiny"] < fgd["mean_pose"], fgd
-    assert fgd["camn_tiny"] < fgd["s2g_tiny"], fgd
+    srgr = {row.source: row.metrics["SRGR"] for row in res.rows}
+    assert fgd["camn_tiny"] < 0.5 * fgd["mean_pose"], fgd
+    assert srgr["camn_tiny"] > srgr["s2g_tiny"], srgr
+    assert srgr["camn_tiny"] > srgr["camn_tiny_no_speaker"], srgr

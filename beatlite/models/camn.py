@@ -135,8 +135,11 @@ PRESETS: dict[str, dict[str, Any]] = {
 ``tiny`` keeps every component of ``paper`` (six-block WavEncoder, TCN text encoder, face,
 emotion and speaker encoders, the cascade, body-then-hands decoders, discriminator) with
 narrower layers. The WavEncoder dominates the cost (its first blocks run at 7891 steps per
-window), so its first block has 4 channels: ``(4, 8, 8, 16, 16, 32)`` trains an epoch about
-1.5x faster than ``(8, 8, 8, 16, 16, 32)`` (``bench/bench_models.py``).
+window), so its first block has 4 channels: with ``(4, 8, 8, 16, 16, 32)`` a generator step
+on 32 windows is about 1.2x faster than with ``(8, 8, 8, 16, 16, 32)`` (0.29 vs 0.35 s on one
+thread of a busy machine, interleaved A/B; whole-epoch timings on a shared machine are too noisy
+to show it). Most of the saving of the shipped training comes from its schedule (15 epochs at
+lr 1e-3, ``beatlite.train.__main__.TRAINING``): about 75 s per tiny CaMN on one idle thread.
 """
 
 

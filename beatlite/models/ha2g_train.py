@@ -74,10 +74,6 @@ def retrain(
         "vocab": list(vocab.itos),
         "data": str(data_dir()),
     }
-    # plain dicts; the train dict also carries the direction mean for HA2G.prepare
-    arrays = {k: train[k] for k in train.keys()}
-    arrays["dirvec_mean"] = train.dir_norm.mean
-    val_arrays = {k: val[k] for k in val.keys()}
     seconds = {}
     for name in chosen:
         torch.manual_seed(seed)
@@ -96,7 +92,7 @@ def retrain(
             progress=progress,
         )
         start = time.perf_counter()
-        fit(model, arrays, config, val_arrays, meta=meta)
+        fit(model, train, config, val, meta=meta)  # prepare() recovers the direction mean
         seconds[name] = time.perf_counter() - start
         export_checkpoint(full, checkpoints_dir() / f"{name}.pt")
         print(f"{name}: {seconds[name]:.0f} s, {model.n_parameters()} parameters", flush=True)

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from beatlite.io.names import emotion_of, split_of
+from beatlite.synth.onsets import speech_onsets
 from beatlite.synth.plan import TimedWord, make_plan, semantic_segments
 from beatlite.synth.speech import (
     ESPEAK_SR,
@@ -289,7 +290,8 @@ def generate_take(
     tic = time.perf_counter()
     streams = [np.random.default_rng([seed, spec.speaker_id, spec.session, spec.seq, k]) for k in range(4)]
     speech = synthesize_speech(spec, streams[0])
-    plan = make_plan(speech.words, spec.speaker, speech.duration, streams[1])
+    onsets = speech_onsets(speech.audio, OUTPUT_SR)
+    plan = make_plan(speech.words, spec.speaker, speech.duration, streams[1], onsets=onsets)
     bvh_fps = 120 if full_rate else fps
     n_frames = int(round(speech.duration * bvh_fps))
     t = np.arange(n_frames) / bvh_fps

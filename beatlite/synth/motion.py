@@ -4,12 +4,17 @@ The wrists follow targets written in the chest frame (the ``Spine3`` joint's fra
 Y up, +Z forward, the character's right at -X):
 
 ``wrist = rest + a(t) reach (centre - rest) - lift(t) d + loop(t) n``, then blended towards
-``target_g`` with weight ``w_g(t)`` for each semantic gesture, plus drift (and tremor in fear)
+``target_g`` with weight ``w_g(t)`` for each semantic gesture, plus a slow, small drift (and
+tremor in fear)
 
 - ``a(t)`` is the phrase envelope (1 while talking, 0 in long pauses; minimum-jerk ramps);
-- each beat lifts the hand by its amplitude against the stroke direction ``d`` during its
-  preparation (bulging sideways along ``n``, so the path loops) and brings it back with a
-  minimum-jerk stroke that ends, with zero velocity, at the word onset (:func:`beat_lift`);
+- between consecutive beats the hand traces one closed loop (a circle in the plane of the stroke
+  direction ``d`` and ``n``: up, over and down into the beat point) with the phase
+  ``phi(s) = 2 pi (s - sin(2 pi s) / (2 pi))`` of the inter-beat time ``s in [0, 1]``, so its speed
+  is ``prop. to 1 - cos(2 pi s)``: zero only at the beats (audio onsets), largest mid-way, with no
+  turnaround stop at the top (:func:`beat_lift`). The head nod, shoulder shrug, spine emphasis
+  and wrist flexion follow the same loop with two components each, so none of them stops
+  between beats either;
 - each semantic gesture ``g`` blends the wrist towards its scripted target with weight ``w_g``
   (minimum-jerk preparation that completes at the word onset, hold, retraction).
 
@@ -25,7 +30,7 @@ import numpy as np
 
 from beatlite.skeleton.core import Skeleton
 from beatlite.skeleton.rotations import axis_angle_to_matrix, euler_to_matrix, matrix_to_euler, unwrap_degrees
-from beatlite.synth.plan import Plan
+from beatlite.synth.plan import Gesture, Plan
 from beatlite.synth.styles import EMOTION_STYLES, SpeakerStyle
 
 HAND_SHAPES: dict[str, tuple[float, float, float, float, float]] = {
@@ -64,7 +69,13 @@ MAX_ELBOW_FLEX_DEG = 145.0
 """Largest elbow flexion the IK produces (human range is about 0-150 degrees)."""
 
 LOOP = 1.0
-"""Sideways bulge of a beat's preparation, as a fraction of the beat amplitude."""
+"""Width of a beat loop across the stroke direction, as a fraction of its height (1 = a circle)."""
+
+FULL_LOOP_S = 0.9
+"""Beat loops shorter than this (seconds) are smaller: amplitude times ``sqrt(duration / FULL_LOOP_S)``."""
+
+DRIFT_CM = 0.3
+"""Amplitude of each of the three slow idle-drift sinusoids of a wrist, per axis, centimetres."""
 
 CIRCLE_RADIUS_CM = 12.0
 """Radius of the ``circle`` gesture's path (frontal plane)."""
@@ -100,42 +111,191 @@ def smooth_box(t: np.ndarray, start: float, end: float, ramp_in: float, ramp_out
     return rise * fall
 
 
-def beat_lift(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
-    """Beat displacement along the stroke direction and across it, centimetres.
+def beat_phase(s: np.ndarray) -> np.ndarray:
+    """Loop phase ``phi(s) = 2 pi s - sin(2 pi s)`` of the inter-beat time ``s`` (clipped to [0, 1]).
 
-    Between consecutive beats the hand first holds (0.08 s), then rises (minimum jerk) to
-    ``A_k`` and strikes back (minimum jerk, ``stroke_k`` s) to reach 0 with zero velocity at
-    the beat time. The preparation also bulges sideways (``loop``, a ``sin^2`` bump of height
-    ``LOOP * A_k`` that returns to 0 before the stroke ends), so the path is a loop and the hand
-    does not stop at the top: the speed minimum of a beat is its stroke end.
+    ``dphi/ds = 2 pi (1 - cos 2 pi s)``: zero only at ``s = 0`` and ``s = 1`` (the beats), largest
+    at ``s = 0.5``; ``phi`` rises monotonically from 0 to ``2 pi``.
+
+    Parameters
+    ----------
+    s : (T,) float
+
+    Returns
+    -------
+    (T,) float64, radians
+    """
+    s = np.clip(np.asarray(s, dtype=np.float64), 0.0, 1.0)
+    return 2.0 * np.pi * s - np.sin(2.0 * np.pi * s)
+
+
+def loop_phase(t: np.ndarray, start: float, end: float, accents: tuple[float, ...] = ()) -> np.ndarray:
+    """Phase ``phi(t)`` of a beat loop on ``[start, end]``, from 0 to ``2 pi``, radians.
+
+    Without accents ``phi = beat_phase((t - start) / (end - start))``: the phase rate is
+    ``prop. to 1 - cos(2 pi s)``, zero only at both ends. With accents (times inside the loop) the
+    rate profile is, on each piece between consecutive boundaries ``u_i < u_{i+1}``,
+    ``r(s) = e(s) + (1 - e(s)) (1 - cos 2 pi s) / 2`` with ``e`` rising by a minimum-jerk step from
+    the depth at ``u_i`` to that at ``u_{i+1}`` (0 at the loop's ends, ``ACCENT_DEPTH`` at an
+    accent): a stop at the beats, a shallow minimum at each accent, one maximum per piece.
+    ``phi`` is ``2 pi`` times the normalised integral of ``r`` (a fixed 1-ms grid, so the value
+    does not depend on the frame rate).
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    start, end : float, seconds (start < end)
+    accents : tuple of float
+        Increasing times in ``(start, end)``, seconds.
+
+    Returns
+    -------
+    (T,) float64, radians: 0 before ``start``, ``2 pi`` after ``end``.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    if not accents:
+        return beat_phase((t - start) / (end - start))
+    from beatlite.synth.plan import ACCENT_DEPTH
+
+    bounds = np.array([start, *accents, end], dtype=np.float64)
+    depth = np.array([0.0] + [ACCENT_DEPTH] * len(accents) + [0.0])
+    grid = np.linspace(start, end, max(int(np.ceil((end - start) / 1e-3)), 8) + 1)
+    piece = np.clip(np.searchsorted(bounds, grid, side="right") - 1, 0, len(bounds) - 2)
+    s = (grid - bounds[piece]) / (bounds[piece + 1] - bounds[piece])
+    e = depth[piece] + (depth[piece + 1] - depth[piece]) * min_jerk(s)
+    rate = e + (1.0 - e) * 0.5 * (1.0 - np.cos(2.0 * np.pi * s))
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(grid))])
+    return np.interp(t, grid, 2.0 * np.pi * cum / cum[-1])
+
+
+def beat_lift(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+    """Beat loops: displacement against the stroke direction and across it, centimetres.
+
+    Beat ``k`` at ``t_k`` owns the loop on ``[t_k - D_k, t_k]`` with
+    ``D_k = min(t_k - t_{k-1}, prep_k + stroke_k)``. With ``phi = loop_phase(t, t_k - D_k, t_k,
+    accents_k)`` the hand traces a circle of diameter ``A_k`` (times ``LOOP`` across):
+
+        lift = A_k (1 - cos phi) / 2,    loop = LOOP A_k sin(phi) / 2,
+
+    so it rises to ``A_k`` mid-way while moving across (no stop at the top) and its speed
+    ``A_k / 2 * dphi/dt`` is zero only at the loop's ends, the beats (with a shallow dip at each
+    accent). ``A_k`` shrinks as ``sqrt(D_k / FULL_LOOP_S)`` for shorter loops. Outside the
+    loops both are 0.
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    plan : Plan
 
     Returns
     -------
     lift : (T,) float64
-        ``sum_k A_k L_k(t)`` (0 at every beat time).
+        Height of the loop (0 at every beat time, ``A_k`` at its middle).
     loop : (T,) float64
-        Sideways bulge of the preparation.
+        Sideways displacement of the loop (0 at the beat times and the middles).
     """
+    t = np.asarray(t, dtype=np.float64)
     lift = np.zeros_like(t)
     loop = np.zeros_like(t)
     previous = -np.inf
     for b in plan.beats:
-        peak = b.time - b.stroke
-        rise_start = max(peak - b.prep, previous + 0.08)
-        rise_len = peak - rise_start
-        if rise_len < 0.06:
-            previous = b.time
-            continue
-        amp = b.amplitude * min(1.0, rise_len / b.prep)
-        up = (t >= rise_start) & (t < peak)
-        lift[up] += amp * min_jerk((t[up] - rise_start) / rise_len)
-        down = (t >= peak) & (t <= b.time)
-        lift[down] += amp * (1.0 - min_jerk((t[down] - peak) / b.stroke))
-        loop_end = b.time - 0.35 * b.stroke
-        side = (t >= rise_start) & (t < loop_end)
-        loop[side] += LOOP * amp * np.sin(np.pi * (t[side] - rise_start) / (loop_end - rise_start)) ** 2
+        dur = min(b.time - previous, b.prep + b.stroke)
         previous = b.time
+        if dur < 0.1:
+            continue
+        amp = b.amplitude * np.sqrt(min(dur / FULL_LOOP_S, 1.0))
+        on = (t > b.time - dur) & (t < b.time)
+        accents = tuple(a for a in b.accents if b.time - dur < a < b.time)
+        phi = loop_phase(t[on], b.time - dur, b.time, accents)
+        lift[on] += 0.5 * amp * (1.0 - np.cos(phi))
+        loop[on] += 0.5 * LOOP * amp * np.sin(phi)
     return lift, loop
+
+
+SYLLABLE_LOOP_S = 1.0
+"""Longest torso bob between two syllable onsets, seconds (longer gaps: still until the last 1.0 s)."""
+
+
+def syllable_pulse(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+    """A small two-component bob of the torso between consecutive syllable onsets.
+
+    Between onsets ``o_{i-1} < o_i`` of ``plan.syllables`` (the last ``SYLLABLE_LOOP_S`` s of the
+    gap at most) ``phi = beat_phase(s)`` and the pulse is ``((1 - cos phi) / 2, sin(phi) / 2)``: a
+    circle traversed once, at rest only at the onsets. Scaled into the shoulders and spine it makes
+    their speed minima fall on the audio onsets (speech rhythm in the body).
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    plan : Plan
+
+    Returns
+    -------
+    up, side : (T,) float64, unitless in [0, 1] and [-0.5, 0.5]
+    """
+    t = np.asarray(t, dtype=np.float64)
+    up = np.zeros_like(t)
+    side = np.zeros_like(t)
+    previous = -np.inf
+    for onset in plan.syllables:
+        dur = min(onset - previous, SYLLABLE_LOOP_S)
+        previous = onset
+        on = (t > onset - dur) & (t < onset)
+        phi = beat_phase((t[on] - (onset - dur)) / dur)
+        up[on] = 0.5 * (1.0 - np.cos(phi))
+        side[on] = 0.5 * np.sin(phi)
+    return up, side
+
+
+def gesture_weight(t: np.ndarray, g: Gesture) -> np.ndarray:
+    """Blend weight of a semantic gesture: 0 -> 1 over the preparation, 1 in the hold, 1 -> 0 after.
+
+    The ramps follow :func:`loop_phase` (zero speed at both ends, a shallow slow-down at each of
+    the gesture's accents), so the hand stops only at the phase boundaries (audio onsets).
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    g : Gesture
+
+    Returns
+    -------
+    (T,) float64 in [0, 1]
+    """
+    t = np.asarray(t, dtype=np.float64)
+    rise_acc = tuple(a for a in g.accents if g.start < a < g.onset)
+    fall_acc = tuple(a for a in g.accents if g.hold_end < a < g.end)
+    rise = loop_phase(t, g.start, g.onset, rise_acc) / (2.0 * np.pi)
+    fall = loop_phase(t, g.hold_end, g.end, fall_acc) / (2.0 * np.pi)
+    return rise * (1.0 - fall)
+
+
+def phrase_envelope(t: np.ndarray, plan: Plan) -> np.ndarray:
+    """Phrase envelope ``a(t)``: 1 from each phrase's first word onset to 0.25 s after its last word.
+
+    Minimum-jerk ramps of 0.6 s before and 0.8 s after; phrases whose ramps would overlap are
+    merged (the hands stay in the gesture space), so the envelope never has a kink.
+
+    Parameters
+    ----------
+    t : (T,) float64, seconds
+    plan : Plan
+
+    Returns
+    -------
+    (T,) float64 in [0, 1]
+    """
+    rise, fall, after = 0.6, 0.8, 0.25
+    merged: list[list[float]] = []
+    for start, end in plan.phrases:
+        if merged and start - rise <= merged[-1][1] + after + fall:
+            merged[-1][1] = max(merged[-1][1], end)
+        else:
+            merged.append([start, end])
+    env = np.zeros_like(t)
+    for start, end in merged:
+        env = np.maximum(env, smooth_box(t, start, end + after, rise, fall))
+    return env
 
 
 def emotion_track(t: np.ndarray, plan: Plan, field: str) -> np.ndarray:
@@ -221,9 +381,7 @@ def wrist_paths(
     """
     amp_e = emotion_track(t, plan, "amplitude")
     tremor_e = emotion_track(t, plan, "tremor")
-    env = np.zeros_like(t)
-    for start, end in plan.phrases:
-        env = np.maximum(env, smooth_box(t, start - 0.1, end + 0.25, 0.6, 0.8))
+    env = phrase_envelope(t, plan)
     lift, loop = beat_lift(t, plan)
     angry = _smooth_track(t, (emotion_ids(t, plan) == 2).astype(np.float64))
     out: dict[str, dict[str, np.ndarray]] = {}
@@ -236,14 +394,17 @@ def wrist_paths(
         wrist = rest[None, :] + (env * reach)[:, None] * (centre - rest)[None, :]
         direction = _mirror(speaker.beat_direction, side)
         direction = direction / np.linalg.norm(direction)
-        across = np.cross(direction, np.array([1.0, 0.0, 0.0]))
+        # the loop's second axis: outwards and forwards (the elbow then loops too, it does not
+        # stop and turn back mid-way); right is -x
+        outward = _mirror(np.array([-1.0, 0.0, 0.6]), side)
+        across = outward - np.dot(outward, direction) * direction
         across = across / max(float(np.linalg.norm(across)), 1e-9)
         wrist = wrist - (role * lift)[:, None] * direction[None, :] + (role * loop)[:, None] * across[None, :]
-        # slow drift and the favourite movement
+        # slow, small drift (no sharp speed minima between beats) and the favourite movement
         for _ in range(3):
-            f = rng.uniform(0.08, 0.35)
+            f = rng.uniform(0.05, 0.15)
             phase = rng.uniform(0, 2 * np.pi, size=3)
-            wrist += 0.8 * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
+            wrist += DRIFT_CM * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
         shape_fav = np.array(HAND_SHAPES[_FAVOURITE_SHAPE[speaker.favourite]])
         curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[
             :, None
@@ -251,8 +412,11 @@ def wrist_paths(
         # anger clenches the gesturing hand towards a fist
         fist = (0.6 * env * role * angry)[:, None]
         curl = (1 - fist) * curl + fist * np.array(HAND_SHAPES["fist"])
-        roll = env * role * _FAVOURITE_ROLL[speaker.favourite]
-        flex = 8.0 + _FAVOURITE_FLEX[speaker.favourite] * lift * role / 5.0
+        # the wrist pulses with the beat loop in two components (flexion ~ height, roll ~ across)
+        # so the hand's rotation, too, is still only at the beats
+        pulse = _FAVOURITE_FLEX[speaker.favourite] * role / 5.0
+        roll = env * role * _FAVOURITE_ROLL[speaker.favourite] + 0.5 * pulse * loop
+        flex = 8.0 + pulse * lift
         # semantic gestures
         weight_sum = np.zeros_like(t)
         g_wrist = np.zeros_like(wrist)
@@ -264,12 +428,12 @@ def wrist_paths(
                 continue
             if hands == "dominant" and speaker.handedness == "both" and side == "left":
                 continue
-            w = smooth_box(t, g.onset, g.hold_end, g.ramp_in, g.ramp_out)
+            w = gesture_weight(t, g)
             tgt = centre + g.amplitude * (_mirror(target, side) - centre)
             path = np.broadcast_to(tgt, wrist.shape).copy()
             if g.kind == "circle":
                 dur = g.hold_end - g.onset
-                phi = 2 * np.pi * min_jerk((t - g.onset) / dur)
+                phi = loop_phase(t, g.onset, g.onset + dur)
                 sign = -1.0 if side == "left" else 1.0
                 path[:, 0] += sign * CIRCLE_RADIUS_CM * np.sin(phi)
                 path[:, 1] += CIRCLE_RADIUS_CM * (np.cos(phi) - 1.0)
@@ -443,17 +607,20 @@ def body_channels(
     zero = np.zeros_like(t)
     head_pitch = emotion_track(t, plan, "head_pitch")
     amp_e = emotion_track(t, plan, "amplitude")
-    lift, _ = beat_lift(t, plan)
-    nod = lift / 5.0  # ~1 at a typical beat
+    lift, loop = beat_lift(t, plan)
+    nod = lift / 5.0  # ~1 at the top of a typical beat loop
+    side_nod = loop / 5.0  # its quadrature component: nod and side_nod never stop together between beats
+    bob_up, bob_side = syllable_pulse(t, plan)  # speech rhythm: at rest only on the syllable onsets
 
     # hips: small translation sway and weight shift; legs counter-rotate so they stay vertical
+    # (slow: idle sway must not add speed minima between beats)
     hips_pos = np.stack(
-        [_sines(t, rng, 1.6, 0.05, 0.2), _sines(t, rng, 0.4, 0.1, 0.3), _sines(t, rng, 1.0, 0.05, 0.2)],
+        [_sines(t, rng, 1.6, 0.03, 0.1), _sines(t, rng, 0.4, 0.05, 0.12), _sines(t, rng, 1.0, 0.03, 0.1)],
         axis=1,
     )
     ch[:, skeleton.position_channel_indices(0)] = hips_pos
     hips_rot = _euler(
-        _sines(t, rng, 1.2, 0.05, 0.2), _sines(t, rng, 2.5, 0.04, 0.15), _sines(t, rng, 1.2, 0.05, 0.2)
+        _sines(t, rng, 1.2, 0.03, 0.1), _sines(t, rng, 2.5, 0.03, 0.08), _sines(t, rng, 1.2, 0.03, 0.1)
     )
     _put(ch, skeleton, "Hips", hips_rot)
     hips_inv = np.swapaxes(hips_rot, 1, 2)
@@ -465,9 +632,11 @@ def body_channels(
     # spine: lean, breathing, beat emphasis, a little twist
     breath = np.sin(2 * np.pi * 0.25 * t + rng.uniform(0, 2 * np.pi))
     lean = speaker.lean + 1.5 * np.clip(head_pitch, 0, None) / 14.0 * 4.0
-    twist = _sines(t, rng, 3.0, 0.05, 0.15)
+    twist = _sines(t, rng, 3.0, 0.03, 0.1)
     spine_rot = _euler(
-        (lean + 0.6 * breath + 0.6 * nod * amp_e) / 4.0, twist / 4.0, _sines(t, rng, 1.0, 0.05, 0.2) / 4.0
+        (lean + 0.3 * breath + 0.8 * bob_up * amp_e) / 4.0,
+        (twist + 0.8 * bob_side * amp_e) / 4.0,
+        _sines(t, rng, 1.0, 0.03, 0.1) / 4.0,
     )
     for name in ("Spine", "Spine1", "Spine2", "Spine3"):
         _put(ch, skeleton, name, spine_rot)
@@ -475,7 +644,8 @@ def body_channels(
     # neck and head: emotion head pitch, nods at beats, slow looking around
     look = _sines(t, rng, 10.0, 0.03, 0.1)
     tilt = _sines(t, rng, 3.0, 0.04, 0.12)
-    head_x = head_pitch + 2.5 * nod * amp_e + _sines(t, rng, 1.5, 0.1, 0.3) - 0.3 * breath
+    head_x = head_pitch + 2.5 * nod * amp_e + _sines(t, rng, 1.5, 0.05, 0.15) - 0.3 * breath
+    look = look + 2.5 * side_nod * amp_e
     neck_rot = _euler(head_x * 0.3, look * 0.3, tilt * 0.3)
     _put(ch, skeleton, "Neck", neck_rot)
     _put(ch, skeleton, "Neck1", _euler(head_x * 0.2, look * 0.2, tilt * 0.2))
@@ -486,8 +656,9 @@ def body_channels(
     for side, cap in (("right", "Right"), ("left", "Left")):
         sgn = 1.0 if side == "right" else -1.0
         p = paths[side]
-        shrug = -sgn * (1.5 + 0.8 * breath + 1.5 * nod * amp_e)
-        clav = _euler(zero, zero, shrug)
+        shrug = -sgn * (1.5 + 0.3 * breath + 2.0 * bob_up * amp_e)
+        protract = sgn * 2.0 * bob_side * amp_e
+        clav = _euler(zero, protract, shrug)
         _put(ch, skeleton, f"{cap}Shoulder", clav)
         j_sh = skeleton.index(f"{cap}Shoulder")
         j_arm = skeleton.index(f"{cap}Arm")

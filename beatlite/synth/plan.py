@@ -8,8 +8,13 @@ Rules (all times in seconds):
   far-travelling kinds of :data:`SLOW_KINDS`) starts at least
   ``0.15`` s after the previous semantic gesture ended; its stroke ends exactly at the word onset
   and it is held until ``max(word end, onset + MIN_HOLD_S)``.
-- Every other word starting at least ``0.3 / tempo`` s after the previous beat (and after any
-  semantic gesture) gets a *beat*: the stroke ends (hand speed minimum) exactly at the word onset.
+- Every other word gets a *beat* on its first acoustic onset (the onset detected in the take's
+  audio within the word, :func:`beatlite.synth.onsets.speech_onsets`; the word onset itself when
+  no onsets are given), and a long word may get a second beat on a later onset (a stressed
+  syllable), when the beat comes at least :data:`MIN_BEAT_GAP_S` after the previous beat,
+  0.25 s after any semantic gesture and after 0.3 s; words of one or two letters only half of the
+  time. Beats come ~1.5-2.5 per second of speech and every beat sits on an audio onset: the hand
+  speed is zero there (:func:`beatlite.synth.motion.beat_lift`).
 """
 
 from __future__ import annotations
@@ -30,6 +35,18 @@ MIN_HOLD_S = 0.35
 """Shortest hold of a semantic gesture, seconds."""
 RETRACT_S = 0.6
 """Retraction time of a semantic gesture at speed 1, seconds."""
+MIN_BEAT_GAP_S = 0.35
+"""Shortest time between two beats, seconds (at speaker tempo 1; divided by tempos below 1)."""
+ONSET_SNAP_S = 0.03
+"""An onset counts as a word's when it lies in ``[start - ONSET_SNAP_S, end - 0.05]``, seconds."""
+ACCENT_GAP_S = 0.2
+"""Shortest time between an accent and the neighbouring beat or accent, seconds (3 frames at 15 fps)."""
+ACCENT_DEPTH = 0.15
+"""Hand speed at an accent, as a fraction of the loop's peak speed profile."""
+GESTURE_GAP_S = 1.0
+"""Shortest time from a semantic gesture's end to the next one's preparation, seconds (room for beats)."""
+LOOP_S = 1.2
+"""Longest beat loop at gesture speed 1, seconds (``prep + stroke`` of a :class:`Beat`)."""
 SLOW_KINDS = {"up": 1.6, "big": 1.3, "everything": 1.3, "idea": 1.3}
 """Gestures whose hands travel far: preparation and retraction take this much longer."""
 
@@ -46,15 +63,20 @@ class TimedWord:
 
 @dataclass(frozen=True)
 class Beat:
-    """A beat stroke ending (speed minimum) at ``time`` s.
+    """A beat: the hand stops at ``time`` s (an audio onset) at the end of its loop.
 
-    ``amplitude`` is in centimetres; ``stroke`` and ``prep`` are durations in seconds.
+    ``amplitude`` is the loop's height in centimetres; ``prep + stroke`` (seconds) is the loop's
+    duration (its rising and falling halves; shortened to the time since the previous beat when
+    that is shorter, see :func:`beatlite.synth.motion.beat_lift`). ``accents`` are the times (s,
+    increasing, inside the loop) of the further syllable onsets the loop passes: the hand slows
+    there (a shallow speed minimum, :data:`ACCENT_DEPTH` of the peak) without stopping.
     """
 
     time: float
     amplitude: float
     stroke: float
     prep: float
+    accents: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -77,6 +99,8 @@ class Gesture:
         BEAT semantic type, e.g. ``"07_iconic_h"``.
     amplitude : float
         Emotion x speaker excursion multiplier.
+    accents : tuple of float
+        Syllable onsets (s) inside the preparation or the retraction: the hand slows there.
     """
 
     kind: str
@@ -87,6 +111,7 @@ class Gesture:
     word: str
     label: str
     amplitude: float
+    accents: tuple[float, ...] = ()
 
     @property
     def start(self) -> float:
@@ -112,6 +137,9 @@ class Plan:
     gestures : tuple of Gesture
     duration : float
         Take length, seconds.
+    syllables : tuple of float
+        Audio onsets at least :data:`ACCENT_GAP_S` apart, seconds: the torso bobs between them
+        (:func:`beatlite.synth.motion.syllable_pulse`).
     """
 
     words: tuple[TimedWord, ...]
@@ -119,6 +147,7 @@ class Plan:
     beats: tuple[Beat, ...]
     gestures: tuple[Gesture, ...]
     duration: float
+    syllables: tuple[float, ...] = ()
 
 
 def find_phrases(words: Sequence[TimedWord], gap: float = PHRASE_GAP_S) -> list[tuple[float, float]]:
@@ -145,7 +174,11 @@ def find_phrases(words: Sequence[TimedWord], gap: float = PHRASE_GAP_S) -> list[
 
 
 def make_plan(
-    words: Sequence[TimedWord], speaker: SpeakerStyle, duration: float, rng: np.random.Generator
+    words: Sequence[TimedWord],
+    speaker: SpeakerStyle,
+    duration: float,
+    rng: np.random.Generator,
+    onsets: Sequence[float] | np.ndarray | None = None,
 ) -> Plan:
     """Choose the beats and semantic gestures of a take.
 
@@ -157,54 +190,151 @@ def make_plan(
     duration : float
         Take length, seconds.
     rng : numpy.random.Generator
+    onsets : (K,) float, optional
+        Acoustic onsets of the take's audio, seconds (increasing). Beats are placed on them;
+        without them, on the word onsets.
 
     Returns
     -------
     Plan
     """
+    onset_arr = None if onsets is None else merge_onsets(onsets)
     beats: list[Beat] = []
     gestures: list[Gesture] = []
-    last_beat = -np.inf
+    last_beat = -np.inf  # last zero-speed point of the hand: a beat or a gesture's retraction end
     busy_until = -np.inf  # end of the last semantic gesture's retraction
-    min_gap = 0.3 / speaker.tempo
+    min_gap = MIN_BEAT_GAP_S / min(speaker.tempo, 1.0)
+    pending: list[float] = []  # onsets since the last beat: accents of the next beat's loop
     for w in words:
         emo = EMOTION_STYLES[w.emotion]
         speed = emo.speed * speaker.tempo
         kw = KEYWORDS.get(w.word)
+        if onset_arr is None:
+            candidates = [w.start]
+        else:
+            inside = (onset_arr >= w.start - ONSET_SNAP_S) & (onset_arr <= w.end - 0.05)
+            candidates = [float(x) for x in onset_arr[inside]]
         if kw is not None:
-            ramp_in = PREP_S * SLOW_KINDS.get(kw[0], 1.0) / speed
-            accept = w.start - ramp_in >= busy_until + 0.15 and w.start - ramp_in >= 0.05
+            slow = SLOW_KINDS.get(kw[0], 1.0)
+            onset = candidates[0] if candidates else w.start
+            ramp_in = _snap_ramp(onset, -PREP_S * slow / speed, onset_arr)
+            start = onset - ramp_in
+            accept = start >= busy_until + GESTURE_GAP_S and start >= 0.05
             if kw[0] == "chest":  # "I" is frequent: not every one gets the gesture
                 accept = accept and rng.random() < 0.7
             if accept:
-                hold_end = max(w.end, w.start + MIN_HOLD_S)
+                while beats and beats[-1].time > start:  # the preparation starts from the last beat
+                    beats.pop()
+                hold_end = max(w.end, onset + MIN_HOLD_S)
                 if kw[0] == "circle":
-                    hold_end = max(hold_end, w.start + 0.9 / speed)
+                    hold_end = max(hold_end, onset + 0.9 / speed)
+                hold_end = _snap_later(hold_end, onset_arr)
+                ramp_out = _snap_ramp(hold_end, RETRACT_S * slow / speed, onset_arr)
                 g = Gesture(
                     kind=kw[0],
-                    onset=w.start,
+                    onset=onset,
                     hold_end=hold_end,
                     ramp_in=ramp_in,
-                    ramp_out=RETRACT_S * SLOW_KINDS.get(kw[0], 1.0) / speed,
+                    ramp_out=ramp_out,
                     word=w.word,
                     label=kw[1],
                     amplitude=float(np.clip(emo.amplitude * speaker.amplitude, 0.6, 1.3)),
+                    accents=_accents(onset_arr, start, onset)
+                    + _accents(onset_arr, hold_end, hold_end + ramp_out),
                 )
                 gestures.append(g)
-                busy_until = g.end
+                busy_until = last_beat = g.end
+                pending = []
                 continue
-        if w.start - last_beat >= min_gap and w.start - 0.25 >= busy_until and w.start > 0.3:
-            if len(w.word) >= 3 or rng.random() < 0.5:
+        short_ok = len(w.word) >= 3 or rng.random() < 0.5
+        for k, time in enumerate(candidates):
+            if (
+                (k > 0 or short_ok)
+                and time - last_beat >= min_gap
+                and time >= busy_until + min_gap
+                and time > 0.3
+            ):
                 amp = 5.0 * emo.amplitude * speaker.amplitude * rng.uniform(0.8, 1.2)
-                beats.append(Beat(time=w.start, amplitude=amp, stroke=0.2 / speed, prep=0.3 / speed))
-                last_beat = w.start
+                loop = min(LOOP_S / speed, time - last_beat)
+                early = [a for a in pending if time - a <= 1.6 * LOOP_S / speed]
+                if loop < time - last_beat and early and time - early[0] > loop:
+                    loop = time - early[0]  # after a pause the loop starts on an onset too
+                accents = tuple(a for a in pending if time - loop + ACCENT_GAP_S <= a <= time - ACCENT_GAP_S)
+                beats.append(
+                    Beat(time=time, amplitude=amp, stroke=0.5 * loop, prep=0.5 * loop, accents=accents)
+                )
+                last_beat = time
+                pending = []
+            elif time >= max([last_beat, *pending]) + ACCENT_GAP_S and time >= busy_until + ACCENT_GAP_S:
+                pending.append(time)
     return Plan(
         words=tuple(words),
         phrases=tuple(find_phrases(words)),
         beats=tuple(beats),
         gestures=tuple(gestures),
         duration=float(duration),
+        syllables=_accents(onset_arr, 0.3 - ACCENT_GAP_S, float(duration) + ACCENT_GAP_S),
     )
+
+
+def merge_onsets(onsets: Sequence[float] | np.ndarray, gap: float | None = None) -> np.ndarray:
+    """Onsets with each run of neighbours closer than ``gap`` replaced by the run's mean time.
+
+    Two onsets 0.13 s apart (a word onset and its first vowel) are one syllable for the motion;
+    at 15 fps two speed minima need ~0.2 s between them.
+
+    Parameters
+    ----------
+    onsets : (K,) float, seconds
+    gap : float, optional
+        Seconds; default :data:`ACCENT_GAP_S`.
+
+    Returns
+    -------
+    (K',) float64 increasing, seconds.
+    """
+    gap = ACCENT_GAP_S if gap is None else float(gap)
+    x = np.sort(np.asarray(onsets, dtype=np.float64).reshape(-1))
+    if x.size == 0:
+        return x
+    runs = np.split(x, np.flatnonzero(np.diff(x) >= gap) + 1)
+    return np.array([float(r.mean()) for r in runs])
+
+
+def _accents(onsets: np.ndarray | None, start: float, end: float) -> tuple[float, ...]:
+    """Onsets inside ``(start, end)`` at least :data:`ACCENT_GAP_S` from both ends and from each other."""
+    if onsets is None:
+        return ()
+    out: list[float] = []
+    for x in onsets[(onsets >= start + ACCENT_GAP_S) & (onsets <= end - ACCENT_GAP_S)]:
+        if not out or x - out[-1] >= ACCENT_GAP_S:
+            out.append(float(x))
+    return tuple(out)
+
+
+def _snap_later(time: float, onsets: np.ndarray | None, within: float = 0.4) -> float:
+    """The first onset in ``[time, time + within]`` (seconds), or ``time`` when there is none."""
+    if onsets is None:
+        return time
+    later = onsets[(onsets >= time) & (onsets <= time + within)]
+    return float(later[0]) if later.size else time
+
+
+def _snap_ramp(anchor: float, ramp: float, onsets: np.ndarray | None) -> float:
+    """A ramp duration (s) whose far end lies on an onset.
+
+    ``ramp > 0`` ends ``ramp`` after ``anchor`` (a retraction), ``ramp < 0`` starts ``-ramp`` before
+    it (a preparation); the far end moves to the onset nearest to it within 0.75-1.4 times the
+    nominal duration. Returns the (positive) duration, the nominal one when no onset fits.
+    """
+    nominal = abs(ramp)
+    if onsets is None:
+        return nominal
+    gaps = (onsets - anchor) * np.sign(ramp)
+    ok = (gaps >= 0.75 * nominal) & (gaps <= 1.4 * nominal)
+    if not np.any(ok):
+        return nominal
+    return float(gaps[ok][np.argmin(np.abs(gaps[ok] - nominal))])
 
 
 def semantic_segments(plan: Plan) -> list[tuple[str, float, float, float, str]]:

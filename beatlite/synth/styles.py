@@ -80,7 +80,7 @@ class SpeakerStyle:
     amplitude : float
         Multiplier of beat size and gesture excursion.
     tempo : float
-        Multiplier of gesture speed; also the minimum gap between beats is ``0.3 / tempo`` s.
+        Multiplier of gesture speed; the minimum gap between beats is ``0.35 / min(tempo, 1)`` s.
     rest : tuple of float
         Right-wrist rest position (x, y, z) in the chest frame, centimetres (mirrored for the left).
     gesture_center : tuple of float

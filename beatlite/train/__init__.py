@@ -3,7 +3,7 @@
 - :class:`TrainConfig` (``beatlite.train.config``), :func:`fit` (``beatlite.train.training``),
 - :func:`save_checkpoint`, :func:`load_checkpoint`, :func:`load_model`, :func:`export_checkpoint`
   (``beatlite.train.checkpoint``),
-- :func:`generate`, :func:`generate_sequence` (``beatlite.train.generation``),
+- :func:`generate`, :func:`generate_sequence`, :func:`generate_sequences` (``beatlite.train.generation``),
 - :func:`evaluate_models`, :func:`load_test_set`, :func:`write_results`, :class:`ModelResults`
   (``beatlite.train.evaluation``: the results table on whole test takes).
 
@@ -27,6 +27,7 @@ _NAMES = {
     "export_checkpoint": "beatlite.train.checkpoint",
     "generate": "beatlite.train.generation",
     "generate_sequence": "beatlite.train.generation",
+    "generate_sequences": "beatlite.train.generation",
     "GeneratedTake": "beatlite.train.generation",
     "evaluate_models": "beatlite.train.evaluation",
     "load_test_set": "beatlite.train.evaluation",

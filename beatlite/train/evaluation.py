@@ -41,6 +41,7 @@ import dataclasses
 import json
 import math
 import time
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -103,6 +104,11 @@ class ResultRow:
         Values of :data:`COLUMNS` (NaN where undefined).
     seconds : float
         Wall time to generate all test takes (0 for ground-truth rows).
+    fingerprint : str
+        Data fingerprint stored in the checkpoint ("" when unknown).
+    stale : bool
+        The checkpoint was trained on other data than the evaluated corpus' train split
+        (marked with a dagger in the table).
     """
 
     label: str
@@ -110,6 +116,8 @@ class ResultRow:
     representation: str
     metrics: dict[str, float]
     seconds: float = 0.0
+    fingerprint: str = ""
+    stale: bool = False
 
 
 @dataclasses.dataclass
@@ -142,9 +150,13 @@ class ModelResults:
         head = ["method", *[f"{n} {'↑' if up else '↓'}" for n, up in COLUMNS], "gen. s"]
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         for row in self.rows:
-            cells = [row.label, *[_fmt(row.metrics.get(n, math.nan), n) for n, _ in COLUMNS]]
+            label = row.label + (" †" if row.stale else "")
+            cells = [label, *[_fmt(row.metrics.get(n, math.nan), n) for n, _ in COLUMNS]]
             cells.append(f"{row.seconds:.2f}" if row.representation != "ground_truth" else "")
             lines.append("| " + " | ".join(cells) + " |")
+        if any(row.stale for row in self.rows):
+            lines.append("")
+            lines.append("† trained on another version of the data than the one evaluated: retrain it.")
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -200,6 +212,9 @@ class EvaluationSet:
         Onset times (s) of each take's audio (:func:`beatlite.metrics.audio_beats` defaults),
         computed once and shared by BeatAlign and BC; filled by :func:`load_test_set` (or on
         first use when empty).
+    fingerprint : str
+        :func:`beatlite.train.data_fingerprint` of the train windows ("" = unknown): checkpoints
+        trained on other data are flagged as stale.
     """
 
     takes: list[str]
@@ -213,6 +228,7 @@ class EvaluationSet:
     vocab: tuple[str, ...]
     split: str = "test"
     audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
+    fingerprint: str = ""
 
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
@@ -294,6 +310,7 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
     from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
     from beatlite.metrics.beats import mean_angle_change
     from beatlite.paths import data_dir
+    from beatlite.train.training import data_fingerprint
 
     if index is None:
         index = index_folder(data_dir())
@@ -338,6 +355,7 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         change_angle=change_angle,
         vocab=tuple(vocab.itos),
         split=split,
+        fingerprint=data_fingerprint(train),
     )
     test.beats()
     return test
@@ -348,6 +366,10 @@ def generated_directions(
     model: Any, test: EvaluationSet, norm: Mapping[str, Any] | None = None
 ) -> list[np.ndarray]:
     """Generate every take of ``test`` with ``model`` and return its TED-43 directions.
+
+    The takes are generated whole as :func:`beatlite.train.generate` does (34-frame units,
+    stride 30, seeded by the first 4 ground-truth frames), all takes' units batched together
+    (:func:`beatlite.train.generation.generate_sequences`).
 
     Parameters
     ----------
@@ -362,19 +384,15 @@ def generated_directions(
     -------
     list of (T, 42, 3) float64 unit vectors, one per take.
     """
-    from beatlite.train.generation import denormalise, generate
+    from beatlite.train.generation import denormalise, generate_sequences
 
     norm = test.norm if norm is None else {**test.norm, **dict(norm)}
     if hasattr(model, "reset"):
         model.reset()  # RandomClip: restart its deterministic draws
-    out = []
-    for stream in test.streams:
-        gen = generate(model, _renormalised(stream, test.norm, norm))
-        if gen.representation == "euler141":
-            out.append(euler_to_directions(denormalise(gen.pose, "euler141", norm)))
-        else:
-            out.append(denormalise(gen.pose, "dirvec126", norm))
-    return out
+    poses = generate_sequences(model, [_renormalised(s, test.norm, norm) for s in test.streams])
+    if model.representation == "euler141":
+        return [euler_to_directions(denormalise(p, "euler141", norm)) for p in poses]
+    return [denormalise(p, "dirvec126", norm) for p in poses]
 
 
 def _renormalised(stream: dict[str, Any], have: Mapping[str, Any], want: Mapping[str, Any]) -> dict[str, Any]:
@@ -582,16 +600,25 @@ def evaluate_models(
                 )
             )
     for label, source, model, norm in entries:
+        fingerprint, stale = "", False
         if model is None:
             model, data = load_model(source)
             norm = data.get("meta") or None
             _check_vocab(model, data, test, source)
+            fingerprint = str(data.get("fingerprint") or "")
+            stale = _is_stale(data, test)
+            if stale:
+                warnings.warn(
+                    f"{source} was trained on other data (fingerprint {fingerprint}) than the evaluated "
+                    f"corpus' train split ({test.fingerprint}); retrain it (python -m beatlite.train retrain-all)",
+                    stacklevel=2,
+                )
         t0 = time.perf_counter()
         with torch.no_grad():
             dirs = generated_directions(model, test, _norm_of(norm))
         seconds = time.perf_counter() - t0
         metrics = score_directions(dirs, test, extractor, reference, seed=seed)
-        rows.append(ResultRow(label, source, model.representation, metrics, seconds))
+        rows.append(ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale))
         if progress:
             print(
                 f"{label}: " + ", ".join(f"{k} {v:.4g}" for k, v in metrics.items()) + f" ({seconds:.1f} s)",
@@ -605,9 +632,29 @@ def evaluate_models(
         "fps": FPS,
         "extractor": str(getattr(extractor, "meta", {}).get("path", type(extractor).__name__)),
         "common_space": "TED-43 unit bone directions; positions from BEAT rest-pose bone lengths, root at origin",
+        "data_fingerprint": test.fingerprint,
         "seconds": round(time.perf_counter() - start, 2),
     }
     return ModelResults(rows, info)
+
+
+def _is_stale(data: Mapping[str, Any], test: EvaluationSet) -> bool:
+    """Whether a checkpoint was trained on other data than ``test``'s train split.
+
+    Compared through the train statistics stored in its ``meta`` (pose mean/std, direction
+    mean; every beatlite trainer stores them) when present, else through the data fingerprint
+    (trainers may fingerprint different window dicts, so the statistics come first).
+    """
+    meta = data.get("meta") or {}
+    keys = ("pose_mean", "pose_std", "dirvec_mean")
+    if all(k in meta for k in keys):
+        return not all(
+            np.shape(meta[k]) == np.shape(test.norm[k])
+            and np.allclose(meta[k], test.norm[k], rtol=1e-5, atol=1e-6)
+            for k in keys
+        )
+    fingerprint = str(data.get("fingerprint") or "")
+    return bool(test.fingerprint and fingerprint and fingerprint != test.fingerprint)
 
 
 def _norm_of(meta: Mapping[str, Any] | None) -> dict[str, np.ndarray] | None:
