@@ -58,7 +58,13 @@ from beatlite.models.ha2g_losses import (
     physical_constraint_loss,
     style_diverging_loss,
 )
-from beatlite.models.layers import TextEncoderTCN, ns_gan_d_loss, ns_gan_g_loss, sum_directions
+from beatlite.models.layers import (
+    ConvDiscriminator,
+    TextEncoderTCN,
+    ns_gan_d_loss,
+    ns_gan_g_loss,
+    sum_directions,
+)
 
 AUDIO_MODES = ("blend", *AUDIO_LEVELS)
 
@@ -241,11 +247,11 @@ class LevelGenerator(nn.Module):
         return self.head(sum_directions(seq, self.hidden))
 
 
-class HA2GDiscriminator(nn.Module):
+class HA2GDiscriminator(ConvDiscriminator):
     """HA2G's ``Hierarchical_ConvDiscriminator`` on the last level (126 channels), returning logits.
 
-    ``Conv1d(D, 16, 3) -> BN -> LReLU -> Conv1d(16, 8, 3) -> BN -> LReLU -> Conv1d(8, 8, 3)``
-    (T -> T - 6), bidirectional GRU (directions summed), ``Linear(hidden, 1)`` per frame,
+    The CaMN/Trimodal :class:`~beatlite.models.layers.ConvDiscriminator` with a bidirectional
+    GRU in place of the LSTM (directions summed), ``Linear(hidden, 1)`` per frame,
     ``Linear(T - 6, 1)`` over time.
 
     Shapes
@@ -254,39 +260,9 @@ class HA2GDiscriminator(nn.Module):
     """
 
     def __init__(self, input_dim: int, hidden: int, n_layers: int, n_frames: int, slope: float) -> None:
-        super().__init__()
-        self.convs = nn.Sequential(
-            nn.Conv1d(input_dim, 16, 3),
-            nn.BatchNorm1d(16),
-            nn.LeakyReLU(slope),
-            nn.Conv1d(16, 8, 3),
-            nn.BatchNorm1d(8),
-            nn.LeakyReLU(slope),
-            nn.Conv1d(8, 8, 3),
+        super().__init__(
+            input_dim, hidden=hidden, n_layers=n_layers, n_frames=n_frames, slope=slope, rnn="gru"
         )
-        self.hidden = hidden
-        self.gru = nn.GRU(
-            8,
-            hidden,
-            num_layers=n_layers,
-            batch_first=True,
-            bidirectional=True,
-            dropout=0.3 if n_layers > 1 else 0,
-        )
-        self.out = nn.Linear(hidden, 1)
-        self.out2 = nn.Linear(n_frames - 6, 1)
-        self.n_frames = n_frames
-        self.input_dim = input_dim
-
-    def forward(self, pose: torch.Tensor) -> torch.Tensor:
-        if pose.ndim != 3 or pose.shape[1] != self.n_frames or pose.shape[2] != self.input_dim:
-            raise ValueError(
-                f"HA2GDiscriminator: pose must be (B, {self.n_frames}, {self.input_dim}), "
-                f"got shape {tuple(pose.shape)}"
-            )
-        feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
-        seq, _ = self.gru(feat)
-        return self.out2(self.out(sum_directions(seq, self.hidden)).squeeze(-1))
 
 
 class HA2G(GestureModel):

@@ -246,7 +246,7 @@ class ConvDiscriminator(nn.Module):
     """The CaMN/Trimodal sequence discriminator, with the reference's crash fixed.
 
     ``Conv1d(D, 16, 3) -> BN -> LReLU(0.1) -> Conv1d(16, 8, 3) -> BN -> LReLU -> Conv1d(8, 8, 3)``
-    (T -> T - 6 frames), a bidirectional LSTM whose two directions are summed
+    (T -> T - 6 frames), a bidirectional LSTM (``rnn="gru"``: HA2G's GRU) whose two directions are summed
     (the reference passed an undefined ``decoder_hidden``; here the LSTM starts from
     zeros), ``Linear(hidden, 1)`` per frame and ``Linear(T - 6, 1)`` over time.
 
@@ -260,11 +260,20 @@ class ConvDiscriminator(nn.Module):
     """
 
     def __init__(
-        self, input_dim: int, *, hidden: int = 64, n_layers: int = 4, n_frames: int = 34, slope: float = 0.1
+        self,
+        input_dim: int,
+        *,
+        hidden: int = 64,
+        n_layers: int = 4,
+        n_frames: int = 34,
+        slope: float = 0.1,
+        rnn: str = "lstm",
     ) -> None:
         super().__init__()
         if n_frames < 7:
-            raise ValueError(f"ConvDiscriminator: n_frames must be >= 7, got {n_frames}")
+            raise ValueError(f"{type(self).__name__}: n_frames must be >= 7, got {n_frames}")
+        if rnn not in ("lstm", "gru"):
+            raise ValueError(f"{type(self).__name__}: rnn must be 'lstm' or 'gru', got {rnn!r}")
         self.convs = nn.Sequential(
             nn.Conv1d(input_dim, 16, 3),
             nn.BatchNorm1d(16),
@@ -275,27 +284,35 @@ class ConvDiscriminator(nn.Module):
             nn.Conv1d(8, 8, 3),
         )
         self.hidden = hidden
-        self.lstm = nn.LSTM(
-            8,
-            hidden,
-            num_layers=n_layers,
-            bidirectional=True,
-            batch_first=True,
-            dropout=0.3 if n_layers > 1 else 0,
+        self.rnn_name = rnn
+        layer = nn.LSTM if rnn == "lstm" else nn.GRU
+        # registered as ``lstm`` or ``gru``: the state-dict keys of the shipped checkpoints
+        setattr(
+            self,
+            rnn,
+            layer(
+                8,
+                hidden,
+                num_layers=n_layers,
+                bidirectional=True,
+                batch_first=True,
+                dropout=0.3 if n_layers > 1 else 0,
+            ),
         )
         self.out = nn.Linear(hidden, 1)
         self.out2 = nn.Linear(n_frames - 6, 1)
         self.n_frames = n_frames
+        self.input_dim = input_dim
 
     def forward(self, pose: torch.Tensor) -> torch.Tensor:
-        if pose.ndim != 3 or pose.shape[1] != self.n_frames:
+        if pose.ndim != 3 or pose.shape[1] != self.n_frames or pose.shape[2] != self.input_dim:
             raise ValueError(
-                f"ConvDiscriminator: pose must be (B, {self.n_frames}, D), got shape {tuple(pose.shape)}"
+                f"{type(self).__name__}: pose must be (B, {self.n_frames}, {self.input_dim}), "
+                f"got shape {tuple(pose.shape)}"
             )
         feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
-        seq, _ = self.lstm(feat)
-        seq = seq[..., : self.hidden] + seq[..., self.hidden :]
-        return self.out2(self.out(seq).squeeze(-1))
+        seq, _ = getattr(self, self.rnn_name)(feat)
+        return self.out2(self.out(sum_directions(seq, self.hidden)).squeeze(-1))
 
 
 def mlp(sizes: Sequence[int], slope: float = 0.1, *, last_act: bool = True) -> nn.Sequential:
