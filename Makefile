@@ -11,8 +11,10 @@ export MPLBACKEND ?= Agg
 export BEATLITE_THREADS ?= 1
 export BEATLITE_MODE ?= lecture
 export PYTHONHASHSEED ?= 0
+# Training processes at once for `make checkpoints` / `make seeds` (1 torch thread each; 2 on an idle 2-core machine).
+JOBS ?= 1
 
-.PHONY: run test lint venv system-deps data checkpoints results bench clean
+.PHONY: run test lint venv system-deps data checkpoints results seeds bench clean
 
 venv: $(STAMP)
 
@@ -43,13 +45,18 @@ lint: $(STAMP)
 data: $(STAMP) system-deps
 	$(VPY) -m beatlite.synth --out data_samples
 
-## Retrain every shipped checkpoint on data_samples/.
+## Retrain every shipped checkpoint on data_samples/ (recipes in beatlite/train/recipes.py).
 checkpoints: $(STAMP)
-	$(VPY) -m beatlite.train retrain-all
+	$(VPY) -m beatlite.train retrain-all --jobs $(JOBS)
 
 ## The model results table on the data_samples test split (build/results_models.md).
 results: $(STAMP)
 	$(VPY) -m beatlite.train results
+
+## Train every recipe with two more seeds (build/seeds/) and record the mean ± sd table of the shipped
+## checkpoints in checkpoints/results_seeds.md/.json (about 1.5 h with JOBS=2 on 2 idle cores).
+seeds: $(STAMP)
+	$(VPY) -m beatlite.train seeds --jobs $(JOBS) --out checkpoints/results_seeds
 
 ## Speed benchmarks (run on demand; they print ratios against the named alternatives).
 bench: $(STAMP)

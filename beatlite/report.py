@@ -56,3 +56,25 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
         Path(tmp).unlink(missing_ok=True)
         raise
     return out
+
+
+def write_markdown_and_json(stem: str | Path, markdown: str, data: object) -> tuple[Path, Path]:
+    """Write ``<stem>.md`` (the text) and ``<stem>.json`` (``data``, indented, sorted keys) atomically.
+
+    Returns
+    -------
+    (Path, Path)
+        The two files written (parent folders are created).
+    """
+    import json
+
+    from beatlite.io.atomic import atomic_write
+
+    stem = Path(stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    md, js = stem.with_suffix(".md"), stem.with_suffix(".json")
+    with atomic_write(md, "w") as fh:
+        fh.write(markdown)
+    with atomic_write(js, "w") as fh:
+        json.dump(data, fh, indent=2, sort_keys=True)
+    return md, js

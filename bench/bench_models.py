@@ -4,13 +4,15 @@ Run: ``BEATLITE_THREADS=1 .venv/bin/python bench/bench_models.py [--windows N] [
 
 Per model it prints the seconds of one plain and one adversarial training epoch on the
 ``data_samples/`` train windows (fake windows with the real shapes when the folder is missing;
-``--windows`` keeps the first N), the extrapolated time of the shipped training
-(``beatlite.train.__main__.TRAINING``: 15 epochs, the last ``15 - no_adv_epochs`` adversarial;
-target <= 180 s per model), and the time to generate a 60 s take with the harness (34-frame
-units, stride 30; target <= 2 s) next to one single forward pass over the whole take (the
-straightforward alternative, no seeding between units). CaMN tiny is also timed with the
-previous tiny audio widths ``(8, 8, 8, 16, 16, 32)`` (the straightforward alternative of the
-narrower ``(4, 8, 8, 16, 16, 32)``), measured in the same run.
+``--windows`` keeps the first N), the seconds of one validation-FGD scoring (the recipes keep the
+best epoch by it), the extrapolated time of the shipped training (its recipe in
+``beatlite.train.recipes.RECIPES``: 60 epochs, HA2G 30, the last ``epochs - no_adv_epochs``
+adversarial, plus one scoring per epoch; target <= 180 s per model on 2 cores), and the time to
+generate a 60 s take with the harness (34-frame units, stride 30; target <= 2 s) next to one
+single forward pass over the whole take (the straightforward alternative, no seeding between
+units). CaMN tiny is also timed with the previous tiny audio widths ``(8, 8, 8, 16, 16, 32)``
+(the straightforward alternative of the narrower ``(4, 8, 8, 16, 16, 32)``), measured in the
+same run. Run it with ``BEATLITE_THREADS=2`` for the 2-core figure.
 Timings on a shared machine are noisy: repeat when idle.
 """
 
@@ -26,15 +28,17 @@ from beatlite.models import build_model
 from beatlite.models.testing import fake_windows
 from beatlite.paths import data_dir, n_threads
 from beatlite.train import TrainConfig, fit
-from beatlite.train.__main__ import TRAINING
 from beatlite.train.generation import generate_sequence
+from beatlite.train.recipes import RECIPES
 
 MODELS = (
-    ("camn", "camn tiny", {}),
-    ("camn", "camn old-audio", {"audio_channels": (8, 8, 8, 16, 16, 32)}),
-    ("s2g", "s2g tiny", {}),
-    ("trimodal", "trimodal tiny", {}),
+    ("camn_tiny", "camn tiny", {}),
+    ("camn_tiny", "camn old-audio", {"audio_channels": (8, 8, 8, 16, 16, 32)}),
+    ("s2g_tiny", "s2g tiny", {}),
+    ("trimodal_tiny", "trimodal tiny", {}),
+    ("ha2g_tiny", "ha2g tiny", {}),
 )
+"""(recipe name, label, extra config overrides)."""
 
 
 def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str]:
@@ -70,19 +74,26 @@ def main() -> None:
     t = int(args.seconds * 15)
     take = {k: v[0] for k, v in fake_windows(1, n_frames=t, vocab_size=vocab).items()}
     take["speaker"] = 1
-    epochs = TRAINING["epochs"]
     print(f"threads={torch.get_num_threads()} {source}: {n} windows; take={args.seconds:g}s ({t} frames)")
+    try:  # the per-epoch validation FGD of the recipes (select_best)
+        from beatlite.train.evaluation import fgd_scorer
+
+        score = fgd_scorer("val")
+    except (OSError, ValueError) as exc:
+        print(f"(no validation takes: {exc}; validation FGD not timed)")
+        score = None
     epoch_times = {}
-    for name, label, kw in MODELS:
-        if name != "s2g":
-            kw = {**kw, "vocab_size": vocab}
+    for recipe_name, label, extra in MODELS:
+        recipe = RECIPES[recipe_name]
+        name, epochs = recipe.model, recipe.epochs
+        kw = {**recipe.overrides, **extra}
+        if recipe.uses_text:
+            kw["vocab_size"] = vocab
         per_kind = {}
         for adversarial in (False, True):  # one plain and one adversarial epoch (with the D step)
             torch.manual_seed(0)
             model = build_model(name, preset="tiny", no_adv_epochs=0 if adversarial else 1, **kw)
-            config = TrainConfig(
-                epochs=1, batch_size=TRAINING["batch_size"], lr=TRAINING["lr"], progress=False
-            )
+            config = TrainConfig(epochs=1, batch_size=recipe.batch_size, lr=recipe.lr, progress=False)
             start = time.perf_counter()
             fit(model, train, config)
             per_kind[adversarial] = time.perf_counter() - start
@@ -91,6 +102,13 @@ def main() -> None:
         epoch_s = per_kind[True]
         epoch_times[label] = per_kind[False]
         model.eval()
+        val_s = 0.0
+        if score is not None and recipe.select_best:
+            start = time.perf_counter()
+            with torch.no_grad():
+                score(model)
+            val_s = time.perf_counter() - start
+            total_s += epochs * val_s
         start = time.perf_counter()
         generate_sequence(model, take)
         gen_s = time.perf_counter() - start
@@ -101,8 +119,8 @@ def main() -> None:
             model(whole)
         one_s = time.perf_counter() - start
         print(
-            f"{label:15s} params={model.n_parameters():7d}  epoch={per_kind[False]:5.2f}s (adv {epoch_s:5.2f}s)  "
-            f"{epochs - n_adv}+{n_adv} adv epochs={total_s:6.1f}s (target <= 180)  "
+            f"{label:15s} params={model.n_parameters():7d}  epoch={per_kind[False]:5.2f}s (adv {epoch_s:5.2f}s, "
+            f"val FGD {val_s:4.2f}s)  {epochs - n_adv}+{n_adv} adv epochs={total_s:6.1f}s (target <= 180)  "
             f"generate {args.seconds:g}s take={gen_s:5.2f}s (target <= 2)  "
             f"single pass={one_s:5.2f}s  ratio={gen_s / one_s:4.1f}x"
         )

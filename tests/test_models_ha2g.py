@@ -351,7 +351,7 @@ def test_shipped_checkpoint_loads_and_generates(name: str) -> None:
 
     path = checkpoints_dir() / f"{name}.pt"
     if not path.is_file():
-        pytest.skip(f"{path} not trained yet (python -m beatlite.models.ha2g_train)")
+        pytest.skip(f"{path} not trained yet (python -m beatlite.train retrain-all --only {name})")
     model, data = load_model(path)
     assert isinstance(model, HA2G) and model.config.preset == "tiny"
     for field, value in CHECKPOINTS[name].items():

@@ -297,3 +297,54 @@ def test_batched_generation_equals_take_by_take():
     counter = _Counter()
     generate_sequences(counter, [_streams(34), _streams(94)])
     assert counter.calls == 3  # units 0, 1, 2 of the longer take; unit 0 of both in one call
+
+
+def _scripted_scores(*values):
+    """A val_score that returns ``values`` in turn (epoch 0, 1, ...), recording the model's mode."""
+    calls = []
+
+    def score(model):
+        calls.append(model.training)
+        return values[len(calls) - 1]
+
+    return score, calls
+
+
+def test_val_score_keeps_the_best_epoch_and_export_uses_it(windows, tmp_path):
+    train, val = windows
+    score, calls = _scripted_scores(3.0, 1.0, float("nan"), 2.0)
+    res = fit(camn(), train, cfg(epochs=4, checkpoint=tmp_path / "run.pt"), val, val_score=score)
+    assert calls == [False] * 4  # scored in eval mode
+    assert (res.best_epoch, res.best_score) == (1, 1.0)  # NaN never wins
+    assert [h["val_score"] for h in res.history][:2] == [3.0, 1.0]
+    # the best state is the model after epoch 1: the same as a 2-epoch run (training is deterministic)
+    fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "two.pt"), val)
+    export_checkpoint(tmp_path / "run.pt", tmp_path / "best.pt", half=False)
+    export_checkpoint(tmp_path / "run.pt", tmp_path / "last.pt", half=False, best=False)
+    best, data = load_model(tmp_path / "best.pt")
+    two, _ = load_model(tmp_path / "two.pt")
+    last, last_data = load_model(tmp_path / "last.pt")
+    assert data["selected"] == {"epoch": 1, "score": 1.0, "of_epochs": 4} and "selected" not in last_data
+    for (name, p), q in zip(best.state_dict().items(), two.state_dict().values(), strict=True):
+        assert torch.equal(p, q), name
+    assert any(not torch.equal(p, q) for p, q in zip(best.state_dict().values(), last.state_dict().values()))
+
+
+def test_resume_keeps_the_best_epoch_so_far(windows, tmp_path):
+    train, val = windows
+    fit(
+        camn(),
+        train,
+        cfg(epochs=2, checkpoint=tmp_path / "r.pt"),
+        val,
+        val_score=_scripted_scores(2.0, 1.0)[0],
+    )
+    res = fit(
+        camn(),
+        train,
+        cfg(epochs=3, checkpoint=tmp_path / "r.pt", resume=True),
+        val,
+        val_score=_scripted_scores(5.0)[0],
+    )
+    assert (res.best_epoch, res.best_score) == (1, 1.0)
+    assert [h["val_score"] for h in res.history] == [2.0, 1.0, 5.0]

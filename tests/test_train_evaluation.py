@@ -257,3 +257,64 @@ def test_checkpoints_trained_on_other_data_are_flagged(test_set, tmp_path):
     with pytest.warns(UserWarning, match="other data"):
         res = evaluate_models([str(tmp_path / "b.pt")], test=same, extractor=_features, ground_truth=False)
     assert res.rows[0].stale
+
+
+def test_evaluate_seeds_collects_each_seeds_row_and_names_missing_checkpoints(
+    test_set, tmp_path, monkeypatch
+):
+    from beatlite.models.testing import fake_windows
+    from beatlite.train import TrainConfig, fit
+    from beatlite.train import seeds as seeds_module
+
+    paths = {1: tmp_path / "1" / "mean_pose.pt", 2: tmp_path / "2" / "mean_pose.pt"}
+    stats = {k: test_set.norm[k] for k in ("pose_mean", "pose_std", "dirvec_mean")}
+    for seed, path in paths.items():
+        windows = fake_windows(4, seed=seed)
+        windows["pose"] = np.full_like(windows["pose"], 0.2 * (seed - 1))  # two different frozen poses
+        fit(
+            build_model("mean_pose"),
+            windows,
+            TrainConfig(epochs=1, checkpoint=path, progress=False),
+            meta=stats,
+        )
+    monkeypatch.setattr(
+        seeds_module, "checkpoint_path", lambda name, seed: tmp_path / str(seed) / f"{name}.pt"
+    )
+    res = seeds_module.evaluate_seeds(["mean_pose"], seeds=[1, 2], test=test_set, extractor=_features)
+    single = [
+        evaluate_models([str(p)], test=test_set, extractor=_features, ground_truth=False).rows[0].metrics
+        for p in paths.values()
+    ]
+    assert list(res.values) == [GROUND_TRUTH, GROUND_TRUTH_141, "Mean pose"]
+    assert res.values[GROUND_TRUTH]["FGD"] == [pytest.approx(0.0, abs=1e-9)]  # scored once, seed-free
+    fgd = [m["FGD"] for m in single]
+    assert fgd[0] != fgd[1]
+    assert res.values["Mean pose"]["FGD"] == pytest.approx(fgd)
+    assert res.mean("Mean pose", "FGD") == pytest.approx(np.mean(fgd))
+    assert res.sd("Mean pose", "FGD") == pytest.approx(abs(fgd[0] - fgd[1]) / math.sqrt(2))
+    md, js = seeds_module.write_seed_results(res, tmp_path / "seeds")
+    assert "±" in md.read_text() and json.loads(js.read_text())["seeds"] == [1, 2]
+    with pytest.raises(FileNotFoundError, match=r"3.mean_pose\.pt.*--seeds 3"):
+        seeds_module.evaluate_seeds(["mean_pose"], seeds=[1, 3], test=test_set, extractor=_features)
+    # missing="skip": the absent seed is a NaN, so value k stays seed k; the first seed must exist
+    skip = seeds_module.evaluate_seeds(
+        ["mean_pose"], seeds=[1, 3, 2], test=test_set, extractor=_features, missing="skip"
+    )
+    assert skip.values["Mean pose"]["FGD"][0] == pytest.approx(fgd[0])
+    assert math.isnan(skip.values["Mean pose"]["FGD"][1])
+    assert skip.values["Mean pose"]["FGD"][2] == pytest.approx(fgd[1])
+    assert skip.mean("Mean pose", "FGD") == pytest.approx(np.mean(fgd))
+    assert "| 2 |" in skip.to_markdown().splitlines()[-1]  # two seeds counted
+    with pytest.raises(FileNotFoundError):
+        seeds_module.evaluate_seeds(
+            ["mean_pose"], seeds=[3, 1], test=test_set, extractor=_features, missing="skip"
+        )
+
+
+def test_fgd_scorer_equals_the_fgd_column(test_set, results):
+    from beatlite.train.evaluation import fgd_scorer
+
+    mean_pose = build_model("mean_pose")
+    mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
+    score = fgd_scorer(takes=test_set, extractor=_features)
+    assert score(mean_pose) == pytest.approx(results.value("Mean pose", "FGD"), rel=1e-9)

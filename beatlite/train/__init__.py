@@ -5,10 +5,13 @@
   (``beatlite.train.checkpoint``),
 - :func:`generate`, :func:`generate_sequence`, :func:`generate_sequences` (``beatlite.train.generation``),
 - :func:`evaluate_models`, :func:`load_test_set`, :func:`write_results`, :class:`ModelResults`
-  (``beatlite.train.evaluation``: the results table on whole test takes).
+  (``beatlite.train.evaluation``: the results table on whole test takes),
+- ``beatlite.train.recipes`` (how every shipped checkpoint is trained: ``RECIPES``, ``retrain``)
+  and ``beatlite.train.seeds`` (the results table as mean ± sd over training seeds), both
+  reachable as attributes (``bl.train.recipes.RECIPES``).
 
 ``import beatlite.train`` does not import torch; the names above import their module on
-first access. Command line: ``python -m beatlite.train {retrain-all,results}``.
+first access. Command line: ``python -m beatlite.train {retrain-all,results,seeds}``.
 """
 
 from __future__ import annotations
@@ -38,7 +41,14 @@ _NAMES = {
 __all__ = sorted(_NAMES)
 
 
+_SUBMODULES = ("recipes", "seeds", "evaluation", "training", "generation", "checkpoint", "config")
+
+
 def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        module = importlib.import_module(f"beatlite.train.{name}")
+        globals()[name] = module
+        return module
     if name in _NAMES:
         value = getattr(importlib.import_module(_NAMES[name]), name)
         globals()[name] = value
@@ -47,4 +57,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(__all__)
+    return sorted([*__all__, *_SUBMODULES])

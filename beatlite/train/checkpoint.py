@@ -114,17 +114,28 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
     return model_from_checkpoint(data), data
 
 
-def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True) -> Path:
+def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, best: bool = True) -> Path:
     """Write a small inference-only copy of a training checkpoint.
 
     Drops the optimiser and RNG states; stores floating-point weights as float16 when
-    ``half`` (:func:`model_from_checkpoint` converts them back to float32).
+    ``half`` (:func:`model_from_checkpoint` converts them back to float32). With ``best`` and a
+    ``"best"`` entry (training with ``val_score``, see :func:`beatlite.train.fit`), the exported
+    weights are those of the best-scoring epoch, recorded as ``"selected"``:
+    ``{"epoch": e, "score": s, "of_epochs": n}``; otherwise the last epoch's.
     """
     data = load_checkpoint(src)
-    keep = {k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng")}
+    keep = {k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng", "best")}
+    chosen = data.get("best")
+    if best and chosen is not None:
+        keep["state"] = chosen["state"]
+        keep["selected"] = {
+            "epoch": int(chosen["epoch"]),
+            "score": float(chosen["score"]),
+            "of_epochs": int(data.get("epoch", 0)),
+        }
     if half:
         keep["state"] = {
             k: v.half() if torch.is_tensor(v) and v.is_floating_point() else v
-            for k, v in data["state"].items()
+            for k, v in keep["state"].items()
         }
     return save_checkpoint(dst, keep)

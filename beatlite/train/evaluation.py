@@ -38,11 +38,10 @@ Nothing is cached outside ``build/`` (the window caches of :mod:`beatlite.data.w
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -151,7 +150,7 @@ class ModelResults:
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         for row in self.rows:
             label = row.label + (" †" if row.stale else "")
-            cells = [label, *[_fmt(row.metrics.get(n, math.nan), n) for n, _ in COLUMNS]]
+            cells = [label, *[fmt_metric(row.metrics.get(n, math.nan), n) for n, _ in COLUMNS]]
             cells.append(f"{row.seconds:.2f}" if row.representation != "ground_truth" else "")
             lines.append("| " + " | ".join(cells) + " |")
         if any(row.stale for row in self.rows):
@@ -174,7 +173,8 @@ class ModelResults:
         }
 
 
-def _fmt(v: float, name: str) -> str:
+def fmt_metric(v: float, name: str) -> str:
+    """``v`` as printed in the results tables: 2 decimals for FGD/Diversity/L1div, 3 for the rest."""
     if not math.isfinite(v):
         return "—"
     if name in ("FGD", "Diversity", "L1div"):
@@ -408,6 +408,57 @@ def _renormalised(stream: dict[str, Any], have: Mapping[str, Any], want: Mapping
     out["pose"] = ((raw - want["pose_mean"]) / want["pose_std"]).astype(np.float32)
     out["dirvec"] = (stream["dirvec"] + have["dirvec_mean"] - want["dirvec_mean"]).astype(np.float32)
     return out
+
+
+def fgd_scorer(
+    split: str = "val",
+    *,
+    index: Any = None,
+    vocab: Any = None,
+    norm: Mapping[str, Any] | None = None,
+    extractor: Any = None,
+    takes: EvaluationSet | None = None,
+) -> Callable[[Any], float]:
+    """A ``val_score`` for :func:`beatlite.train.fit`: FGD of a model's generation of ``split``'s whole takes.
+
+    BEAT's reference trainer validates every epoch by FGD on the validation set and keeps the
+    best epoch (facts B.6); this is that score, computed exactly as the ``FGD`` column of
+    :func:`evaluate_models` but on the ``val`` takes (so the test split stays unseen).
+
+    Parameters
+    ----------
+    split : str
+        Takes to generate (``"val"``).
+    index, vocab
+        As :func:`load_test_set` (pass the training vocabulary).
+    norm : mapping, optional
+        The statistics the model trains with (its checkpoint ``meta``); default the split's.
+    extractor : callable, optional
+        Default ``load_extractor("dirvec")``.
+    takes : EvaluationSet, optional
+        The prepared takes (default ``load_test_set(index, split=split, vocab=vocab)``).
+
+    Returns
+    -------
+    callable
+        ``score(model) -> float`` (model in eval mode; call under ``torch.no_grad()``).
+    """
+    from beatlite.metrics import fgd
+    from beatlite.metrics.extractor import load_extractor
+
+    takes = load_test_set(index, split=split, vocab=vocab) if takes is None else takes
+    extractor = load_extractor("dirvec") if extractor is None else extractor
+    mean = takes.norm["dirvec_mean"]
+    real = np.asarray(extractor(_windows(takes.gt_directions, mean)), np.float64)
+    model_norm = _norm_of(norm)
+
+    def score(model: Any) -> float:
+        feats = np.asarray(
+            extractor(_windows(generated_directions(model, takes, model_norm), mean)), np.float64
+        )
+        return float(fgd(feats, real))
+
+    return score
 
 
 # ------------------------------------------------------------------------------------ scoring
@@ -680,12 +731,10 @@ def _check_vocab(model: Any, data: Mapping[str, Any], test: EvaluationSet, sourc
 
 def write_results(results: ModelResults, stem: str | Path | None = None) -> tuple[Path, Path]:
     """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_models``)."""
-    from beatlite.io.atomic import atomic_write
     from beatlite.paths import build_dir
+    from beatlite.report import write_markdown_and_json
 
     stem = Path(stem) if stem is not None else build_dir() / "results_models"
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    md, js = stem.with_suffix(".md"), stem.with_suffix(".json")
     info = results.info
     text = (
         f"# Gesture models on the `{info['split']}` split\n\n"
@@ -694,8 +743,4 @@ def write_results(results: ModelResults, stem: str | Path | None = None) -> tupl
         + results.to_markdown()
         + f"\n\nEvaluation time: {info['seconds']:.1f} s.\n"
     )
-    with atomic_write(md, "w") as fh:
-        fh.write(text)
-    with atomic_write(js, "w") as fh:
-        json.dump(results.to_dict(), fh, indent=2, sort_keys=True)
-    return md, js
+    return write_markdown_and_json(stem, text, results.to_dict())

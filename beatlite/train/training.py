@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -32,11 +33,18 @@ class FitResult:
         The checkpoint written after the last epoch.
     fingerprint : str
         :func:`data_fingerprint` of the training windows.
+    best_epoch : int or None
+        With ``val_score``: the epoch whose weights scored lowest (the model is left with the
+        *last* epoch's weights; the checkpoint holds both, :func:`export_checkpoint` exports the best).
+    best_score : float or None
+        That epoch's score.
     """
 
     history: list[dict[str, Any]]
     checkpoint: Path | None
     fingerprint: str
+    best_epoch: int | None = None
+    best_score: float | None = None
 
 
 def as_arrays(windows: Any) -> Mapping[str, np.ndarray]:
@@ -166,6 +174,7 @@ def fit(
     val_windows: Any = None,
     *,
     meta: Mapping[str, Any] | None = None,
+    val_score: Callable[[GestureModel], float] | None = None,
 ) -> FitResult:
     """Train ``model`` on window batches (in place) and checkpoint it after every epoch.
 
@@ -184,6 +193,11 @@ def fit(
     meta : mapping, optional
         Stored verbatim in the checkpoint (e.g. normalisation statistics needed by
         :func:`beatlite.train.generate`).
+    val_score : callable, optional
+        ``val_score(model) -> float``, lower is better, called in eval mode after every epoch
+        (e.g. :func:`beatlite.train.evaluation.fgd_scorer`: FGD on the validation takes, the
+        reference's choice of its best checkpoint). Recorded as ``history[e]["val_score"]``; the
+        lowest-scoring epoch's weights are kept in the checkpoint as ``"best"``.
 
     Returns
     -------
@@ -225,6 +239,7 @@ def fit(
 
     history: list[dict[str, Any]] = []
     start_epoch = 0
+    best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
     ckpt_path = None if config.checkpoint is None else Path(config.checkpoint)
     if config.resume and ckpt_path is not None and ckpt_path.is_file():
         data = load_checkpoint(ckpt_path)
@@ -244,6 +259,7 @@ def fit(
             torch.set_rng_state(data["rng"])
         history = list(data.get("history", []))
         start_epoch = int(data["epoch"])
+        best = data.get("best")
 
     def save(epoch_done: int) -> None:
         if ckpt_path is None:
@@ -262,12 +278,18 @@ def fit(
                 "train_config": config.to_dict(),
                 "rng": torch.get_rng_state(),
                 "meta": dict(meta or {}),
+                "best": best,
             },
         )
 
+    def result() -> FitResult:
+        if best is None:
+            return FitResult(history, ckpt_path, fingerprint)
+        return FitResult(history, ckpt_path, fingerprint, int(best["epoch"]), float(best["score"]))
+
     if g_opt is None:  # untrained baseline: nothing to optimise
         save(config.epochs)
-        return FitResult(history, ckpt_path, fingerprint)
+        return result()
 
     bar = tqdm(range(start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch")
     for epoch in bar:
@@ -300,7 +322,15 @@ def fit(
         entry: dict[str, Any] = {"epoch": epoch, "train": _mean_losses(sums, seen), "val": {}}
         if val_windows is not None:
             entry["val"] = evaluate_losses(model, val_windows, epoch=epoch, batch_size=config.batch_size)
+        if val_score is not None:
+            model.eval()
+            with torch.no_grad():
+                score = float(val_score(model))
+            entry["val_score"] = score
+            if math.isfinite(score) and (best is None or score < best["score"]):
+                state = {k: v.detach().clone() for k, v in model.state_dict().items()}
+                best = {"epoch": epoch, "score": score, "state": state}
         history.append(entry)
         bar.set_postfix(loss=f"{entry['train'].get('total', float('nan')):.4g}")
         save(epoch + 1)
-    return FitResult(history, ckpt_path, fingerprint)
+    return result()

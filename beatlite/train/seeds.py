@@ -1,0 +1,380 @@
+"""The results table over several training seeds: mean ± standard deviation per model and metric.
+
+>>> from beatlite.train.seeds import train_seeds, evaluate_seeds    # doctest: +SKIP
+>>> train_seeds(["camn_tiny", "s2g_tiny"], seeds=[2022, 2023], jobs=2)   # doctest: +SKIP
+>>> table = evaluate_seeds(["camn_tiny", "s2g_tiny"], seeds=[2021, 2022, 2023])  # doctest: +SKIP
+>>> print(table.to_markdown())                                       # doctest: +SKIP
+
+One seed is one draw: on the 143 test windows of ``data_samples/`` the FGD of one model moves
+by about ±1 between seeds, as much as the gap between some rows. A claim such as "CaMN beats
+Trimodal on FGD" is therefore checked on the mean over seeds, against the spread.
+
+Seed :data:`beatlite.train.recipes.SEED` is the shipped checkpoint (``checkpoints/<name>.pt``);
+every other seed ``s`` is trained by :func:`beatlite.train.recipes.retrain` into
+``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from beatlite.train.recipes import RECIPES, SEED, retrain_many
+
+
+def seeds_dir() -> Path:
+    """``build/seeds``: one folder per extra seed."""
+    from beatlite.paths import build_dir
+
+    return build_dir() / "seeds"
+
+
+def checkpoint_path(name: str, seed: int) -> Path:
+    """Where the checkpoint of recipe ``name`` trained with ``seed`` lives (shipped for :data:`SEED`)."""
+    from beatlite.paths import checkpoints_dir
+
+    if seed == SEED:
+        return checkpoints_dir() / f"{name}.pt"
+    return seeds_dir() / str(seed) / f"{name}.pt"
+
+
+def train_seeds(
+    names: Sequence[str] | None = None,
+    seeds: Sequence[int] = (2022, 2023),
+    *,
+    jobs: int = 1,
+    force: bool = False,
+    verbose: bool = True,
+) -> dict[tuple[str, int], float]:
+    """Train every recipe of ``names`` with every seed of ``seeds`` that has no checkpoint yet.
+
+    Parameters
+    ----------
+    names : sequence of str, optional
+        Keys of :data:`beatlite.train.recipes.RECIPES` (default all).
+    seeds : sequence of int
+        :data:`~beatlite.train.recipes.SEED` is skipped (that is the shipped checkpoint).
+    jobs : int
+        Training processes run at once, one torch thread each (2 on a 2-core machine that
+        does nothing else; 1 otherwise: two busy processes on two cores slow each other).
+    force : bool
+        Retrain checkpoints that exist.
+    verbose : bool
+        Print one line per finished checkpoint.
+
+    Returns
+    -------
+    dict (name, seed) -> seconds of training, for the checkpoints trained now.
+    """
+    names = list(RECIPES) if names is None else list(names)
+    unknown = sorted(set(names) - set(RECIPES))
+    if unknown:
+        raise ValueError(f"unknown checkpoint name(s) {unknown}; known: {sorted(RECIPES)}")
+    if jobs < 1:
+        raise ValueError(f"jobs must be >= 1, got {jobs}")
+    todo = [
+        (name, int(seed), checkpoint_path(name, int(seed)).parent)
+        for seed in seeds
+        for name in names
+        if int(seed) != SEED and (force or not checkpoint_path(name, int(seed)).is_file())
+    ]
+
+    def report(name: str, seed: int, seconds: float) -> None:
+        if verbose:
+            print(f"seed {seed} {name}: {seconds:.1f} s", flush=True)
+
+    return retrain_many(todo, jobs=jobs, on_done=report)
+
+
+@dataclasses.dataclass
+class SeedResults:
+    """Per-seed metric values of several models and their mean ± sd.
+
+    Attributes
+    ----------
+    values : dict
+        Row label -> metric -> list of values, one per seed of ``seeds`` in order, NaN where that
+        seed's checkpoint was missing (ground-truth rows: one value, they do not depend on a seed).
+    seeds : list of int
+    info : dict
+        Evaluation settings of :func:`beatlite.train.evaluate_models`, plus the checkpoint paths.
+    """
+
+    values: dict[str, dict[str, list[float]]]
+    seeds: list[int]
+    info: dict[str, Any]
+
+    def mean(self, row: str, metric: str) -> float:
+        """Mean over seeds (NaN seeds ignored)."""
+        v = np.asarray(self.values[row][metric], float)
+        return float(np.nanmean(v)) if np.isfinite(v).any() else math.nan
+
+    def count(self, row: str, metric: str = "FGD") -> int:
+        """How many seeds have a (finite) value of ``metric`` in ``row``."""
+        return int(np.isfinite(np.asarray(self.values[row][metric], float)).sum())
+
+    def sd(self, row: str, metric: str) -> float:
+        """Sample standard deviation over seeds (ddof 1; NaN with fewer than 2 finite values)."""
+        v = np.asarray(self.values[row][metric], float)
+        v = v[np.isfinite(v)]
+        return float(np.std(v, ddof=1)) if len(v) > 1 else math.nan
+
+    def difference(self, row: str, reference: str, metric: str) -> tuple[float, float]:
+        """``mean(row) - mean(reference)`` and its standard error ``sqrt(sd_r²/n_r + sd_ref²/n_ref)`` (Welch).
+
+        A difference larger than about two standard errors is unlikely to be seed noise; the
+        standard error is NaN when either row has fewer than two seeds.
+        """
+        a = np.asarray(self.values[row][metric], float)
+        b = np.asarray(self.values[reference][metric], float)
+        a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+        delta = self.mean(row, metric) - self.mean(reference, metric)
+        if len(a) < 2 or len(b) < 2:
+            return delta, math.nan
+        return delta, float(math.sqrt(np.var(a, ddof=1) / len(a) + np.var(b, ddof=1) / len(b)))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SeedResults:
+        """Inverse of :meth:`to_dict` (None read back as NaN)."""
+        values = {
+            row: {m: [math.nan if v is None else float(v) for v in d["values"]] for m, d in metrics.items()}
+            for row, metrics in data["rows"].items()
+        }
+        return cls(values, [int(s) for s in data["seeds"]], dict(data.get("info", {})))
+
+    def to_markdown(self) -> str:
+        """A Markdown table of ``mean ± sd`` over seeds for every metric of :data:`COLUMNS`."""
+        from beatlite.train.evaluation import COLUMNS, fmt_metric
+
+        head = ["method", *[f"{n} {'↑' if up else '↓'}" for n, up in COLUMNS], "seeds"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for row, metrics in self.values.items():
+            cells = [row]
+            for name, _ in COLUMNS:
+                if name not in metrics:
+                    cells.append("")
+                    continue
+                mean, sd = self.mean(row, name), self.sd(row, name)
+                cell = fmt_metric(mean, name)
+                if math.isfinite(sd):
+                    cell += " ± " + fmt_metric(sd, name)
+                cells.append(cell)
+            cells.append(str(self.count(row, next(iter(metrics)))))
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly dict (NaN written as None)."""
+
+        def clean(v: float) -> float | None:
+            return v if math.isfinite(v) else None
+
+        rows = {
+            row: {
+                m: {
+                    "values": [clean(x) for x in vals],
+                    "mean": clean(self.mean(row, m)),
+                    "sd": clean(self.sd(row, m)),
+                }
+                for m, vals in metrics.items()
+            }
+            for row, metrics in self.values.items()
+        }
+        return {"seeds": self.seeds, "rows": rows, "info": self.info}
+
+
+@dataclasses.dataclass(frozen=True)
+class Effect:
+    """How one row differs from a reference row on one metric, over seeds (:func:`compare_rows`).
+
+    Attributes
+    ----------
+    variant, metric : str
+    delta : float
+        ``mean(variant) - mean(full)`` in the metric's units.
+    se : float
+        Its standard error (:meth:`SeedResults.difference`).
+    verdict : str
+        ``"worse"`` or ``"better"`` than the full model when ``|delta| > 2 se``, else ``"noise"``
+        (``"unknown"`` without a standard error).
+    """
+
+    variant: str
+    metric: str
+    delta: float
+    se: float
+    verdict: str
+
+    def cell(self, digits: int = 2) -> str:
+        """``"+0.52 ± 0.31 worse"``: delta ± 2 standard errors and the verdict."""
+        return f"{self.delta:+.{digits}f} ± {2 * self.se:.{digits}f} {self.verdict}"
+
+
+def compare_rows(
+    results: SeedResults, full: str, variants: Sequence[str], metrics: Sequence[str] = ("FGD", "SRGR")
+) -> list[Effect]:
+    """How each row of ``variants`` differs from row ``full``, metric by metric, against seed noise.
+
+    For an ablation study ``full`` is the full model and ``variants`` its ablations; for a
+    benchmark ``full`` can be a baseline and ``variants`` the models compared with it.
+    A difference counts (``"worse"``/``"better"`` than ``full``) only when it exceeds two standard
+    errors of the difference of the seed means (Welch); the direction uses :data:`COLUMNS` (FGD
+    lower is better, the others higher).
+
+    Returns
+    -------
+    list of Effect, variant-major.
+    """
+    from beatlite.train.evaluation import COLUMNS
+
+    higher = dict(COLUMNS)
+    effects = []
+    for variant in variants:
+        for metric in metrics:
+            if metric not in higher:
+                raise ValueError(f"metric must be one of {[n for n, _ in COLUMNS]}, got {metric!r}")
+            delta, se = results.difference(variant, full, metric)
+            if not math.isfinite(se):
+                verdict = "unknown"
+            elif abs(delta) <= 2 * se:
+                verdict = "noise"
+            else:
+                verdict = "better" if (delta > 0) == higher[metric] else "worse"
+            effects.append(Effect(variant, metric, delta, se, verdict))
+    return effects
+
+
+def evaluate_seeds(
+    names: Sequence[str] | None = None,
+    seeds: Sequence[int] = (SEED, 2022, 2023),
+    *,
+    test: Any = None,
+    extractor: Any = None,
+    missing: str = "error",
+    progress: bool = False,
+) -> SeedResults:
+    """Score the checkpoints of every (name, seed) on the test split and collect them by row.
+
+    Parameters
+    ----------
+    names : sequence of str, optional
+        Keys of :data:`~beatlite.train.recipes.RECIPES`; default those whose checkpoints exist
+        for every seed.
+    seeds : sequence of int
+        Checkpoints from :func:`checkpoint_path` (:data:`~beatlite.train.recipes.SEED` = shipped).
+    test, extractor
+        As :func:`beatlite.train.evaluate_models` (loaded once for all seeds).
+    missing : {"error", "skip"}
+        A missing (name, seed) checkpoint raises, or is left out (that row then has fewer
+        values; the table's ``seeds`` column gives the count).
+    progress : bool
+        Print one line per seed.
+
+    Returns
+    -------
+    SeedResults
+        Rows in :data:`beatlite.train.evaluation.LABELS` order; the two ground-truth rows first.
+
+    Raises
+    ------
+    FileNotFoundError
+        A requested checkpoint is missing (names the file and the command that trains it).
+    """
+    from beatlite.metrics.extractor import load_extractor
+    from beatlite.train.evaluation import LABELS, evaluate_models, load_test_set
+
+    seeds = [int(s) for s in seeds]
+    if not seeds:
+        raise ValueError("seeds must not be empty")
+    if names is None:
+        names = [
+            n
+            for n in LABELS
+            if checkpoint_path(n, seeds[0]).is_file()
+            and (missing == "skip" or all(checkpoint_path(n, s).is_file() for s in seeds))
+        ]
+    names = list(names)
+    if missing not in ("error", "skip"):
+        raise ValueError(f"missing must be 'error' or 'skip', got {missing!r}")
+    for name in names:
+        for seed in seeds:
+            path = checkpoint_path(name, seed)
+            if not path.is_file() and (missing == "error" or seed == seeds[0]):
+                raise FileNotFoundError(
+                    f"{path}: no checkpoint of {name!r} for seed {seed}; train it with "
+                    f"`python -m beatlite.train seeds --seeds {seed} --only {name}`"
+                )
+    test = load_test_set() if test is None else test
+    extractor = load_extractor("dirvec") if extractor is None else extractor
+    values: dict[str, dict[str, list[float]]] = {}
+    info: dict[str, Any] = {}
+    for i, seed in enumerate(seeds):
+        present = [n for n in names if checkpoint_path(n, seed).is_file()]
+        res = evaluate_models(
+            [str(checkpoint_path(n, seed)) for n in present],
+            test=test,
+            extractor=extractor,
+            ground_truth=i == 0,
+        )
+        info = dict(res.info)
+        for row in res.rows:
+            slot = values.setdefault(row.label, {})
+            for metric, v in row.metrics.items():
+                slot.setdefault(metric, []).append(float(v))
+        for name in names:  # a skipped checkpoint is a NaN, so that value k is always seed k
+            if name not in present:
+                for vals in values[LABELS.get(name, name)].values():
+                    vals.append(math.nan)
+        if progress:
+            print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
+    info["checkpoints"] = {
+        n: [str(checkpoint_path(n, s)) for s in seeds if checkpoint_path(n, s).is_file()] for n in names
+    }
+    return SeedResults(values, seeds, info)
+
+
+def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
+    """The seed table recorded beside the shipped checkpoints (``checkpoints/results_seeds.json``).
+
+    Written by ``make seeds`` (``python -m beatlite.train seeds --out checkpoints/results_seeds``)
+    when the checkpoints were trained; its seed-2021 column is the shipped checkpoints.
+
+    Raises
+    ------
+    FileNotFoundError
+        No recorded table (names the file and the command that writes it).
+    """
+    from beatlite.io.errors import FormatError
+    from beatlite.paths import checkpoints_dir
+
+    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no recorded seed table; write it with `make seeds`")
+    try:
+        return SeedResults.from_dict(json.loads(path.read_text()))
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise FormatError(path, f"not a seed table written by write_seed_results ({exc})") from exc
+
+
+def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
+    """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``)."""
+    from beatlite.paths import build_dir
+    from beatlite.report import write_markdown_and_json
+
+    stem = Path(stem) if stem is not None else build_dir() / "results_seeds"
+    info = results.info
+    text = (
+        f"# Gesture models on the `{info.get('split', 'test')}` split, seeds {results.seeds}\n\n"
+        f"Mean ± sample standard deviation over the training seeds of each row (column `seeds`: how many; "
+        f"{info.get('windows', '?')} FGD windows; ground-truth rows do not depend on a seed). "
+        f"Seed {SEED} is the shipped checkpoint; the others are in `build/seeds/<seed>/`.\n\n"
+        + results.to_markdown()
+        + "\n"
+    )
+    return write_markdown_and_json(stem, text, results.to_dict())

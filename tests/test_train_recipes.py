@@ -1,0 +1,152 @@
+"""The recipes of the shipped checkpoints (beatlite.train.recipes) and the seeds table (beatlite.train.seeds)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from beatlite.models import MODELS
+from beatlite.train.recipes import CAMN_ABLATIONS, HA2G_ABLATIONS, RECIPES, SEED, retrain, retrain_many
+from beatlite.train.seeds import SeedResults
+
+
+def test_every_recipe_builds_a_registered_model_and_has_a_table_label():
+    from beatlite.train.evaluation import LABELS
+
+    assert set(RECIPES) == set(LABELS)
+    for name, recipe in RECIPES.items():
+        assert recipe.model in MODELS, name
+        assert recipe.epochs >= 0 and recipe.batch_size >= 2 and recipe.lr > 0, name
+    assert RECIPES["mean_pose"].epochs == 0 and RECIPES["random_clip"].epochs == 0
+
+
+def test_each_ablation_switches_off_exactly_one_thing():
+    for table, full in ((CAMN_ABLATIONS, "camn_tiny"), (HA2G_ABLATIONS, "ha2g_tiny")):
+        assert table[full] == {}
+        for name, overrides in table.items():
+            if name != full:
+                assert len(overrides) == 1, name
+                assert all(v in (False, "low") for v in overrides.values()), name
+
+
+def test_ha2g_recipes_use_the_model_modules_switches():
+    pytest.importorskip("torch")
+    from beatlite.models.ha2g import ABLATIONS, CHECKPOINTS
+
+    assert CHECKPOINTS == HA2G_ABLATIONS
+    assert HA2G_ABLATIONS["ha2g_tiny_holistic"] == ABLATIONS["holistic"]
+    assert HA2G_ABLATIONS["ha2g_tiny_single_audio"] == ABLATIONS["single_audio"]
+    assert HA2G_ABLATIONS["ha2g_tiny_no_contrastive"] == ABLATIONS["no_contrastive"]
+    assert HA2G_ABLATIONS["ha2g_tiny_no_physical"] == ABLATIONS["no_physical"]
+
+
+def test_unknown_names_and_bad_jobs_are_rejected_before_any_work():
+    with pytest.raises(ValueError, match="camn_tiny_typo"):
+        retrain("camn_tiny_typo")
+    with pytest.raises(ValueError, match="camn_tiny_typo"):
+        retrain_many([("camn_tiny_typo", SEED, None)])
+    with pytest.raises(ValueError, match="jobs"):
+        retrain_many([("s2g_tiny", SEED, None)], jobs=0)
+
+
+@pytest.mark.slow
+def test_retrain_is_deterministic_exports_float16_and_does_not_depend_on_jobs(tmp_path):
+    torch = pytest.importorskip("torch")
+    from beatlite.train.checkpoint import load_checkpoint
+    from beatlite.train.recipes import training_data
+
+    data = training_data()
+    runs = [("s2g_tiny", 7, tmp_path / "a"), ("random_clip", 7, tmp_path / "a")]
+    for name, seed, out in runs:
+        retrain(name, seed=seed, epochs=1, out_dir=out, data=data, progress=False)
+    again = [(name, seed, tmp_path / "b") for name, seed, _ in runs]
+    seconds = retrain_many(again, jobs=2, epochs=1)
+    assert set(seconds) == {("s2g_tiny", 7), ("random_clip", 7)}
+    other = tmp_path / "c"
+    retrain("s2g_tiny", seed=8, epochs=1, out_dir=other, data=data, progress=False)
+    for name, _, _ in runs:
+        a, b = load_checkpoint(tmp_path / "a" / f"{name}.pt"), load_checkpoint(tmp_path / "b" / f"{name}.pt")
+        assert (tmp_path / "a" / "train" / f"{name}.pt").is_file()  # the resumable full checkpoint
+        assert a["state"].keys() == b["state"].keys()
+        for key, value in a["state"].items():
+            assert torch.equal(value, b["state"][key]), (name, key)
+            if value.is_floating_point():
+                assert value.dtype == torch.float16, (name, key)
+    s2g, s2g8 = load_checkpoint(tmp_path / "a" / "s2g_tiny.pt"), load_checkpoint(other / "s2g_tiny.pt")
+    assert any(not torch.equal(v, s2g8["state"][k]) for k, v in s2g["state"].items())
+    clip = load_checkpoint(tmp_path / "a" / "random_clip.pt")
+    assert clip["model"]["seed"] == 7  # the seed also picks the random clips
+
+
+def test_seed_results_mean_and_sample_sd_by_hand():
+    res = SeedResults(
+        {
+            "A": {"FGD": [1.0, 2.0, 4.0], "SRGR": [0.1, math.nan, 0.3]},
+            "B": {"FGD": [5.0], "SRGR": [math.nan]},
+        },
+        seeds=[1, 2, 3],
+        info={},
+    )
+    assert res.mean("A", "FGD") == pytest.approx(7 / 3)
+    assert res.sd("A", "FGD") == pytest.approx(math.sqrt(7 / 3))  # sum of squares 42/9 over n-1 = 2
+    assert res.mean("A", "SRGR") == pytest.approx(0.2) and res.sd("A", "SRGR") == pytest.approx(
+        math.sqrt(0.02)
+    )
+    assert res.mean("B", "FGD") == 5.0 and math.isnan(res.sd("B", "FGD"))
+    assert res.count("A", "FGD") == 3 and res.count("A", "SRGR") == 2 and res.count("B", "SRGR") == 0
+    assert math.isnan(res.mean("B", "SRGR"))
+    md = res.to_markdown()
+    assert "| A | 2.33 ± 1.53 | 0.200 ± 0.141 |" in md
+    assert "| B | 5.00 | — |" in md
+    d = res.to_dict()
+    assert d["rows"]["A"]["SRGR"]["values"] == [0.1, None, 0.3] and d["rows"]["B"]["FGD"]["sd"] is None
+    assert np.isclose(d["rows"]["A"]["FGD"]["mean"], 7 / 3)
+
+
+def test_seed_difference_is_welch_by_hand_and_the_table_round_trips(tmp_path):
+    import json
+
+    from beatlite.io import FormatError
+    from beatlite.train.seeds import recorded_seed_results
+
+    res = SeedResults(
+        {"A": {"FGD": [1.0, 3.0]}, "B": {"FGD": [4.0, 4.0, 7.0]}, "C": {"FGD": [2.0]}}, [1, 2, 3], {}
+    )
+    delta, se = res.difference("A", "B", "FGD")
+    # var(A) = 2 (ddof 1), var(B) = 3; se = sqrt(2/2 + 3/3) = sqrt(2)
+    assert delta == pytest.approx(2.0 - 5.0) and se == pytest.approx(math.sqrt(2.0))
+    assert math.isnan(res.difference("A", "C", "FGD")[1])
+    path = tmp_path / "seeds.json"
+    path.write_text(json.dumps(res.to_dict()))
+    back = recorded_seed_results(path)
+    assert back.values == res.values and back.seeds == [1, 2, 3]
+    with pytest.raises(FileNotFoundError, match="make seeds"):
+        recorded_seed_results(tmp_path / "missing.json")
+    path.write_text('{"rows": 3}')
+    with pytest.raises(FormatError, match="seeds.json"):
+        recorded_seed_results(path)
+
+
+def test_compare_rows_need_two_standard_errors_and_know_each_metrics_direction():
+    from beatlite.train.seeds import compare_rows
+
+    res = SeedResults(
+        {
+            "full": {"FGD": [4.0, 4.2, 3.8], "SRGR": [0.20, 0.21, 0.19]},
+            "no_x": {"FGD": [6.0, 6.2, 5.8], "SRGR": [0.20, 0.22, 0.18]},  # FGD +2 (se 0.163): worse
+            "no_y": {"FGD": [3.9, 4.5, 3.6], "SRGR": [0.25, 0.26, 0.24]},  # SRGR +0.05 (se 0.0082): better
+        },
+        [1, 2, 3],
+        {},
+    )
+    effects = {(e.variant, e.metric): e for e in compare_rows(res, "full", ["no_x", "no_y"])}
+    assert effects["no_x", "FGD"].verdict == "worse" and effects["no_x", "FGD"].delta == pytest.approx(2.0)
+    # sd of both FGD rows is 0.2: se = sqrt(0.04/3 + 0.04/3)
+    assert effects["no_x", "FGD"].se == pytest.approx(math.sqrt(0.08 / 3))
+    assert effects["no_x", "SRGR"].verdict == "noise"
+    assert effects["no_y", "SRGR"].verdict == "better" and effects["no_y", "FGD"].verdict == "noise"
+    assert effects["no_x", "FGD"].cell() == f"+2.00 ± {2 * math.sqrt(0.08 / 3):.2f} worse"
+    with pytest.raises(ValueError, match="metric"):
+        compare_rows(res, "full", ["no_x"], metrics=["speed"])
