@@ -115,9 +115,12 @@ def main() -> None:
         whole = {k: torch.from_numpy(np.asarray(v)[None]) for k, v in take.items() if k != "speaker"}
         whole["speaker"] = torch.tensor([1])
         start = time.perf_counter()
-        with torch.no_grad():
-            model(whole)
-        one_s = time.perf_counter() - start
+        try:
+            with torch.no_grad():
+                model(whole)
+            one_s = time.perf_counter() - start
+        except ValueError:  # HA2G only takes its fixed 34-frame windows
+            one_s = float("nan")
         print(
             f"{label:15s} params={model.n_parameters():7d}  epoch={per_kind[False]:5.2f}s (adv {epoch_s:5.2f}s, "
             f"val FGD {val_s:4.2f}s)  {epochs - n_adv}+{n_adv} adv epochs={total_s:6.1f}s (target <= 180)  "
