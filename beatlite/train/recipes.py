@@ -2,7 +2,7 @@
 
 >>> from beatlite.train.recipes import RECIPES, retrain     # doctest: +SKIP
 >>> RECIPES["camn_tiny"].epochs                              # doctest: +SKIP
-40
+60
 >>> seconds = retrain("camn_tiny", seed=2022, out_dir="build/seeds/2022")  # doctest: +SKIP
 
 A :class:`Recipe` names a model of :data:`beatlite.models.MODELS`, its ``tiny`` preset
@@ -24,6 +24,7 @@ epochs on 30 h of data, we have minutes). All use batch 32.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -117,6 +118,14 @@ class TrainingData:
     val: Any
     sentences: Any
     meta: dict[str, Any]
+
+    @functools.cached_property
+    def val_takes(self) -> Any:
+        """The whole validation takes that :func:`~beatlite.train.evaluation.fgd_scorer` generates
+        (an :class:`~beatlite.train.evaluation.EvaluationSet`, prepared on first use, then shared)."""
+        from beatlite.train.evaluation import load_test_set
+
+        return load_test_set(self.index, split="val", vocab=self.vocab)
 
 
 def training_data(data: str | Path | None = None) -> TrainingData:
@@ -226,7 +235,7 @@ def retrain(
     if recipe.select_best and config.epochs > 0:
         from beatlite.train.evaluation import fgd_scorer
 
-        score = fgd_scorer("val", index=data.index, vocab=data.vocab, norm=data.meta)
+        score = fgd_scorer(norm=data.meta, takes=data.val_takes)
     start = time.perf_counter()
     fit(model, data.train, config, data.val, meta=data.meta, val_score=score)
     seconds = time.perf_counter() - start

@@ -76,8 +76,6 @@ def train_seeds(
     unknown = sorted(set(names) - set(RECIPES))
     if unknown:
         raise ValueError(f"unknown checkpoint name(s) {unknown}; known: {sorted(RECIPES)}")
-    if jobs < 1:
-        raise ValueError(f"jobs must be >= 1, got {jobs}")
     todo = [
         (name, int(seed), checkpoint_path(name, int(seed)).parent)
         for seed in seeds
