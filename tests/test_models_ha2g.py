@@ -52,15 +52,27 @@ def _model(seed: int = 0, **overrides: object) -> HA2G:
 
 # ----------------------------------------------------------------------------- audio learner
 @pytest.mark.parametrize(
-    ("channels", "blocks", "feat"),
-    [((4, 8, 16, 32), (1, 1, 1, 1), 16), ((32, 64, 128, 256), (1, 1, 1, 1), 32)],
+    ("channels", "blocks", "feat", "freq_stride"),
+    [
+        ((4, 8, 16, 32), (1, 1, 1, 1), 16, 1),
+        ((4, 8, 16, 32), (1, 1, 1, 1), 16, 2),
+        ((32, 64, 128, 256), (1, 1, 1, 1), 32, 1),
+    ],
 )
-def test_audio_encoder_maps_mel_to_three_levels_of_34_frames(channels, blocks, feat) -> None:
-    enc = HierarchicalAudioEncoder(channels, blocks, reduction=4, out_features=feat)
+def test_audio_encoder_maps_mel_to_three_levels_of_34_frames(channels, blocks, feat, freq_stride) -> None:
+    enc = HierarchicalAudioEncoder(channels, blocks, reduction=4, out_features=feat, freq_stride=freq_stride)
     out = enc(torch.randn(2, 70, 128) * 20 - 40)
     assert sorted(out) == ["high", "low", "mid"]
     for level in ("low", "mid", "high"):
         assert tuple(out[level].shape) == (2, 34, feat)
+    # each stream's Linear reads (frequency rows after its conv) x channels: 128 / (2 s) - 1 rows for low
+    assert enc.streams["low"].proj.in_features == (128 // (2 * freq_stride) - 1) * channels[1]
+    assert enc.streams["high"].proj.in_features == (128 // (8 * freq_stride) * 4 - 2) * (channels[3] // 16)
+
+
+def test_audio_encoder_freq_stride_is_validated() -> None:
+    with pytest.raises(ValueError, match="freq_stride"):
+        HierarchicalAudioEncoder((4, 8, 16, 32), (1, 1, 1, 1), freq_stride=3)
 
 
 def test_audio_encoder_builds_only_requested_levels_and_validates() -> None:
@@ -202,6 +214,25 @@ def test_loss_terms_follow_the_switches_and_warmup() -> None:
     terms = bare.losses(batch, bare(batch), epoch=100)
     assert set(terms) == {"huber", "kld", "total"}
     assert bare.discriminator is None and bare.contrastive_text is None
+
+
+def test_style_decode_in_the_forward_batch_equals_a_separate_decode() -> None:
+    """Training forward runs the random-speaker cascade in the same 2B batch: same output as alone."""
+    model = _model()
+    model.train()
+    batch = fake_batch(3)
+    out = model(batch)
+    assert tuple(out["pose_other"].shape) == (3, 34, 126) and tuple(out["z_other"].shape) == (3, 8)
+    audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
+    texts = [out[f"text{k}"] for k in range(len(model.text_encoders))]
+    alone, _ = model._decode(batch["dirvec"], audio, texts, out["z_other"])
+    torch.testing.assert_close(out["pose_other"], alone[-1], rtol=1e-5, atol=1e-6)
+    mine, _ = model._decode(batch["dirvec"], audio, texts, out["z"])
+    torch.testing.assert_close(out["level5"], mine[-1], rtol=1e-5, atol=1e-6)
+    assert not torch.allclose(out["pose_other"], out["level5"])  # another style, another output
+    model.eval()
+    assert "pose_other" not in model(batch)  # inference pays nothing for the style loss
+    assert "style" in model.losses(batch, model(batch), epoch=0)  # an eval output still gets it
 
 
 @pytest.mark.parametrize("ablation", sorted(ABLATIONS))

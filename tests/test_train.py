@@ -56,6 +56,46 @@ def test_resume_reproduces_an_uninterrupted_run(windows, tmp_path):
     assert not list(tmp_path.glob("*.tmp"))  # atomic writes leave no temp file
 
 
+def test_cosine_schedule_factors_closed_form():
+    c = TrainConfig(epochs=4, lr_schedule="cosine")
+    # (1 + cos(pi e / 4)) / 2 for e = 0..4: 1, (2 + sqrt 2) / 4, 1/2, (2 - sqrt 2) / 4, 0
+    expected = [1.0, (2 + 2**0.5) / 4, 0.5, (2 - 2**0.5) / 4, 0.0]
+    assert [c.lr_factor(e) for e in range(5)] == pytest.approx(expected)
+    assert TrainConfig(epochs=4).lr_factor(3) == 1.0  # constant
+    with pytest.raises(ValueError, match="lr_schedule"):
+        TrainConfig(lr_schedule="linear")
+
+
+class _RecordLr(torch.optim.Adam):
+    """Adam that records the learning rate of each step (to see the schedule fit applies)."""
+
+    seen: list[float] = []
+
+    def step(self, closure=None):  # type: ignore[override]
+        _RecordLr.seen.append(self.param_groups[0]["lr"])
+        return super().step(closure)
+
+
+def test_fit_applies_the_cosine_schedule_to_both_optimisers(windows, monkeypatch):
+    train, _ = windows
+    _RecordLr.seen = []
+    monkeypatch.setattr(torch.optim, "Adam", _RecordLr)
+    model = build_model("camn", preset="tiny", vocab_size=V, no_adv_epochs=0)
+    fit(model, train, cfg(epochs=2, lr=1e-3, lr_schedule="cosine"))
+    steps = len(train["pose"]) // 8  # 3 batches per epoch; each has a D step then a G step
+    d_lr, g_lr = _RecordLr.seen[0::2], _RecordLr.seen[1::2]
+    assert g_lr == pytest.approx([1e-3] * steps + [5e-4] * steps)  # epoch 1 of 2: (1 + cos(pi/2)) / 2
+    assert d_lr == pytest.approx([2e-4] * steps + [1e-4] * steps)  # d_lr_weight 0.2
+
+
+def test_resume_is_exact_with_the_cosine_schedule(windows, tmp_path):
+    train, val = windows
+    full = fit(camn(), train, cfg(epochs=3, lr_schedule="cosine", checkpoint=tmp_path / "full.pt"), val)
+    fit(camn(), train, cfg(epochs=1, lr_schedule="cosine", checkpoint=tmp_path / "part.pt"), val)
+    again = cfg(epochs=3, lr_schedule="cosine", checkpoint=tmp_path / "part.pt", resume=True)
+    assert fit(camn(), train, again, val).history == full.history
+
+
 def test_resume_refuses_other_data(windows, tmp_path):
     train, val = windows
     fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "a.pt"))

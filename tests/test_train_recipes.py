@@ -150,3 +150,63 @@ def test_compare_rows_need_two_standard_errors_and_know_each_metrics_direction()
     assert effects["no_x", "FGD"].cell() == f"+2.00 ± {2 * math.sqrt(0.08 / 3):.2f} worse"
     with pytest.raises(ValueError, match="metric"):
         compare_rows(res, "full", ["no_x"], metrics=["speed"])
+
+
+def _checkpoint_of(name: str, **train_changes):
+    """What retrain's export of recipe ``name`` stores about its training (config dicts only)."""
+    from beatlite.models import build_model
+    from beatlite.train import TrainConfig
+
+    recipe = RECIPES[name]
+    config = TrainConfig(
+        epochs=recipe.epochs, batch_size=recipe.batch_size, lr=recipe.lr, lr_schedule=recipe.lr_schedule
+    ).to_dict()
+    config.update(train_changes)
+    kw = dict(recipe.overrides)
+    if recipe.uses_text:
+        kw["vocab_size"] = 207
+    from beatlite.train.checkpoint import FORMAT
+
+    model = build_model(recipe.model, preset="tiny", **kw).to_config()
+    return {"format": FORMAT, "train_config": config, "model": model, "state": {}}
+
+
+def test_recipe_mismatch_sees_changed_settings_and_model_configs():
+    pytest.importorskip("torch")
+    from beatlite.train.seeds import recipe_mismatch
+
+    for name in ("camn_tiny", "ha2g_tiny_holistic", "random_clip"):
+        assert recipe_mismatch(name, _checkpoint_of(name)) is None, name
+    why = recipe_mismatch("camn_tiny", _checkpoint_of("camn_tiny", epochs=60, lr=1e-3))
+    assert (
+        why is not None
+        and "epochs=60" in why
+        and "lr=0.001" in why
+        and f"epochs={RECIPES['camn_tiny'].epochs}" in why
+    )
+    old = _checkpoint_of("camn_tiny")
+    del old["train_config"]["lr_schedule"]  # checkpoints from before the option: constant
+    assert recipe_mismatch("camn_tiny", old) is None
+    other = _checkpoint_of("ha2g_tiny")
+    other["model"]["audio_freq_stride"] = 1  # a preset change since it was trained
+    assert "audio_freq_stride" in recipe_mismatch("ha2g_tiny", other)
+    # an ablation's checkpoint is not the full model's
+    assert "use_audio" in recipe_mismatch("camn_tiny", _checkpoint_of("camn_tiny_no_audio"))
+
+
+def test_train_seeds_keeps_current_checkpoints_and_retrains_stale_ones(tmp_path, monkeypatch):
+    pytest.importorskip("torch")
+    from beatlite.train import checkpoint, seeds
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path))
+    checkpoint.save_checkpoint(seeds.checkpoint_path("s2g_tiny", 7), _checkpoint_of("s2g_tiny"))
+    checkpoint.save_checkpoint(
+        seeds.checkpoint_path("trimodal_tiny", 7), _checkpoint_of("trimodal_tiny", lr=5e-4)
+    )
+    asked = []
+    monkeypatch.setattr(seeds, "retrain_many", lambda todo, **kw: asked.extend(todo) or {})
+    seeds.train_seeds(["s2g_tiny", "trimodal_tiny", "mean_pose"], seeds=[SEED, 7], verbose=False)
+    assert [(name, seed) for name, seed, _ in asked] == [("trimodal_tiny", 7), ("mean_pose", 7)]
+    asked.clear()
+    seeds.train_seeds(["s2g_tiny"], seeds=[7], force=True, verbose=False)
+    assert [(name, seed) for name, seed, _ in asked] == [("s2g_tiny", 7)]

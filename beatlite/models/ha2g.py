@@ -80,7 +80,8 @@ class HA2GConfig(ModelConfig):
     level), ``use_contrastive``, ``use_physical``, ``adversarial``, ``use_style_loss``.
     ``no_adv_epochs`` is the 0-based epoch from which the GAN term is on (reference: epoch >
     ``loss_warmup`` = 10). ``d_lr_scale`` is the discriminator's learning rate relative to the
-    generator's (reference 0.2).
+    generator's (reference 0.2). ``audio_freq_stride`` is the frequency stride of the audio
+    learner's first convolution (reference 1; ``tiny`` 2).
     """
 
     preset: str = "paper"
@@ -97,6 +98,7 @@ class HA2GConfig(ModelConfig):
     audio_blocks: tuple[int, ...] = (3, 4, 6, 3)
     se_reduction: int = 8
     audio_features: int = 32
+    audio_freq_stride: int = 1
     hidden: int = 300
     n_layers: int = 4
     dropout: float = 0.3
@@ -158,6 +160,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "audio_blocks": (1, 1, 1, 1),
         "se_reduction": 4,
         "audio_features": 16,
+        "audio_freq_stride": 2,
         "hidden": 48,
         "n_layers": 1,
         "dropout": 0.1,
@@ -170,7 +173,11 @@ PRESETS: dict[str, dict[str, Any]] = {
 
 ``tiny``'s GRUs have 48 units: with 32, training from seed 1 reached a validation FGD of 5.7 in
 30 epochs and a test FGD of 7.19; with 48 the same seed reached 3.28 and 4.60 (issue 6 notes),
-for about 15 % more time per epoch.
+for about 15 % more time per epoch. Its audio stem has a frequency stride of 2
+(``audio_freq_stride``), as the "fast" SE-ResNet-34 of the voxceleb_trainer repository that the
+reference's ResNetSE34V2 comes from (a stride-(2, 1) first convolution): the 4-channel first layer
+then runs on 64 x 70 instead of 128 x 70, and the audio learner's training step takes about 2.5x
+less time (37 vs 93 ms for 32 windows on 2 threads).
 """
 
 ABLATIONS: dict[str, dict[str, Any]] = {
@@ -279,7 +286,10 @@ class HA2G(GestureModel):
         ``"mu"``, ``"logvar"``, ``"z"`` (B, Z) the speaker style distribution and sample;
         ``"style_weights"`` (B, 3, H) audio-level weights per body level;
         ``"audio_low"`` / ``"audio_mid"`` / ``"audio_high"`` (B, T, F) the levels computed;
-        ``"text_contrast"`` (B, T, F) the contrastive text features (when used).
+        ``"text_contrast"`` (B, T, F) the contrastive text features (when used);
+        in training mode with ``use_style_loss``: ``"z_other"`` (B, Z) random speakers' style
+        vectors and ``"pose_other"`` (B, T, 126) the last level's prediction with them (the
+        style diverging loss' second output, decoded in the same cascade pass as a batch of 2B).
     """
 
     name = "ha2g"
@@ -318,7 +328,13 @@ class HA2G(GestureModel):
         if c.use_contrastive:
             needed |= {"low", "high"}
         self.audio = HierarchicalAudioEncoder(
-            c.audio_channels, c.audio_blocks, c.se_reduction, c.audio_features, sorted(needed), c.n_frames
+            c.audio_channels,
+            c.audio_blocks,
+            c.se_reduction,
+            c.audio_features,
+            sorted(needed),
+            c.n_frames,
+            c.audio_freq_stride,
         )
         # speaker style: Embedding -> Linear -> LReLU -> (mu, logvar)
         self.speaker_embedding = nn.Sequential(
@@ -478,7 +494,23 @@ class HA2G(GestureModel):
         audio = self.audio(batch["mel"])
         mu, logvar, z = self.speaker_style(batch["speaker"])
         texts = [enc(batch["word"]) for enc in self.text_encoders]
-        preds, weights = self._decode(dirvec, audio, texts, z)
+        b = dirvec.shape[0]
+        if self.training and self.config.use_style_loss:
+            # the style diverging loss needs the cascade run again with random speakers' z:
+            # both runs go through the cascade as one batch of 2B (same result, half the
+            # per-time-step GRU calls)
+            _, _, z_other = self.speaker_style(self._random_speakers(b, z.device))
+            both, weights = self._decode(
+                dirvec.repeat(2, 1, 1),
+                {lv: f.repeat(2, 1, 1) for lv, f in audio.items()},
+                [text.repeat(2, 1, 1) for text in texts],
+                torch.cat([z, z_other]),
+            )
+            preds, weights = [p[:b] for p in both], weights[:b]
+            other = {"pose_other": both[-1][b:], "z_other": z_other}
+        else:
+            preds, weights = self._decode(dirvec, audio, texts, z)
+            other = {}
         pose = dirvec.new_zeros(dirvec.shape).index_copy(
             -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1]
         )
@@ -495,7 +527,11 @@ class HA2G(GestureModel):
             out[f"text{k}"] = text
         if self.contrastive_text is not None:
             out["text_contrast"] = self.contrastive_text(batch["word"])
+        out.update(other)
         return out
+
+    def _random_speakers(self, b: int, device: torch.device) -> torch.Tensor:
+        return torch.randint(0, self.config.n_speakers, (b,), device=device)
 
     # ------------------------------------------------------------------ losses
     def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
@@ -545,16 +581,21 @@ class HA2G(GestureModel):
         return terms
 
     def _style_loss(self, batch: Batch, out: dict[str, torch.Tensor]) -> torch.Tensor:
-        """Style diverging loss against the outputs for random speakers' style vectors."""
-        b = out["z"].shape[0]
-        other = torch.randint(0, self.config.n_speakers, (b,), device=out["z"].device)
-        _, _, z_other = self.speaker_style(other)
-        audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
-        texts = [out[f"text{k}"] for k in range(len(self.text_encoders))]
-        preds_other, _ = self._decode(batch["dirvec"], audio, texts, z_other)
+        """Style diverging loss against the outputs for random speakers' style vectors.
+
+        Training-mode forward passes already carry them (``"pose_other"``, ``"z_other"``);
+        otherwise (an eval-mode ``out``) the cascade is run here with new random speakers.
+        """
+        if "pose_other" in out:
+            pose_other, z_other = out["pose_other"], out["z_other"]
+        else:
+            _, _, z_other = self.speaker_style(self._random_speakers(out["z"].shape[0], out["z"].device))
+            audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
+            texts = [out[f"text{k}"] for k in range(len(self.text_encoders))]
+            pose_other = self._decode(batch["dirvec"], audio, texts, z_other)[0][-1]
         return style_diverging_loss(
             out[f"level{self.n_levels - 1}"],
-            preds_other[-1],
+            pose_other,
             out["z"],
             z_other,
             beta=self.config.style_beta,

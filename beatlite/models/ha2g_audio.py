@@ -27,6 +27,8 @@ from collections.abc import Sequence
 import torch
 from torch import nn
 
+from beatlite.models.fast_conv import Conv2d
+
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
 
@@ -65,14 +67,14 @@ class SEBasicBlock2d(nn.Module):
 
     def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int) -> None:
         super().__init__()
-        self.conv1 = nn.Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
+        self.conv1 = Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
         self.bn1 = nn.BatchNorm2d(out_ch)
-        self.conv2 = nn.Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
+        self.conv2 = Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
         self.bn2 = nn.BatchNorm2d(out_ch)
         self.se = SEBlock2d(out_ch, reduction)
         self.relu = nn.ReLU(inplace=True)
         self.shortcut: nn.Module = (
-            nn.Sequential(nn.Conv2d(in_ch, out_ch, 1, stride=stride, bias=False), nn.BatchNorm2d(out_ch))
+            nn.Sequential(Conv2d(in_ch, out_ch, 1, stride=stride, bias=False), nn.BatchNorm2d(out_ch))
             if stride != 1 or in_ch != out_ch
             else nn.Identity()
         )
@@ -101,7 +103,7 @@ class _Stream(nn.Module):
             )
         self.shuffle: nn.Module = nn.PixelShuffle(upscale) if upscale > 1 else nn.Identity()
         ch = channels // (upscale * upscale)
-        self.conv = nn.Conv2d(ch, ch, kernel)
+        self.conv = Conv2d(ch, ch, kernel)
         freq = freq_in * upscale - kernel + 1
         self.proj = nn.Linear(freq * ch, out_features)
 
@@ -130,6 +132,11 @@ class HierarchicalAudioEncoder(nn.Module):
         reads a level does not build it).
     n_frames : int
         Pose frames T per window; every stream is cropped / edge-padded to T.
+    freq_stride : int
+        Stride of the first convolution along the mel axis (reference 1). 2 halves the
+        frequency size of every layer (the stride-(2, 1) stem of voxceleb_trainer's "fast"
+        SE-ResNet-34), so the low / mid / high streams read 32 / 16 / 8 frequency rows instead of
+        64 / 32 / 16; the time axis, and so the 34 output frames, is unchanged.
 
     Shapes
     ------
@@ -145,6 +152,7 @@ class HierarchicalAudioEncoder(nn.Module):
         out_features: int = 32,
         levels: Sequence[str] = AUDIO_LEVELS,
         n_frames: int = 34,
+        freq_stride: int = 1,
     ) -> None:
         super().__init__()
         c = tuple(int(v) for v in channels)
@@ -156,8 +164,13 @@ class HierarchicalAudioEncoder(nn.Module):
             raise ValueError(f"levels must be a non-empty subset of {AUDIO_LEVELS}, got {tuple(levels)}")
         self.levels = tuple(lv for lv in AUDIO_LEVELS if lv in levels)
         self.n_frames = int(n_frames)
+        fs = int(freq_stride)
+        if fs not in (1, 2, 4):
+            raise ValueError(f"freq_stride must be 1, 2 or 4, got {freq_stride}")
         self.stem = nn.Sequential(
-            nn.Conv2d(1, c[0], 3, padding=1, bias=False), nn.BatchNorm2d(c[0]), nn.ReLU(inplace=True)
+            Conv2d(1, c[0], 3, stride=(fs, 1), padding=1, bias=False),
+            nn.BatchNorm2d(c[0]),
+            nn.ReLU(inplace=True),
         )
         self.layer1 = _layer(c[0], c[0], nb[0], 1, reduction)
         self.layer2 = _layer(c[0], c[1], nb[1], 2, reduction)
@@ -167,11 +180,11 @@ class HierarchicalAudioEncoder(nn.Module):
         self.layer4 = _layer(c[2], c[3], nb[3], 2, reduction) if need4 else None
         streams: dict[str, nn.Module] = {}
         if "low" in self.levels:
-            streams["low"] = _Stream(c[1], 1, 2, N_MELS // 2, out_features)
+            streams["low"] = _Stream(c[1], 1, 2, N_MELS // (2 * fs), out_features)
         if "mid" in self.levels:
-            streams["mid"] = _Stream(c[2], 2, 3, N_MELS // 4, out_features)
+            streams["mid"] = _Stream(c[2], 2, 3, N_MELS // (4 * fs), out_features)
         if "high" in self.levels:
-            streams["high"] = _Stream(c[3], 4, 3, N_MELS // 8, out_features)
+            streams["high"] = _Stream(c[3], 4, 3, N_MELS // (8 * fs), out_features)
         self.streams = nn.ModuleDict(streams)
         self.out_features = int(out_features)
 
@@ -180,7 +193,8 @@ class HierarchicalAudioEncoder(nn.Module):
             raise ValueError(
                 f"HierarchicalAudioEncoder: mel must be (B, M >= 8, {N_MELS}), got shape {tuple(mel.shape)}"
             )
-        x = (mel / 40.0 + 1.0).transpose(1, 2).unsqueeze(1)  # (B, 1, 128 mels, M frames)
+        # contiguous: a transposed view sends every later convolution down a slow strided path
+        x = (mel / 40.0 + 1.0).transpose(1, 2).unsqueeze(1).contiguous()  # (B, 1, 128 mels, M frames)
         x2 = self.layer2(self.layer1(self.stem(x)))
         feats = {"low": x2}
         if self.layer3 is not None:

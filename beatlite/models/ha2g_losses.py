@@ -58,9 +58,9 @@ def contrastive_ce(query: torch.Tensor, key: torch.Tensor, *, min_distance: floa
         )
     q = nn.functional.normalize(query.reshape(-1, query.shape[-1]), dim=1)
     k = nn.functional.normalize(key.reshape(-1, key.shape[-1]), dim=1)
-    # |q - k|^2 = 2 - 2 <q, k> for unit rows; clamp keeps sqrt differentiable at 0.
-    dist = torch.sqrt(torch.clamp(2.0 - 2.0 * q @ k.T, min=min_distance**2))
-    logits = 1.0 / dist
+    # |q - k|^2 = 2 - 2 <q, k> for unit rows; the clamp keeps rsqrt finite and differentiable at 0.
+    # logits = 1 / |q - k| as one rsqrt (half the time of sqrt then 1/x on the (B T)^2 matrix)
+    logits = torch.rsqrt(torch.clamp(2.0 - 2.0 * q @ k.T, min=min_distance**2))
     target = torch.arange(q.shape[0], device=q.device)
     return nn.functional.cross_entropy(logits, target)
 

@@ -12,8 +12,9 @@ a float16 inference copy to ``checkpoints/<name>.pt`` and the training times to
 test split (:func:`beatlite.train.evaluation.evaluate_models`) and writes
 ``build/results_models.md`` and ``.json``.
 
-``seeds [--seeds S ...] [--only NAME ...] [--jobs J]`` trains the recipes again with the other
-seeds (``build/seeds/<seed>/``; existing ones are kept) and writes the mean ± sd table over
+``seeds [--seeds S ...] [--only NAME ...] [--jobs J] [--force]`` trains the recipes again with the
+other seeds (``build/seeds/<seed>/``; existing ones are kept when their stored settings and model
+config match today's recipe, see :func:`beatlite.train.seeds.recipe_mismatch`) and writes the mean ± sd table over
 all seeds (shipped = seed 2021) to ``build/results_seeds.md`` and ``.json``
 (:mod:`beatlite.train.seeds`).
 """
@@ -63,6 +64,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     s.add_argument(
         "--evaluate-only", action="store_true", help="train nothing; rows lacking a seed get fewer values"
     )
+    s.add_argument(
+        "--force", action="store_true", help="retrain checkpoints that exist and match their recipe"
+    )
     args = parser.parse_args(argv)
     if args.command == "results":
         from beatlite.train.evaluation import evaluate_models, write_results
@@ -76,7 +80,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         from beatlite.train.seeds import evaluate_seeds, train_seeds, write_seed_results
 
         if not args.evaluate_only:
-            train_seeds(args.only or None, args.seeds, jobs=args.jobs)
+            train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
         missing = "skip" if args.evaluate_only else "error"
         table = evaluate_seeds(args.only or None, args.seeds, missing=missing, progress=True)
         md, js = write_seed_results(table, args.out)

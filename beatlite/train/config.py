@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 from typing import Any
+
+LR_SCHEDULES = ("constant", "cosine")
+"""Values of :attr:`TrainConfig.lr_schedule`."""
 
 
 @dataclasses.dataclass
@@ -20,6 +24,10 @@ class TrainConfig:
     lr : float or None
         Generator learning rate; ``None`` = ``5e-4 * batch_size / 256`` (the reference's
         ``lr_base * batch / 128`` with ``lr_base = 2.5e-4``).
+    lr_schedule : {"constant", "cosine"}
+        ``"constant"`` (the reference's); ``"cosine"``: epoch e trains at
+        ``lr * (1 + cos(pi * e / epochs)) / 2`` (both optimisers), from ``lr`` down towards 0.
+        A function of the epoch alone, so resuming is exact.
     betas : (float, float)
         Adam betas (0.5, 0.999).
     d_lr_weight : float
@@ -46,6 +54,7 @@ class TrainConfig:
     epochs: int = 30
     batch_size: int = 64
     lr: float | None = None
+    lr_schedule: str = "constant"
     betas: tuple[float, float] = (0.5, 0.999)
     d_lr_weight: float = 0.2
     seed: int = 2021
@@ -64,6 +73,10 @@ class TrainConfig:
             raise ValueError(f"TrainConfig: batch_size must be >= 2 (BatchNorm), got {self.batch_size}")
         if self.lr is not None and not self.lr > 0:
             raise ValueError(f"TrainConfig: lr must be positive, got {self.lr}")
+        if self.lr_schedule not in LR_SCHEDULES:
+            raise ValueError(
+                f"TrainConfig: lr_schedule must be one of {LR_SCHEDULES}, got {self.lr_schedule!r}"
+            )
         if self.windows_per_epoch is not None and self.windows_per_epoch < 2:
             raise ValueError(f"TrainConfig: windows_per_epoch must be >= 2, got {self.windows_per_epoch}")
         if self.threads is not None and self.threads < 1:
@@ -74,6 +87,12 @@ class TrainConfig:
     def learning_rate(self) -> float:
         """The generator learning rate actually used (``lr`` or ``5e-4 * batch_size / 256``)."""
         return float(self.lr) if self.lr is not None else 5e-4 * self.batch_size / 256
+
+    def lr_factor(self, epoch: int) -> float:
+        """Multiplier of both learning rates during 0-based ``epoch`` (see ``lr_schedule``)."""
+        if self.lr_schedule == "constant" or self.epochs <= 0:
+            return 1.0
+        return 0.5 * (1.0 + math.cos(math.pi * min(epoch, self.epochs) / self.epochs))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly dict (paths as strings)."""

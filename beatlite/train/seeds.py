@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +44,54 @@ def checkpoint_path(name: str, seed: int) -> Path:
     return seeds_dir() / str(seed) / f"{name}.pt"
 
 
+def _current(name: str, seed: int, verbose: bool) -> bool:
+    """Whether the checkpoint of (name, seed) exists and was trained by today's recipe."""
+    from beatlite.train.checkpoint import load_checkpoint
+
+    path = checkpoint_path(name, seed)
+    if not path.is_file():
+        return False
+    why = recipe_mismatch(name, load_checkpoint(path))
+    if why is not None and verbose:
+        print(f"{path}: {why}: retraining", flush=True)
+    return why is None
+
+
+def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
+    """Why ``checkpoint`` (a loaded checkpoint dict) was not trained by today's recipe ``name``, or None.
+
+    Compares the harness settings stored in its ``"train_config"`` (epochs, batch size, learning
+    rate and schedule) and its model config with what :data:`~beatlite.train.recipes.RECIPES`
+    builds now (same vocabulary size and seed), so a seed table is never filled with checkpoints of
+    an older recipe. Code changes that leave both unchanged are not seen: retrain with ``force``.
+    """
+    from beatlite.models import build_model
+
+    recipe = RECIPES[name]
+    stored = checkpoint.get("train_config") or {}
+    want = {
+        "epochs": recipe.epochs,
+        "batch_size": recipe.batch_size,
+        "lr": recipe.lr,
+        "lr_schedule": recipe.lr_schedule,
+    }
+    have = {key: stored.get(key, "constant" if key == "lr_schedule" else None) for key in want}
+    if have != want:
+        diff = {key: (have[key], want[key]) for key in want if have[key] != want[key]}
+        return (
+            f"trained with {', '.join(f'{k}={a!r}' for k, (a, _) in diff.items())}; the recipe says "
+            + ", ".join(f"{k}={b!r}" for k, (_, b) in diff.items())
+        )
+    model = dict(checkpoint.get("model") or {})
+    kw = dict(recipe.overrides)
+    kw.update({key: model[key] for key in ("vocab_size", "seed") if key in model})
+    expected = build_model(recipe.model, preset="tiny", **kw).to_config()
+    if expected != model:
+        fields = sorted(k for k in set(expected) | set(model) if expected.get(k) != model.get(k))
+        return f"its model config differs from the recipe's in {fields}"
+    return None
+
+
 def train_seeds(
     names: Sequence[str] | None = None,
     seeds: Sequence[int] = (2022, 2023),
@@ -64,7 +112,8 @@ def train_seeds(
         Training processes run at once, one torch thread each (2 on a 2-core machine that
         does nothing else; 1 otherwise: two busy processes on two cores slow each other).
     force : bool
-        Retrain checkpoints that exist.
+        Retrain checkpoints that exist. Without it, an existing checkpoint is kept only when
+        :func:`recipe_mismatch` finds nothing (one of an older recipe is retrained).
     verbose : bool
         Print one line per finished checkpoint.
 
@@ -80,7 +129,7 @@ def train_seeds(
         (name, int(seed), checkpoint_path(name, int(seed)).parent)
         for seed in seeds
         for name in names
-        if int(seed) != SEED and (force or not checkpoint_path(name, int(seed)).is_file())
+        if int(seed) != SEED and (force or not _current(name, int(seed), verbose))
     ]
 
     def report(name: str, seed: int, seconds: float) -> None:

@@ -294,6 +294,10 @@ def fit(
     bar = tqdm(range(start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch")
     for epoch in bar:
         model.train()
+        factor = config.lr_factor(epoch)
+        for opt, base in ((g_opt, lr), (d_opt, lr * config.d_lr_weight)):
+            for group in [] if opt is None else opt.param_groups:
+                group["lr"] = base * factor
         order = np.random.default_rng([config.seed, epoch]).permutation(n)
         if config.windows_per_epoch is not None:
             order = order[: config.windows_per_epoch]
