@@ -193,7 +193,6 @@ class HierarchicalAudioEncoder(nn.Module):
             raise ValueError(
                 f"HierarchicalAudioEncoder: mel must be (B, M >= 8, {N_MELS}), got shape {tuple(mel.shape)}"
             )
-        # contiguous: a transposed view sends every later convolution down a slow strided path
         x = (mel / 40.0 + 1.0).transpose(1, 2).unsqueeze(1).contiguous()  # (B, 1, 128 mels, M frames)
         x2 = self.layer2(self.layer1(self.stem(x)))
         feats = {"low": x2}
