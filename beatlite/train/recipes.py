@@ -17,7 +17,8 @@ validation FGD within the budget of 3 minutes per model on 2 cores (``BEATLITE_T
 the Euler models (CaMN, S2G, Trimodal, like for like) train 40 epochs at lr 2e-3 (:data:`LR`),
 HA2G 25 epochs at lr 2e-3 (:data:`HA2G_EPOCHS`). That is 32x the reference's batch-scaled
 6.25e-5: the reference trains 100+ epochs on 30 h of data, we have minutes. All use batch 32
-(48 and 64 were no faster per epoch: the convolutions over raw audio cost the same per window).
+(48 and 64 were hardly faster per epoch, CaMN 202 s for 60 epochs at 48 vs 216 s at 32 on 2 threads: the
+convolutions over raw audio cost the same per window).
 """
 
 from __future__ import annotations
