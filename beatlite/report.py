@@ -8,9 +8,48 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+import numpy as np
+
 from beatlite.paths import build_dir
+
+
+def markdown_table(header: Sequence[str], rows: Iterable[Sequence[object]], *, digits: int = 3) -> str:
+    """A Markdown table: the one way beatlite writes tables (never hand-built ``|---|`` strings).
+
+    Parameters
+    ----------
+    header : sequence of str
+        Column titles.
+    rows : iterable of sequences
+        Cells; floats are printed with ``digits`` decimals, NaN as ``—``, everything else with ``str``.
+    digits : int
+        Decimals of float cells.
+
+    Examples
+    --------
+    >>> print(markdown_table(["model", "FGD"], [["CaMN", 3.1234], ["Mean pose", float("nan")]], digits=2))
+    | model | FGD |
+    |---|---|
+    | CaMN | 3.12 |
+    | Mean pose | — |
+    """
+    header = [str(h) for h in header]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for i, row in enumerate(rows):
+        cells = [_cell(c, digits) for c in row]
+        if len(cells) != len(header):
+            raise ValueError(f"markdown_table: row {i + 1} has {len(cells)} cells for {len(header)} columns")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _cell(value: object, digits: int) -> str:
+    if isinstance(value, float | np.floating):
+        return "—" if not np.isfinite(value) else f"{value:.{digits}f}"
+    return str(value)
 
 
 def tables_dir() -> Path:

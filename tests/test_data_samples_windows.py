@@ -24,7 +24,7 @@ def test_windows_contract_on_data_samples(data_samples: Path, tmp_path: Path) ->
     assert test["take"].tolist() == test_stems
     lengths = [len(p) for p in test["pose"]]
     assert lengths == [load_take(idx[s].path("motion")).n_frames for s in test_stems]
-    windows = build_windows(idx, split="test", cache=tmp_path, stats=(train.pose_norm, train.dir_norm))
+    windows = build_windows(idx, split="test", cache=tmp_path, stats=train.normalizers)
     assert len(windows) == sum(len(window_starts(n, 34, 10)) for n in lengths)
     shapes = {
         "pose": (34, 141),

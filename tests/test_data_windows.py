@@ -17,7 +17,7 @@ from test_data_fixtures import (
 )
 
 from beatlite.data.index import index_folder
-from beatlite.data.normalize import Normalizer
+from beatlite.data.normalize import Normalizer, Normalizers
 from beatlite.data.vocab import Vocab
 from beatlite.data.windows import (
     Windows,
@@ -137,16 +137,16 @@ def test_pose_values_and_train_normalisation(train: Windows) -> None:
     assert np.allclose(train["pose_raw"][3], ch9[30:64], atol=1e-4)
     # statistics of all 160 train frames, computed here with numpy
     frames = np.concatenate([ch9, ch10])
-    assert np.allclose(train.pose_norm.mean, frames.mean(axis=0), atol=1e-4)
-    assert np.allclose(train.pose_norm.std, frames.std(axis=0), atol=1e-4)
+    assert np.allclose(train.normalizers.pose.mean, frames.mean(axis=0), atol=1e-4)
+    assert np.allclose(train.normalizers.pose.std, frames.std(axis=0), atol=1e-4)
     assert np.allclose(train["pose"][8], (ch10[10:44] - frames.mean(0)) / frames.std(0), atol=1e-3)
-    assert np.allclose(train.pose_norm.inverse_transform(train["pose"]), train["pose_raw"], atol=1e-3)
+    assert np.allclose(train.normalizers.pose.inverse_transform(train["pose"]), train["pose_raw"], atol=1e-3)
 
 
 def test_dirvec_are_unit_directions_minus_train_mean(train: Windows) -> None:
-    d = (train["dirvec"] + train.dir_norm.mean).reshape(10, 34, 42, 3)
+    d = (train["dirvec"] + train.normalizers.dirvec.mean).reshape(10, 34, 42, 3)
     assert np.allclose(np.linalg.norm(d, axis=-1), 1.0, atol=1e-5)
-    assert np.all(train.dir_norm.std == 1.0)
+    assert np.all(train.normalizers.dirvec.std == 1.0)
 
 
 def test_audio_mel_face_word_semantic_emotion(train: Windows) -> None:
@@ -179,18 +179,18 @@ def test_normalisation_uses_train_only(corpus: Path, tmp_path: Path) -> None:
     base = build_windows(index_folder(copy), split="val", vocab=VOCAB, cache=False)
     write_take(copy, "2_scott_0_57_57", 50, scale=3.0)  # change the val take
     changed_val = build_windows(index_folder(copy), split="val", vocab=VOCAB, cache=False)
-    assert np.array_equal(base.pose_norm.mean, changed_val.pose_norm.mean)
-    assert np.array_equal(base.pose_norm.std, changed_val.pose_norm.std)
-    assert np.array_equal(base.dir_norm.mean, changed_val.dir_norm.mean)
+    assert np.array_equal(base.normalizers.pose.mean, changed_val.normalizers.pose.mean)
+    assert np.array_equal(base.normalizers.pose.std, changed_val.normalizers.pose.std)
+    assert np.array_equal(base.normalizers.dirvec.mean, changed_val.normalizers.dirvec.mean)
     assert not np.allclose(base["pose_raw"], changed_val["pose_raw"])
     write_take(copy, "2_scott_0_9_9", 100, scale=3.0)  # change a train take: the statistics move
     changed_train = build_windows(index_folder(copy), split="val", vocab=VOCAB, cache=False)
-    assert not np.allclose(base.pose_norm.std, changed_train.pose_norm.std)
+    assert not np.allclose(base.normalizers.pose.std, changed_train.normalizers.pose.std)
 
 
 def test_explicit_stats_and_errors(corpus: Path, train: Windows) -> None:
     idx = index_folder(corpus)
-    fake = (Normalizer(np.zeros(141), np.ones(141)), Normalizer(np.zeros(126), np.ones(126)))
+    fake = Normalizers(Normalizer(np.zeros(141), np.ones(141)), Normalizer(np.zeros(126), np.ones(126)))
     test = build_windows(idx, split="test", vocab=VOCAB, stats=fake, cache=False)
     assert np.array_equal(test["pose"], test["pose_raw"])  # identity statistics
     with pytest.raises(ValueError, match="split must be"):
@@ -232,7 +232,10 @@ def test_cache_round_trip(corpus: Path, tmp_path: Path) -> None:
     assert second.path == first.path
     for k in first.keys():
         assert np.array_equal(first[k], second[k]), k
-    assert np.array_equal(second.pose_norm.std, first.pose_norm.std) and second.params == first.params
+    assert (
+        np.array_equal(second.normalizers.pose.std, first.normalizers.pose.std)
+        and second.params == first.params
+    )
     other = build_windows(idx, split="test", vocab=VOCAB, stride=5, cache=tmp_path)  # new parameters
     assert other.path != first.path
     whole = build_windows(idx, split="test", vocab=VOCAB, whole_takes=True, cache=tmp_path)
@@ -275,7 +278,7 @@ def test_b_half_words_use_the_sequence_offset(tmp_path: Path) -> None:
     write_textgrid(tmp_path / f"{stem}.TextGrid", [(30.5, 31.0, "hello")], 62.0)
     idx = index_folder(tmp_path)
     assert idx[stem].half == "b" and idx[stem].split == "val"
-    fake = (Normalizer(np.zeros(141), np.ones(141)), Normalizer(np.zeros(126), np.ones(126)))
+    fake = Normalizers(Normalizer(np.zeros(141), np.ones(141)), Normalizer(np.zeros(126), np.ones(126)))
     w = build_windows(idx, split="val", vocab=VOCAB, stats=fake, whole_takes=True, cache=False)
     # frame i at 30 + i / 15 s: [30.5, 31.0) -> frames 8..14
     expected = np.zeros(40, np.int64)

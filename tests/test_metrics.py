@@ -10,7 +10,12 @@ import numpy as np
 import pytest
 from scipy import linalg
 
+from beatlite.data.windows import sliding_windows
 from beatlite.metrics import (
+    GroundTruth,
+    Takes,
+    beat_align,
+    beat_consistency,
     diversity,
     evaluate,
     fgd,
@@ -24,7 +29,6 @@ from beatlite.metrics import (
     srgr,
     velocity_stats,
 )
-from beatlite.metrics._checks import sliding_windows
 from beatlite.metrics.srgr import srgr_per_frame
 
 
@@ -277,55 +281,59 @@ def test_evaluate_ground_truth_against_itself():
     rng = np.random.default_rng(0)
     pos = np.cumsum(rng.normal(size=(60, 5, 3)), axis=0)
     sem = rng.uniform(0, 1, 60)
-    windows = sliding_windows(pos.reshape(60, -1), 34, 2)
-    rep = evaluate(
-        pos,
-        pos,
-        semantic=sem,
-        extractor=lambda w: w.mean(axis=1),
-        generated_windows=windows,
-        real_windows=windows,
-    )
-    assert rep.get("FGD", "stable").value == pytest.approx(0.0, abs=1e-9)
-    assert rep.get("SRGR", "paper").value == pytest.approx(sem.mean())
+    feats = sliding_windows(pos.reshape(60, -1), 34, 2).mean(axis=1)  # a stand-in extractor
+    takes = Takes(positions=[pos], features=feats)
+    rep = evaluate(takes, GroundTruth(takes, semantic=[sem]))
+    assert rep.get("FGD").value == pytest.approx(0.0, abs=1e-9)
+    assert rep.get("SRGR").value == pytest.approx(sem.mean())
     assert rep.get("PCK").value == 1.0
     assert rep.get("MPJPE").value == 0.0
-    assert "BeatAlign" in rep.skipped and "BC" in rep.skipped
+    assert rep.skipped["BeatAlign"] == "needs beats" and rep.skipped["BC"].startswith("needs directions")
     md = rep.to_markdown()
-    assert md.splitlines()[0].startswith("| metric | variant | value")
+    assert md.splitlines()[0] == "| metric | variant | value | better | definition |"
     assert "| SRGR | paper |" in md and "skipped" in md
     with pytest.raises(KeyError, match="no metric"):
         rep.get("nonsense")
+    with pytest.raises(ValueError, match="unknown metric"):
+        evaluate(takes, GroundTruth(takes), metrics=("nonsense",))
 
 
 def test_evaluate_rejects_mismatched_takes():
     p = np.zeros((10, 3, 3))
-    with pytest.raises(ValueError, match="differ"):
-        evaluate(p, p[:5])
+    with pytest.raises(ValueError, match="frames"):
+        evaluate(Takes(positions=[p]), GroundTruth(Takes(positions=[p[:5]])))
+    with pytest.raises(ValueError, match="takes"):
+        evaluate(Takes(positions=[p, p]), GroundTruth(Takes(positions=[p])))
 
 
-def test_evaluate_on_beat_skeleton_motion_with_audio():
-    from beatlite.skeleton.beat import beat_skeleton
+def test_evaluate_variants_equal_the_metric_functions_on_beat_skeleton_motion():
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.beats import mean_angle_change
+    from beatlite.skeleton.beat import beat_skeleton, subset_columns
+    from beatlite.skeleton.directions import positions_to_directions
     from beatlite.skeleton.kinematics import forward_kinematics
+    from beatlite.skeleton.ted import TED_BONES, beat_to_ted43
 
     sk = beat_skeleton()
     rng = np.random.default_rng(0)
-    t = np.arange(90) / 15.0
-    channels = np.zeros((90, sk.n_channels))
+    t = np.arange(180) / 15.0
+    channels = np.zeros((180, sk.n_channels))
     channels[:, 6:] = 15 * np.sin(2 * np.pi * 0.7 * t[:, None] + rng.uniform(0, 6, sk.n_channels - 6))
     pos = forward_kinematics(sk, channels)
-    audio = np.zeros(6 * 16000, np.float32)
-    audio[16000 * np.arange(1, 6)] = 0.9  # one-sample clicks every second
-    rep = evaluate(
-        pos,
-        pos,
-        audio=audio,
-        semantic=np.full(90, 0.5),
-        generated_euler=channels,
-        ground_truth_euler=channels,
+    dirs = positions_to_directions(beat_to_ted43(pos), np.asarray(TED_BONES))
+    euler = channels[:, subset_columns(sk, "spine_neck_141")]
+    audio = np.zeros(12 * 16000, np.float32)
+    audio[16000 * np.arange(1, 12)] = 0.9  # one-sample clicks every second
+    maac = mean_angle_change([prepare_directions(dirs)], default_angle_pairs())
+    takes = Takes(positions=[pos], directions=[dirs], euler=[euler])
+    truth = GroundTruth(takes, semantic=[np.full(180, 0.5)], audio=[audio], change_angle=maac)
+    rep = evaluate(takes, truth)
+    assert rep.get("BeatAlign").value == beat_align(audio, 16000, pos, 15)
+    assert rep.get("BeatAlign (reference)").value == beat_align(audio, 16000, euler, 15, variant="reference")
+    assert rep.get("BC").value == beat_consistency(audio, 16000, dirs, 15, change_angle=maac)
+    assert rep.get("BC (ha2g)").value == beat_consistency(
+        audio, 16000, dirs, 15, change_angle=maac, variant="ha2g"
     )
-    ba, ba_gt = rep.get("BeatAlign", "positions").value, rep.get("BeatAlign", "positions, ground truth").value
-    assert ba == ba_gt and 0 <= ba <= 1
-    assert 0 <= rep.get("BC").value <= 1
-    assert rep.get("SRGR", "reference").value == pytest.approx(0.5 / 0.165)
-    assert rep.get("L1div", "reference (windowed)").value > 0
+    assert rep.get("SRGR (reference)").value == pytest.approx(0.5 / 0.165)
+    assert rep.get("L1div (reference)").value == l1_diversity(euler, windowed=True)
+    assert {"FGD", "Diversity"} <= set(rep.skipped)  # no features given

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from beatlite.metrics import audio_beats, beat_align, beat_consistency, gaussian_alignment
-from beatlite.metrics.beat_align import REFERENCE_COLUMNS_141, motion_beat_times
+from beatlite.metrics.beat_align import REFERENCE_COLUMNS_141, VARIANTS, BeatAlignVariant, motion_beat_times
+from beatlite.metrics.beat_consistency import BCVariant
 from beatlite.metrics.beats import (
     alignment_score,
     angle_change_beats,
@@ -131,7 +133,7 @@ def test_beat_align_exact_value_with_onset_backtracking():
     # motion 2 frames early: d = 2/15 s -> exp(-d^2 / (2 * 0.3^2)) = exp(-0.017778 / 0.18) = 0.90596
     a = audio_beats(AUDIO, SR, backtrack="onset")
     np.testing.assert_allclose(a, CLICKS, atol=1e-9)
-    s = beat_align(AUDIO, SR, swinging_joint(-2 / FPS), FPS, backtrack="onset")
+    s = beat_align(AUDIO, SR, swinging_joint(-2 / FPS), FPS, variant=BeatAlignVariant(backtrack="onset"))
     assert s == pytest.approx(math.exp(-((2 / 15) ** 2) / 0.18), rel=1e-9)
 
 
@@ -142,13 +144,28 @@ def test_beat_align_frozen_pose_scores_zero_and_lists_average():
     assert both == pytest.approx(beat_align(AUDIO, SR, swinging_joint(), FPS) / 2)
 
 
+EULER = BeatAlignVariant(motion_kind="euler")
+
+
+def test_precomputed_audio_beats_give_the_same_scores():
+    beats = VARIANTS["beatlite"].audio_beats(AUDIO, SR)
+    direct = beat_align(AUDIO, SR, swinging_joint(-1 / FPS), FPS)
+    assert beat_align(None, SR, swinging_joint(-1 / FPS), FPS, audio_beats=beats) == direct
+    bc = _bc(AUDIO, rotating_bone(-1 / FPS))
+    variant = BCVariant(pairs=((0, 1),), palm_normals=False)
+    assert beat_consistency(None, SR, rotating_bone(-1 / FPS), FPS, variant=variant, audio_beats=beats) == bc
+    with pytest.raises(ValueError, match="clip variant"):
+        clips = BCVariant(pairs=((0, 1),), palm_normals=False, clip_length=34)
+        beat_consistency(None, SR, rotating_bone(), FPS, variant=clips, audio_beats=beats)
+
+
 def test_euler_motion_beats_hand_computed():
     # column 36 = [0, 3, 5, 6, 8, 11, 15]: forward differences 3, 2, 1, 2, 3, 4 (x 15 fps);
     # index 2 is below its 2 neighbours on each side -> one beat at 2/15 s
     ch = np.zeros((7, 141))
     ch[:, 36] = [0, 3, 5, 6, 8, 11, 15]
     np.testing.assert_allclose(euler_speed(ch, [36, 37, 38], 15)[:, 0], np.array([3, 2, 1, 2, 3, 4]) * 15.0)
-    beats = motion_beat_times(ch, 15, motion_kind="euler")
+    beats = motion_beat_times(ch, 15, variant=EULER)
     assert len(beats) == 1
     np.testing.assert_allclose(beats[0], [2 / 15])
 
@@ -161,14 +178,15 @@ def test_reference_columns_are_the_ring_finger_triplet_of_the_30_39_slice():
     in_slice[:, 36] = wave
     arm_only = np.zeros((165, 141))
     arm_only[:, 9:18] = wave[:, None]  # the real right shoulder/arm/forearm of spine_neck_141
-    assert motion_beat_times(in_slice, FPS, motion_kind="euler")[0].size > 0
-    assert motion_beat_times(arm_only, FPS, motion_kind="euler")[0].size == 0
-    assert beat_align(AUDIO, SR, arm_only, FPS, legacy=True, window=(0.0, 500.0)) == 0.0
+    assert motion_beat_times(in_slice, FPS, variant=EULER)[0].size > 0
+    assert motion_beat_times(arm_only, FPS, variant=EULER)[0].size == 0
+    whole_take = dataclasses.replace(VARIANTS["reference"], window=(0.0, 500.0))
+    assert beat_align(AUDIO, SR, arm_only, FPS, variant=whole_take) == 0.0
 
 
 def test_window_makes_times_relative_to_its_start():
     full = motion_beat_times(swinging_joint(), FPS)[0]
-    cut = motion_beat_times(swinging_joint(), FPS, window=(1.6, 8.0))[0]
+    cut = motion_beat_times(swinging_joint(), FPS, variant=BeatAlignVariant(window=(1.6, 8.0)))[0]
     inside = full[(full > 1.6 + 1e-9) & (full < 8.0 - 1e-9)] - 1.6
     # frames [24, 120) are searched; 1.6 s itself is the first sample (never a minimum): beats 2.4 .. 7.2 s
     np.testing.assert_allclose(cut, inside, atol=1e-9)
@@ -177,7 +195,9 @@ def test_window_makes_times_relative_to_its_start():
 
 def test_beat_align_errors():
     with pytest.raises(ValueError, match="motion_kind"):
-        beat_align(AUDIO, SR, swinging_joint(), FPS, motion_kind="quaternions")
+        beat_align(AUDIO, SR, swinging_joint(), FPS, variant=BeatAlignVariant(motion_kind="quaternions"))
+    with pytest.raises(ValueError, match="variant must be one of"):
+        beat_align(AUDIO, SR, swinging_joint(), FPS, variant="legacy")
     with pytest.raises(ValueError, match=r"motion must be 3-D, got shape \(10, 4\)"):
         beat_align(AUDIO, SR, np.zeros((10, 4)), FPS)
     with pytest.raises(ValueError, match="lists of equal length"):
@@ -227,8 +247,9 @@ def rotating_bone(shift_s=0.0, duration=11.0):
     return d
 
 
-def _bc(audio, dirs, **kw):
-    return beat_consistency(audio, SR, dirs, FPS, pairs=np.array([[0, 1]]), palm_normals=False, **kw)
+def _bc(audio, dirs, change_angle=None, **kw):
+    variant = BCVariant(pairs=((0, 1),), palm_normals=False, **kw)
+    return beat_consistency(audio, SR, dirs, FPS, change_angle=change_angle, variant=variant)
 
 
 def test_bc_is_one_when_beats_coincide_and_decreases_with_offset():

@@ -66,12 +66,10 @@ def test_beat_align_ground_truth_beats_shuffled(takes):
     joints = sk.indices(list(ARM_JOINTS))
     audio = [t.audio for t in takes]
     pos = [t.positions() for t in takes]
-    gt = beat_align(audio, takes[0].sr, pos, takes[0].fps, joints=joints)
+    pos = [p[:, joints] for p in pos]
+    gt = beat_align(audio, takes[0].sr, pos, takes[0].fps)
     shuffled = np.mean(
-        [
-            beat_align(audio, takes[0].sr, [block_shuffle(p, s) for p in pos], takes[0].fps, joints=joints)
-            for s in range(3)
-        ]
+        [beat_align(audio, takes[0].sr, [block_shuffle(p, s) for p in pos], takes[0].fps) for s in range(3)]
     )
     assert 0 < gt <= 1
     assert shuffled < gt - 0.03
@@ -97,7 +95,7 @@ def test_beat_consistency_ground_truth_beats_shuffled(takes):
 
 
 def test_fgd_zero_and_frozen_pose_has_the_least_diversity(takes):
-    from beatlite.metrics._checks import sliding_windows
+    from beatlite.data.windows import sliding_windows
 
     dirs = [ted_directions(t).reshape(-1, 126) for t in takes]
     windows = np.concatenate([sliding_windows(d, 34, 10) for d in dirs])
@@ -131,7 +129,7 @@ def split_windows(data_samples):
 
     index = index_folder(data_samples)
     train = build_windows(index, split="train")
-    stats = (train.pose_norm, train.dir_norm)
+    stats = train.normalizers
     return (
         train,
         build_windows(index, split="val", stats=stats),

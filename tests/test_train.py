@@ -206,6 +206,7 @@ def test_units_are_seeded_by_the_previous_output():
 
 
 def test_generate_returns_denormalised_full_motion():
+    from beatlite.data.normalize import Normalizer, Normalizers
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
 
     t = 50
@@ -214,7 +215,8 @@ def test_generate_returns_denormalised_full_motion():
     model = build_model("mean_pose")
     model.prepare(windows)
     mean, std = rng.normal(size=141), rng.uniform(1, 20, size=141)
-    result = generate(model, _streams(t), norm={"pose_mean": mean, "pose_std": std})
+    norms = Normalizers(Normalizer(mean, std), Normalizer(np.zeros(126), np.ones(126)))
+    result = generate(model, _streams(t), normalizers=norms)
     assert result.motion.channels.shape == (t, 228) and result.motion.fps == 15
     expected = windows["pose"].astype(np.float64).mean(axis=(0, 1)) * std + mean
     cols = subset_columns(beat_skeleton(), "spine_neck_141")

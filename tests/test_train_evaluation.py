@@ -10,6 +10,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+from beatlite.data.normalize import Normalizer, Normalizers  # noqa: E402
 from beatlite.models import build_model  # noqa: E402
 from beatlite.skeleton.beat import beat_skeleton  # noqa: E402
 from beatlite.skeleton.directions import positions_to_directions  # noqa: E402
@@ -20,10 +21,8 @@ from beatlite.train.evaluation import (  # noqa: E402
     GROUND_TRUTH,
     GROUND_TRUTH_141,
     EvaluationSet,
-    _renormalised,
-    _windows,
-    beat_align_cached,
-    beat_consistency_cached,
+    _in_units,
+    direction_features,
     directions_to_ted_positions,
     euler_to_directions,
     evaluate_models,
@@ -76,20 +75,16 @@ def test_set() -> EvaluationSet:
         gt141.append(d[::-1].copy())
         sems.append(streams[-1]["semantic"].astype(np.float64))
         audios.append(audio)
-    norm = {
-        "pose_mean": np.zeros(141),
-        "pose_std": np.ones(141),
-        "dirvec_mean": mean,
-        "bone_lengths": rest_bone_lengths(),
-    }
+    norms = Normalizers(Normalizer(np.zeros(141), np.ones(141)), Normalizer(mean, np.ones(126)))
     return EvaluationSet(
         takes=["a", "b"],
         streams=streams,
         gt_directions=gt,
         gt_directions_141=gt141,
+        gt_euler=[np.zeros((t, 141)) for t in LENGTHS],
         semantic=sems,
         audio=audios,
-        norm=norm,
+        normalizers=norms,
         change_angle=np.full(41, 0.01),
         vocab=("<pad>", "<sos>", "<eos>", "<unk>"),
     )
@@ -104,7 +99,7 @@ def results(test_set):
 
 def test_rows_are_ground_truth_then_models(results):
     assert [r.label for r in results.rows] == [GROUND_TRUTH, GROUND_TRUTH_141, "Mean pose"]
-    assert set(results.rows[0].metrics) == {name for name, _ in COLUMNS}
+    assert set(results.rows[0].metrics) == set(COLUMNS)
     assert results.get("Mean pose").representation == "euler141"
     with pytest.raises(KeyError, match="no row"):
         results.get("CaMN")
@@ -126,19 +121,19 @@ def test_mean_pose_row_closed_forms(results, test_set):
     assert mp["BeatAlign"] == 0.0  # a frozen pose has no motion beat
     # the constant window's features: mean = rest - dirvec_mean = 0, std = 0 -> f = 0; FGD to the
     # real features = |mu_real|^2 + tr(Sigma_real) (biased or unbiased covariance: take the max)
-    real = _features(_windows(test_set.gt_directions, test_set.norm["dirvec_mean"]))
+    real = direction_features(test_set.gt_directions, test_set, _features)
     low = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T, bias=True))
     high = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T))
     assert low - 1e-6 <= mp["FGD"] <= high + 1e-6
 
 
 def test_windows_are_stride_10_and_pooled(test_set):
-    w = _windows(test_set.gt_directions, test_set.norm["dirvec_mean"])
+    w = direction_features(test_set.gt_directions, test_set, lambda x: x.reshape(len(x), -1))
     # (200 - 34) // 10 + 1 = 17 and (150 - 34) // 10 + 1 = 12 windows
-    assert w.shape == (29, 34, 126)
-    third = test_set.gt_directions[0][20:54].reshape(34, -1) - test_set.norm["dirvec_mean"]
-    np.testing.assert_allclose(w[2], third, atol=1e-6)
-    np.testing.assert_allclose(w[17], test_set.streams[1]["dirvec"][:34], atol=1e-6)
+    assert w.shape == (29, 34 * 126)
+    third = test_set.gt_directions[0][20:54].reshape(34, -1) - test_set.normalizers.dirvec.mean
+    np.testing.assert_allclose(w[2].reshape(34, 126), third, atol=1e-6)
+    np.testing.assert_allclose(w[17].reshape(34, 126), test_set.streams[1]["dirvec"][:34], atol=1e-6)
 
 
 def test_positions_round_trip_and_mirrored_lengths():
@@ -172,21 +167,25 @@ def test_euler_to_directions_of_zero_angles_is_the_rest_pose():
 def test_seed_streams_are_renormalised_for_other_statistics(test_set):
     stream = test_set.streams[0]
     rng = np.random.default_rng(2)
-    have = {**test_set.norm, "pose_mean": rng.normal(size=141), "pose_std": rng.uniform(1, 3, 141)}
-    want = {**test_set.norm, "pose_mean": rng.normal(size=141), "pose_std": rng.uniform(1, 3, 141)}
-    want["dirvec_mean"] = have["dirvec_mean"] + 0.1
+    dir_mean = test_set.normalizers.dirvec.mean
+    have = Normalizers(
+        Normalizer(rng.normal(size=141), rng.uniform(1, 3, 141)), Normalizer(dir_mean, np.ones(126))
+    )
+    want = Normalizers(
+        Normalizer(rng.normal(size=141), rng.uniform(1, 3, 141)), Normalizer(dir_mean + 0.1, np.ones(126))
+    )
     pose = rng.normal(size=(4, 141))
-    out = _renormalised({**stream, "pose": pose}, have, want)
-    # the same degrees in either normalisation
+    out = _in_units({**stream, "pose": pose}, have, want)
+    # the same degrees, and the same unit directions, in either normalisation
     np.testing.assert_allclose(
-        out["pose"] * want["pose_std"] + want["pose_mean"],
-        pose * have["pose_std"] + have["pose_mean"],
-        atol=1e-4,
+        want.inverse_transform(out["pose"], "euler141"), have.inverse_transform(pose, "euler141"), atol=1e-4
     )
     np.testing.assert_allclose(
-        out["dirvec"] + want["dirvec_mean"], stream["dirvec"] + have["dirvec_mean"], atol=1e-5
+        want.inverse_transform(out["dirvec"], "dirvec126"),
+        have.inverse_transform(stream["dirvec"], "dirvec126"),
+        atol=1e-5,
     )
-    assert _renormalised(stream, have, have) is stream
+    assert _in_units(stream, have, have) is stream
 
 
 def test_written_markdown_and_json(results, tmp_path):
@@ -195,7 +194,7 @@ def test_written_markdown_and_json(results, tmp_path):
     table = [line for line in text.splitlines() if line.startswith("|")]
     assert len(table) == 2 + len(results.rows)
     header = table[0]
-    positions = [header.index(name) for name, _ in COLUMNS]
+    positions = [header.index(f"| {name} ") for name in COLUMNS]
     assert positions == sorted(positions)  # metric columns in COLUMNS order
     data = json.loads(js.read_text())
     assert [r["label"] for r in data["rows"]] == [r.label for r in results.rows]
@@ -210,21 +209,16 @@ def test_bad_model_entries_are_rejected(test_set):
         evaluate_models([42], test=test_set, extractor=_features)
 
 
-def test_cached_beat_metrics_equal_the_metrics_functions(test_set, results):
+def test_table_beat_metrics_equal_the_metrics_functions(test_set, results):
     from beatlite.metrics import beat_align, beat_consistency
 
     dirs = test_set.gt_directions
-    pos = [directions_to_ted_positions(d, test_set.norm["bone_lengths"]) for d in dirs]
-    beats = test_set.beats()
+    pos = [directions_to_ted_positions(d) for d in dirs]
     expected_ba = beat_align(test_set.audio, 16000, pos, 15, sigma=0.3)
     expected_bc = beat_consistency(
         test_set.audio, 16000, dirs, 15, sigma=0.1, change_angle=test_set.change_angle
     )
     assert np.isfinite(expected_ba) and np.isfinite(expected_bc)
-    assert beat_align_cached(pos, beats) == pytest.approx(expected_ba, abs=1e-12)
-    assert beat_consistency_cached(dirs, beats, test_set.change_angle) == pytest.approx(
-        expected_bc, abs=1e-12
-    )
     assert results.value(GROUND_TRUTH, "BeatAlign") == pytest.approx(expected_ba, abs=1e-12)
     assert results.value(GROUND_TRUTH, "BC") == pytest.approx(expected_bc, abs=1e-12)
 
@@ -248,7 +242,7 @@ def test_checkpoints_trained_on_other_data_are_flagged(test_set, tmp_path):
     assert res.rows[0].stale and res.rows[0].fingerprint == result.fingerprint
     assert "mp †" in res.to_markdown()
     # with statistics, those decide (a trainer may fingerprint another window dict)
-    stats = {k: test_set.norm[k] for k in ("pose_mean", "pose_std", "dirvec_mean")}
+    stats = test_set.normalizers.to_meta()
     fit(build_model("mean_pose"), windows, TrainConfig(epochs=1, checkpoint=tmp_path / "a.pt"), meta=stats)
     res = evaluate_models([str(tmp_path / "a.pt")], test=other, extractor=_features, ground_truth=False)
     assert not res.rows[0].stale
@@ -267,7 +261,7 @@ def test_evaluate_seeds_collects_each_seeds_row_and_names_missing_checkpoints(
     from beatlite.train import seeds as seeds_module
 
     paths = {1: tmp_path / "1" / "mean_pose.pt", 2: tmp_path / "2" / "mean_pose.pt"}
-    stats = {k: test_set.norm[k] for k in ("pose_mean", "pose_std", "dirvec_mean")}
+    stats = test_set.normalizers.to_meta()
     for seed, path in paths.items():
         windows = fake_windows(4, seed=seed)
         windows["pose"] = np.full_like(windows["pose"], 0.2 * (seed - 1))  # two different frozen poses

@@ -94,3 +94,95 @@ class Normalizer:
     def from_arrays(cls, arrays: dict[str, np.ndarray] | np.lib.npyio.NpzFile, prefix: str) -> Normalizer:
         """Inverse of :meth:`to_arrays`."""
         return cls(np.asarray(arrays[f"{prefix}_mean"]), np.asarray(arrays[f"{prefix}_std"]))
+
+
+#: The pose representations of the batch contract and the window key of each.
+REPRESENTATIONS = {"euler141": "pose", "dirvec126": "dirvec"}
+#: Directions shorter than this after the mean is added back are returned as zero vectors.
+MIN_DIRECTION_NORM = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class Normalizers:
+    """The fitted train-split normalisers of both pose representations, carried end to end.
+
+    Fitted once by :func:`beatlite.data.build_windows` on the train split, then stored in every
+    checkpoint (:meth:`to_meta`), in every evaluation set, and used by training, generation,
+    evaluation and the notebooks through :meth:`transform` / :meth:`inverse_transform` only.
+
+    Attributes
+    ----------
+    pose : Normalizer
+        (141,) mean/std of the ``spine_neck_141`` Euler degrees (``"euler141"``, window key ``pose``).
+    dirvec : Normalizer
+        (126,) mean of the 42 unit bone directions with ``std = 1`` (``"dirvec126"``, key ``dirvec``):
+        HA2G only subtracts the mean.
+
+    Examples
+    --------
+    >>> pose = Normalizer(np.full(141, 10.0), np.full(141, 2.0))
+    >>> dirvec = Normalizer(np.tile([0.0, 0.0, 0.5], 42), np.ones(126))
+    >>> norms = Normalizers(pose, dirvec)
+    >>> norms.inverse_transform(np.ones((1, 141)), "euler141")[0, :2]   # z * std + mean, degrees
+    array([12., 12.])
+    >>> norms.inverse_transform(np.zeros((1, 126)), "dirvec126")[0, 0]  # mean added back, unit length
+    array([0., 0., 1.])
+    """
+
+    pose: Normalizer
+    dirvec: Normalizer
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.pose, Normalizer) and isinstance(self.dirvec, Normalizer)):
+            raise TypeError("Normalizers: pose and dirvec must be Normalizer objects")
+        if self.dirvec.dim % 3:
+            raise ValueError(f"Normalizers: dirvec must have 3 x bones dimensions, got {self.dirvec.dim}")
+
+    def __getitem__(self, representation: str) -> Normalizer:
+        """The normaliser of ``"euler141"`` or ``"dirvec126"``."""
+        if representation not in REPRESENTATIONS:
+            raise ValueError(
+                f"representation must be one of {sorted(REPRESENTATIONS)}, got {representation!r}"
+            )
+        return getattr(self, REPRESENTATIONS[representation])
+
+    def transform(self, values: np.ndarray, representation: str) -> np.ndarray:
+        """Degrees (..., 141) or unit directions (..., 126) / (..., 42, 3) -> normalised (..., D)."""
+        values = np.asarray(values)
+        if representation == "dirvec126" and values.ndim >= 2 and values.shape[-1] == 3:
+            values = values.reshape(*values.shape[:-2], -1)
+        return self[representation].transform(values)
+
+    def inverse_transform(self, z: np.ndarray, representation: str) -> np.ndarray:
+        """Normalised (..., D) -> degrees (..., 141) float64, or unit directions (..., 42, 3) float64.
+
+        Directions get the train mean added back and are re-normalised to unit length (HA2G's
+        code trains on mean-subtracted directions and adds the mean back before scoring).
+        """
+        x = self[representation].inverse_transform(np.asarray(z, dtype=np.float64))
+        if representation == "euler141":
+            return x
+        dirs = x.reshape(*x.shape[:-1], -1, 3)
+        length = np.linalg.norm(dirs, axis=-1, keepdims=True)
+        return np.divide(dirs, length, out=np.zeros_like(dirs), where=length > MIN_DIRECTION_NORM)
+
+    def to_meta(self) -> dict[str, np.ndarray]:
+        """The checkpoint-metadata entries ``pose_mean``, ``pose_std``, ``dirvec_mean`` (float64 arrays)."""
+        return {"pose_mean": self.pose.mean, "pose_std": self.pose.std, "dirvec_mean": self.dirvec.mean}
+
+    @classmethod
+    def from_meta(cls, meta: dict) -> Normalizers:
+        """Inverse of :meth:`to_meta` (a checkpoint's ``meta``); ``KeyError`` naming a missing entry."""
+        missing = [k for k in ("pose_mean", "pose_std", "dirvec_mean") if k not in meta]
+        if missing:
+            raise KeyError(
+                f"Normalizers.from_meta: the metadata has no {missing} (a checkpoint without statistics)"
+            )
+        mean = np.asarray(meta["dirvec_mean"], np.float64)
+        return cls(Normalizer(meta["pose_mean"], meta["pose_std"]), Normalizer(mean, np.ones_like(mean)))
+
+    def matches(self, other: Normalizers, *, rtol: float = 1e-5, atol: float = 1e-6) -> bool:
+        """Whether ``other`` holds the same statistics (float32 round trips of a checkpoint included)."""
+        pairs = ((self.pose.mean, other.pose.mean), (self.pose.std, other.pose.std))
+        pairs += ((self.dirvec.mean, other.dirvec.mean),)
+        return all(a.shape == b.shape and np.allclose(a, b, rtol=rtol, atol=atol) for a, b in pairs)

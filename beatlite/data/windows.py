@@ -49,7 +49,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from beatlite.data.normalize import Normalizer
+from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
+from beatlite.data.normalize import Normalizer, Normalizers
 
 if TYPE_CHECKING:
     from beatlite.data.index import TakeIndex, TakeRecord
@@ -71,10 +72,6 @@ WINDOW_KEYS = (
     "take",
     "start",
 )
-#: Keys with one row per frame (sliced along time).
-FRAME_KEYS = ("pose", "pose_raw", "positions", "dirvec", "face", "word", "emotion", "semantic")
-#: Size of the reference's speaker embedding (speaker index = id - 1).
-N_SPEAKERS = 30
 #: HA2G log-mel settings (facts C.7).
 MEL_SETTINGS = {"n_mels": 128, "n_fft": 1024, "hop_length": 512, "power": 2.0}
 POSE_SUBSET = "spine_neck_141"
@@ -82,7 +79,7 @@ POSE_SUBSET = "spine_neck_141"
 CACHE_VERSION = 1
 
 
-def window_starts(n_frames: int, length: int, stride: int) -> np.ndarray:
+def window_starts(n_frames: int, length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE) -> np.ndarray:
     """First frames of the windows of a take: ``0, stride, ...`` while ``start + length <= n_frames``.
 
     >>> window_starts(100, 34, 10).tolist()
@@ -96,6 +93,48 @@ def window_starts(n_frames: int, length: int, stride: int) -> np.ndarray:
     if n_frames < length:
         return np.zeros(0, dtype=np.int64)
     return np.arange(0, n_frames - length + 1, stride, dtype=np.int64)
+
+
+def sliding_windows(
+    x: np.ndarray | Sequence[np.ndarray], length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE
+) -> np.ndarray:
+    """Overlapping windows along the first (time) axis: the one window cutter of beatlite.
+
+    Like ``librosa.util.frame`` but with the window axis first (the batch layout): window ``i``
+    is ``x[starts[i] : starts[i] + length]`` with ``starts = window_starts(T, length, stride)``.
+
+    Parameters
+    ----------
+    x : (T, ...) array, or a list of (T_i, ...) arrays (several takes)
+        Per-frame values. A list is cut take by take (no window crosses two takes) and the
+        windows are concatenated in take order.
+    length, stride : int
+        Window length and hop in frames (BEAT / HA2G: 34 and 10).
+
+    Returns
+    -------
+    (N, length, ...) array, a copy with ``x``'s dtype; N = 0 when no take has ``length`` frames.
+
+    Examples
+    --------
+    >>> x = np.arange(10)
+    >>> sliding_windows(x, 4, 3)
+    array([[0, 1, 2, 3],
+           [3, 4, 5, 6],
+           [6, 7, 8, 9]])
+    >>> sliding_windows([x, x[:5]], 4, 3).shape  # 3 windows of the first take, 1 of the second
+    (4, 4)
+    """
+    takes = [np.asarray(t) for t in x] if isinstance(x, list | tuple) else [np.asarray(x)]
+    if not takes:
+        raise ValueError("sliding_windows: got an empty list of takes")
+    parts = []
+    for t in takes:
+        if t.ndim == 0:
+            raise ValueError("sliding_windows: x must be (T, ...), got a scalar")
+        starts = window_starts(int(t.shape[0]), length, stride)
+        parts.append(t[starts[:, None] + np.arange(length)[None, :]])
+    return np.concatenate(parts) if len(parts) > 1 else parts[0]
 
 
 def audio_samples(n_frames: int, fps: float, sr: int) -> int:
@@ -260,10 +299,9 @@ class Windows:
 
     Attributes
     ----------
-    pose_norm : Normalizer
-        141-d pose statistics of the train split (degrees).
-    dir_norm : Normalizer
-        126-d direction mean of the train split (``std = 1``).
+    normalizers : Normalizers
+        The train split's fitted normalisers: ``normalizers.pose`` (141-d Euler degrees) and
+        ``normalizers.dirvec`` (126-d direction mean, ``std = 1``).
     params : dict
         Parameters the windows were built with (split, length, stride, fps, sr, ...).
     whole_takes : bool
@@ -276,14 +314,12 @@ class Windows:
         self,
         arrays: dict[str, np.ndarray],
         *,
-        pose_norm: Normalizer,
-        dir_norm: Normalizer,
+        normalizers: Normalizers,
         params: dict[str, Any],
         path: Path | None = None,
     ) -> None:
         self._arrays = arrays
-        self.pose_norm = pose_norm
-        self.dir_norm = dir_norm
+        self.normalizers = normalizers
         self.params = dict(params)
         self.whole_takes = bool(params.get("whole_takes", False))
         self.path = path
@@ -364,8 +400,8 @@ class Windows:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         payload = dict(self._arrays)
-        payload.update(self.pose_norm.to_arrays("pose"))
-        payload.update(self.dir_norm.to_arrays("dirvec"))
+        payload.update(self.normalizers.pose.to_arrays("pose"))
+        payload.update(self.normalizers.dirvec.to_arrays("dirvec"))
         payload["_params"] = np.array(json.dumps(self.params, sort_keys=True))
         with atomic_write(path, "wb") as f:
             np.savez(f, **payload)
@@ -387,9 +423,9 @@ class Windows:
             if key not in data:
                 raise FormatError(path, "missing array", field=key)
         params = json.loads(str(data.pop("_params")))
-        pose_norm = Normalizer(data.pop("pose_mean"), data.pop("pose_std"))
-        dir_norm = Normalizer(data.pop("dirvec_mean"), data.pop("dirvec_std"))
-        return cls(data, pose_norm=pose_norm, dir_norm=dir_norm, params=params, path=path)
+        pose = Normalizer(data.pop("pose_mean"), data.pop("pose_std"))
+        dirvec = Normalizer(data.pop("dirvec_mean"), data.pop("dirvec_std"))
+        return cls(data, normalizers=Normalizers(pose, dirvec), params=params, path=path)
 
 
 # ---------------------------------------------------------------------- building
@@ -424,58 +460,24 @@ def _stats_path(records: Sequence[TakeRecord], fps: float, sr: int, cache: bool 
     return folder / f"stats_{fp[:20]}.npz"
 
 
-def _load_stats(path: Path | None) -> tuple[Normalizer, Normalizer] | None:
+def _load_stats(path: Path | None) -> Normalizers | None:
     if path is None or not path.is_file():
         return None
     try:
         with np.load(path, allow_pickle=False) as z:
-            return Normalizer.from_arrays(z, "pose"), Normalizer.from_arrays(z, "dirvec")
+            return Normalizers(Normalizer.from_arrays(z, "pose"), Normalizer.from_arrays(z, "dirvec"))
     except (OSError, ValueError, KeyError):
         return None  # a broken cache file is rebuilt
 
 
-def _fit_stats(features: Sequence[TakeFeatures], path: Path | None) -> tuple[Normalizer, Normalizer]:
-    pose_norm = Normalizer.fit([f.pose_raw for f in features])
-    dir_norm = Normalizer.fit([f.dirs for f in features], center_only=True)
+def _fit_stats(features: Sequence[TakeFeatures], path: Path | None) -> Normalizers:
+    norms = Normalizers(
+        Normalizer.fit([f.pose_raw for f in features]),
+        Normalizer.fit([f.dirs for f in features], center_only=True),
+    )
     if path is not None:
-        _save_npz(path, {**pose_norm.to_arrays("pose"), **dir_norm.to_arrays("dirvec")})
-    return pose_norm, dir_norm
-
-
-def _train_records(index: TakeIndex) -> list[TakeRecord]:
-    records = _usable(index, "train")
-    if not records:
-        raise ValueError("train_statistics: the index has no usable train takes to compute statistics from")
-    return records
-
-
-def train_statistics(
-    index: TakeIndex,
-    *,
-    fps: float = 15,
-    sr: int = 16000,
-    cache: bool | str | Path = True,
-) -> tuple[Normalizer, Normalizer]:
-    """Pose and direction statistics of the **train** split of ``index`` (cached like the windows).
-
-    Returns
-    -------
-    pose_norm : Normalizer
-        (141,) mean/std over all train frames of the Euler degrees (std < 1e-6 -> 1).
-    dir_norm : Normalizer
-        (126,) mean over all train frames of the unit directions, ``std = 1``.
-
-    Raises
-    ------
-    ValueError
-        If the index has no usable train take.
-    """
-    records = _train_records(index)
-    path = _stats_path(records, fps, sr, cache)
-    stats = _load_stats(path)
-    if stats is None:
-        stats = _fit_stats([take_features(r, fps=fps, sr=sr, mel=False) for r in records], path)
-    return stats
+        _save_npz(path, {**norms.pose.to_arrays("pose"), **norms.dirvec.to_arrays("dirvec")})
+    return norms
 
 
 def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
@@ -500,13 +502,13 @@ def build_windows(
     index: TakeIndex,
     *,
     split: str | None,
-    length: int = 34,
-    stride: int = 10,
-    fps: float = 15,
-    sr: int = 16000,
+    length: int = WINDOW_LENGTH,
+    stride: int = WINDOW_STRIDE,
+    fps: float = FPS,
+    sr: int = SR,
     whole_takes: bool = False,
     vocab: Vocab | None = None,
-    stats: tuple[Normalizer, Normalizer] | None = None,
+    stats: Normalizers | None = None,
     positions: bool = False,
     word_rule: str = "span",
     cache: bool | str | Path = True,
@@ -531,9 +533,9 @@ def build_windows(
         One item per take, full length (evaluation mode); ``length``/``stride`` unused.
     vocab : Vocab, optional
         Word ids; default :func:`beatlite.data.vocab.build_vocab` of the whole index.
-    stats : (pose Normalizer, direction Normalizer), optional
-        Statistics to use instead of the index's train split (e.g. ``(w.pose_norm, w.dir_norm)``
-        of the training windows).
+    stats : Normalizers, optional
+        Statistics to use instead of fitting them on the index's train split (e.g. the training
+        windows' ``w.normalizers``).
     positions : bool
         Also return ``"positions"`` (N, length, 47, 3) float32 cm.
     word_rule : {"span", "onset", "beat"}
@@ -554,39 +556,19 @@ def build_windows(
     """
     from beatlite.data.vocab import build_vocab
 
-    if split not in ("train", "val", "test", None):
-        raise ValueError(f"build_windows: split must be 'train', 'val', 'test' or None, got {split!r}")
-    for name, v in (("length", length), ("stride", stride), ("sr", sr)):
-        if not isinstance(v, int | np.integer) or v < 1:
-            raise ValueError(f"build_windows: {name} must be a positive int, got {v!r}")
-    if not fps > 0:
-        raise ValueError(f"build_windows: fps must be positive, got {fps!r}")
+    _check_window_params(split, length, stride, fps, sr)
     records = _usable(index, split)
     if not records:
         raise ValueError(f"build_windows: no usable takes in split {split!r} ({len(index)} takes indexed)")
-    if vocab is None:
-        vocab = build_vocab(index)
+    vocab = build_vocab(index) if vocab is None else vocab
+    feature_args = {"fps": fps, "sr": sr, "vocab": vocab, "word_rule": word_rule, "positions": positions}
     loaded: dict[str, TakeFeatures] = {}
-    feature_args: dict[str, Any] = {
-        "fps": fps,
-        "sr": sr,
-        "vocab": vocab,
-        "word_rule": word_rule,
-        "positions": positions,
-    }
     if stats is None:
-        train_records = _train_records(index)
-        stats_path = _stats_path(train_records, fps, sr, cache)
-        stats = _load_stats(stats_path)
-        if stats is None:
-            if split == "train":  # load the train takes once: for the statistics and the windows
-                loaded = {r.stem: take_features(r, **feature_args) for r in train_records}
-                stats = _fit_stats(list(loaded.values()), stats_path)
-            else:
-                stats = _fit_stats(
-                    [take_features(r, fps=fps, sr=sr, mel=False) for r in train_records], stats_path
-                )
-    pose_norm, dir_norm = stats
+        stats, loaded = _train_normalizers(index, split, feature_args, cache)
+    elif not isinstance(stats, Normalizers):
+        raise TypeError(
+            f"build_windows: stats must be Normalizers (e.g. train.normalizers), got {type(stats).__name__}"
+        )
     params: dict[str, Any] = {
         "split": split,
         "length": int(length),
@@ -600,82 +582,143 @@ def build_windows(
         "mel": dict(MEL_SETTINGS),
         "subset": POSE_SUBSET,
     }
-    folder = _cache_folder(cache)
-    path = None
-    if folder is not None:
-        vocab_hash = hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
-        stats_hash = hashlib.sha256(
-            b"".join(a.tobytes() for a in (pose_norm.mean, pose_norm.std, dir_norm.mean))
-        ).hexdigest()
-        fp = _fingerprint(records, {**params, "vocab": vocab_hash, "stats": stats_hash})
-        path = folder / f"windows_{split}_{'takes' if whole_takes else 'win'}_{fp[:20]}.npz"
-        if path.is_file():
-            try:
-                return Windows.load(path)
-            except ValueError:
-                pass  # broken cache: rebuild
-    items = records
+    path = _windows_cache_path(records, params, vocab, stats, cache)
+    if path is not None and path.is_file():
+        try:
+            return Windows.load(path)
+        except ValueError:
+            pass  # broken cache: rebuild
     if progress:
-        from tqdm import tqdm
+        from tqdm.auto import tqdm
 
-        items = tqdm(records, desc=f"windows {split}")
-    parts: dict[str, list[np.ndarray]] = {k: [] for k in WINDOW_KEYS}
-    lens: dict[str, list[int]] = {"frames": [], "audio": [], "mel": []}
-    for record in items:
-        f = loaded.pop(record.stem, None) or take_features(record, **feature_args)
-        pose = pose_norm.transform(f.pose_raw).astype(np.float32)
-        dirvec = dir_norm.transform(f.dirs).astype(np.float32)
-        per_frame = {
-            "pose": pose,
-            "pose_raw": f.pose_raw.astype(np.float32),
-            "positions": f.positions,
-            "dirvec": dirvec,
-            "face": f.face,
-            "word": f.word,
-            "emotion": f.emotion,
-            "semantic": f.semantic,
-        }
-        if whole_takes:
-            n = f.n_frames
-            n_audio = audio_samples(n, fps, sr)
-            n_mel = mel_frames(n_audio)
-            for k, v in per_frame.items():
-                if v is not None:
-                    parts[k].append(v)
-            parts["audio"].append(_fit_audio(f.audio, 0, n_audio))
-            parts["mel"].append(_fit_rows(f.mel, 0, n_mel))
-            parts["speaker"].append(np.array([f.speaker], np.int64))
-            parts["take"].append(np.array([f.stem]))
-            parts["start"].append(np.zeros(1, np.int64))
-            lens["frames"].append(n)
-            lens["audio"].append(n_audio)
-            lens["mel"].append(n_mel)
-            continue
-        starts = window_starts(f.n_frames, int(length), int(stride))
-        if len(starts) == 0:
-            continue
-        n_audio = audio_samples(int(length), fps, sr)
-        n_mel = mel_frames(n_audio)
-        frame_idx = starts[:, None] + np.arange(length)[None, :]
-        for k, v in per_frame.items():
-            if v is not None:
-                parts[k].append(v[frame_idx])
-        a0 = [audio_start(int(s), fps, sr) for s in starts]
-        parts["audio"].append(np.stack([_fit_audio(f.audio, a, n_audio) for a in a0]))
-        hop = MEL_SETTINGS["hop_length"]
-        parts["mel"].append(np.stack([_fit_rows(f.mel, a // hop, n_mel) for a in a0]))
-        parts["speaker"].append(np.full(len(starts), f.speaker, np.int64))
-        parts["take"].append(np.array([f.stem] * len(starts)))
-        parts["start"].append(starts)
-    if not parts["take"]:
-        raise ValueError(
-            f"build_windows: no take of split {split!r} is at least {length} frames long ({len(records)} takes)"
-        )
-    arrays = {k: np.concatenate(v) for k, v in parts.items() if v}
-    if whole_takes:
-        for k, v in lens.items():
-            arrays[f"_len_{k}"] = np.array(v, dtype=np.int64)
-    windows = Windows(arrays, pose_norm=pose_norm, dir_norm=dir_norm, params=params)
+        records = tqdm(records, desc=f"windows {split}")
+    features = (loaded.pop(r.stem, None) or take_features(r, **feature_args) for r in records)
+    windows = Windows(_cut(features, stats, params), normalizers=stats, params=params)
     if path is not None:
         windows.save(path)
     return windows
+
+
+def _check_window_params(split: str | None, length: int, stride: int, fps: float, sr: int) -> None:
+    if split not in ("train", "val", "test", None):
+        raise ValueError(f"build_windows: split must be 'train', 'val', 'test' or None, got {split!r}")
+    for name, v in (("length", length), ("stride", stride), ("sr", sr)):
+        if not isinstance(v, int | np.integer) or v < 1:
+            raise ValueError(f"build_windows: {name} must be a positive int, got {v!r}")
+    if not fps > 0:
+        raise ValueError(f"build_windows: fps must be positive, got {fps!r}")
+
+
+def _train_normalizers(
+    index: TakeIndex, split: str | None, feature_args: dict[str, Any], cache: bool | str | Path
+) -> tuple[Normalizers, dict[str, TakeFeatures]]:
+    """The train split's normalisers (cached); for ``split="train"`` also the loaded train takes."""
+    records = _usable(index, "train")
+    if not records:
+        raise ValueError("build_windows: the index has no usable train takes to compute statistics from")
+    fps, sr = feature_args["fps"], feature_args["sr"]
+    stats_path = _stats_path(records, fps, sr, cache)
+    stats = _load_stats(stats_path)
+    if stats is not None:
+        return stats, {}
+    if split == "train":  # load the train takes once: for the statistics and the windows
+        loaded = {r.stem: take_features(r, **feature_args) for r in records}
+        return _fit_stats(list(loaded.values()), stats_path), loaded
+    return _fit_stats([take_features(r, fps=fps, sr=sr, mel=False) for r in records], stats_path), {}
+
+
+def _windows_cache_path(
+    records: Sequence[TakeRecord],
+    params: dict[str, Any],
+    vocab: Vocab,
+    stats: Normalizers,
+    cache: bool | str | Path,
+) -> Path | None:
+    folder = _cache_folder(cache)
+    if folder is None:
+        return None
+    vocab_hash = hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
+    stats_hash = hashlib.sha256(
+        b"".join(a.tobytes() for a in (stats.pose.mean, stats.pose.std, stats.dirvec.mean))
+    ).hexdigest()
+    fp = _fingerprint(records, {**params, "vocab": vocab_hash, "stats": stats_hash})
+    return folder / f"windows_{params['split']}_{'takes' if params['whole_takes'] else 'win'}_{fp[:20]}.npz"
+
+
+def _cut(
+    features: Iterator[TakeFeatures], stats: Normalizers, params: dict[str, Any]
+) -> dict[str, np.ndarray]:
+    """The arrays of :class:`Windows`: every take's windows (or whole take) concatenated."""
+    parts: dict[str, list[np.ndarray]] = {k: [] for k in WINDOW_KEYS}
+    lens: dict[str, list[int]] = {"frames": [], "audio": [], "mel": []}
+    n_takes = 0
+    for f in features:
+        n_takes += 1
+        cut = _whole_take if params["whole_takes"] else _take_windows
+        for k, v in cut(f, _per_frame(f, stats), params, lens).items():
+            parts[k].append(v)
+    if not parts["take"]:
+        raise ValueError(
+            f"build_windows: no take of split {params['split']!r} is at least {params['length']} frames long "
+            f"({n_takes} takes)"
+        )
+    arrays = {k: np.concatenate(v) for k, v in parts.items() if v}
+    if params["whole_takes"]:
+        arrays.update({f"_len_{k}": np.array(v, dtype=np.int64) for k, v in lens.items()})
+    return arrays
+
+
+def _per_frame(f: TakeFeatures, stats: Normalizers) -> dict[str, np.ndarray]:
+    """The per-frame streams of one take, normalised (``positions`` only when loaded)."""
+    per_frame = {
+        "pose": stats.pose.transform(f.pose_raw).astype(np.float32),
+        "pose_raw": f.pose_raw.astype(np.float32),
+        "positions": f.positions,
+        "dirvec": stats.dirvec.transform(f.dirs).astype(np.float32),
+        "face": f.face,
+        "word": f.word,
+        "emotion": f.emotion,
+        "semantic": f.semantic,
+    }
+    return {k: v for k, v in per_frame.items() if v is not None}
+
+
+def _whole_take(
+    f: TakeFeatures, per_frame: dict[str, np.ndarray], params: dict[str, Any], lens: dict[str, list[int]]
+) -> dict[str, np.ndarray]:
+    """One full-length item; records its frame, audio and mel lengths in ``lens``."""
+    n = f.n_frames
+    n_audio = audio_samples(n, params["fps"], params["sr"])
+    n_mel = mel_frames(n_audio)
+    for key, value in (("frames", n), ("audio", n_audio), ("mel", n_mel)):
+        lens[key].append(value)
+    return {
+        **per_frame,
+        "audio": _fit_audio(f.audio, 0, n_audio),
+        "mel": _fit_rows(f.mel, 0, n_mel),
+        "speaker": np.array([f.speaker], np.int64),
+        "take": np.array([f.stem]),
+        "start": np.zeros(1, np.int64),
+    }
+
+
+def _take_windows(
+    f: TakeFeatures, per_frame: dict[str, np.ndarray], params: dict[str, Any], lens: dict[str, list[int]]
+) -> dict[str, np.ndarray]:
+    """The windows of one take (an empty dict when it is shorter than one window)."""
+    length, fps, sr = params["length"], params["fps"], params["sr"]
+    starts = window_starts(f.n_frames, length, params["stride"])
+    if len(starts) == 0:
+        return {}
+    n_audio = audio_samples(length, fps, sr)
+    n_mel = mel_frames(n_audio)
+    a0 = [audio_start(int(s), fps, sr) for s in starts]
+    hop = MEL_SETTINGS["hop_length"]
+    return {
+        **{k: sliding_windows(v, length, params["stride"]) for k, v in per_frame.items()},
+        "audio": np.stack([_fit_audio(f.audio, a, n_audio) for a in a0]),
+        "mel": np.stack([_fit_rows(f.mel, a // hop, n_mel) for a in a0]),
+        "speaker": np.full(len(starts), f.speaker, np.int64),
+        "take": np.array([f.stem] * len(starts)),
+        "start": starts,
+    }

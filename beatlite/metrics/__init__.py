@@ -7,7 +7,7 @@
 ``beat_consistency``            HA2G Beat Consistency: onsets vs bone-angle-change minima (0.1 s)
 ``l1_diversity``, ``diversity`` BEAT L1div on poses; HA2G Diversity on features of clip pairs
 ``pck``, ``mae``, ``mpjpe``     extras, plus ``velocity_stats``, ``jerk_stats``
-``evaluate``                    all of the above at once -> ``Evaluation`` (``to_markdown()``)
+``evaluate``                    the one evaluation path: metrics by name and variant -> ``Evaluation``
 ``load_extractor``              the shipped FGD feature extractor (imports torch lazily)
 ==============================  ===================================================================
 """
@@ -20,13 +20,16 @@ from beatlite.metrics.beat_align import beat_align
 from beatlite.metrics.beat_consistency import beat_consistency
 from beatlite.metrics.beats import audio_beats, gaussian_alignment, mean_angle_change
 from beatlite.metrics.diversity import diversity, l1_diversity
-from beatlite.metrics.evaluate import Evaluation, MetricResult, evaluate
 from beatlite.metrics.extras import jerk_stats, mae, mpjpe, pck, velocity_stats
 from beatlite.metrics.fgd import fgd, fit_gaussian, frechet_distance
+from beatlite.metrics.scoring import METRICS, Evaluation, GroundTruth, MetricResult, Takes, evaluate
 from beatlite.metrics.srgr import srgr
 
 __all__ = [
+    "METRICS",
     "Evaluation",
+    "GroundTruth",
+    "Takes",
     "MetricResult",
     "audio_beats",
     "beat_align",

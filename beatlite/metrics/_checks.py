@@ -45,12 +45,6 @@ def positive(value: float, name: str) -> float:
     return v
 
 
-def same_shape(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
-    """``ValueError`` naming both arguments when the shapes differ."""
-    if a.shape != b.shape:
-        raise ValueError(f"{name_a} and {name_b} must have the same shape, got {a.shape} and {b.shape}")
-
-
 def as_list(x: object, name: str) -> tuple[list[object], bool]:
     """``(items, was_list)``: a list/tuple of takes stays a list; anything else becomes ``[x]``.
 
@@ -61,27 +55,3 @@ def as_list(x: object, name: str) -> tuple[list[object], bool]:
             raise ValueError(f"{name} is an empty list of takes")
         return list(x), True
     return [x], False
-
-
-def sliding_windows(x: np.ndarray, length: int, stride: int) -> np.ndarray:
-    """Overlapping windows along axis 0.
-
-    Parameters
-    ----------
-    x : (T, ...) array
-    length, stride : int
-        Window length and hop in frames (BEAT: 34 and 10).
-
-    Returns
-    -------
-    (N, length, ...) array, ``N = (T - length) // stride + 1`` (0 windows when ``T < length``);
-    window ``i`` is ``x[i * stride : i * stride + length]``. A copy.
-    """
-    if length < 1 or stride < 1:
-        raise ValueError(f"length and stride must be >= 1, got {length} and {stride}")
-    x = np.asarray(x)
-    n = 0 if x.shape[0] < length else (x.shape[0] - length) // stride + 1
-    if n == 0:
-        return np.zeros((0, length, *x.shape[1:]), dtype=x.dtype)
-    idx = np.arange(n)[:, None] * stride + np.arange(length)[None, :]
-    return x[idx]

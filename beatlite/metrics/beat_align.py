@@ -6,22 +6,28 @@ with audio beats ``B_a`` (onsets) and motion beats ``B_m`` (local minima of spee
 better, in [0, 1]. The paper calls it a Chamfer distance between beat sets; the code
 (``utils/metric.py``, facts C.3) averages over audio beats as written above.
 
-Variants
---------
-- default (beatlite): joint *positions*, per-joint speed by central differences, minima with
+Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BeatAlignVariant`)
+--------------------------------------------------------------------------------------
+- ``"beatlite"`` (default): joint *positions*, per-joint speed by central differences, minima with
   ``order=2`` per joint, one score per joint and the mean over the joints that have beats;
   correct audio times.
-- ``legacy=True`` reproduces the reference code: Euler-angle speed of columns 36:39 of the
+- ``"reference"`` reproduces BEAT's code: Euler-angle speed of columns 36:39 of the
   141-d ``spine_neck_141`` vector (the third triplet of its ``30:39`` slice, which the code
   believed to be the right wrist but which is the right ring finger), forward differences,
   only the 10-500 s window, audio onsets backtracked to RMS minima and converted to seconds
-  with librosa's default 22050 Hz (times x 0.726 at 16 kHz). Each piece is also selectable.
+  with librosa's default 22050 Hz (times x 0.726 at 16 kHz). Each piece is a field of
+  :class:`BeatAlignVariant`: ``dataclasses.replace(VARIANTS["reference"], window=None)`` mixes them.
+
+Taught in ``notebooks/03_audio_and_text_features.ipynb`` (beats) and ``notebooks/04_metrics.ipynb``.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from beatlite.constants import FPS
 from beatlite.metrics._checks import as_array, as_list, positive
 from beatlite.metrics.beats import (
     alignment_score,
@@ -37,58 +43,103 @@ REFERENCE_COLUMNS_141 = (36, 37, 38)
 REFERENCE_WINDOW = (10.0, 500.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class BeatAlignVariant:
+    """Every choice that distinguishes one BeatAlign definition from another.
+
+    Attributes
+    ----------
+    motion_kind : "positions" or "euler"
+        Speed of joint positions (central differences; motion (T, J, 3) cm) or of Euler triplets
+        (forward differences; motion (T, C) degrees).
+    euler_columns : tuple of int
+        Channel triplets scored in the Euler case (default: the reference's 36:39 of 141).
+    order : int
+        Neighbours on each side a speed minimum must beat (``argrelextrema`` order; 2 in BEAT).
+    backtrack, legacy_sr, peak_pick, hop_length
+        Audio onset options of :func:`beatlite.metrics.beats.audio_beats`.
+    window : (start, end) seconds or None
+        Score only this part of each take (beat times relative to ``start``); the reference
+        uses (10, 500).
+    """
+
+    motion_kind: str = "positions"
+    euler_columns: tuple[int, ...] = REFERENCE_COLUMNS_141
+    order: int = 2
+    backtrack: str | None = None
+    legacy_sr: bool = False
+    peak_pick: str = "beatlite"
+    hop_length: int = 512
+    window: tuple[float, float] | None = None
+
+    def audio_beats(self, audio: np.ndarray, sr: int) -> np.ndarray:
+        """Onset times (s) of one take's audio as this variant detects them (window applied)."""
+        y = as_array(audio, "audio", ndim=1, dtype=np.float32)
+        if self.window is not None:
+            a, b = _window_indices(self.window, sr, y.shape[0])
+            y = y[a:b]
+        return audio_beats(
+            y, sr, hop_length=self.hop_length, backtrack=self.backtrack, legacy_sr=self.legacy_sr,
+            peak_pick=self.peak_pick,
+        )  # fmt: skip
+
+    def motion_beats(self, motion: np.ndarray, fps: float) -> list[np.ndarray]:
+        """Speed-minimum motion beats (s), one array per joint (positions) or triplet (Euler)."""
+        if self.motion_kind == "positions":
+            speed = position_speed(as_array(motion, "motion", ndim=3, last=3), fps)
+        elif self.motion_kind == "euler":
+            speed = euler_speed(as_array(motion, "motion", ndim=2), self.euler_columns, fps)
+        else:
+            raise ValueError(f"motion_kind must be 'positions' or 'euler', got {self.motion_kind!r}")
+        if self.window is not None:
+            a, b = _window_indices(self.window, fps, speed.shape[0])
+            speed = speed[a:b]
+        return [local_minima(speed[:, k], self.order) / fps for k in range(speed.shape[1])]
+
+
+VARIANTS: dict[str, BeatAlignVariant] = {
+    "beatlite": BeatAlignVariant(),
+    "reference": BeatAlignVariant(
+        motion_kind="euler", backtrack="rms", legacy_sr=True, peak_pick="librosa", window=REFERENCE_WINDOW
+    ),
+}
+"""The named BeatAlign definitions: beatlite's (positions) and BEAT's reference code."""
+
+
 def beat_align(
     audio: np.ndarray | list[np.ndarray],
     sr: int,
     motion: np.ndarray | list[np.ndarray],
-    fps: float = 15.0,
+    fps: float = FPS,
     *,
     sigma: float = 0.3,
-    motion_kind: str = "positions",
-    joints: list[int] | np.ndarray | None = None,
-    euler_columns: tuple[int, ...] | list[int] = REFERENCE_COLUMNS_141,
-    order: int = 2,
-    backtrack: str | None = None,
-    legacy_sr: bool = False,
-    peak_pick: str = "beatlite",
-    window: tuple[float, float] | None = None,
+    variant: str | BeatAlignVariant = "beatlite",
     direction: str = "audio_to_motion",
-    hop_length: int = 512,
-    legacy: bool = False,
+    audio_beats: np.ndarray | list[np.ndarray] | None = None,
 ) -> float:
     """BeatAlign of one take or the mean over several takes.
 
     Parameters
     ----------
     audio : (N,) float or list of (N_i,)
-        Mono waveform(s) at ``sr``, aligned with the motion (sample 0 = frame 0).
+        Mono waveform(s) at ``sr``, aligned with the motion (sample 0 = frame 0). Unused when
+        ``audio_beats`` is given (pass ``None``).
     sr : int
         Audio sample rate in Hz.
-    motion : (T, J, 3) positions in cm (``motion_kind="positions"``) or (T, C) Euler degrees
-        (``motion_kind="euler"``), or a list of such, one per take.
+    motion : (T, J, 3) positions in cm (``"beatlite"``) or (T, C) Euler degrees (``"reference"``),
+        or a list of such, one per take. To score some joints only, pass ``positions[:, joints]``.
     fps : float
         Motion frame rate.
     sigma : float
         Gaussian width in seconds (0.3 for BEAT).
-    motion_kind : "positions" or "euler"
-        Speed of joint positions (central differences) or of Euler triplets (forward differences).
-    joints : (K,) int, optional
-        Joints scored in the positions variant (default: all J).
-    euler_columns : (3K,) int
-        Channel triplets scored in the Euler variant (default: the reference's 36:39 of 141).
-    order : int
-        Neighbours on each side a speed minimum must beat (``argrelextrema`` order; 2 in BEAT).
-    backtrack, legacy_sr, peak_pick, hop_length
-        Audio onset options, see :func:`beatlite.metrics.beats.audio_beats`.
-    window : (start, end) seconds, optional
-        Score only this part of each take (beat times become relative to ``start``);
-        the reference uses (10, 500).
+    variant : str or BeatAlignVariant
+        A name of :data:`VARIANTS` (``"beatlite"``, ``"reference"``) or a custom variant.
     direction : "audio_to_motion" | "motion_to_audio" | "symmetric"
-        Which beats are averaged over (both references: audio -> motion).
-    legacy : bool
-        Shortcut for the reference settings: ``motion_kind="euler"`` with the default
-        ``euler_columns``, ``order=2``, ``backtrack="rms"``, ``legacy_sr=True``, ``peak_pick="librosa"``,
-        ``window=(10, 500)``.
+        Which beats are averaged over (both references: audio -> motion; BEAT's supplement
+        writes the average over gesture beats, ``"motion_to_audio"``).
+    audio_beats : (A,) float or list, optional
+        Precomputed onset times in seconds, one array per take, as ``variant.audio_beats(y, sr)``
+        returns them (compute them once when scoring several models on the same audio).
 
     Returns
     -------
@@ -98,101 +149,63 @@ def beat_align(
         joint/triplet without any motion beat is left out of the joint mean; a take whose
         joints have no motion beat at all (a frozen pose) scores 0.
     """
-    if legacy:
-        motion_kind, backtrack, legacy_sr, order, peak_pick = "euler", "rms", True, 2, "librosa"
-        window = REFERENCE_WINDOW if window is None else window
-    if motion_kind not in ("positions", "euler"):
-        raise ValueError(f"motion_kind must be 'positions' or 'euler', got {motion_kind!r}")
+    v = _variant(variant)
     fps = positive(fps, "fps")
-    audios, many_a = as_list(audio, "audio")
-    motions, many_m = as_list(motion, "motion")
-    if many_a != many_m or len(audios) != len(motions):
-        raise ValueError(
-            f"audio and motion must both be one take or lists of equal length, got "
-            f"{len(audios)} audio and {len(motions)} motion takes"
-        )
-    scores = []
-    for i, (y, m) in enumerate(zip(audios, motions)):
-        s = beat_align_take(
-            y, sr, m, fps, sigma=sigma, motion_kind=motion_kind, joints=joints,
-            euler_columns=euler_columns, order=order, backtrack=backtrack, legacy_sr=legacy_sr,
-            peak_pick=peak_pick, window=window, direction=direction, hop_length=hop_length, _name=f"take {i}",
-        )  # fmt: skip
-        if np.isfinite(s):
-            scores.append(s)
+    motions, many = as_list(motion, "motion")
+    beats = _audio_beats_per_take(audio, sr, audio_beats, v, len(motions), many)
+    scores = [_take_score(a, v.motion_beats(m, fps), sigma, direction) for a, m in zip(beats, motions)]
+    scores = [s for s in scores if np.isfinite(s)]
     return float(np.mean(scores)) if scores else float("nan")
 
 
 def motion_beat_times(
-    motion: np.ndarray,
-    fps: float,
-    *,
-    motion_kind: str = "positions",
-    joints: list[int] | np.ndarray | None = None,
-    euler_columns: tuple[int, ...] | list[int] = REFERENCE_COLUMNS_141,
-    order: int = 2,
-    window: tuple[float, float] | None = None,
+    motion: np.ndarray, fps: float = FPS, *, variant: str | BeatAlignVariant = "beatlite"
 ) -> list[np.ndarray]:
-    """Speed-minimum motion beats, one array of times (seconds) per scored joint or triplet.
+    """Speed-minimum motion beats of one take, one array of times (s) per scored joint or triplet.
 
-    Parameters are those of :func:`beat_align`. With a ``window``, the speed curve is cut
-    to frames ``[start * fps, end * fps)`` before the minima search and times are relative
-    to ``start`` (as the reference does).
+    Parameters
+    ----------
+    motion : (T, J, 3) positions cm, or (T, C) Euler degrees (an ``"euler"`` variant)
+    fps : float
+    variant : str or BeatAlignVariant
+        As :func:`beat_align`; with a ``window`` the speed curve is cut to frames
+        ``[start * fps, end * fps)`` before the minima search and times are relative to ``start``.
 
     Returns
     -------
     list of (K_j,) float64
         Beat times ``index / fps`` per joint (positions) or triplet (Euler).
     """
-    if motion_kind == "positions":
-        p = as_array(motion, "motion", ndim=3, last=3)
-        if joints is not None:
-            jj = np.asarray(joints, dtype=np.int64).ravel()
-            if jj.size == 0 or jj.min() < -p.shape[1] or jj.max() >= p.shape[1]:
-                raise ValueError(f"joints {jj.tolist()} out of range for motion of shape {p.shape}")
-            p = p[:, jj]
-        speed = position_speed(p, fps)
-    elif motion_kind == "euler":
-        speed = euler_speed(as_array(motion, "motion", ndim=2), euler_columns, fps)
+    return _variant(variant).motion_beats(motion, positive(fps, "fps"))
+
+
+def _variant(variant: str | BeatAlignVariant) -> BeatAlignVariant:
+    v = VARIANTS.get(variant) if isinstance(variant, str) else variant
+    if not isinstance(v, BeatAlignVariant):
+        raise ValueError(f"variant must be one of {sorted(VARIANTS)} or a BeatAlignVariant, got {variant!r}")
+    return v
+
+
+def _audio_beats_per_take(
+    audio, sr, given, variant: BeatAlignVariant, n: int, many: bool
+) -> list[np.ndarray]:
+    """One array of audio onset times per take: the given ones, or detected from ``audio``."""
+    if given is not None:
+        items, many_b = as_list(given, "audio_beats") if many else ([given], False)
+        beats = [as_array(b, f"audio_beats[{i}]", ndim=1) for i, b in enumerate(items)]
     else:
-        raise ValueError(f"motion_kind must be 'positions' or 'euler', got {motion_kind!r}")
-    if window is not None:
-        a, b = _window_indices(window, fps, speed.shape[0])
-        speed = speed[a:b]
-    return [local_minima(speed[:, k], order) / fps for k in range(speed.shape[1])]
+        items, many_b = as_list(audio, "audio")
+        beats = [variant.audio_beats(y, sr) for y in items]
+    if many_b != many or len(beats) != n:
+        raise ValueError(
+            f"audio (or audio_beats) and motion must both be one take or lists of equal length, got "
+            f"{len(beats)} and {n} takes"
+        )
+    return beats
 
 
-def beat_align_take(
-    audio: np.ndarray,
-    sr: int,
-    motion: np.ndarray,
-    fps: float = 15.0,
-    *,
-    sigma: float = 0.3,
-    motion_kind: str = "positions",
-    joints: list[int] | np.ndarray | None = None,
-    euler_columns: tuple[int, ...] | list[int] = REFERENCE_COLUMNS_141,
-    order: int = 2,
-    backtrack: str | None = None,
-    legacy_sr: bool = False,
-    peak_pick: str = "beatlite",
-    window: tuple[float, float] | None = None,
-    direction: str = "audio_to_motion",
-    hop_length: int = 512,
-    _name: str = "take",
-) -> float:
-    """BeatAlign of a single take (see :func:`beat_align`); NaN when it has no audio beat."""
-    y = as_array(audio, "audio", ndim=1, dtype=np.float32)
-    if window is not None:
-        a, b = _window_indices(window, sr, y.shape[0])
-        y = y[a:b]
-    a_times = audio_beats(
-        y, sr, hop_length=hop_length, backtrack=backtrack, legacy_sr=legacy_sr, peak_pick=peak_pick
-    )
-    m_times = motion_beat_times(
-        motion, fps, motion_kind=motion_kind, joints=joints, euler_columns=euler_columns,
-        order=order, window=window,
-    )  # fmt: skip
+def _take_score(a_times: np.ndarray, m_times: list[np.ndarray], sigma: float, direction: str) -> float:
+    """BeatAlign of one take; NaN when it has no audio beat (audio -> motion)."""
     if a_times.size == 0 and direction == "audio_to_motion":
         return float("nan")
     per_joint = [alignment_score(a_times, m, sigma, direction) for m in m_times if m.size > 0]

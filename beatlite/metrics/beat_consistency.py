@@ -12,15 +12,21 @@ with MAAC_p the mean absolute frame-to-frame change of pair p on the training da
 eq. 10) and A the audio onsets. Vectors are the 42 TED bone directions (not mean-subtracted)
 plus the two palm normals; the pairs are ``beatlite.skeleton.ted.ANGLE_PAIRS``.
 
-HA2G scores each 34-frame validation clip with its own audio and averages the clips weighted
-by their number of audio beats, skipping clips without motion beats (``clip_length=34``).
-beatlite's default scores the whole take at once.
+Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BCVariant`): HA2G's code
+(``"ha2g"``) scores each 34-frame validation clip with its own audio and averages the clips
+weighted by their number of audio beats, skipping clips without motion beats, with librosa's
+own peak picking; beatlite's default (``"beatlite"``) scores the whole take at once.
+
+Taught in ``notebooks/04_metrics.ipynb``.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from beatlite.constants import FPS, WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.metrics._checks import as_array, as_list, positive
 from beatlite.metrics.beats import (
     alignment_score,
@@ -37,13 +43,62 @@ def default_angle_pairs() -> np.ndarray:
 
     Taken from ``beatlite.skeleton.ted.ANGLE_PAIRS``.
     """
-    try:
-        from beatlite.skeleton.ted import ANGLE_PAIRS
-    except ImportError as exc:  # pragma: no cover - depends on a module written in parallel
-        raise ImportError(
-            "beatlite.skeleton.ted.ANGLE_PAIRS is not available; pass pairs=(P, 2) explicitly"
-        ) from exc
+    from beatlite.skeleton.ted import ANGLE_PAIRS
+
     return np.asarray(ANGLE_PAIRS, dtype=np.int64).reshape(-1, 2)
+
+
+@dataclasses.dataclass(frozen=True)
+class BCVariant:
+    """Every choice that distinguishes one beat-consistency definition from another.
+
+    Attributes
+    ----------
+    threshold : float
+        Minimum drop of a motion beat (0.03).
+    pairs : tuple of (int, int) or None
+        Angle pairs over the vectors (None: ``beatlite.skeleton.ted.ANGLE_PAIRS``).
+    palm_normals : bool
+        Append the two palm normals (42 -> 44 vectors) before measuring angles.
+    clip_length, clip_stride : int or None, int
+        HA2G's protocol: cut each take into clips of ``clip_length`` frames every ``clip_stride``
+        frames, score each clip with its own audio (``round(clip_length / fps * sr)`` samples) and
+        average the clips weighted by their number of audio beats, skipping clips without motion
+        beats. ``None``: whole takes, weighted the same way.
+    direction : str
+        See :func:`beatlite.metrics.beats.alignment_score`.
+    backtrack, peak_pick, hop_length
+        Audio onset options of :func:`beatlite.metrics.beats.audio_beats`.
+    """
+
+    threshold: float = 0.03
+    pairs: tuple[tuple[int, int], ...] | None = None
+    palm_normals: bool = True
+    clip_length: int | None = None
+    clip_stride: int = WINDOW_STRIDE
+    direction: str = "audio_to_motion"
+    backtrack: str | None = None
+    peak_pick: str = "beatlite"
+    hop_length: int = 512
+
+    def angle_pairs(self) -> np.ndarray:
+        """(P, 2) int64 pairs (the default ones when ``pairs`` is None)."""
+        return (
+            default_angle_pairs() if self.pairs is None else np.asarray(self.pairs, np.int64).reshape(-1, 2)
+        )
+
+    def audio_beats(self, audio: np.ndarray, sr: int) -> np.ndarray:
+        """Onset times (s) of one take's (or clip's) audio as this variant detects them."""
+        return audio_beats(
+            audio, sr, hop_length=self.hop_length, backtrack=self.backtrack, peak_pick=self.peak_pick
+        )
+
+
+VARIANTS: dict[str, BCVariant] = {
+    "beatlite": BCVariant(),
+    "ha2g": BCVariant(clip_length=WINDOW_LENGTH, peak_pick="librosa"),
+}
+"""The named BC definitions: beatlite's (whole takes) and HA2G's code (34-frame clips)."""
 
 
 def prepare_directions(
@@ -82,95 +137,95 @@ def prepare_directions(
 
 
 def beat_consistency(
-    audio: np.ndarray | list[np.ndarray],
+    audio: np.ndarray | list[np.ndarray] | None,
     sr: int,
     directions: np.ndarray | list[np.ndarray],
-    fps: float = 15.0,
+    fps: float = FPS,
     *,
     sigma: float = 0.1,
-    pairs: np.ndarray | None = None,
     change_angle: np.ndarray | None = None,
-    threshold: float = 0.03,
-    mean_direction: np.ndarray | None = None,
-    palm_normals: bool = True,
-    clip_length: int | None = None,
-    clip_stride: int = 10,
-    direction: str = "audio_to_motion",
-    backtrack: str | None = None,
-    peak_pick: str = "beatlite",
-    hop_length: int = 512,
-    legacy: bool = False,
+    variant: str | BCVariant = "beatlite",
+    audio_beats: np.ndarray | list[np.ndarray] | None = None,
 ) -> float:
     """Beat Consistency score of one take or several.
 
     Parameters
     ----------
     audio : (N,) float or list
-        Mono waveform(s) at ``sr``, aligned with the motion.
+        Mono waveform(s) at ``sr``, aligned with the motion (may be None with ``audio_beats``).
     sr : int
         Sample rate, Hz.
     directions : (T, 42, 3) / (T, 126) float or list
-        TED bone directions per frame (see :func:`prepare_directions`). With
-        ``palm_normals=False`` any (T, V, 3) vectors matching ``pairs`` are accepted.
+        TED bone unit directions per frame (add a "dirvec" window's mean back first, see
+        :func:`prepare_directions`). With ``palm_normals=False`` in the variant any (T, V, 3)
+        vectors matching its pairs are accepted.
     fps : float
         Motion frame rate.
     sigma : float
         Gaussian width in seconds (0.1 in HA2G).
-    pairs : (P, 2) int, optional
-        Angle pairs (default: ``beatlite.skeleton.ted.ANGLE_PAIRS``).
     change_angle : (P,) float, optional
         MAAC per pair from the **training** data (:func:`beatlite.metrics.beats.mean_angle_change`).
         Default: computed from the given directions themselves (a fallback; pass the
         ground-truth / training values when comparing models).
-    threshold : float
-        Minimum drop of a motion beat (0.03).
-    mean_direction, palm_normals
-        See :func:`prepare_directions`.
-    clip_length, clip_stride : int, optional
-        HA2G protocol: cut each take into clips of ``clip_length`` frames every
-        ``clip_stride`` frames, score each clip with its own audio
-        (``round(clip_length / fps * sr)`` samples), and average the clips weighted by their
-        number of audio beats, skipping clips without motion beats. ``None``: whole takes,
-        averaged weighted by their number of audio beats too.
-    direction, backtrack, peak_pick, hop_length
-        See :func:`beatlite.metrics.beats.alignment_score` / ``audio_beats``.
-    legacy : bool
-        The HA2G protocol: ``clip_length=34`` (if not given), ``peak_pick="librosa"``
-        (HA2G's ``onset_detect(y=clip, sr=16000, units="time")``), sigma and threshold as given.
+    variant : str or BCVariant
+        A name of :data:`VARIANTS` (``"beatlite"``, ``"ha2g"``) or a custom variant.
+    audio_beats : (A,) float or list, optional
+        Precomputed onset times (s) per take, as ``variant.audio_beats(y, sr)`` returns them
+        (whole takes only: a clip variant detects the onsets of each clip's audio).
 
     Returns
     -------
     float in [0, 1]; NaN when no clip/take has both audio and motion beats.
     """
-    if legacy:
-        clip_length, peak_pick = (34 if clip_length is None else clip_length), "librosa"
+    v = VARIANTS.get(variant) if isinstance(variant, str) else variant
+    if not isinstance(v, BCVariant):
+        raise ValueError(f"variant must be one of {sorted(VARIANTS)} or a BCVariant, got {variant!r}")
     fps = positive(fps, "fps")
-    audios, many_a = as_list(audio, "audio")
-    dirs, many_d = as_list(directions, "directions")
-    if many_a != many_d or len(audios) != len(dirs):
-        raise ValueError(
-            f"audio and directions must both be one take or lists of equal length, got "
-            f"{len(audios)} and {len(dirs)}"
-        )
-    vecs = [prepare_directions(d, mean_direction=mean_direction, palm_normals=palm_normals) for d in dirs]
-    pr = default_angle_pairs() if pairs is None else np.asarray(pairs, dtype=np.int64)
+    dirs, many = as_list(directions, "directions")
+    vecs = [prepare_directions(d, palm_normals=v.palm_normals) for d in dirs]
+    pairs = v.angle_pairs()
     ca = (
-        mean_angle_change(vecs, pr)
+        mean_angle_change(vecs, pairs)
         if change_angle is None
         else as_array(change_angle, "change_angle", ndim=1)
     )
     total, weight = 0.0, 0
-    for y, v in zip(audios, vecs):
-        y = as_array(y, "audio", ndim=1, dtype=np.float32)
-        pieces = [(y, v)] if clip_length is None else _clips(y, sr, v, fps, clip_length, clip_stride)
-        for y_c, v_c in pieces:
-            a_times = audio_beats(y_c, sr, hop_length=hop_length, backtrack=backtrack, peak_pick=peak_pick)
-            m_times = angle_change_beats(angle_change_curve(v_c, pr, ca), fps, threshold=threshold)
-            if a_times.size == 0 or m_times.size == 0:
-                continue
-            total += alignment_score(a_times, m_times, sigma, direction) * a_times.size
-            weight += a_times.size
+    for a_times, vec in _scored_pieces(audio, sr, audio_beats, vecs, many, fps, v):
+        m_times = angle_change_beats(angle_change_curve(vec, pairs, ca), fps, threshold=v.threshold)
+        if a_times.size == 0 or m_times.size == 0:
+            continue
+        total += alignment_score(a_times, m_times, sigma, v.direction) * a_times.size
+        weight += a_times.size
     return total / weight if weight else float("nan")
+
+
+def _scored_pieces(audio, sr, given, vecs, many, fps, v: BCVariant):
+    """(audio beat times, vectors) of every take, or of every clip with the clip protocol."""
+    if given is not None:
+        if v.clip_length is not None:
+            raise ValueError("audio_beats= cannot be used with a clip variant (each clip has its own onsets)")
+        items, many_b = as_list(given, "audio_beats") if many else ([given], False)
+        beats = [as_array(b, f"audio_beats[{i}]", ndim=1) for i, b in enumerate(items)]
+        _same_takes(len(beats), many_b, len(vecs), many)
+        yield from zip(beats, vecs)
+        return
+    audios, many_a = as_list(audio, "audio")
+    _same_takes(len(audios), many_a, len(vecs), many)
+    for y, vec in zip(audios, vecs):
+        y = as_array(y, "audio", ndim=1, dtype=np.float32)
+        if v.clip_length is None:
+            yield v.audio_beats(y, sr), vec
+            continue
+        for y_c, v_c in _clips(y, sr, vec, fps, v.clip_length, v.clip_stride):
+            yield v.audio_beats(y_c, sr), v_c
+
+
+def _same_takes(n_audio: int, many_audio: bool, n_dirs: int, many_dirs: bool) -> None:
+    if many_audio != many_dirs or n_audio != n_dirs:
+        raise ValueError(
+            f"audio (or audio_beats) and directions must both be one take or lists of equal length, "
+            f"got {n_audio} and {n_dirs}"
+        )
 
 
 def _clips(y: np.ndarray, sr: int, v: np.ndarray, fps: float, length: int, stride: int):

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from beatlite.metrics._checks import as_array, as_list, sliding_windows
+from beatlite.constants import WINDOW_LENGTH, WINDOW_STRIDE
+from beatlite.data.windows import sliding_windows
+from beatlite.metrics._checks import as_array, as_list
 from beatlite.metrics.fgd import Extractor
 
 
@@ -18,8 +20,8 @@ def l1_diversity(
     motion: np.ndarray | list[np.ndarray],
     *,
     windowed: bool = False,
-    length: int = 34,
-    stride: int = 10,
+    length: int = WINDOW_LENGTH,
+    stride: int = WINDOW_STRIDE,
 ) -> float:
     """Mean per-frame L1 distance to the take's mean pose (BEAT "L1div").
 

@@ -360,7 +360,7 @@ def _train_command(args: argparse.Namespace) -> int:
     train = build_windows(index, split="train", cache=not args.no_cache)
     w = np.asarray(train[key], dtype=np.float32)
     try:
-        val = np.asarray(build_windows(index, split="val", stats=(train.pose_norm, train.dir_norm),
+        val = np.asarray(build_windows(index, split="val", stats=train.normalizers,
                                        cache=not args.no_cache)[key], dtype=np.float32)  # fmt: skip
     except ValueError:
         val = None

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # pragma: no cover
     from beatlite.models.base import GestureModel
 
-MODELS: dict[str, tuple[str, str]] = {
+MODELS: dict[str, tuple[str, str] | type[GestureModel]] = {
     "camn": ("beatlite.models.camn", "CaMN"),
     "ha2g": ("beatlite.models.ha2g", "HA2G"),
     "s2g": ("beatlite.models.baselines", "S2G"),
@@ -35,9 +35,36 @@ MODELS: dict[str, tuple[str, str]] = {
     "mean_pose": ("beatlite.models.baselines", "MeanPose"),
     "random_clip": ("beatlite.models.baselines", "RandomClip"),
 }
-"""Registry: model name -> (module, class name)."""
+"""Registry: model name -> (module, class name), imported on first use, or a registered class."""
 
-__all__ = ["MODELS", "build_model", "model_class", "presets"]
+__all__ = ["MODELS", "build_model", "model_class", "presets", "register_model"]
+
+
+def register_model(name: str, model: str | type[GestureModel]) -> None:
+    """Add a model to :data:`MODELS`: the one step that makes it buildable, trainable and loadable.
+
+    Parameters
+    ----------
+    name : str
+        The registry name (stored in its checkpoints' config; ``GestureModel.name`` should equal it).
+    model : str or GestureModel subclass
+        ``"package.module:ClassName"`` (imported on first use, so torch stays lazy) or the class.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is already registered to another model.
+
+    Examples
+    --------
+    >>> register_model("camn", "beatlite.models.camn:CaMN")  # the same entry again: a no-op
+    """
+    entry = tuple(model.split(":")) if isinstance(model, str) else model
+    if isinstance(entry, tuple) and len(entry) != 2:
+        raise ValueError(f"register_model: give 'package.module:ClassName', got {model!r}")
+    if name in MODELS and MODELS[name] != entry:
+        raise ValueError(f"register_model: {name!r} is already registered as {MODELS[name]!r}")
+    MODELS[name] = entry
 
 
 def model_class(name: str) -> type[GestureModel]:
@@ -50,8 +77,11 @@ def model_class(name: str) -> type[GestureModel]:
     """
     if name not in MODELS:
         raise ValueError(f"model name must be one of {sorted(MODELS)}, got {name!r}")
-    module_name, class_name = MODELS[name]
-    return getattr(importlib.import_module(module_name), class_name)
+    entry = MODELS[name]
+    if isinstance(entry, tuple):
+        module_name, class_name = entry
+        return getattr(importlib.import_module(module_name), class_name)
+    return entry
 
 
 def presets(name: str) -> dict[str, dict[str, Any]]:
@@ -60,7 +90,7 @@ def presets(name: str) -> dict[str, dict[str, Any]]:
     The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module.
     """
     cls = model_class(name)
-    table = cls.presets if cls.presets is not None else importlib.import_module(MODELS[name][0]).PRESETS
+    table = cls.presets if cls.presets is not None else importlib.import_module(cls.__module__).PRESETS
     return {k: dict(v) for k, v in table.items()}
 
 

@@ -166,6 +166,15 @@ class GestureModel(nn.Module):
         self.config = config
         self.discriminator: nn.Module | None = None
 
+    @classmethod
+    def keys_for(cls, config: ModelConfig) -> tuple[str, ...]:
+        """Batch keys a model built from ``config`` reads (default: the class's ``input_keys``).
+
+        Override it when switches in the config change the inputs (CaMN's ablations); the recipes
+        ask it whether a model reads words (to give it the vocabulary and word vectors).
+        """
+        return tuple(cls.input_keys)
+
     # ---------------------------------------------------------------- representation
     @property
     def target_key(self) -> str:

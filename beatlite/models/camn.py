@@ -327,21 +327,25 @@ class CaMN(GestureModel):
                 POSE_DIM, hidden=cfg.d_hidden, n_layers=cfg.d_layers, n_frames=cfg.n_frames, slope=cfg.slope
             )
 
-    @property
-    def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
-        """Batch keys the forward pass reads."""
-        cfg = self.config
+    @classmethod
+    def keys_for(cls, config: CaMNConfig) -> tuple[str, ...]:
+        """Batch keys read with ``config``: ``pose`` plus every modality switched on."""
         keys = ["pose"]
         for flag, key in (
-            (cfg.use_audio, "audio"),
-            (cfg.use_text, "word"),
-            (cfg.use_face, "face"),
-            (cfg.use_emotion, "emotion"),
-            (cfg.use_speaker, "speaker"),
+            (config.use_audio, "audio"),
+            (config.use_text, "word"),
+            (config.use_face, "face"),
+            (config.use_emotion, "emotion"),
+            (config.use_speaker, "speaker"),
         ):
             if flag:
                 keys.append(key)
         return tuple(keys)
+
+    @property
+    def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
+        """Batch keys the forward pass reads (:meth:`keys_for` of its config)."""
+        return self.keys_for(self.config)
 
     def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
         """Initialise the text embedding with pretrained vectors (vocab_size, word_dim); no-op without text."""

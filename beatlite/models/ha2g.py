@@ -190,7 +190,7 @@ ABLATIONS: dict[str, dict[str, Any]] = {
 }
 """Ablation switch name -> config overrides (HA2G Tables 3-4)."""
 
-CHECKPOINTS: dict[str, dict[str, Any]] = dict(HA2G_ABLATIONS)
+CHECKPOINTS: dict[str, dict[str, Any]] = {name: dict(kw) for name, (_, kw) in HA2G_ABLATIONS.items()}
 """Shipped checkpoint name (``checkpoints/<name>.pt``, tiny preset) -> config overrides."""
 
 

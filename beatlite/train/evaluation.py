@@ -38,6 +38,7 @@ Nothing is cached outside ``build/`` (the window caches of :mod:`beatlite.data.w
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 import warnings
@@ -47,41 +48,14 @@ from typing import Any
 
 import numpy as np
 
-FPS = 15
-SR = 16000
-WINDOW = 34
-WINDOW_STRIDE = 10
+from beatlite.constants import FPS, SR, WINDOW_LENGTH
+from beatlite.data.normalize import Normalizers
+from beatlite.metrics.scoring import METRICS, GroundTruth, Takes, describe, evaluate
 
-COLUMNS: tuple[tuple[str, bool], ...] = (
-    ("FGD", False),
-    ("SRGR", True),
-    ("BeatAlign", True),
-    ("BC", True),
-    ("Diversity", True),
-    ("L1div", True),
-)
-"""Metric name -> higher is better, in table order."""
-
-LABELS: dict[str, str] = {
-    "mean_pose": "Mean pose",
-    "random_clip": "Random clip",
-    "s2g_tiny": "S2G-style",
-    "trimodal_tiny": "Trimodal-style",
-    "camn_tiny": "CaMN",
-    "camn_tiny_no_cascade": "CaMN w/o cascade",
-    "camn_tiny_no_text": "CaMN w/o text",
-    "camn_tiny_no_audio": "CaMN w/o audio",
-    "camn_tiny_no_speaker": "CaMN w/o speaker ID",
-    "camn_tiny_no_face": "CaMN w/o face",
-    "camn_tiny_no_emotion": "CaMN w/o emotion",
-    "camn_tiny_no_semantic": "CaMN w/o semantic weighting",
-    "ha2g_tiny": "HA2G",
-    "ha2g_tiny_holistic": "HA2G w/o hierarchy (holistic)",
-    "ha2g_tiny_single_audio": "HA2G single audio feature",
-    "ha2g_tiny_no_contrastive": "HA2G w/o contrastive loss",
-    "ha2g_tiny_no_physical": "HA2G w/o physical loss",
-}
-"""Shipped checkpoint name -> row label, in the default row order."""
+NORMALIZER_KEYS = ("pose_mean", "pose_std", "dirvec_mean")
+COLUMNS: tuple[str, ...] = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div")
+"""The results table's columns, in order: keys of :data:`beatlite.metrics.scoring.METRICS`
+(each names its variant and parameters; the table caption lists them)."""
 
 GROUND_TRUTH = "Ground truth"
 GROUND_TRUTH_141 = "Ground truth (141 Euler channels)"
@@ -144,24 +118,28 @@ class ModelResults:
         """``get(row).metrics[metric]``."""
         return self.get(row).metrics[metric]
 
-    def to_markdown(self) -> str:
-        """A Markdown table: one row per model, the metrics of :data:`COLUMNS`, generation seconds."""
-        head = ["method", *[f"{n} {'↑' if up else '↓'}" for n, up in COLUMNS], "gen. s"]
-        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    def to_markdown(self, *, caption: bool = True) -> str:
+        """A Markdown table: one row per model, the metrics of :data:`COLUMNS`, generation seconds.
+
+        With ``caption`` the variant and parameters of every column follow the table.
+        """
+        from beatlite.report import markdown_table
+
+        rows = []
         for row in self.rows:
-            label = row.label + (" †" if row.stale else "")
-            cells = [label, *[fmt_metric(row.metrics.get(n, math.nan), n) for n, _ in COLUMNS]]
+            cells = [row.label + (" †" if row.stale else "")]
+            cells += [fmt_metric(row.metrics.get(key, math.nan), key) for key in COLUMNS]
             cells.append(f"{row.seconds:.2f}" if row.representation != "ground_truth" else "")
-            lines.append("| " + " | ".join(cells) + " |")
+            rows.append(cells)
+        text = markdown_table(["method", *column_headers(COLUMNS), "gen. s"], rows)
         if any(row.stale for row in self.rows):
-            lines.append("")
-            lines.append("† trained on another version of the data than the one evaluated: retrain it.")
-        return "\n".join(lines)
+            text += "\n\n† trained on another version of the data than the one evaluated: retrain it."
+        return text + ("\n\n" + describe(COLUMNS) if caption else "")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly dict: ``{"columns", "rows": [...], "info"}`` (NaN written as None)."""
         return {
-            "columns": [{"name": n, "higher_is_better": up} for n, up in COLUMNS],
+            "columns": [{"name": key, "higher_is_better": METRICS[key].higher_is_better} for key in COLUMNS],
             "rows": [
                 {
                     **dataclasses.asdict(r),
@@ -173,11 +151,16 @@ class ModelResults:
         }
 
 
-def fmt_metric(v: float, name: str) -> str:
+def column_headers(keys: Sequence[str]) -> list[str]:
+    """``"FGD ↓"``, ``"SRGR ↑"``, ...: each metric key with the arrow of its better direction."""
+    return [f"{key} {'↑' if METRICS[key].higher_is_better else '↓'}" for key in keys]
+
+
+def fmt_metric(v: float, key: str) -> str:
     """``v`` as printed in the results tables: 2 decimals for FGD/Diversity/L1div, 3 for the rest."""
     if not math.isfinite(v):
         return "—"
-    if name in ("FGD", "Diversity", "L1div"):
+    if METRICS[key].name in ("FGD", "Diversity", "L1div"):
         return f"{v:.2f}" if abs(v) < 100 else f"{v:.1f}"
     return f"{v:.3f}"
 
@@ -199,19 +182,19 @@ class EvaluationSet:
         The dataset's TED-43 unit bone directions (full motion).
     gt_directions_141 : list of (T, 42, 3) float64
         The same computed from the 141 Euler channels only (other joints at rest).
+    gt_euler : list of (T, 141) float64
+        The ground truth's ``spine_neck_141`` Euler degrees (the reference metric variants).
     semantic : list of (T,) float
     audio : list of (S,) float32, 16 kHz
-    norm : dict
-        ``pose_mean``/``pose_std`` (141,) degrees, ``dirvec_mean`` (126,), ``bone_lengths`` (42,) cm:
-        train-split statistics the windows were normalised with.
+    normalizers : Normalizers
+        The train split's fitted normalisers the streams were normalised with.
     change_angle : (41,) float64
         HA2G's MAAC per angle pair from the train windows (for BC).
     vocab : tuple of str
         The vocabulary the word ids refer to.
     audio_beats : list of (K,) float64
         Onset times (s) of each take's audio (:func:`beatlite.metrics.audio_beats` defaults),
-        computed once and shared by BeatAlign and BC; filled by :func:`load_test_set` (or on
-        first use when empty).
+        computed once and shared by BeatAlign and BC (:meth:`beats`).
     fingerprint : str
         :func:`beatlite.train.data_fingerprint` of the train windows ("" = unknown): checkpoints
         trained on other data are flagged as stale.
@@ -221,9 +204,10 @@ class EvaluationSet:
     streams: list[dict[str, Any]]
     gt_directions: list[np.ndarray]
     gt_directions_141: list[np.ndarray]
+    gt_euler: list[np.ndarray]
     semantic: list[np.ndarray]
     audio: list[np.ndarray]
-    norm: dict[str, np.ndarray]
+    normalizers: Normalizers
     change_angle: np.ndarray
     vocab: tuple[str, ...]
     split: str = "test"
@@ -235,8 +219,19 @@ class EvaluationSet:
         if len(self.audio_beats) != len(self.audio):
             from beatlite.metrics import audio_beats
 
-            self.audio_beats = [audio_beats(np.asarray(y, np.float64), SR) for y in self.audio]
+            self.audio_beats = [audio_beats(y, SR) for y in self.audio]
         return self.audio_beats
+
+    def ground_truth(self, extractor: Any) -> GroundTruth:
+        """The :class:`~beatlite.metrics.scoring.GroundTruth` every row is scored against."""
+        takes = directions_takes(self.gt_directions, self, extractor, euler=self.gt_euler)
+        return GroundTruth(
+            takes,
+            semantic=self.semantic,
+            audio=self.audio,
+            audio_beats=self.beats(),
+            change_angle=self.change_angle,
+        )
 
     @property
     def n_frames(self) -> int:
@@ -244,6 +239,7 @@ class EvaluationSet:
         return int(sum(s["pose"].shape[0] for s in self.streams))
 
 
+@functools.cache
 def rest_bone_lengths() -> np.ndarray:
     """(42,) float64 cm: TED-43 bone lengths of the BEAT rest skeleton (the common positions space)."""
     from beatlite.skeleton.beat import beat_skeleton
@@ -252,7 +248,9 @@ def rest_bone_lengths() -> np.ndarray:
 
     ted = beat_to_ted43(rest_pose(beat_skeleton())[None])[0]
     bones = np.asarray(TED_BONES)
-    return np.linalg.norm(ted[bones[:, 1]] - ted[bones[:, 0]], axis=-1)
+    lengths = np.linalg.norm(ted[bones[:, 1]] - ted[bones[:, 0]], axis=-1)
+    lengths.setflags(write=False)
+    return lengths
 
 
 def euler_to_directions(euler: np.ndarray) -> np.ndarray:
@@ -280,11 +278,15 @@ def euler_to_directions(euler: np.ndarray) -> np.ndarray:
     return positions_to_directions(beat_to_ted43(motion.positions()), np.asarray(TED_BONES))
 
 
-def directions_to_ted_positions(directions: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """(T, 42, 3) unit directions -> (T, 43, 3) cm TED-43 positions, root at the origin."""
+def directions_to_ted_positions(directions: np.ndarray, lengths: np.ndarray | None = None) -> np.ndarray:
+    """(T, 42, 3) unit directions -> (T, 43, 3) cm TED-43 positions, root at the origin.
+
+    ``lengths`` (42,) cm default to :func:`rest_bone_lengths` (the common positions space).
+    """
     from beatlite.skeleton.directions import directions_to_positions
     from beatlite.skeleton.ted import TED_BONES
 
+    lengths = rest_bone_lengths() if lengths is None else lengths
     return directions_to_positions(directions, np.asarray(TED_BONES), lengths, np.zeros(3))
 
 
@@ -307,52 +309,25 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
     from beatlite.data.index import index_folder
     from beatlite.data.vocab import build_vocab
     from beatlite.data.windows import build_windows
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
-    from beatlite.metrics.beats import mean_angle_change
     from beatlite.paths import data_dir
     from beatlite.train.training import data_fingerprint
 
-    if index is None:
-        index = index_folder(data_dir())
-    if vocab is None:
-        vocab = build_vocab(index)
+    index = index_folder(data_dir()) if index is None else index
+    vocab = build_vocab(index) if vocab is None else vocab
     train = build_windows(index, split="train", vocab=vocab)
-    stats = (train.pose_norm, train.dir_norm)
-    whole = build_windows(index, split=split, vocab=vocab, stats=stats, whole_takes=True)
-    dir_mean = np.asarray(train.dir_norm.mean, dtype=np.float64)
-    pairs = default_angle_pairs()
-    train_dirs = np.asarray(train["dirvec"], np.float64) + dir_mean
-    change_angle = mean_angle_change([prepare_directions(w) for w in train_dirs], pairs)
-    norm = {
-        "pose_mean": np.asarray(train.pose_norm.mean, np.float64),
-        "pose_std": np.asarray(train.pose_norm.std, np.float64),
-        "dirvec_mean": dir_mean,
-        "bone_lengths": rest_bone_lengths(),
-    }
-    takes, streams, gt_dirs, gt_dirs_141, sems, audios = [], [], [], [], [], []
-    for i in range(len(whole)):
-        item = whole.item(i)
-        t = item["pose"].shape[0]
-        stream = {
-            k: item[k] for k in ("pose", "dirvec", "audio", "mel", "face", "word", "emotion", "semantic")
-        }
-        stream["speaker"] = int(item["speaker"])
-        takes.append(str(item["take"]))
-        streams.append(stream)
-        d = (np.asarray(item["dirvec"], np.float64) + dir_mean).reshape(t, 42, 3)
-        gt_dirs.append(d / np.linalg.norm(d, axis=-1, keepdims=True))
-        gt_dirs_141.append(euler_to_directions(item["pose_raw"]))
-        sems.append(np.asarray(item["semantic"], np.float64))
-        audios.append(np.asarray(item["audio"], np.float32))
+    whole = build_windows(index, split=split, vocab=vocab, stats=train.normalizers, whole_takes=True)
+    items = [whole.item(i) for i in range(len(whole))]
+    keys = ("pose", "dirvec", "audio", "mel", "face", "word", "emotion", "semantic")
     test = EvaluationSet(
-        takes=takes,
-        streams=streams,
-        gt_directions=gt_dirs,
-        gt_directions_141=gt_dirs_141,
-        semantic=sems,
-        audio=audios,
-        norm=norm,
-        change_angle=change_angle,
+        takes=[str(item["take"]) for item in items],
+        streams=[{**{k: item[k] for k in keys}, "speaker": int(item["speaker"])} for item in items],
+        gt_directions=[train.normalizers.inverse_transform(item["dirvec"], "dirvec126") for item in items],
+        gt_directions_141=[euler_to_directions(item["pose_raw"]) for item in items],
+        gt_euler=[np.asarray(item["pose_raw"], np.float64) for item in items],
+        semantic=[np.asarray(item["semantic"], np.float64) for item in items],
+        audio=[np.asarray(item["audio"], np.float32) for item in items],
+        normalizers=train.normalizers,
+        change_angle=train_change_angle(train),
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=data_fingerprint(train),
@@ -361,9 +336,19 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
     return test
 
 
+def train_change_angle(train: Any) -> np.ndarray:
+    """(41,) MAAC per HA2G angle pair over the train windows (beat consistency's normaliser, HA2G eq. 10)."""
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.beats import mean_angle_change
+
+    # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
+    dirs = train.normalizers.dirvec.inverse_transform(np.asarray(train["dirvec"], np.float64))
+    return mean_angle_change([prepare_directions(w) for w in dirs], default_angle_pairs())
+
+
 # ------------------------------------------------------------------------------------ generation
 def generated_directions(
-    model: Any, test: EvaluationSet, norm: Mapping[str, Any] | None = None
+    model: Any, test: EvaluationSet, normalizers: Normalizers | None = None
 ) -> list[np.ndarray]:
     """Generate every take of ``test`` with ``model`` and return its TED-43 directions.
 
@@ -376,37 +361,46 @@ def generated_directions(
     model : GestureModel
         Trained, in eval mode.
     test : EvaluationSet
-    norm : mapping, optional
-        The statistics the model was trained with (checkpoint ``meta``); default ``test.norm``.
+    normalizers : Normalizers, optional
+        The statistics the model was trained with (its checkpoint's); default ``test.normalizers``.
         The seed frames and outputs are in these units.
 
     Returns
     -------
     list of (T, 42, 3) float64 unit vectors, one per take.
     """
-    from beatlite.train.generation import denormalise, generate_sequences
+    directions, _ = _generate(model, test, normalizers)
+    return directions
 
-    norm = test.norm if norm is None else {**test.norm, **dict(norm)}
+
+def _generate(
+    model: Any, test: EvaluationSet, normalizers: Normalizers | None
+) -> tuple[list[np.ndarray], list[np.ndarray] | None]:
+    """(directions per take, Euler degrees per take or None for direction models)."""
+    from beatlite.train.generation import generate_sequences
+
+    norms = test.normalizers if normalizers is None else normalizers
     if hasattr(model, "reset"):
         model.reset()  # RandomClip: restart its deterministic draws
-    poses = generate_sequences(model, [_renormalised(s, test.norm, norm) for s in test.streams])
-    if model.representation == "euler141":
-        return [euler_to_directions(denormalise(p, "euler141", norm)) for p in poses]
-    return [denormalise(p, "dirvec126", norm) for p in poses]
-
-
-def _renormalised(stream: dict[str, Any], have: Mapping[str, Any], want: Mapping[str, Any]) -> dict[str, Any]:
-    """The take's seed streams re-expressed in the model's normalisation when it differs."""
-    same_pose = np.allclose(have["pose_mean"], want["pose_mean"]) and np.allclose(
-        have["pose_std"], want["pose_std"]
+    streams = (
+        test.streams
+        if norms is test.normalizers
+        else [_in_units(s, test.normalizers, norms) for s in test.streams]
     )
-    same_dir = np.allclose(have["dirvec_mean"], want["dirvec_mean"])
-    if same_pose and same_dir:
+    poses = generate_sequences(model, streams)
+    if model.representation == "euler141":
+        euler = [norms.inverse_transform(p, "euler141") for p in poses]
+        return [euler_to_directions(e) for e in euler], euler
+    return [norms.inverse_transform(p, "dirvec126") for p in poses], None
+
+
+def _in_units(stream: dict[str, Any], have: Normalizers, want: Normalizers) -> dict[str, Any]:
+    """The take's seed streams re-expressed in the model's normalisation when it differs."""
+    if have.matches(want, rtol=0, atol=0):
         return stream
     out = dict(stream)
-    raw = stream["pose"] * have["pose_std"] + have["pose_mean"]
-    out["pose"] = ((raw - want["pose_mean"]) / want["pose_std"]).astype(np.float32)
-    out["dirvec"] = (stream["dirvec"] + have["dirvec_mean"] - want["dirvec_mean"]).astype(np.float32)
+    for rep, key in (("euler141", "pose"), ("dirvec126", "dirvec")):
+        out[key] = want.transform(have.inverse_transform(stream[key], rep), rep).astype(np.float32)
     return out
 
 
@@ -415,15 +409,15 @@ def fgd_scorer(
     *,
     index: Any = None,
     vocab: Any = None,
-    norm: Mapping[str, Any] | None = None,
+    normalizers: Normalizers | None = None,
     extractor: Any = None,
     takes: EvaluationSet | None = None,
 ) -> Callable[[Any], float]:
     """A ``val_score`` for :func:`beatlite.train.fit`: FGD of a model's generation of ``split``'s whole takes.
 
     BEAT's reference trainer validates every epoch by FGD on the validation set and keeps the
-    best epoch (facts B.6); this is that score, computed exactly as the ``FGD`` column of
-    :func:`evaluate_models` but on the ``val`` takes (so the test split stays unseen).
+    best epoch (docs/reference_code.md); this is that score, computed exactly as the ``FGD``
+    column of :func:`evaluate_models` but on the ``val`` takes (so the test split stays unseen).
 
     Parameters
     ----------
@@ -431,8 +425,8 @@ def fgd_scorer(
         Takes to generate (``"val"``).
     index, vocab
         As :func:`load_test_set` (pass the training vocabulary).
-    norm : mapping, optional
-        The statistics the model trains with (its checkpoint ``meta``); default the split's.
+    normalizers : Normalizers, optional
+        The statistics the model trains with; default the split's.
     extractor : callable, optional
         Default ``load_extractor("dirvec")``.
     takes : EvaluationSet, optional
@@ -448,139 +442,86 @@ def fgd_scorer(
 
     takes = load_test_set(index, split=split, vocab=vocab) if takes is None else takes
     extractor = load_extractor("dirvec") if extractor is None else extractor
-    mean = takes.norm["dirvec_mean"]
-    real = np.asarray(extractor(_windows(takes.gt_directions, mean)), np.float64)
-    model_norm = _norm_of(norm)
+    real = direction_features(takes.gt_directions, takes, extractor)
 
     def score(model: Any) -> float:
-        feats = np.asarray(
-            extractor(_windows(generated_directions(model, takes, model_norm), mean)), np.float64
+        return float(
+            fgd(direction_features(generated_directions(model, takes, normalizers), takes, extractor), real)
         )
-        return float(fgd(feats, real))
 
     return score
 
 
 # ------------------------------------------------------------------------------------ scoring
-def _windows(directions: list[np.ndarray], mean: np.ndarray) -> np.ndarray:
-    """(N, 34, 126) float32 mean-subtracted direction windows, stride 10, pooled over takes."""
-    out = []
-    for d in directions:
-        x = d.reshape(d.shape[0], -1) - mean
-        for s in range(0, x.shape[0] - WINDOW + 1, WINDOW_STRIDE):
-            out.append(x[s : s + WINDOW])
-    if not out:
-        raise ValueError(f"no take has {WINDOW} frames: cannot cut FGD windows")
-    return np.stack(out).astype(np.float32)
+def direction_features(directions: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
+    """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes."""
+    from beatlite.data.windows import sliding_windows
+
+    windows = sliding_windows([test.normalizers.transform(d, "dirvec126") for d in directions])
+    if not len(windows):
+        raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
+    return np.asarray(extractor(windows.astype(np.float32)), np.float64)
 
 
-@dataclasses.dataclass(eq=False)
-class _Reference:
-    features: np.ndarray
-    positions: list[np.ndarray]
-
-
-def score_directions(
-    directions: list[np.ndarray], test: EvaluationSet, extractor: Any, reference: _Reference, *, seed: int = 0
-) -> dict[str, float]:
-    """The metrics of :data:`COLUMNS` for one row's per-take directions (T, 42, 3)."""
-    from beatlite.metrics import diversity, fgd, l1_diversity, srgr
-
+def directions_takes(
+    directions: list[np.ndarray],
+    test: EvaluationSet,
+    extractor: Any,
+    *,
+    euler: list[np.ndarray] | None = None,
+) -> Takes:
+    """A row's :class:`~beatlite.metrics.scoring.Takes`: TED-43 positions, directions, features (+ Euler)."""
     if len(directions) != len(test.takes):
         raise ValueError(f"directions has {len(directions)} takes, the test set {len(test.takes)}")
     for i, (d, s) in enumerate(zip(directions, test.streams, strict=True)):
         if d.shape != (s["pose"].shape[0], 42, 3):
             raise ValueError(f"directions[{i}] must be ({s['pose'].shape[0]}, 42, 3), got {d.shape}")
-    lengths = test.norm["bone_lengths"]
-    positions = [directions_to_ted_positions(d, lengths) for d in directions]
-    feats = np.asarray(extractor(_windows(directions, test.norm["dirvec_mean"])), np.float64)
-    return {
-        "FGD": float(fgd(feats, reference.features)),
-        "SRGR": float(srgr(positions, reference.positions, test.semantic, variant="paper", delta=10.0)),
-        "BeatAlign": beat_align_cached(positions, test.beats()),
-        "BC": beat_consistency_cached(directions, test.beats(), test.change_angle),
-        "Diversity": float(diversity(feats, n_pairs=500, seed=seed)),
-        "L1div": float(l1_diversity(positions)),
-    }
+    return Takes(
+        positions=[directions_to_ted_positions(d) for d in directions],
+        directions=list(directions),
+        euler=euler,
+        features=direction_features(directions, test, extractor),
+    )
 
 
-def beat_align_cached(positions: list[np.ndarray], beats: list[np.ndarray], sigma: float = 0.3) -> float:
-    """:func:`beatlite.metrics.beat_align` (positions, order 2, audio -> motion) with precomputed audio beats.
-
-    Parameters
-    ----------
-    positions : list of (T, J, 3) float, cm
-    beats : list of (K,) float, seconds
-        Audio onset times of each take (``audio_beats(y, 16000)``).
-
-    Returns
-    -------
-    float: mean over takes with audio beats; a take whose joints have no speed minimum scores 0.
-    """
-    from beatlite.metrics.beat_align import motion_beat_times
-    from beatlite.metrics.beats import alignment_score
-
-    scores = []
-    for p, a in zip(positions, beats, strict=True):
-        if a.size == 0:
-            continue
-        per_joint = [alignment_score(a, m, sigma) for m in motion_beat_times(p, FPS, order=2) if m.size]
-        per_joint = [v for v in per_joint if np.isfinite(v)]
-        scores.append(float(np.mean(per_joint)) if per_joint else 0.0)
-    return float(np.mean(scores)) if scores else math.nan
+def score_directions(
+    directions: list[np.ndarray],
+    test: EvaluationSet,
+    extractor: Any,
+    truth: GroundTruth,
+    *,
+    euler: list[np.ndarray] | None = None,
+    columns: Sequence[str] = COLUMNS,
+    seed: int = 0,
+) -> dict[str, float]:
+    """The metrics of ``columns`` for one row's per-take directions (T, 42, 3) (NaN where undefined)."""
+    takes = directions_takes(directions, test, extractor, euler=euler)
+    values = evaluate(takes, truth, metrics=columns, seed=seed).values()
+    return {key: values[key] for key in columns}
 
 
-def beat_consistency_cached(
-    directions: list[np.ndarray], beats: list[np.ndarray], change_angle: np.ndarray, sigma: float = 0.1
-) -> float:
-    """:func:`beatlite.metrics.beat_consistency` on whole takes (threshold 0.03) with precomputed audio beats.
-
-    Parameters
-    ----------
-    directions : list of (T, 42, 3) float unit vectors
-    beats : list of (K,) float, seconds
-    change_angle : (41,) float
-        MAAC per angle pair.
-
-    Returns
-    -------
-    float: mean over takes weighted by their number of audio beats, skipping takes without
-    motion beats; NaN when none has both.
-    """
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
-    from beatlite.metrics.beats import alignment_score, angle_change_beats, angle_change_curve
-
-    pairs = default_angle_pairs()
-    total, weight = 0.0, 0
-    for d, a in zip(directions, beats, strict=True):
-        m = angle_change_beats(
-            angle_change_curve(prepare_directions(d), pairs, change_angle), FPS, threshold=0.03
-        )
-        if a.size == 0 or m.size == 0:
-            continue
-        total += alignment_score(a, m, sigma) * a.size
-        weight += a.size
-    return total / weight if weight else math.nan
-
-
-def _as_entries(models: Sequence[Any] | None) -> list[tuple[str, str, Any, Mapping[str, Any] | None]]:
-    """Normalise ``models`` to (label, source, model or None, norm) entries."""
+def _as_entries(models: Sequence[Any] | None) -> list[tuple[str, str, Any, Normalizers | None]]:
+    """Normalise ``models`` to (label, source, model or None, normalizers) entries."""
     from beatlite.paths import checkpoints_dir
+    from beatlite.train.recipes import RECIPES, label_of
 
     if models is None:
-        models = [name for name in LABELS if (checkpoints_dir() / f"{name}.pt").is_file()]
+        models = [name for name in RECIPES if (checkpoints_dir() / f"{name}.pt").is_file()]
     entries = []
     for item in models:
         if isinstance(item, str | Path):
             name = Path(item).stem if str(item).endswith(".pt") else str(item)
-            entries.append((LABELS.get(name, name), str(item), None, None))
+            entries.append((label_of(name), str(item), None, None))
         elif isinstance(item, tuple) and len(item) in (2, 3):
-            label, model = item[0], item[1]
-            norm = item[2] if len(item) == 3 else None
-            entries.append((str(label), "<given>", model, norm))
+            norms = item[2] if len(item) == 3 else None
+            if norms is not None and not isinstance(norms, Normalizers):
+                raise TypeError(
+                    f"the third entry of {item[0]!r} must be Normalizers, got {type(norms).__name__}"
+                )
+            entries.append((str(item[0]), "<given>", item[1], norms))
         else:
             raise TypeError(
-                "models entries must be checkpoint names/paths or (label, model[, norm]) tuples, "
+                "models entries must be checkpoint names/paths or (label, model[, normalizers]) tuples, "
                 f"got {type(item).__name__}"
             )
     return entries
@@ -602,9 +543,10 @@ def evaluate_models(
     ----------
     models : sequence, optional
         Checkpoint names (``"camn_tiny"``, looked up in ``checkpoints/``) or paths, and/or
-        ``(label, model)`` / ``(label, model, norm)`` tuples for models trained in a notebook
-        (``norm``: the ``meta`` statistics they were trained with; default the test set's).
-        Default: every shipped checkpoint of :data:`LABELS` that exists, in that order.
+        ``(label, model)`` / ``(label, model, normalizers)`` tuples for models trained in a notebook
+        (``normalizers``: the :class:`~beatlite.data.normalize.Normalizers` they were trained with;
+        default the test set's). Default: every checkpoint of :data:`~beatlite.train.recipes.RECIPES`
+        found in ``checkpoints/``, in that order.
     test : EvaluationSet, optional
         Default :func:`load_test_set` (``data_samples/`` test split).
     extractor : callable, optional
@@ -626,95 +568,82 @@ def evaluate_models(
 
     from beatlite.metrics.extractor import load_extractor
     from beatlite.paths import n_threads
-    from beatlite.train.checkpoint import load_model
 
     start = time.perf_counter()
     torch.set_num_threads(threads if threads is not None else n_threads())
     entries = _as_entries(models)
     test = load_test_set() if test is None else test
     extractor = load_extractor("dirvec") if extractor is None else extractor
-    lengths = test.norm["bone_lengths"]
-    real = _windows(test.gt_directions, test.norm["dirvec_mean"])
-    reference = _Reference(
-        features=np.asarray(extractor(real), np.float64),
-        positions=[directions_to_ted_positions(d, lengths) for d in test.gt_directions],
-    )
+    truth = test.ground_truth(extractor)
     rows: list[ResultRow] = []
     if ground_truth:
         for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):
-            rows.append(
-                ResultRow(
-                    label,
-                    "ground_truth",
-                    "ground_truth",
-                    score_directions(dirs, test, extractor, reference, seed=seed),
-                )
-            )
-    for label, source, model, norm in entries:
-        fingerprint, stale = "", False
-        if model is None:
-            model, data = load_model(source)
-            norm = data.get("meta") or None
-            _check_vocab(model, data, test, source)
-            fingerprint = str(data.get("fingerprint") or "")
-            stale = _is_stale(data, test)
-            if stale:
-                warnings.warn(
-                    f"{source} was trained on other data (fingerprint {fingerprint}) than the evaluated "
-                    f"corpus' train split ({test.fingerprint}); retrain it (python -m beatlite.train retrain-all)",
-                    stacklevel=2,
-                )
-        t0 = time.perf_counter()
-        with torch.no_grad():
-            dirs = generated_directions(model, test, _norm_of(norm))
-        seconds = time.perf_counter() - t0
-        metrics = score_directions(dirs, test, extractor, reference, seed=seed)
-        rows.append(ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale))
+            metrics = score_directions(dirs, test, extractor, truth, euler=test.gt_euler, seed=seed)
+            rows.append(ResultRow(label, "ground_truth", "ground_truth", metrics))
+    for label, source, model, norms in entries:
+        rows.append(_model_row(label, source, model, norms, test, extractor, truth, seed))
         if progress:
-            print(
-                f"{label}: " + ", ".join(f"{k} {v:.4g}" for k, v in metrics.items()) + f" ({seconds:.1f} s)",
-                flush=True,
-            )
+            values = ", ".join(f"{k} {v:.4g}" for k, v in rows[-1].metrics.items())
+            print(f"{label}: {values} ({rows[-1].seconds:.1f} s)", flush=True)
     info = {
         "split": test.split,
         "takes": list(test.takes),
         "frames": test.n_frames,
-        "windows": int(len(real)),
+        "windows": int(len(truth.takes.features)),
         "fps": FPS,
         "extractor": str(getattr(extractor, "meta", {}).get("path", type(extractor).__name__)),
         "common_space": "TED-43 unit bone directions; positions from BEAT rest-pose bone lengths, root at origin",
+        "columns": {key: METRICS[key].describe for key in COLUMNS},
         "data_fingerprint": test.fingerprint,
         "seconds": round(time.perf_counter() - start, 2),
     }
     return ModelResults(rows, info)
 
 
-def _is_stale(data: Mapping[str, Any], test: EvaluationSet) -> bool:
-    """Whether a checkpoint was trained on other data than ``test``'s train split.
+def _model_row(
+    label: str,
+    source: str,
+    model: Any,
+    norms: Normalizers | None,
+    test: EvaluationSet,
+    extractor: Any,
+    truth: GroundTruth,
+    seed: int,
+) -> ResultRow:
+    """Load (when ``model`` is None), generate and score one model's row."""
+    import torch
 
-    Compared through the train statistics stored in its ``meta`` (pose mean/std, direction
-    mean; every beatlite trainer stores them) when present, else through the data fingerprint
-    (trainers may fingerprint different window dicts, so the statistics come first).
-    """
+    fingerprint, stale = "", False
+    if model is None:
+        model, norms, fingerprint, stale = _load_checkpoint(source, test)
+    t0 = time.perf_counter()
+    with torch.no_grad():
+        dirs, euler = _generate(model, test, norms)
+    seconds = time.perf_counter() - t0
+    metrics = score_directions(dirs, test, extractor, truth, euler=euler, seed=seed)
+    return ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale)
+
+
+def _load_checkpoint(source: str, test: EvaluationSet) -> tuple[Any, Normalizers | None, str, bool]:
+    """(model, its training normalisers, data fingerprint, stale?) of a checkpoint name or path."""
+    from beatlite.train.checkpoint import load_model
+
+    model, data = load_model(source)
     meta = data.get("meta") or {}
-    keys = ("pose_mean", "pose_std", "dirvec_mean")
-    if all(k in meta for k in keys):
-        return not all(
-            np.shape(meta[k]) == np.shape(test.norm[k])
-            and np.allclose(meta[k], test.norm[k], rtol=1e-5, atol=1e-6)
-            for k in keys
-        )
+    norms = Normalizers.from_meta(meta) if all(k in meta for k in NORMALIZER_KEYS) else None
+    _check_vocab(model, data, test, source)
     fingerprint = str(data.get("fingerprint") or "")
-    return bool(test.fingerprint and fingerprint and fingerprint != test.fingerprint)
-
-
-def _norm_of(meta: Mapping[str, Any] | None) -> dict[str, np.ndarray] | None:
-    if not meta:
-        return None
-    keys = ("pose_mean", "pose_std", "dirvec_mean")
-    if not all(k in meta for k in keys):
-        return None
-    return {k: np.asarray(meta[k], np.float64) for k in keys}
+    if norms is not None:
+        stale = not norms.matches(test.normalizers)
+    else:  # trainers may fingerprint different window dicts, so the statistics come first
+        stale = bool(test.fingerprint and fingerprint and fingerprint != test.fingerprint)
+    if stale:
+        warnings.warn(
+            f"{source} was trained on other data (fingerprint {fingerprint}) than the evaluated "
+            f"corpus' train split ({test.fingerprint}); retrain it (python -m beatlite.train retrain-all)",
+            stacklevel=3,
+        )
+    return model, norms, fingerprint, stale
 
 
 def _check_vocab(model: Any, data: Mapping[str, Any], test: EvaluationSet, source: str) -> None:

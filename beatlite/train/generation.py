@@ -13,20 +13,18 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 import torch
 
+from beatlite.constants import FPS, GENERATION_STRIDE, SR, WINDOW_LENGTH
+from beatlite.data.normalize import Normalizers
+from beatlite.data.windows import MEL_SETTINGS, mel_frames
 from beatlite.io.motion import Motion
 from beatlite.models.base import GestureModel
 
-FPS = 15
-SR = 16000
-UNIT = 34
-STRIDE = 30
-MEL_HOP = 512
-MEL_FRAMES = 70
+UNIT = WINDOW_LENGTH
+STRIDE = GENERATION_STRIDE
 
 
 @dataclasses.dataclass(eq=False)
@@ -45,7 +43,8 @@ class GeneratedTake:
         origin). ``None`` for direction models (no IK).
     positions : (T, J, 3) float64 or None, centimetres
         Direction models: TED-43 joint positions from the denormalised unit directions
-        and the training-mean bone lengths (root at the origin). Euler models: ``None``
+        and the BEAT rest-pose bone lengths (root at the origin; the common space of the
+        results tables, :func:`beatlite.train.evaluation.rest_bone_lengths`). Euler models: ``None``
         (use ``motion.positions()``).
     fps : float
         15.
@@ -96,7 +95,8 @@ def unit_batch(
         if key == "audio":
             part = _zero_padded(a, int(start * SR // FPS), int(np.floor(UNIT / FPS * SR)))
         elif key == "mel":
-            part = _unit_slice(a, int(start * SR // FPS) // MEL_HOP, MEL_FRAMES)
+            hop = MEL_SETTINGS["hop_length"]
+            part = _unit_slice(a, int(start * SR // FPS) // hop, mel_frames(int(np.floor(UNIT / FPS * SR))))
         else:
             part = _unit_slice(a, start, UNIT)
         dtype = np.int64 if part.dtype.kind in "iu" else np.float32
@@ -193,25 +193,8 @@ def generate_sequences(
     return [out[:t] for out, t in zip(outs, lengths, strict=True)]
 
 
-def denormalise(pose: np.ndarray, representation: str, norm: Mapping[str, Any]) -> np.ndarray:
-    """Undo the window normalisation.
-
-    euler141: ``pose * norm["pose_std"] + norm["pose_mean"]`` (degrees);
-    dirvec126: ``pose + norm["dirvec_mean"]`` reshaped to (T, 42, 3) and re-normalised to
-    unit length (HA2G adds the mean back, facts C.5).
-    """
-    pose = np.asarray(pose, dtype=np.float64)
-    if representation == "euler141":
-        return pose * np.asarray(norm["pose_std"], np.float64) + np.asarray(norm["pose_mean"], np.float64)
-    if representation == "dirvec126":
-        dirs = (pose + np.asarray(norm["dirvec_mean"], np.float64)).reshape(pose.shape[0], -1, 3)
-        length = np.linalg.norm(dirs, axis=-1, keepdims=True)
-        return np.divide(dirs, length, out=np.zeros_like(dirs), where=length > 1e-9)
-    raise ValueError(f"representation must be 'euler141' or 'dirvec126', got {representation!r}")
-
-
 def generate(
-    model: GestureModel, take: Mapping[str, np.ndarray], *, norm: Mapping[str, Any] | None = None
+    model: GestureModel, take: Mapping[str, np.ndarray], *, normalizers: Normalizers | None = None
 ) -> GeneratedTake:
     """Generate a whole take of any length and return it as motion / positions.
 
@@ -222,10 +205,10 @@ def generate(
     take : mapping
         Whole-take streams as for :func:`generate_sequence` (the per-take arrays that
         the window builder cuts windows from).
-    norm : mapping, optional
-        Normalisation statistics: ``pose_mean``/``pose_std`` (141,) degrees for euler
-        models; ``dirvec_mean`` (126,) and ``bone_lengths`` (42,) cm for direction models.
-        Without it only :attr:`GeneratedTake.pose` is filled.
+    normalizers : Normalizers, optional
+        The train statistics the model was trained with (``Windows.normalizers``, or
+        ``Normalizers.from_meta(checkpoint["meta"])``). Without them only :attr:`GeneratedTake.pose`
+        is filled.
 
     Returns
     -------
@@ -233,18 +216,15 @@ def generate(
     """
     pose = generate_sequence(model, take)
     motion = positions = None
-    if norm is not None:
-        values = denormalise(pose, model.representation, norm)
+    if normalizers is not None:
+        values = normalizers.inverse_transform(pose, model.representation)
         if model.representation == "euler141":
             from beatlite.skeleton.beat import beat_skeleton, expand_subset
 
             skeleton = beat_skeleton()
             motion = Motion(skeleton, expand_subset(values, "spine_neck_141", skeleton), FPS)
         else:
-            from beatlite.skeleton.directions import directions_to_positions
-            from beatlite.skeleton.ted import TED_BONES
+            from beatlite.train.evaluation import directions_to_ted_positions
 
-            positions = directions_to_positions(
-                values, np.asarray(TED_BONES), np.asarray(norm["bone_lengths"], np.float64), np.zeros(3)
-            )
+            positions = directions_to_ted_positions(values)
     return GeneratedTake(pose=pose, representation=model.representation, motion=motion, positions=positions)

@@ -42,6 +42,8 @@ class Recipe:
     ----------
     model : str
         A key of :data:`beatlite.models.MODELS`.
+    label : str
+        The row label of the checkpoint in every results table (``"CaMN w/o audio"``).
     overrides : mapping
         Config fields on top of the ``tiny`` preset (the ablation switches).
     epochs, batch_size : int
@@ -57,6 +59,7 @@ class Recipe:
     """
 
     model: str
+    label: str
     overrides: Mapping[str, Any] = dataclasses.field(default_factory=dict)
     epochs: int = 60
     batch_size: int = 32
@@ -66,21 +69,30 @@ class Recipe:
 
     @property
     def uses_text(self) -> bool:
-        """Whether the model reads word ids (needs the vocabulary size and word vectors)."""
-        return self.model in ("camn", "trimodal", "ha2g") and self.overrides.get("use_text", True)
+        """Whether the model reads word ids (then it gets the vocabulary size and word vectors).
+
+        Asked of the model class (:meth:`beatlite.models.base.GestureModel.keys_for`) with the
+        recipe's ``tiny`` config, so a new model needs no entry here.
+        """
+        from beatlite.models import model_class, presets
+        from beatlite.models.base import config_from_preset
+
+        cls = model_class(self.model)
+        config = config_from_preset(cls.config_class, presets(self.model), "tiny", **self.overrides)
+        return "word" in cls.keys_for(config)
 
 
-CAMN_ABLATIONS: dict[str, dict[str, Any]] = {
-    "camn_tiny": {},
-    "camn_tiny_no_audio": {"use_audio": False},
-    "camn_tiny_no_text": {"use_text": False},
-    "camn_tiny_no_face": {"use_face": False},
-    "camn_tiny_no_emotion": {"use_emotion": False},
-    "camn_tiny_no_speaker": {"use_speaker": False},
-    "camn_tiny_no_cascade": {"cascade": False},
-    "camn_tiny_no_semantic": {"semantic_weighting": False},
+CAMN_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
+    "camn_tiny": ("CaMN", {}),
+    "camn_tiny_no_cascade": ("CaMN w/o cascade", {"cascade": False}),
+    "camn_tiny_no_text": ("CaMN w/o text", {"use_text": False}),
+    "camn_tiny_no_audio": ("CaMN w/o audio", {"use_audio": False}),
+    "camn_tiny_no_speaker": ("CaMN w/o speaker ID", {"use_speaker": False}),
+    "camn_tiny_no_face": ("CaMN w/o face", {"use_face": False}),
+    "camn_tiny_no_emotion": ("CaMN w/o emotion", {"use_emotion": False}),
+    "camn_tiny_no_semantic": ("CaMN w/o semantic weighting", {"semantic_weighting": False}),
 }
-"""Shipped CaMN checkpoints: name -> config overrides of the ``tiny`` preset (BEAT Table 5)."""
+"""Shipped CaMN checkpoints: name -> (row label, config overrides of the ``tiny`` preset) (BEAT Table 5)."""
 
 EPOCHS = 40
 """Epochs of the CaMN, S2G and Trimodal checkpoints (see :data:`LR`)."""
@@ -99,26 +111,53 @@ HA2G_LR = 2e-3
 6.6 at epoch 24, 3.71 at 29; test FGD 5.45); at 2e-3 the same seed reached 2.57 (test 3.52)."""
 
 
-HA2G_ABLATIONS: dict[str, dict[str, Any]] = {
-    "ha2g_tiny": {},
-    "ha2g_tiny_holistic": {"hierarchical": False},
-    "ha2g_tiny_single_audio": {"audio_mode": "low"},
-    "ha2g_tiny_no_contrastive": {"use_contrastive": False},
-    "ha2g_tiny_no_physical": {"use_physical": False},
+HA2G_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
+    "ha2g_tiny": ("HA2G", {}),
+    "ha2g_tiny_holistic": ("HA2G w/o hierarchy (holistic)", {"hierarchical": False}),
+    "ha2g_tiny_single_audio": ("HA2G single audio feature", {"audio_mode": "low"}),
+    "ha2g_tiny_no_contrastive": ("HA2G w/o contrastive loss", {"use_contrastive": False}),
+    "ha2g_tiny_no_physical": ("HA2G w/o physical loss", {"use_physical": False}),
 }
-"""Shipped HA2G checkpoints: name -> config overrides of the ``tiny`` preset (HA2G Tables 3-4;
-the same switches as :data:`beatlite.models.ha2g.ABLATIONS`)."""
+"""Shipped HA2G checkpoints: name -> (row label, config overrides of the ``tiny`` preset) (HA2G Tables 3-4)."""
 
 
 RECIPES: dict[str, Recipe] = {
-    **{name: Recipe("camn", kw, epochs=EPOCHS, lr=LR) for name, kw in CAMN_ABLATIONS.items()},
-    "s2g_tiny": Recipe("s2g", epochs=EPOCHS, lr=LR),
-    "trimodal_tiny": Recipe("trimodal", epochs=EPOCHS, lr=LR),
-    "mean_pose": Recipe("mean_pose", epochs=0),
-    "random_clip": Recipe("random_clip", epochs=0),
-    **{name: Recipe("ha2g", kw, epochs=HA2G_EPOCHS, lr=HA2G_LR) for name, kw in HA2G_ABLATIONS.items()},
+    "mean_pose": Recipe("mean_pose", "Mean pose", epochs=0),
+    "random_clip": Recipe("random_clip", "Random clip", epochs=0),
+    "s2g_tiny": Recipe("s2g", "S2G-style", epochs=EPOCHS, lr=LR),
+    "trimodal_tiny": Recipe("trimodal", "Trimodal-style", epochs=EPOCHS, lr=LR),
+    **{name: Recipe("camn", label, kw, epochs=EPOCHS, lr=LR) for name, (label, kw) in CAMN_ABLATIONS.items()},
+    **{
+        name: Recipe("ha2g", label, kw, epochs=HA2G_EPOCHS, lr=HA2G_LR)
+        for name, (label, kw) in HA2G_ABLATIONS.items()
+    },
 }
-"""Every shipped checkpoint (``checkpoints/<name>.pt``) -> its :class:`Recipe`."""
+"""Every trained checkpoint (``checkpoints/<name>.pt``) -> its :class:`Recipe`, in table row order.
+
+Adding a model: :func:`beatlite.models.register_model`, then :func:`register_recipe`
+(``docs/architecture.md``, "Adding a model")."""
+
+
+def register_recipe(name: str, recipe: Recipe) -> None:
+    """Add checkpoint ``name`` trained by ``recipe`` to :data:`RECIPES` (its row joins the tables).
+
+    Raises
+    ------
+    ValueError
+        The recipe's model is not registered, or ``name`` is taken by another recipe.
+    """
+    from beatlite.models import MODELS
+
+    if recipe.model not in MODELS:
+        raise ValueError(f"register_recipe: model {recipe.model!r} is not registered (register_model first)")
+    if name in RECIPES and RECIPES[name] != recipe:
+        raise ValueError(f"register_recipe: {name!r} is already a recipe ({RECIPES[name]})")
+    RECIPES[name] = recipe
+
+
+def label_of(name: str) -> str:
+    """The table row label of checkpoint ``name`` (its recipe's; the name itself when it has none)."""
+    return RECIPES[name].label if name in RECIPES else name
 
 
 @dataclasses.dataclass
@@ -152,11 +191,9 @@ def training_data(data: str | Path | None = None) -> TrainingData:
     index = index_folder(root)
     vocab = build_vocab(index)
     train = build_windows(index, split="train", vocab=vocab)
-    val = build_windows(index, split="val", vocab=vocab, stats=(train.pose_norm, train.dir_norm))
+    val = build_windows(index, split="val", vocab=vocab, stats=train.normalizers)
     meta = {
-        "pose_mean": train.pose_norm.mean,
-        "pose_std": train.pose_norm.std,
-        "dirvec_mean": train.dir_norm.mean,
+        **train.normalizers.to_meta(),
         "vocab": list(vocab.itos),
         "data": str(root),
     }
@@ -249,7 +286,7 @@ def retrain(
     if recipe.select_best and config.epochs > 0:
         from beatlite.train.evaluation import fgd_scorer
 
-        score = fgd_scorer(norm=data.meta, takes=data.val_takes)
+        score = fgd_scorer(normalizers=data.train.normalizers, takes=data.val_takes)
     start = time.perf_counter()
     fit(model, data.train, config, data.val, meta=data.meta, val_score=score)
     seconds = time.perf_counter() - start

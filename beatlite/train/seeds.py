@@ -197,24 +197,25 @@ class SeedResults:
 
     def to_markdown(self) -> str:
         """A Markdown table of ``mean ± sd`` over seeds for every metric of :data:`COLUMNS`."""
-        from beatlite.train.evaluation import COLUMNS, fmt_metric
+        from beatlite.report import markdown_table
+        from beatlite.train.evaluation import COLUMNS, column_headers
 
-        head = ["method", *[f"{n} {'↑' if up else '↓'}" for n, up in COLUMNS], "seeds"]
-        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        for row, metrics in self.values.items():
-            cells = [row]
-            for name, _ in COLUMNS:
-                if name not in metrics:
-                    cells.append("")
-                    continue
-                mean, sd = self.mean(row, name), self.sd(row, name)
-                cell = fmt_metric(mean, name)
-                if math.isfinite(sd):
-                    cell += " ± " + fmt_metric(sd, name)
-                cells.append(cell)
-            cells.append(str(self.count(row, next(iter(metrics)))))
-            lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines)
+        rows = [
+            [
+                row,
+                *[self.cell(row, key) if key in metrics else "" for key in COLUMNS],
+                self.count(row, next(iter(metrics))),
+            ]
+            for row, metrics in self.values.items()
+        ]
+        return markdown_table(["method", *column_headers(COLUMNS), "seeds"], rows)
+
+    def cell(self, row: str, metric: str) -> str:
+        """``"mean ± sd"`` of one row and metric as the tables print it (``"mean"`` with one seed)."""
+        from beatlite.train.evaluation import fmt_metric
+
+        mean, sd = self.mean(row, metric), self.sd(row, metric)
+        return fmt_metric(mean, metric) + (" ± " + fmt_metric(sd, metric) if math.isfinite(sd) else "")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly dict (NaN written as None)."""
@@ -278,14 +279,15 @@ def compare_rows(
     -------
     list of Effect, variant-major.
     """
+    from beatlite.metrics.scoring import METRICS
     from beatlite.train.evaluation import COLUMNS
 
-    higher = dict(COLUMNS)
+    higher = {key: METRICS[key].higher_is_better for key in COLUMNS}
     effects = []
     for variant in variants:
         for metric in metrics:
             if metric not in higher:
-                raise ValueError(f"metric must be one of {[n for n, _ in COLUMNS]}, got {metric!r}")
+                raise ValueError(f"metric must be one of {list(COLUMNS)}, got {metric!r}")
             delta, se = results.difference(variant, full, metric)
             if not math.isfinite(se):
                 verdict = "unknown"
@@ -326,7 +328,7 @@ def evaluate_seeds(
     Returns
     -------
     SeedResults
-        Rows in :data:`beatlite.train.evaluation.LABELS` order; the two ground-truth rows first.
+        Rows in :data:`~beatlite.train.recipes.RECIPES` order; the two ground-truth rows first.
 
     Raises
     ------
@@ -334,7 +336,8 @@ def evaluate_seeds(
         A requested checkpoint is missing (names the file and the command that trains it).
     """
     from beatlite.metrics.extractor import load_extractor
-    from beatlite.train.evaluation import LABELS, evaluate_models, load_test_set
+    from beatlite.train.evaluation import evaluate_models, load_test_set
+    from beatlite.train.recipes import label_of
 
     seeds = [int(s) for s in seeds]
     if not seeds:
@@ -342,7 +345,7 @@ def evaluate_seeds(
     if names is None:
         names = [
             n
-            for n in LABELS
+            for n in RECIPES
             if checkpoint_path(n, seeds[0]).is_file()
             and (missing == "skip" or all(checkpoint_path(n, s).is_file() for s in seeds))
         ]
@@ -376,7 +379,7 @@ def evaluate_seeds(
                 slot.setdefault(metric, []).append(float(v))
         for name in names:  # a skipped checkpoint is a NaN, so that value k is always seed k
             if name not in present:
-                for vals in values[LABELS.get(name, name)].values():
+                for vals in values[label_of(name)].values():
                     vals.append(math.nan)
         if progress:
             print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
@@ -407,6 +410,41 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
         return SeedResults.from_dict(json.loads(path.read_text()))
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise FormatError(path, f"not a seed table written by write_seed_results ({exc})") from exc
+
+
+#: Tolerances of :func:`check_against_record`. Generation runs float32 torch kernels whose rounding
+#: differs between CPUs (oneDNN picks kernels per instruction set), and the autoregressive units
+#: carry it forward: scores agree to ~1e-5 relative, so 1e-3 is safe. Values that are zero by
+#: definition (the ground truth's FGD against itself) are pure float64 round-off of size ~1e-14
+#: that differs between machines: hence an absolute 1e-9, far below any printed digit.
+RECORD_RTOL, RECORD_ATOL = 1e-3, 1e-9
+
+
+def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None) -> None:
+    """Assert that a live :func:`~beatlite.train.evaluation.evaluate_models` table equals the record.
+
+    Each row's value must equal the record's seed-:data:`~beatlite.train.recipes.SEED` value (ground-truth
+    rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`.
+
+    Raises
+    ------
+    AssertionError
+        Naming the row and metric and ``make seeds``: the record or the checkpoint is stale.
+    """
+    k = record.seeds.index(SEED)
+    for row in results.rows:
+        assert row.label in record.values, f"{row.label} is not in the recorded table: make seeds"
+        for metric, value in row.metrics.items():
+            if metrics is not None and metric not in metrics:
+                continue
+            recorded = record.values[row.label][metric][0 if row.representation == "ground_truth" else k]
+            np.testing.assert_allclose(
+                recorded,
+                value,
+                rtol=RECORD_RTOL,
+                atol=RECORD_ATOL,
+                err_msg=f"{row.label} {metric}: make seeds",
+            )
 
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:

@@ -191,8 +191,8 @@ def fit(
     val_windows : same type as ``train_windows``, optional
         Validation windows: their mean losses are recorded after every epoch.
     meta : mapping, optional
-        Stored verbatim in the checkpoint (e.g. normalisation statistics needed by
-        :func:`beatlite.train.generate`).
+        Stored verbatim in the checkpoint (e.g. the train split's
+        :meth:`~beatlite.data.normalize.Normalizers.to_meta` needed by :func:`beatlite.train.generate`).
     val_score : callable, optional
         ``val_score(model) -> float``, lower is better, called in eval mode after every epoch
         (e.g. :func:`beatlite.train.evaluation.fgd_scorer`: FGD on the validation takes, the
@@ -219,86 +219,98 @@ def fit(
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
     from tqdm.auto import tqdm
 
-    arrays = as_arrays(train_windows)
-    keys = _needed_keys(model, arrays, "fit")
-    n = _n_windows(arrays, keys, "fit")
-    fingerprint = data_fingerprint(train_windows)
+    data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
-    model.prepare(arrays)
+    model.prepare(data.arrays)
+    run = _Run(model, config, data.fingerprint, dict(meta or {}))
+    if config.resume and run.path is not None and run.path.is_file():
+        run.resume()
+    if run.g_opt is None:  # untrained baseline: nothing to optimise
+        run.save(config.epochs)
+        return run.result()
+    bar = tqdm(
+        range(run.start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch"
+    )
+    for epoch in bar:
+        entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch), "val": {}}
+        if val_windows is not None:
+            entry["val"] = evaluate_losses(model, val_windows, epoch=epoch, batch_size=config.batch_size)
+        if val_score is not None:
+            run.score(epoch, val_score, entry)
+        run.history.append(entry)
+        bar.set_postfix(loss=f"{entry['train'].get('total', float('nan')):.4g}")
+        run.save(epoch + 1)
+    return run.result()
 
-    lr = config.learning_rate
-    g_params = model.generator_parameters()
-    g_opt = torch.optim.Adam(g_params, lr=lr, betas=config.betas) if g_params else None
-    d_opt = None
-    if model.discriminator is not None:
-        d_opt = torch.optim.Adam(
-            model.discriminator.parameters(), lr=lr * config.d_lr_weight, betas=config.betas
+
+@dataclasses.dataclass(eq=False)
+class _Data:
+    """The training windows as the loop reads them."""
+
+    arrays: Mapping[str, np.ndarray]
+    keys: tuple[str, ...]
+    n: int
+    fingerprint: str
+
+    @classmethod
+    def of(cls, model: GestureModel, windows: Any) -> _Data:
+        arrays = as_arrays(windows)
+        keys = _needed_keys(model, arrays, "fit")
+        return cls(arrays, keys, _n_windows(arrays, keys, "fit"), data_fingerprint(windows))
+
+
+class _Run:
+    """One training run's optimisers, history, best epoch and checkpoint (the state :func:`fit` resumes)."""
+
+    def __init__(
+        self, model: GestureModel, config: TrainConfig, fingerprint: str, meta: dict[str, Any]
+    ) -> None:
+        self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
+        self.lr = config.learning_rate
+        self.g_params = model.generator_parameters()
+        self.g_opt = (
+            torch.optim.Adam(self.g_params, lr=self.lr, betas=config.betas) if self.g_params else None
         )
+        self.d_opt = None
+        if model.discriminator is not None:
+            d_lr = self.lr * config.d_lr_weight
+            self.d_opt = torch.optim.Adam(model.discriminator.parameters(), lr=d_lr, betas=config.betas)
+        self.history: list[dict[str, Any]] = []
+        self.start_epoch = 0
+        self.best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
+        self.path = None if config.checkpoint is None else Path(config.checkpoint)
 
-    history: list[dict[str, Any]] = []
-    start_epoch = 0
-    best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
-    ckpt_path = None if config.checkpoint is None else Path(config.checkpoint)
-    if config.resume and ckpt_path is not None and ckpt_path.is_file():
-        data = load_checkpoint(ckpt_path)
-        if data.get("fingerprint") != fingerprint:
+    def resume(self) -> None:
+        """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``)."""
+        data = load_checkpoint(self.path)
+        if data.get("fingerprint") != self.fingerprint:
             raise ValueError(
-                f"fit: cannot resume from {ckpt_path}: it was trained on data {data.get('fingerprint')!r}, "
-                f"these windows are {fingerprint!r}"
+                f"fit: cannot resume from {self.path}: it was trained on data {data.get('fingerprint')!r}, "
+                f"these windows are {self.fingerprint!r}"
             )
-        if data["model"] != model.to_config():
-            raise ValueError(f"fit: cannot resume from {ckpt_path}: model config differs ({data['model']})")
-        model.load_state_dict(data["state"])
-        if g_opt is not None and data.get("optimizer") is not None:
-            g_opt.load_state_dict(data["optimizer"])
-        if d_opt is not None and data.get("d_optimizer") is not None:
-            d_opt.load_state_dict(data["d_optimizer"])
+        if data["model"] != self.model.to_config():
+            raise ValueError(f"fit: cannot resume from {self.path}: model config differs ({data['model']})")
+        self.model.load_state_dict(data["state"])
+        for opt, key in ((self.g_opt, "optimizer"), (self.d_opt, "d_optimizer")):
+            if opt is not None and data.get(key) is not None:
+                opt.load_state_dict(data[key])
         if data.get("rng") is not None:
             torch.set_rng_state(data["rng"])
-        history = list(data.get("history", []))
-        start_epoch = int(data["epoch"])
-        best = data.get("best")
+        self.history = list(data.get("history", []))
+        self.start_epoch = int(data["epoch"])
+        self.best = data.get("best")
 
-    def save(epoch_done: int) -> None:
-        if ckpt_path is None:
-            return
-        save_checkpoint(
-            ckpt_path,
-            {
-                "format": FORMAT,
-                "model": model.to_config(),
-                "state": model.state_dict(),
-                "optimizer": None if g_opt is None else g_opt.state_dict(),
-                "d_optimizer": None if d_opt is None else d_opt.state_dict(),
-                "epoch": epoch_done,
-                "history": history,
-                "fingerprint": fingerprint,
-                "train_config": config.to_dict(),
-                "rng": torch.get_rng_state(),
-                "meta": dict(meta or {}),
-                "best": best,
-            },
-        )
-
-    def result() -> FitResult:
-        if best is None:
-            return FitResult(history, ckpt_path, fingerprint)
-        return FitResult(history, ckpt_path, fingerprint, int(best["epoch"]), float(best["score"]))
-
-    if g_opt is None:  # untrained baseline: nothing to optimise
-        save(config.epochs)
-        return result()
-
-    bar = tqdm(range(start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch")
-    for epoch in bar:
+    def train_epoch(self, data: _Data, epoch: int) -> dict[str, float]:
+        """One epoch of optimiser steps; returns the mean losses over its windows."""
+        model, config = self.model, self.config
         model.train()
         factor = config.lr_factor(epoch)
-        for opt, base in ((g_opt, lr), (d_opt, lr * config.d_lr_weight)):
+        for opt, base in ((self.g_opt, self.lr), (self.d_opt, self.lr * config.d_lr_weight)):
             for group in [] if opt is None else opt.param_groups:
                 group["lr"] = base * factor
-        order = np.random.default_rng([config.seed, epoch]).permutation(n)
+        order = np.random.default_rng([config.seed, epoch]).permutation(data.n)
         if config.windows_per_epoch is not None:
             order = order[: config.windows_per_epoch]
         sums: dict[str, float] = {}
@@ -307,34 +319,63 @@ def fit(
             idx = np.sort(order[start : start + config.batch_size])
             if len(idx) < 2:
                 continue
-            batch = _batch(arrays, keys, idx)
-            out = model(batch)
-            if d_opt is not None and model.adversarial_active(epoch):
-                d_losses = model.discriminator_losses(batch, out)
-                d_opt.zero_grad(set_to_none=True)
-                d_losses["total"].backward()
-                torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
-                d_opt.step()
-                _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, len(idx), "D_")
-            losses = model.losses(batch, out, epoch=epoch)
-            g_opt.zero_grad(set_to_none=True)
-            losses["total"].backward()
-            torch.nn.utils.clip_grad_norm_(g_params, config.grad_clip)
-            g_opt.step()
-            _accumulate(sums, losses, len(idx))
+            self.step(_batch(data.arrays, data.keys, idx), len(idx), epoch, sums)
             seen += len(idx)
-        entry: dict[str, Any] = {"epoch": epoch, "train": _mean_losses(sums, seen), "val": {}}
-        if val_windows is not None:
-            entry["val"] = evaluate_losses(model, val_windows, epoch=epoch, batch_size=config.batch_size)
-        if val_score is not None:
-            model.eval()
-            with torch.no_grad():
-                score = float(val_score(model))
-            entry["val_score"] = score
-            if math.isfinite(score) and (best is None or score < best["score"]):
-                state = {k: v.detach().clone() for k, v in model.state_dict().items()}
-                best = {"epoch": epoch, "score": score, "state": state}
-        history.append(entry)
-        bar.set_postfix(loss=f"{entry['train'].get('total', float('nan')):.4g}")
-        save(epoch + 1)
-    return result()
+        return _mean_losses(sums, seen)
+
+    def step(self, batch: dict[str, torch.Tensor], weight: int, epoch: int, sums: dict[str, float]) -> None:
+        """The discriminator step (when adversarial) then the generator step on one batch of ``weight`` windows."""
+        model, config = self.model, self.config
+        out = model(batch)
+        if self.d_opt is not None and model.adversarial_active(epoch):
+            d_losses = model.discriminator_losses(batch, out)
+            self.d_opt.zero_grad(set_to_none=True)
+            d_losses["total"].backward()
+            torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
+            self.d_opt.step()
+            _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
+        losses = model.losses(batch, out, epoch=epoch)
+        self.g_opt.zero_grad(set_to_none=True)
+        losses["total"].backward()
+        torch.nn.utils.clip_grad_norm_(self.g_params, config.grad_clip)
+        self.g_opt.step()
+        _accumulate(sums, losses, weight)
+
+    def score(self, epoch: int, val_score: Callable[[GestureModel], float], entry: dict[str, Any]) -> None:
+        """Score the epoch in eval mode; keep a copy of the weights when it is the best so far."""
+        self.model.eval()
+        with torch.no_grad():
+            score = float(val_score(self.model))
+        entry["val_score"] = score
+        if math.isfinite(score) and (self.best is None or score < self.best["score"]):
+            state = {k: v.detach().clone() for k, v in self.model.state_dict().items()}
+            self.best = {"epoch": epoch, "score": score, "state": state}
+
+    def save(self, epoch_done: int) -> None:
+        """Write the full (resumable) checkpoint, when a path is configured."""
+        if self.path is None:
+            return
+        save_checkpoint(
+            self.path,
+            {
+                "format": FORMAT,
+                "model": self.model.to_config(),
+                "state": self.model.state_dict(),
+                "optimizer": None if self.g_opt is None else self.g_opt.state_dict(),
+                "d_optimizer": None if self.d_opt is None else self.d_opt.state_dict(),
+                "epoch": epoch_done,
+                "history": self.history,
+                "fingerprint": self.fingerprint,
+                "train_config": self.config.to_dict(),
+                "rng": torch.get_rng_state(),
+                "meta": self.meta,
+                "best": self.best,
+            },
+        )
+
+    def result(self) -> FitResult:
+        if self.best is None:
+            return FitResult(self.history, self.path, self.fingerprint)
+        return FitResult(
+            self.history, self.path, self.fingerprint, int(self.best["epoch"]), float(self.best["score"])
+        )

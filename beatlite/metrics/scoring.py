@@ -1,0 +1,334 @@
+"""The one evaluation path: every metric, by name and variant, on one system's takes vs the ground truth.
+
+Every table of beatlite (the results tables of BEAT Tables 4/5 and HA2G Tables 1/3/4, the seed
+tables, the notebooks) scores a system by calling :func:`evaluate` with
+
+- a :class:`Takes`: the system's motion on every evaluated take, in the forms the metrics read
+  (positions, TED directions, Euler degrees, extractor features of its windows), and
+- a :class:`GroundTruth`: the same for the dataset, plus what is computed once for all systems
+  (semantic scores, audio onsets, the training MAAC of beat consistency).
+
+Metrics are looked up by name in :data:`METRICS`; each names its variant and parameters, so a
+table can say which definition produced each column (:func:`describe`). A metric whose input
+is missing (e.g. Euler angles for a direction model) is skipped with the reason.
+
+Adding a metric: write the function (its own module in ``beatlite.metrics``), then one
+:class:`Metric` entry in :data:`METRICS` that reads what it needs from the two objects.
+
+>>> import numpy as np
+>>> pos = [np.zeros((40, 2, 3))]
+>>> truth = GroundTruth(Takes(positions=pos), semantic=[np.full(40, 0.5)])
+>>> evaluate(Takes(positions=pos), truth, metrics=("SRGR", "PCK")).get("SRGR").value  # perfect: mean score
+0.5
+
+Taught in ``notebooks/04_metrics.ipynb`` (the metrics) and ``notebooks/07_benchmark.ipynb`` (the tables).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
+
+
+@dataclass(eq=False)
+class Takes:
+    """One system's motion on every evaluated take (lists in take order).
+
+    Attributes
+    ----------
+    positions : list of (T_k, J, 3) float, cm
+        Joint positions (SRGR, PCK, BeatAlign, L1div).
+    directions : list of (T_k, 42, 3) float, optional
+        Unit TED bone directions (beat consistency).
+    euler : list of (T_k, 141) float, degrees, optional
+        ``spine_neck_141`` Euler channels (the reference SRGR / BeatAlign / L1div of BEAT's code).
+    features : (N, F) float, optional
+        Extractor features of the system's 34-frame windows (FGD, Diversity).
+    """
+
+    positions: list[np.ndarray]
+    directions: list[np.ndarray] | None = None
+    euler: list[np.ndarray] | None = None
+    features: np.ndarray | None = None
+
+
+@dataclass(eq=False)
+class GroundTruth:
+    """The dataset's takes and what every system is scored against, computed once.
+
+    Attributes
+    ----------
+    takes : Takes
+        The ground truth's own motion (its ``features`` are FGD's real distribution).
+    semantic : list of (T_k,) float in [0, 1], optional
+        Per-frame semantic scores (SRGR).
+    audio : list of (N_k,) float32, optional
+        The takes' audio at ``sr`` (metrics whose variant detects its own onsets).
+    audio_beats : list of (A_k,) float, optional
+        Onset times (s) of each take's audio with beatlite's detector
+        (:func:`beatlite.metrics.beats.audio_beats` defaults), shared by BeatAlign and BC;
+        computed from ``audio`` on first use when not given.
+    change_angle : (P,) float, optional
+        MAAC of the training directions per angle pair (beat consistency).
+    fps, sr : float, int
+    """
+
+    takes: Takes
+    semantic: list[np.ndarray] | None = None
+    audio: list[np.ndarray] | None = None
+    audio_beats: list[np.ndarray] | None = None
+    change_angle: np.ndarray | None = None
+    fps: float = FPS
+    sr: int = SR
+
+    def beats(self) -> list[np.ndarray] | None:
+        """:attr:`audio_beats`, detected from :attr:`audio` now if needed (None without audio)."""
+        if self.audio_beats is None and self.audio is not None:
+            from beatlite.metrics.beats import audio_beats
+
+            self.audio_beats = [audio_beats(y, self.sr) for y in self.audio]
+        return self.audio_beats
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One column a table can show.
+
+    Attributes
+    ----------
+    name : str
+        The metric as the papers name it (``"FGD"``, ``"SRGR"``, ...).
+    variant : str
+        Which definition (``"beatlite"``, ``"paper"``, ``"reference"``, ``"ha2g"``, ...).
+    higher_is_better : bool or None
+        None for descriptive statistics.
+    needs : tuple of str
+        Inputs it reads: ``"positions"``, ``"directions"``, ``"euler"``, ``"features"``,
+        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``.
+    compute : callable
+        ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float``.
+    describe : str
+        One line for a table caption: the variant and its parameters.
+    """
+
+    name: str
+    variant: str
+    higher_is_better: bool | None
+    needs: tuple[str, ...]
+    compute: Callable[[Takes, GroundTruth, int], float]
+    describe: str
+
+
+@dataclass(frozen=True)
+class MetricResult:
+    """One metric value with the definition that produced it (a :class:`Metric`'s fields)."""
+
+    key: str
+    name: str
+    value: float
+    variant: str
+    higher_is_better: bool | None = None
+    describe: str = ""
+
+
+@dataclass
+class Evaluation:
+    """The results of :func:`evaluate`: ``results`` plus ``skipped`` ``{metric key: reason}``."""
+
+    results: list[MetricResult]
+    skipped: dict[str, str] = field(default_factory=dict)
+
+    def get(self, key: str) -> MetricResult:
+        """The result of metric ``key`` (a key of :data:`METRICS`); ``KeyError`` otherwise."""
+        for r in self.results:
+            if r.key == key:
+                return r
+        raise KeyError(
+            f"no metric {key!r}; have {[r.key for r in self.results]}, skipped {sorted(self.skipped)}"
+        )
+
+    def values(self) -> dict[str, float]:
+        """``{metric key: value}``, NaN for the skipped ones."""
+        return {**{k: float("nan") for k in self.skipped}, **{r.key: r.value for r in self.results}}
+
+    def to_markdown(self) -> str:
+        """A Markdown table: metric, variant, value, better direction, definition."""
+        from beatlite.report import markdown_table
+
+        better = {True: "higher", False: "lower", None: ""}
+        rows = [
+            [r.name, r.variant, f"{r.value:.4g}", better[r.higher_is_better], r.describe]
+            for r in self.results
+        ]
+        rows += [[key, "—", "skipped", "", why] for key, why in self.skipped.items()]
+        return markdown_table(["metric", "variant", "value", "better", "definition"], rows)
+
+
+def evaluate(
+    generated: Takes, truth: GroundTruth, *, metrics: Sequence[str] | None = None, seed: int = 0
+) -> Evaluation:
+    """Score one system: every metric of ``metrics`` whose inputs are there.
+
+    Parameters
+    ----------
+    generated : Takes
+        The system's takes (same takes, in the same order and lengths, as ``truth.takes``).
+    truth : GroundTruth
+    metrics : sequence of str, optional
+        Keys of :data:`METRICS` (default: all of them).
+    seed : int
+        Seed of the Diversity pairing.
+
+    Returns
+    -------
+    Evaluation
+    """
+    _check_pairing(generated, truth)
+    results, skipped = [], {}
+    for key in METRICS if metrics is None else metrics:
+        if key not in METRICS:
+            raise ValueError(f"unknown metric {key!r}; known: {sorted(METRICS)}")
+        m = METRICS[key]
+        missing = [n for n in m.needs if not _has(n, generated, truth)]
+        if missing:
+            skipped[key] = f"needs {', '.join(missing)}"
+            continue
+        value = float(m.compute(generated, truth, seed))
+        results.append(MetricResult(key, m.name, value, m.variant, m.higher_is_better, m.describe))
+    return Evaluation(results, skipped)
+
+
+def describe(keys: Sequence[str]) -> str:
+    """Caption lines ``- <key>: <variant and parameters>`` for the columns of a table."""
+    return "\n".join(f"- **{key}**: {METRICS[key].describe}" for key in keys)
+
+
+def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:
+    if need in ("positions", "directions", "euler", "features"):
+        return getattr(gen, need) is not None and getattr(truth.takes, need) is not None
+    if need == "beats":
+        return truth.beats() is not None
+    return getattr(truth, need) is not None
+
+
+def _check_pairing(gen: Takes, truth: GroundTruth) -> None:
+    n, m = len(gen.positions), len(truth.takes.positions)
+    if n != m:
+        raise ValueError(f"generated has {n} takes, the ground truth {m}")
+    for i, (g, t) in enumerate(zip(gen.positions, truth.takes.positions, strict=True)):
+        if np.shape(g)[:1] != np.shape(t)[:1]:
+            raise ValueError(
+                f"take {i}: generated has {np.shape(g)[0]} frames, the ground truth {np.shape(t)[0]}"
+            )
+
+
+# --------------------------------------------------------------------------- the metrics
+def _fgd(reference: bool) -> Callable[[Takes, GroundTruth, int], float]:
+    from beatlite.metrics.fgd import fgd
+
+    return lambda g, t, seed: fgd(g.features, t.takes.features, reference=reference)
+
+
+def _srgr_paper(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.srgr import srgr
+
+    return srgr(g.positions, t.takes.positions, t.semantic, variant="paper", delta=10.0)
+
+
+def _srgr_reference(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.srgr import srgr
+
+    return srgr(g.euler, t.takes.euler, t.semantic, variant="reference")
+
+
+def _beat_align(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.beat_align import beat_align
+
+    return beat_align(None, t.sr, g.positions, t.fps, audio_beats=t.beats())
+
+
+def _beat_align_reference(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.beat_align import beat_align
+
+    return beat_align(t.audio, t.sr, g.euler, t.fps, variant="reference")
+
+
+def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
+    from beatlite.metrics.beat_consistency import beat_consistency
+
+    def compute(g: Takes, t: GroundTruth, seed: int) -> float:
+        if variant == "beatlite":
+            return beat_consistency(
+                None, t.sr, g.directions, t.fps, change_angle=t.change_angle, audio_beats=t.beats()
+            )
+        return beat_consistency(
+            t.audio, t.sr, g.directions, t.fps, change_angle=t.change_angle, variant=variant
+        )
+
+    return compute
+
+
+def _diversity(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.diversity import diversity
+
+    return diversity(g.features, n_pairs=500, seed=seed)
+
+
+def _l1div(windowed: bool) -> Callable[[Takes, GroundTruth, int], float]:
+    from beatlite.metrics.diversity import l1_diversity
+
+    if windowed:
+        return lambda g, t, seed: l1_diversity(g.euler, windowed=True)
+    return lambda g, t, seed: l1_diversity(g.positions)
+
+
+def _frame_weighted(fn: Callable[..., float]) -> Callable[[Takes, GroundTruth, int], float]:
+    def compute(g: Takes, t: GroundTruth, seed: int) -> float:
+        frames = np.array([len(p) for p in g.positions], dtype=np.float64)
+        values = np.array([fn(a, b) for a, b in zip(g.positions, t.takes.positions, strict=True)])
+        return float((values * frames).sum() / frames.sum())
+
+    return compute
+
+
+def _metrics() -> dict[str, Metric]:
+    from beatlite.metrics.extras import mpjpe, pck
+
+    win = f"{WINDOW_LENGTH}-frame windows, stride {WINDOW_STRIDE}"
+    return {
+        "FGD": Metric("FGD", "beatlite", False, ("features",), _fgd(False),
+                      f"Fréchet distance of extractor features of {win} (stable square root)"),
+        "FGD (reference)": Metric("FGD", "reference", False, ("features",), _fgd(True),
+                                  "the same with scipy's sqrtm, 1e10 on a complex result (BEAT's code)"),
+        "SRGR": Metric("SRGR", "paper", True, ("positions", "semantic"), _srgr_paper,
+                       "BEAT eq. 11 on joint positions, δ = 10 cm, ground-truth semantic scores"),
+        "SRGR (reference)": Metric("SRGR", "reference", True, ("euler", "semantic"), _srgr_reference,
+                                   "BEAT's code: Euler degrees, summed |diff| < 4°, weight score / 0.165"),
+        "BeatAlign": Metric("BeatAlign", "beatlite", True, ("positions", "beats"), _beat_align,
+                            "audio onsets vs joint-speed minima (positions), σ = 0.3 s, mean over audio beats"),
+        "BeatAlign (reference)": Metric("BeatAlign", "reference", True, ("euler", "audio"), _beat_align_reference,
+                                        "BEAT's code: Euler speed of columns 36:39, 10-500 s, RMS backtrack, "
+                                        "times at 22050 Hz"),
+        "BC": Metric("BC", "beatlite", True, ("directions", "beats", "change_angle"), _bc("beatlite"),
+                     "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows"),
+        "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),
+                            "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s"),
+        "Diversity": Metric("Diversity", "ha2g", True, ("features",), _diversity,
+                            "mean L1 distance of extractor features of 500 random window pairs"),
+        "L1div": Metric("L1div", "beatlite", True, ("positions",), _l1div(False),
+                        "BEAT L1div on positions (cm summed over joints x 3 per frame)"),
+        "L1div (reference)": Metric("L1div", "reference", True, ("euler",), _l1div(True),
+                                    f"BEAT's code: Euler degrees of the concatenated {win}"),
+        "PCK": Metric("PCK", "positions", True, ("positions",), _frame_weighted(lambda a, b: pck(a, b, 10.0)),
+                      "fraction of joints within 10 cm, frame-weighted over takes"),
+        "MPJPE": Metric("MPJPE", "positions", False, ("positions",), _frame_weighted(mpjpe),
+                        "mean per-joint position error, cm, frame-weighted over takes"),
+    }  # fmt: skip
+
+
+METRICS: dict[str, Metric] = _metrics()
+"""Every metric a table can show, by key (``"<name>"`` or ``"<name> (<variant>)"``)."""
