@@ -1,6 +1,6 @@
 """Word vocabulary and offline word vectors from the corpus transcripts.
 
-The reference (BEAT ``build_vocab.py``, facts A.5) indexes every word of the
+The reference (BEAT ``build_vocab.py``, docs/reference_code.md#vocabulary) indexes every word of the
 train + val + test TextGrids after the special tokens PAD=0, SOS=1, EOS=2,
 UNK=3, and gives each word its 300-d FastText ``cc.en.300.bin`` vector. That
 file is 7 GB and needs a download, so beatlite *learns* vectors from the

@@ -11,7 +11,7 @@ Frame rates: ``Frame Time`` is printed with few digits (BEAT writes
 ``0.008333``), so the reader snaps it to an integer frame rate when
 ``1/n`` agrees with the printed value to within one unit of its last digit
 (``0.008333`` -> 120.0, ``0.0333333`` -> 30.0). Real BEAT files sometimes carry a
-wrong Frame Time (facts A.3); pass ``fps=`` to override it.
+wrong Frame Time (docs/reference_code.md#bvh-header); pass ``fps=`` to override it.
 """
 
 from __future__ import annotations
@@ -466,7 +466,7 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: 
         The file. Gzip is detected from the content.
     fps : float, optional
         Frame rate to use instead of the file's ``Frame Time`` (some real BEAT
-        files have a wrong one, facts A.3). By default the rate comes from
+        files have a wrong one, docs/reference_code.md#bvh-header). By default the rate comes from
         :func:`parse_frame_time`, which snaps e.g. ``0.008333`` to 120.
     strict : bool
         If True, a ``Frames:`` value that differs from the number of rows

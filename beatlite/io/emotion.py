@@ -1,4 +1,4 @@
-"""BEAT emotion annotations (``.csv``, comma-separated, no header; facts A.7).
+"""BEAT emotion annotations (``.csv``, comma-separated, no header; docs/reference_code.md#emotion-annotations).
 
 Each line is ``name,start,end,duration,class`` with ``class`` in 0..7
 (neutral, happiness, anger, sadness, contempt, surprise, fear, disgust).

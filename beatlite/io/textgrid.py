@@ -12,9 +12,9 @@ rules, all vectorised with :func:`numpy.searchsorted`:
 - ``"span"`` (beatlite's default): frame ``i`` at ``t = i / fps`` gets the word
   whose half-open ``[start, end)`` contains ``t``; PAD (0) in silence, UNK (3)
   for a word missing from the vocabulary.
-- ``"onset"`` (HA2G / Trimodal, facts A.5): only frame ``floor(start * fps)``
+- ``"onset"`` (HA2G / Trimodal, docs/reference_code.md#textgrid): only frame ``floor(start * fps)``
   of each word gets its id; every other frame is PAD.
-- ``"beat"`` (BEAT/CaMN's loader, facts A.5): the *first* interval with
+- ``"beat"`` (BEAT/CaMN's loader, docs/reference_code.md#textgrid): the *first* interval with
   ``start <= t <= end`` (closed) wins, silence included. A mark equal to
   ``" "`` is PAD, but an empty mark ``""`` (MFA silence) is looked up in the
   vocabulary like a word (the reference's ``build_vocab`` indexes ``""``), so

@@ -4,7 +4,7 @@
 
 with audio beats ``B_a`` (onsets) and motion beats ``B_m`` (local minima of speed). Higher is
 better, in [0, 1]. The paper calls it a Chamfer distance between beat sets; the code
-(``utils/metric.py``, facts C.3) averages over audio beats as written above.
+(``utils/metric.py``, docs/reference_code.md#beatalign-reference) averages over audio beats as written above.
 
 Variants
 --------

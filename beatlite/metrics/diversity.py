@@ -1,7 +1,7 @@
 """Diversity metrics: BEAT's L1 diversity and HA2G's feature-space Diversity.
 
-``l1_diversity`` (BEAT, facts C.4) measures how far the poses of a generated take wander from
-that take's mean pose; ``diversity`` (HA2G, facts C.6) measures how different the features of
+``l1_diversity`` (BEAT, docs/reference_code.md#l1-diversity) measures how far the poses of a generated take wander from
+that take's mean pose; ``diversity`` (HA2G §4.3, docs/reference_code.md#ha2g-diversity) measures how different the features of
 randomly paired generated clips are. Higher means more varied motion for both; neither says
 the motion is *right*.
 """

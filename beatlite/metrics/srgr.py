@@ -13,7 +13,7 @@ Two variants:
 with ``lambda_t`` in [0, 1] the frame's semantic score and ``delta`` in cm. A perfect
 prediction scores ``mean_t lambda_t``. Use it to compare methods on positions (any skeleton).
 
-``variant="reference"`` — what BEAT's ``utils/metric.py`` computes (facts C.2), on **Euler
+``variant="reference"`` — what BEAT's ``utils/metric.py`` computes (docs/reference_code.md#srgr-reference), on **Euler
 angles in degrees**, J = C/3 joints::
 
     hit_{t,j} = 1[ sum_{xyz} |r_{t,j} - r^_{t,j}| < 4 ],

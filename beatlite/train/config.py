@@ -13,7 +13,7 @@ LR_SCHEDULES = ("constant", "cosine")
 
 @dataclasses.dataclass
 class TrainConfig:
-    """Settings of :func:`beatlite.train.fit` (defaults follow CaMN's reference, facts B.6).
+    """Settings of :func:`beatlite.train.fit` (defaults follow CaMN's reference, docs/reference_code.md#camn-training).
 
     Attributes
     ----------

@@ -422,7 +422,7 @@ def fgd_scorer(
     """A ``val_score`` for :func:`beatlite.train.fit`: FGD of a model's generation of ``split``'s whole takes.
 
     BEAT's reference trainer validates every epoch by FGD on the validation set and keeps the
-    best epoch (facts B.6); this is that score, computed exactly as the ``FGD`` column of
+    best epoch (docs/reference_code.md#camn-training); this is that score, computed exactly as the ``FGD`` column of
     :func:`evaluate_models` but on the ``val`` takes (so the test split stays unseen).
 
     Parameters

@@ -1,6 +1,6 @@
 """Generation of whole takes of any length with any :class:`~beatlite.models.base.GestureModel`.
 
-The take is cut into 34-frame units with stride 30 (facts C.7 "Inference"): unit ``k``
+The take is cut into 34-frame units with stride 30 (docs/reference_code.md#ha2g-inference): unit ``k``
 covers frames ``[30 k, 30 k + 34)``; its seed (first ``n_pre = 4`` frames) is the
 ground-truth seed for ``k = 0`` and the previous unit's last 4 output frames
 afterwards; the 4 overlapping frames are linearly cross-faded
@@ -198,7 +198,7 @@ def denormalise(pose: np.ndarray, representation: str, norm: Mapping[str, Any]) 
 
     euler141: ``pose * norm["pose_std"] + norm["pose_mean"]`` (degrees);
     dirvec126: ``pose + norm["dirvec_mean"]`` reshaped to (T, 42, 3) and re-normalised to
-    unit length (HA2G adds the mean back, facts C.5).
+    unit length (HA2G adds the mean back, docs/reference_code.md#ted-expressive).
     """
     pose = np.asarray(pose, dtype=np.float64)
     if representation == "euler141":
