@@ -484,6 +484,47 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: 
     FormatError
         For any malformed content, naming the file and line (and column for a
         bad number).
+
+    Examples
+    --------
+    A two-joint BVH file: a root with 6 channels and a child 10 cm above it with 3.
+
+    >>> import pathlib, tempfile
+    >>> from beatlite.io.bvh import read_bvh
+    >>> text = '''HIERARCHY
+    ... ROOT Hips
+    ... {
+    ...   OFFSET 0 0 0
+    ...   CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+    ...   JOINT Spine
+    ...   {
+    ...     OFFSET 0 10 0
+    ...     CHANNELS 3 Zrotation Xrotation Yrotation
+    ...     End Site
+    ...     {
+    ...       OFFSET 0 5 0
+    ...     }
+    ...   }
+    ... }
+    ... MOTION
+    ... Frames: 2
+    ... Frame Time: 0.008333
+    ... 0 95 0 0 0 0 0 0 0
+    ... 4 95 0 0 0 0 0 0 0
+    ... '''
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "tiny.bvh"
+    ...     _ = path.write_text(text)
+    ...     motion = read_bvh(path)
+    >>> motion
+    Motion(2 frames @ 120 fps = 0.02 s, 2 joints, 9 channels)
+    >>> motion.skeleton.names, motion.skeleton.channels[1]
+    (('Hips', 'Spine'), ('Zrotation', 'Xrotation', 'Yrotation'))
+    >>> motion.channels.shape  # (T, C): positions in cm, rotations in degrees
+    (2, 9)
+    >>> motion.positions()[1]  # frame 1: the root moved 4 cm along x; Spine sits 10 cm above
+    array([[  4.,  95.,   0.],
+           [  4., 105.,   0.]])
     """
     p = Path(path)
     if fps is not None:

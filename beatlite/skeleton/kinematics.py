@@ -242,6 +242,36 @@ def forward_kinematics(
     Returns
     -------
     (T, J, 3) float64, centimetres; (T, J + E, 3) with ``end_sites=True``.
+
+    Examples
+    --------
+    A shoulder-elbow-wrist chain along +x (upper arm 30 cm, forearm 25 cm). Turning the
+    shoulder 90 degrees about z swings the whole arm onto +y; turning only the elbow
+    swings the forearm.
+
+    >>> import numpy as np
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> from beatlite.skeleton.kinematics import forward_kinematics
+    >>> zxy = ("Zrotation", "Xrotation", "Yrotation")
+    >>> arm = Skeleton(
+    ...     names=("Shoulder", "Elbow", "Wrist"), parents=[-1, 0, 1],
+    ...     offsets=[[0, 0, 0], [30, 0, 0], [25, 0, 0]], channels=(zxy, zxy, ()))
+    >>> channels = np.array([[0.0, 0, 0, 0, 0, 0], [90, 0, 0, 0, 0, 0], [0, 0, 0, 90, 0, 0]])
+    >>> positions = forward_kinematics(arm, channels)  # (T, J, 3) cm
+    >>> positions.shape
+    (3, 3, 3)
+    >>> positions[0]
+    array([[ 0.,  0.,  0.],
+           [30.,  0.,  0.],
+           [55.,  0.,  0.]])
+    >>> positions[1].round(6) + 0.0  # shoulder at 90 degrees
+    array([[ 0.,  0.,  0.],
+           [ 0., 30.,  0.],
+           [ 0., 55.,  0.]])
+    >>> positions[2].round(6) + 0.0  # elbow at 90 degrees
+    array([[ 0.,  0.,  0.],
+           [30.,  0.,  0.],
+           [30., 25.,  0.]])
     """
     ch = _check_inputs(skeleton, channels, position_mode)
     n_joints = skeleton.n_joints
