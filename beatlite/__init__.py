@@ -6,6 +6,8 @@ imports torch:
 >>> import beatlite
 >>> motion = beatlite.io.read_bvh("data_samples/2_scott_0_1_1.bvh.gz")  # doctest: +SKIP
 
+(The doctests skip the ``read_bvh`` line: its path is relative to the repository root.)
+
 ==================  ==========================================================
 ``beatlite.io``       readers and writers for every file of a BEAT take
 ``beatlite.skeleton`` the BEAT skeleton, rotations, forward kinematics

@@ -9,6 +9,8 @@ whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds -- the
 TextGrid of an ``_a``/``_b`` half is not compared, it spans the whole sequence)
 are recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
 
+Usage (the doctests skip the last two lines: the path is relative to the repository root):
+
 >>> from beatlite.data.index import index_folder
 >>> idx = index_folder("data_samples")  # doctest: +SKIP
 >>> print(idx.where(split="test").to_markdown())  # doctest: +SKIP

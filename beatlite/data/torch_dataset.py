@@ -1,5 +1,7 @@
 """A torch ``Dataset`` over :class:`beatlite.data.windows.Windows` (torch imported here only).
 
+Usage (skipped by the doctests: ``windows`` stands for a :class:`~beatlite.data.windows.Windows` of a corpus):
+
 >>> from torch.utils.data import DataLoader  # doctest: +SKIP
 >>> loader = DataLoader(WindowDataset(windows), batch_size=64, shuffle=True)  # doctest: +SKIP
 >>> batch = next(iter(loader)); batch["pose"].shape  # doctest: +SKIP

@@ -1,5 +1,7 @@
 """Atomic file writing: a reader never sees a half-written file.
 
+Usage (skipped by the doctests: it writes ``out.txt`` in the current folder):
+
 >>> with atomic_write("out.txt") as f:  # doctest: +SKIP
 ...     f.write("hello\\n")
 """

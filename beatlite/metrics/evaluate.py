@@ -1,5 +1,7 @@
 """One call that computes every metric beatlite knows, with its variant and parameters.
 
+Usage (skipped by the doctests: ``gen_positions``, ``audio``, ... stand for your own arrays):
+
 >>> report = evaluate(gen_positions, gt_positions, audio=audio, semantic=sem)  # doctest: +SKIP
 >>> print(report.to_markdown())  # doctest: +SKIP
 

@@ -1,5 +1,7 @@
 """Gesture models (CaMN, HA2G and baselines), built by name; torch is imported lazily.
 
+Usage (skipped by the doctests: building a network is covered by ``tests/test_models_*.py``):
+
 >>> from beatlite.models import build_model          # doctest: +SKIP
 >>> model = build_model("camn", preset="tiny", use_audio=False)  # doctest: +SKIP
 

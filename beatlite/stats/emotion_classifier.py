@@ -50,6 +50,8 @@ class EmotionClassifier:
 
     Examples
     --------
+    Skipped by the doctests: ``train_windows``, ``train_labels``, ... stand for your own windows and labels.
+
     >>> clf = EmotionClassifier().fit(train_windows, train_labels)  # doctest: +SKIP
     >>> clf.per_class_accuracy(test_windows, test_labels)["avg"]  # doctest: +SKIP
     """

@@ -7,6 +7,8 @@ BEAT skeleton (beats whose stroke ends on word onsets, scripted semantic gesture
 emotion- and speaker-dependent style) and written in BEAT's formats and names. The generative
 rules and every planted effect are described in ``data_samples/README.md``.
 
+Usage (skipped by the doctests: it needs espeak-ng and writes a take under ``out/``):
+
 >>> from beatlite.synth import TakeSpec, generate_take  # doctest: +SKIP
 >>> generate_take(TakeSpec(2, 0, 65, 10.0), "out", seed=0)  # doctest: +SKIP
 """

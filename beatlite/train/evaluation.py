@@ -1,5 +1,7 @@
 """Evaluate gesture models on whole test takes: the results table of BEAT Tables 4/5 and HA2G Tables 1/3/4.
 
+Usage (skipped by the doctests: it loads every shipped checkpoint and runs for minutes):
+
 >>> from beatlite.train.evaluation import evaluate_models      # doctest: +SKIP
 >>> res = evaluate_models(["mean_pose", "camn_tiny", "s2g_tiny"])  # doctest: +SKIP
 >>> print(res.to_markdown())                                     # doctest: +SKIP

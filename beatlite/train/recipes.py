@@ -1,5 +1,7 @@
 """How every shipped checkpoint is trained: one table of recipes and one :func:`retrain`.
 
+Usage (skipped by the doctests: ``retrain`` trains a model for minutes):
+
 >>> from beatlite.train.recipes import RECIPES, retrain     # doctest: +SKIP
 >>> RECIPES["camn_tiny"].epochs                              # doctest: +SKIP
 40

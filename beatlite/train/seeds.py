@@ -1,5 +1,7 @@
 """The results table over several training seeds: mean ± standard deviation per model and metric.
 
+Usage (skipped by the doctests: it trains models for minutes):
+
 >>> from beatlite.train.seeds import train_seeds, evaluate_seeds    # doctest: +SKIP
 >>> train_seeds(["camn_tiny", "s2g_tiny"], seeds=[2022, 2023], jobs=2)   # doctest: +SKIP
 >>> table = evaluate_seeds(["camn_tiny", "s2g_tiny"], seeds=[2021, 2022, 2023])  # doctest: +SKIP

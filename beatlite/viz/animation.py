@@ -6,6 +6,8 @@ a heat map), and the current word as a caption. Lines are updated in place
 (``set_data_3d``); axes are never rebuilt, and frames are subsampled to the
 playback rate asked (``out_fps``).
 
+Usage (skipped by the doctests: ``gt``, ``camn``, ``y`` and ``take`` stand for your own data; it writes a file):
+
 >>> anim = animate_skeletons({"ground truth": gt, "CaMN": camn}, skeleton, fps=15,
 ...                          audio=y, sr=16000, words=take.words)        # doctest: +SKIP
 >>> anim                        # in JupyterLab: shown inline as JS/HTML (to_jshtml)  # doctest: +SKIP

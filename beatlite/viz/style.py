@@ -4,6 +4,8 @@ Nothing here changes matplotlib's global state at import time: apply the style
 for a block of code with :func:`figure_style` (a ``plt.rc_context``), or pass
 :data:`STYLE` to ``plt.rc_context`` yourself.
 
+Usage (the doctests skip the ``with`` block: it writes files under ``build/``):
+
 >>> import matplotlib.pyplot as plt
 >>> from beatlite.viz.style import figure_style, save_figure
 >>> with figure_style():                                  # doctest: +SKIP
