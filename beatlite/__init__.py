@@ -19,6 +19,8 @@ imports torch:
 ``beatlite.train``    one training harness and generation of whole takes (torch)
 ``beatlite.viz``      skeleton plots and animations (matplotlib, pyvista)
 ==================  ==========================================================
+
+Taught in notebooks/00_setup_and_tour.ipynb, sections 1 (the environment) and 2 (the data folder); its section 6 maps every notebook.
 """
 
 from __future__ import annotations

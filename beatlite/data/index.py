@@ -14,6 +14,8 @@ Usage (the doctests skip the last two lines: the path is relative to the reposit
 >>> from beatlite.data.index import index_folder
 >>> idx = index_folder("data_samples")  # doctest: +SKIP
 >>> print(idx.where(split="test").to_markdown())  # doctest: +SKIP
+
+Taught in notebooks/00_setup_and_tour.ipynb, sections 2 (what is in the data folder) and 4 (running everything on the real BEAT dataset).
 """
 
 from __future__ import annotations

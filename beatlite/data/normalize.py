@@ -1,4 +1,7 @@
-"""Per-dimension mean/std normalisation computed on the training split only."""
+"""Per-dimension mean/std normalisation computed on the training split only.
+
+No notebook teaches it directly; notebooks/05_camn.ipynb, section 1 shows the normalised training windows that :mod:`beatlite.data.windows` makes with it.
+"""
 
 from __future__ import annotations
 

@@ -6,6 +6,8 @@ Usage (skipped by the doctests: ``windows`` stands for a :class:`~beatlite.data.
 >>> loader = DataLoader(WindowDataset(windows), batch_size=64, shuffle=True)  # doctest: +SKIP
 >>> batch = next(iter(loader)); batch["pose"].shape  # doctest: +SKIP
 torch.Size([64, 34, 141])
+
+Not used in the notebooks: :func:`beatlite.train.fit` (notebooks/05_camn.ipynb, section 4) batches windows itself.
 """
 
 from __future__ import annotations

@@ -11,6 +11,8 @@ unlike FastText it knows only the corpus's words (no sub-word information,
 no vectors for unseen words, much weaker semantics on a small corpus). If you
 have a FastText ``.vec`` text file offline, :func:`read_vec_file` maps it onto
 a :class:`Vocab` instead.
+
+Taught in notebooks/03_audio_and_text_features.ipynb, sections 6 (words to frames: three rules) and 7 (the vocabulary and word vectors).
 """
 
 from __future__ import annotations

@@ -35,6 +35,8 @@ The log-mel is computed once per take (``center=True``, ``ref=max`` over the
 take, as HA2G does per clip) and sliced: a window starting at audio sample
 ``a0`` takes the 70 mel frames from ``floor(a0 / 512)``. No window is dropped
 (the reference drops near-static training windows; beatlite keeps them).
+
+Taught in notebooks/05_camn.ipynb, section 1 (a batch of training windows); its audio features in notebooks/03_audio_and_text_features.ipynb, sections 2 (the mel spectrogram) and 5 (the raw wave for CaMN).
 """
 
 from __future__ import annotations

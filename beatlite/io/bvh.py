@@ -12,6 +12,8 @@ Frame rates: ``Frame Time`` is printed with few digits (BEAT writes
 ``1/n`` agrees with the printed value to within one unit of its last digit
 (``0.008333`` -> 120.0, ``0.0333333`` -> 30.0). Real BEAT files sometimes carry a
 wrong Frame Time (docs/reference_code.md#bvh-header); pass ``fps=`` to override it.
+
+Taught in notebooks/01_beat_formats.ipynb, sections 2 (the BVH file) and 3 (reading the motion); writing in notebooks/08_visualisation_3d.ipynb, section 6 (export to Blender: BVH).
 """
 
 from __future__ import annotations

@@ -2,6 +2,8 @@
 
 Each line is ``name,start,end,duration,class`` with ``class`` in 0..7
 (neutral, happiness, anger, sadness, contempt, surprise, fear, disgust).
+
+Taught in notebooks/01_beat_formats.ipynb, section 10 (semantic relevance and emotion annotations).
 """
 
 from __future__ import annotations

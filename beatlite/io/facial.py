@@ -3,6 +3,8 @@
 The format is ``{"names": [51 names], "frames": [{"time": t, "weights": [51 floats]}, ...]}``
 with ``time`` in seconds (docs/reference_code.md#facial-json). BEAT has 51 weights: ARKit's 52 minus
 ``tongueOut``.
+
+Taught in notebooks/01_beat_formats.ipynb, section 8 (the face: 51 ARKit blendshapes at 60 fps).
 """
 
 from __future__ import annotations

@@ -4,6 +4,8 @@
 session types 0..7 are (English, Chinese, Spanish, Japanese) x (speech,
 conversation); speech sequence ids imply the emotion; the train/val/test
 split is within each speaker, by sequence id.
+
+Taught in notebooks/00_setup_and_tour.ipynb, section 2 (what is in the data folder: take names, emotions, splits) and its Exercises.
 """
 
 from __future__ import annotations

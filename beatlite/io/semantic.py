@@ -3,6 +3,8 @@
 Each line is ``type  start  end  duration  score  [keywords]``, e.g.
 ``08_metaphoric_l\\t31.931\\t34.035\\t2.104\\t0.8\\tlove``: a gesture type, its
 time span in seconds and a relevance score in [0, 1].
+
+Taught in notebooks/01_beat_formats.ipynb, section 10 (semantic relevance and emotion annotations).
 """
 
 from __future__ import annotations

@@ -20,6 +20,8 @@ rules, all vectorised with :func:`numpy.searchsorted`:
   vocabulary like a word (the reference's ``build_vocab`` indexes ``""``), so
   it gets ``vocab[""]`` if present and UNK otherwise. A frame outside every
   interval is UNK.
+
+Taught in notebooks/01_beat_formats.ipynb, section 9 (the words: a Praat TextGrid); ``words_to_frames`` in notebooks/03_audio_and_text_features.ipynb, section 6 (words to frames: three rules).
 """
 
 from __future__ import annotations

@@ -10,6 +10,8 @@
 ``evaluate``                    all of the above at once -> ``Evaluation`` (``to_markdown()``)
 ``load_extractor``              the shipped FGD feature extractor (imports torch lazily)
 ==============================  ===================================================================
+
+Taught in notebooks/04_metrics.ipynb (metrics), sections 1-5.
 """
 
 from __future__ import annotations

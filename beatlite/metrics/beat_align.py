@@ -16,6 +16,8 @@ Variants
   believed to be the right wrist but which is the right ring finger), forward differences,
   only the 10-500 s window, audio onsets backtracked to RMS minima and converted to seconds
   with librosa's default 22050 Hz (times x 0.726 at 16 kHz). Each piece is also selectable.
+
+Taught in notebooks/04_metrics.ipynb, section 3 (BeatAlign and beat consistency); the idea first in notebooks/03_audio_and_text_features.ipynb, section 4.
 """
 
 from __future__ import annotations

@@ -15,6 +15,8 @@ plus the two palm normals; the pairs are ``beatlite.skeleton.ted.ANGLE_PAIRS``.
 HA2G scores each 34-frame validation clip with its own audio and averages the clips weighted
 by their number of audio beats, skipping clips without motion beats (``clip_length=34``).
 beatlite's default scores the whole take at once.
+
+Taught in notebooks/04_metrics.ipynb, section 3 (BeatAlign and beat consistency).
 """
 
 from __future__ import annotations

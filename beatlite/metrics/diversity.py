@@ -4,6 +4,8 @@
 that take's mean pose; ``diversity`` (HA2G §4.3, docs/reference_code.md#ha2g-diversity) measures how different the features of
 randomly paired generated clips are. Higher means more varied motion for both; neither says
 the motion is *right*.
+
+Taught in notebooks/04_metrics.ipynb, section 4 (4.1 BEAT's L1 diversity, 4.2 HA2G's diversity).
 """
 
 from __future__ import annotations

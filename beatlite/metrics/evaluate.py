@@ -8,6 +8,8 @@ Usage (skipped by the doctests: ``gen_positions``, ``audio``, ... stand for your
 Each metric is computed only when its inputs are given (FGD and Diversity need windows and an
 extractor, SRGR needs semantic scores, BeatAlign and BC need audio, ...); ``skipped`` lists
 the others with the reason.
+
+Not used by the notebooks: notebooks/04_metrics.ipynb, section 5 calls each metric itself.
 """
 
 from __future__ import annotations

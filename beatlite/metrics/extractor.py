@@ -23,6 +23,8 @@ deterministic with ``--seed``); the shipped checkpoints are ``checkpoints/fgd_di
 (TED-43 direction vectors, 126-d, the common evaluation space) and
 ``checkpoints/fgd_euler141.pt`` (z-scored Euler angles, 141-d, BEAT's space).
 :func:`load_extractor` returns a callable ``windows (N, 34, D) -> features (N, L)``.
+
+Taught in notebooks/04_metrics.ipynb, section 1.3 (FGD on motion: the features decide what it sees).
 """
 
 from __future__ import annotations

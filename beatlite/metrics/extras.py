@@ -1,6 +1,8 @@
 """Extra motion statistics: PCK, MAE, and velocity / jerk statistics.
 
 Simple, interpretable numbers to report beside the paper metrics.
+
+Taught in notebooks/04_metrics.ipynb, section 2.1 (from PCK).
 """
 
 from __future__ import annotations

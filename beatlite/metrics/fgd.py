@@ -9,6 +9,8 @@ one to the real ones, and reports
 Lower is better; 0 means identical first and second moments. The value depends
 entirely on the extractor, so FGD numbers are only comparable with the same
 extractor (see :mod:`beatlite.metrics.extractor`).
+
+Taught in notebooks/04_metrics.ipynb, section 1 (FGD: the Fréchet distance between two Gaussians).
 """
 
 from __future__ import annotations

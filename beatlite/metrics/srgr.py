@@ -24,6 +24,8 @@ about 1 there). Use it to reproduce numbers reported with the BEAT code (0.239 f
 
 Several takes are pooled frame-weighted (``sum_takes T_k SRGR_k / sum_takes T_k``), as the
 reference code does.
+
+Taught in notebooks/04_metrics.ipynb, section 2 (2.1 from PCK, 2.2 the paper's SRGR vs the released code's).
 """
 
 from __future__ import annotations

@@ -19,6 +19,8 @@ name                class                                          representatio
 ``mean_pose``       :class:`beatlite.models.baselines.MeanPose`    euler141
 ``random_clip``     :class:`beatlite.models.baselines.RandomClip`  euler141
 ==================  =============================================  ===============
+
+Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
 """
 
 from __future__ import annotations

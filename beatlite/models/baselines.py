@@ -14,6 +14,8 @@ architectures): ``rec_weight * Huber_0.1(pred, target)`` (no semantic weighting;
 z-scored error sizes Huber_0.1 is L1 minus 0.05, i.e. S2G's L1 loss) plus NS-GAN from
 ``no_adv_epochs`` on. Trimodal adds ``kld_weight * KLD`` of its speaker z; its
 diversity regulariser is not implemented.
+
+Taught in notebooks/07_benchmark.ipynb, section 1 (one evaluation, one common space: the baselines).
 """
 
 from __future__ import annotations

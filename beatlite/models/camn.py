@@ -26,6 +26,8 @@ epoch ``no_adv_epochs`` on, ``adv_weight * -log D(pred)`` (NS-GAN) with a workin
 :class:`~beatlite.models.layers.ConvDiscriminator`. ``squared_adv_loss=True`` reproduces
 the reference's generator term ``adv_weight * D(pred)**2`` (a bug: minimising it pushes
 D(pred) towards 0, i.e. it rewards looking *fake*); it exists only for comparison.
+
+Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece).
 """
 
 from __future__ import annotations

@@ -32,6 +32,8 @@ the discriminator returns logits (NS-GAN through ``logsigmoid``); the contrastiv
 ``1 / distance`` have the distance floored at ``contrastive_min_distance``; the text
 encoders use learned word embeddings (no FastText); the spectrogram is scaled by
 ``mel / 40 + 1`` before the first convolution.
+
+Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy) to 8 (generation and evaluation).
 """
 
 from __future__ import annotations

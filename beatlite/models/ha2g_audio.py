@@ -18,6 +18,8 @@ exactly 34 time steps (70 -> 35 -> 34, 70 -> 18 -> 36 -> 34, 70 -> 9 -> 36 -> 34
 
 The style coordinator turns a speaker style vector into softmax weights over the
 three audio levels for each body level (paper eq. 3).
+
+Taught in notebooks/06_ha2g.ipynb, sections 3 (the hierarchical audio learner) and 5 (the style coordinator).
 """
 
 from __future__ import annotations

@@ -6,6 +6,8 @@ and 0.005 (negative), physical constraint 0.01.
 
 Angles are in units of pi radians (``arccos(cos) / pi`` in [0, 1]), as in the reference
 and :func:`beatlite.metrics.beats.included_angles`.
+
+Taught in notebooks/06_ha2g.ipynb, sections 4 (the multi-level contrastive loss) and 6 (the physical constraint).
 """
 
 from __future__ import annotations

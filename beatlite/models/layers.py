@@ -8,6 +8,8 @@ upstream in PantoMatrix PR #52). beatlite uses the corrected slopes: 0.1 in fusi
 MLPs, output heads and the discriminator, 0.01 (torch's default, as the reference)
 inside the residual :class:`BasicBlock1d`, 0.3 in the emotion encoder and the
 Trimodal wave encoder.
+
+Taught in notebooks/05_camn.ipynb, sections 2.1 (audio: from 36266 samples to 34 frames) and 2.2 (text, speaker, emotion and face).
 """
 
 from __future__ import annotations

@@ -17,6 +17,8 @@ distal joints; for the thumb ``Thumb1..3``).
 and turn with the head. They need the head's world rotation, which :func:`beat_to_ted43` takes
 from forward kinematics when given channels, or from ``rotations``; from positions alone the
 head frame is estimated (see there).
+
+Taught in notebooks/06_ha2g.ipynb, sections 1 (poses as unit bone directions), 2 (the body hierarchy) and 6 (the angle pairs of the physical constraint).
 """
 
 from __future__ import annotations

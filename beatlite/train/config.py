@@ -1,4 +1,7 @@
-"""The training configuration :class:`TrainConfig` (no torch import)."""
+"""The training configuration :class:`TrainConfig` (no torch import).
+
+Taught in notebooks/05_camn.ipynb, section 4 (training).
+"""
 
 from __future__ import annotations
 

@@ -35,6 +35,8 @@ Two ground-truth rows: ``Ground truth`` (the dataset's TED-43 directions, the FG
 FGD 0 by definition) and ``Ground truth (141 Euler channels)`` (only the channels the Euler
 models predict, the rest at rest pose: the floor an Euler model can reach).
 Nothing is cached outside ``build/`` (the window caches of :mod:`beatlite.data.windows`).
+
+Taught in notebooks/05_camn.ipynb, section 6 (evaluation on the test split) and notebooks/07_benchmark.ipynb, section 1 (one evaluation, one common space).
 """
 
 from __future__ import annotations

@@ -7,6 +7,8 @@ afterwards; the 4 overlapping frames are linearly cross-faded
 (weights ``linspace(0, 1, 4)`` for the new unit). Audio and mel slices follow the
 unit's *time* axis (the reference sliced the spectrogram along its mel axis, a bug).
 The last unit is padded (edge frames, silent audio) and the result cropped to T frames.
+
+Taught in notebooks/05_camn.ipynb, section 5 (generating a whole take).
 """
 
 from __future__ import annotations

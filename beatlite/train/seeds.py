@@ -14,6 +14,8 @@ Trimodal on FGD" is therefore checked on the mean over seeds, against the spread
 Seed :data:`beatlite.train.recipes.SEED` is the shipped checkpoint (``checkpoints/<name>.pt``);
 every other seed ``s`` is trained by :func:`beatlite.train.recipes.retrain` into
 ``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``).
+
+Taught in notebooks/07_benchmark.ipynb, section 2 (one run is one draw: the table over three seeds) and notebooks/05_camn.ipynb, section 7.
 """
 
 from __future__ import annotations

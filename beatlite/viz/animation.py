@@ -12,6 +12,8 @@ Usage (skipped by the doctests: ``gt``, ``camn``, ``y`` and ``take`` stand for y
 ...                          audio=y, sr=16000, words=take.words)        # doctest: +SKIP
 >>> anim                        # in JupyterLab: shown inline as JS/HTML (to_jshtml)  # doctest: +SKIP
 >>> anim.save_as("build/clip.gif")     # or .mp4 (needs ffmpeg) or .html             # doctest: +SKIP
+
+Taught in notebooks/08_visualisation_3d.ipynb, section 3 (one clock for everything: the synced animation).
 """
 
 from __future__ import annotations

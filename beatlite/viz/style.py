@@ -12,6 +12,8 @@ Usage (the doctests skip the ``with`` block: it writes files under ``build/``):
 ...     fig, ax = plt.subplots()
 ...     ax.plot([0, 1], [0, 1])
 ...     save_figure(fig, "build/figures/line")           # -> line.png, line.svg
+
+Used by every figure of the notebooks; first in notebooks/00_setup_and_tour.ipynb, section 2 (``save_figure``).
 """
 
 from __future__ import annotations
