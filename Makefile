@@ -33,9 +33,10 @@ system-deps:
 run: $(STAMP) system-deps
 	$(VPY) scripts/run_notebooks.py --out build
 
-## The test suite: lint, unit tests and nbval over every notebook.
+## The test suite: lint, unit tests, nbval over every notebook, then the doctests (Examples) of beatlite.
 test: $(STAMP) system-deps lint
 	$(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
+	$(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
 
 lint: $(STAMP)
 	$(VPY) -m ruff check beatlite tests bench scripts

@@ -6,6 +6,8 @@ imports torch:
 >>> import beatlite
 >>> motion = beatlite.io.read_bvh("data_samples/2_scott_0_1_1.bvh.gz")  # doctest: +SKIP
 
+(The doctests skip the ``read_bvh`` line: its path is relative to the repository root.)
+
 ==================  ==========================================================
 ``beatlite.io``       readers and writers for every file of a BEAT take
 ``beatlite.skeleton`` the BEAT skeleton, rotations, forward kinematics
@@ -17,6 +19,8 @@ imports torch:
 ``beatlite.train``    one training harness and generation of whole takes (torch)
 ``beatlite.viz``      skeleton plots and animations (matplotlib, pyvista)
 ==================  ==========================================================
+
+Taught in notebooks/00_setup_and_tour.ipynb, sections 1 (the environment) and 2 (the data folder); its section 6 maps every notebook.
 """
 
 from __future__ import annotations

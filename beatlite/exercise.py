@@ -6,6 +6,8 @@ and a ``solution`` cell (tagged ``solution``; instructors keep it, the student
 copy made by ``make run`` in ``build/student/`` drops it). :func:`resolve`
 lets later cells keep working while the exercise is not done yet, so every
 notebook still runs end to end.
+
+Used by the Exercises section at the end of every notebook (first in notebooks/00_setup_and_tour.ipynb, Exercises).
 """
 
 from __future__ import annotations

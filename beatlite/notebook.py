@@ -1,4 +1,7 @@
-"""One call at the top of every notebook: versions, mode, seeds, threads, figure style."""
+"""One call at the top of every notebook: versions, mode, seeds, threads, figure style.
+
+Used by the setup cell at the top of every notebook (the first code cell of notebooks/00_setup_and_tour.ipynb).
+"""
 
 from __future__ import annotations
 

@@ -2,6 +2,8 @@
 
 A notebook calls :func:`save_table` for every table it reproduces; ``make run``
 collects ``build/tables/*.md`` into ``build/results.md`` in notebook order.
+
+Taught in notebooks/00_setup_and_tour.ipynb, section 5 (the two commands: what ``make run`` writes).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Tiny hand-made BEAT-format takes for the data/stats tests (helpers + checks of the helpers).
 
-Every file is written by the minimal writers below (formats as in the reference facts A.3-A.7),
+Every file is written by the minimal writers below (formats as in docs/reference_code.md#bvh-header to #emotion-annotations),
 so the tests know every value: motion channels, audio samples, words, annotations.
 """
 

@@ -12,7 +12,7 @@ from test_data_fixtures import make_tiny_take, write_tiny_bvh, write_wav
 
 from beatlite.data.index import MAX_DURATION_GAP, TakeIndex, TakeRecord, index_folder
 
-# stem -> seconds; splits by BEAT's rule for the 4-hour speakers 2 and 4 (facts A.8):
+# stem -> seconds; splits by BEAT's rule for the 4-hour speakers 2 and 4 (docs/reference_code.md#splits):
 # speech 1-8 test, 9-56 train, 57-64 val; 74 lies inside the anger block 73-80 -> train.
 GOOD = {
     "2_scott_0_1_1": 4.0,  # test, neutral
@@ -167,7 +167,7 @@ def test_rows_and_markdown(corpus: Path) -> None:
 
 
 def test_wrong_frame_time_shows_as_disagreement(tmp_path: Path) -> None:
-    # a BEAT quirk (facts A.3): 120-fps data with 'Frame Time: 0.041667' -> 5x too long
+    # a BEAT quirk (docs/reference_code.md#bvh-header): 120-fps data with 'Frame Time: 0.041667' -> 5x too long
     write_tiny_bvh(tmp_path / "2_scott_0_9_9.bvh", 120 * 2, frame_time=0.041667)
     write_wav(tmp_path / "2_scott_0_9_9.wav", np.zeros(2 * 16000, np.float32))
     r = index_folder(tmp_path)["2_scott_0_9_9"]

@@ -19,7 +19,7 @@ from beatlite.io import (
     write_semantic,
 )
 
-# the example of PM#53 (facts A.6), tab-separated
+# the example of PM#53 (docs/reference_code.md#semantic-annotations), tab-separated
 SEMANTIC = "08_metaphoric_l\t31.931\t34.035\t2.104\t0.8\tlove\n01_beat_align\t34.035\t34.577\t0.542\t0.1\n\n"
 
 

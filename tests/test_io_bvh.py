@@ -120,7 +120,7 @@ def test_no_warning_when_counts_match(tmp_path: Path) -> None:
 
 
 def test_fps_override_and_frame_time_parsing(tmp_path: Path) -> None:
-    p = write(tmp_path, small_bvh(frame_time="0.041667"))  # a wrong BEAT Frame Time (facts A.3)
+    p = write(tmp_path, small_bvh(frame_time="0.041667"))  # BEAT quirk: docs/reference_code.md#bvh-header
     assert read_bvh(p).fps == 24.0
     assert read_bvh(p, fps=120).fps == 120.0
     assert parse_frame_time("0.008333") == 120.0  # |1/120 - 0.008333| = 3.3e-7 <= 1e-6
@@ -183,7 +183,7 @@ def test_real_beat_skeleton(real_samples: Path) -> None:
     assert all(c == ("Xrotation", "Yrotation", "Zrotation") for c in sk.channels[1:])
     assert sk.names[sk.parents[sk.index("RightArm")]] == "RightShoulder"
     assert m.fps == 120.0 and m.n_frames == 1
-    # 1 HIERARCHY + 5 root lines + 74*5 + 13*4 = 428 lines, then MOTION, Frames, Frame Time (facts A.3)
+    # 1 HIERARCHY + 5 root lines + 74*5 + 13*4 = 428 lines, then MOTION, Frames, Frame Time (docs/reference_code.md#bvh-header)
     np.testing.assert_array_equal(m.channels, _python_rows(p, 432))
     assert m.channels[0, :3].tolist() == [0.002950, -0.007960, -0.012340]
 

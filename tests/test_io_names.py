@@ -1,4 +1,4 @@
-"""Tests of BEAT take-name parsing, the emotion table and the split tables (facts A.1, A.2, A.8)."""
+"""Tests of BEAT take-name parsing, the emotion table and the split tables (BEAT §3.1; docs/reference_code.md#take-names, #splits)."""
 
 from __future__ import annotations
 

@@ -103,7 +103,7 @@ def test_load_take_start_phase(tmp_path: Path) -> None:
 def test_load_take_beat_phase_and_path_argument(tmp_path: Path) -> None:
     stem = make_take(tmp_path)
     take = load_take(str(stem) + ".bvh.gz", phase="beat")
-    # BEAT keeps 120-fps frames 1, 9, 17, ... (facts A.3): 239 source frames after frame 0 -> 30 frames
+    # BEAT keeps 120-fps frames 1, 9, 17, ... (docs/reference_code.md#downsampling): 239 source frames after frame 0 -> 30 frames
     np.testing.assert_array_equal(take.motion.channels[:, 0], 1 + np.arange(30) * 8)
     assert take.face is not None
     np.testing.assert_allclose(take.face[:, 0], np.arange(30) * 4 / 1000, rtol=1e-6)  # face from frame 0

@@ -217,7 +217,7 @@ def test_beat_rule_matches_reference_semantics() -> None:
     vocab = {**VOCAB, "": 7}
     out = words_to_frames(TIER, 18, 10, vocab, rule="beat")
     assert out.tolist() == [5] * 6 + [6] * 5 + [7, 7] + [3] * 3 + [0] + [3]
-    # without "" in the vocabulary, MFA silence becomes UNK, not PAD (facts A.5)
+    # without "" in the vocabulary, MFA silence becomes UNK, not PAD (docs/reference_code.md#textgrid)
     out = words_to_frames(TIER, 18, 10, VOCAB, rule="beat")
     assert out[11:13].tolist() == [3, 3]
 

@@ -22,7 +22,7 @@ from beatlite.models.ha2g import (  # noqa: E402
 from beatlite.models.ha2g_audio import HierarchicalAudioEncoder, StyleCoordinator, blend_audio  # noqa: E402
 from beatlite.models.testing import fake_batch, fake_windows  # noqa: E402
 
-PAPER_LEVEL_DIMS = (24, 30, 36, 66, 96, 126)  # facts C.7: 8/10/12/22/32/42 bones x 3
+PAPER_LEVEL_DIMS = (24, 30, 36, 66, 96, 126)  # docs/reference_code.md#ha2g-levels: 8/10/12/22/32/42 bones x 3
 
 
 @pytest.fixture(autouse=True)

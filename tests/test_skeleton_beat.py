@@ -56,7 +56,7 @@ def test_channel_layout_as_described():
         f"{s}Hand{f}4" for s in ("Right", "Left") for f in ("Middle", "Ring", "Pinky", "Index", "Thumb")
     }
     assert tips == {"HeadEnd", "RightToeBaseEnd", "LeftToeBaseEnd"} | fingers
-    # reference facts A.3: the channel dict's end index for joint k is 6 + 3k
+    # docs/reference_code.md#bvh-channels: the channel dict's end index for joint k is 6 + 3k
     starts = skel.channel_starts
     assert [int(starts[k]) + len(skel.channels[k]) for k in (1, 8, 74)] == [9, 30, 228]
 
@@ -151,7 +151,7 @@ def test_subset_sizes_and_body27_names():
 
 
 def test_spine_neck_141_is_depth_first_order_minus_excluded_joints():
-    # Reference facts A.3: excluded are Hips, Spine1-3, Head, HeadEnd, the ten *4 tips and the 12 legs.
+    # docs/reference_code.md#joint-subsets: excluded are Hips, Spine1-3, Head, HeadEnd, the ten *4 tips and the 12 legs.
     skel = beat_skeleton()
     excluded = {"Hips", "Spine1", "Spine2", "Spine3", "Head", "HeadEnd"}
     keep = [
@@ -160,7 +160,7 @@ def test_spine_neck_141_is_depth_first_order_minus_excluded_joints():
         if n not in excluded and not n.endswith("4") and not any(w in n for w in ("Leg", "Foot", "Toe"))
     ]
     assert tuple(keep) == JOINT_SUBSETS["spine_neck_141"]
-    # index map of facts A.3: joints 3-5 right shoulder/arm/forearm, 25-27 the left ones
+    # index map of docs/reference_code.md#joint-subsets: joints 3-5 right shoulder/arm/forearm, 25-27 the left ones
     s = JOINT_SUBSETS["spine_neck_141"]
     assert s[3:6] == ("RightShoulder", "RightArm", "RightForeArm")
     assert s[25:28] == ("LeftShoulder", "LeftArm", "LeftForeArm")

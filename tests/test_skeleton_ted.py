@@ -24,7 +24,7 @@ from beatlite.skeleton import (
     positions_to_directions,
 )
 
-# Reference facts C.7: joint ids and the 42 (parent, child) vectors of TED Expressive, written out.
+# docs/reference_code.md#ted-expressive: joint ids and the 42 (parent, child) vectors of TED Expressive, written out.
 EXPECTED_BONES = (
     [(0, 1), (1, 2), (1, 3), (2, 4), (4, 6)]
     + [(6, 8), (8, 9), (9, 10), (6, 11), (11, 12), (12, 13), (6, 14), (14, 15), (15, 16)]
@@ -40,7 +40,7 @@ def r(a, b):
     return list(range(a, b + 1))
 
 
-# Reference facts C.7 table of levels
+# docs/reference_code.md#ha2g-levels: table of levels
 EXPECTED_LEVELS = [
     r(0, 2) + r(37, 41),
     r(0, 3) + [20] + r(37, 41),
@@ -71,7 +71,7 @@ def test_levels_match_reference_table():
 def test_angle_pairs_as_described_in_reference():
     assert len(ANGLE_PAIRS) == 41
     pairs = set(ANGLE_PAIRS)
-    # facts C.7: finger-base spreads, shoulder chains, head chain, forearm x palm normal
+    # docs/reference_code.md#palm-normals: finger-base spreads, shoulder chains, head chain, forearm x palm normal
     assert {(17, 5), (5, 8), (8, 14), (14, 11), (34, 22), (22, 25), (25, 31), (31, 28)} <= pairs
     assert {(0, 1), (0, 2), (1, 3), (3, 4), (2, 20), (20, 21)} <= pairs
     assert {(0, 37), (37, 38), (37, 39), (38, 40), (39, 41), (4, 42), (21, 43)} <= pairs

@@ -326,7 +326,7 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
 def test_subset_dims_body27_matches_reference_layout() -> None:
     from beatlite.stats.emotion_clusters import subset_dims
 
-    # facts A.3: spine/neck = dims 0-8, right shoulder/arm/forearm = 9-17, left ones = 75-83
+    # docs/reference_code.md#joint-subsets: spine/neck = dims 0-8, right shoulder/arm/forearm = 9-17, left ones = 75-83
     assert subset_dims("body27").tolist() == list(range(18)) + list(range(75, 84))
     assert subset_dims("spine_neck_141").tolist() == list(range(141))
     with pytest.raises(ValueError, match="joints must be one of"):

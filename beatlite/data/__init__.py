@@ -7,6 +7,8 @@
 ``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract)
 ``torch_dataset``       ``WindowDataset`` (imports torch; import it explicitly)
 =====================  =============================================================
+
+Taught in notebooks/03_audio_and_text_features.ipynb, sections 5-7 (raw wave, words to frames, vocabulary) and notebooks/05_camn.ipynb, section 1 (a batch of training windows).
 """
 
 from __future__ import annotations

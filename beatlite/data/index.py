@@ -9,9 +9,13 @@ whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds -- the
 TextGrid of an ``_a``/``_b`` half is not compared, it spans the whole sequence)
 are recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
 
+Usage (the doctests skip the last two lines: the path is relative to the repository root):
+
 >>> from beatlite.data.index import index_folder
 >>> idx = index_folder("data_samples")  # doctest: +SKIP
 >>> print(idx.where(split="test").to_markdown())  # doctest: +SKIP
+
+Taught in notebooks/00_setup_and_tour.ipynb, sections 2 (what is in the data folder) and 4 (running everything on the real BEAT dataset).
 """
 
 from __future__ import annotations
@@ -329,7 +333,7 @@ def bvh_duration(path: str | Path) -> float:
     """Duration of a BVH file from its header, ``Frames`` x ``Frame Time``, seconds.
 
     Uses :func:`beatlite.io.read_bvh_header` (reads the HIERARCHY, not the motion rows).
-    Note that some real BEAT files declare a wrong ``Frame Time`` (facts A.3); the
+    Note that some real BEAT files declare a wrong ``Frame Time`` (docs/reference_code.md#bvh-header); the
     index then reports a duration disagreement with the audio.
     """
     from beatlite.io import read_bvh_header
@@ -497,7 +501,7 @@ def index_take(stem: str, files: dict[str, list[Path]], *, read_durations: bool 
                 record.durations[modality] = float(_DURATION_READERS[modality](record.files[modality]))
             except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
                 record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
-        # the TextGrid of an "_a"/"_b" half spans the whole sequence (facts A.5): not compared
+        # the TextGrid of an "_a"/"_b" half spans the whole sequence (docs/reference_code.md#textgrid): not compared
         compared = {m: d for m, d in record.durations.items() if not (m == "text" and record.half)}
         if len(compared) >= 2:
             lo = min(compared, key=compared.__getitem__)

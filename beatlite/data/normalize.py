@@ -1,4 +1,7 @@
-"""Per-dimension mean/std normalisation computed on the training split only."""
+"""Per-dimension mean/std normalisation computed on the training split only.
+
+No notebook teaches it directly; notebooks/05_camn.ipynb, section 1 shows the normalised training windows that :mod:`beatlite.data.windows` makes with it.
+"""
 
 from __future__ import annotations
 
@@ -157,7 +160,8 @@ class Normalizers:
         """Normalised (..., D) -> degrees (..., 141) float64, or unit directions (..., 42, 3) float64.
 
         Directions get the train mean added back and are re-normalised to unit length (HA2G's
-        code trains on mean-subtracted directions and adds the mean back before scoring).
+        code trains on mean-subtracted directions and adds the mean back before scoring,
+        docs/reference_code.md#ted-expressive).
         """
         x = self[representation].inverse_transform(np.asarray(z, dtype=np.float64))
         if representation == "euler141":

@@ -1,9 +1,13 @@
 """A torch ``Dataset`` over :class:`beatlite.data.windows.Windows` (torch imported here only).
 
+Usage (skipped by the doctests: ``windows`` stands for a :class:`~beatlite.data.windows.Windows` of a corpus):
+
 >>> from torch.utils.data import DataLoader  # doctest: +SKIP
 >>> loader = DataLoader(WindowDataset(windows), batch_size=64, shuffle=True)  # doctest: +SKIP
 >>> batch = next(iter(loader)); batch["pose"].shape  # doctest: +SKIP
 torch.Size([64, 34, 141])
+
+Not used in the notebooks: :func:`beatlite.train.fit` (notebooks/05_camn.ipynb, section 4) batches windows itself.
 """
 
 from __future__ import annotations

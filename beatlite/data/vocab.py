@@ -1,6 +1,6 @@
 """Word vocabulary and offline word vectors from the corpus transcripts.
 
-The reference (BEAT ``build_vocab.py``, facts A.5) indexes every word of the
+The reference (BEAT ``build_vocab.py``, docs/reference_code.md#vocabulary) indexes every word of the
 train + val + test TextGrids after the special tokens PAD=0, SOS=1, EOS=2,
 UNK=3, and gives each word its 300-d FastText ``cc.en.300.bin`` vector. That
 file is 7 GB and needs a download, so beatlite *learns* vectors from the
@@ -11,6 +11,8 @@ unlike FastText it knows only the corpus's words (no sub-word information,
 no vectors for unseen words, much weaker semantics on a small corpus). If you
 have a FastText ``.vec`` text file offline, :func:`read_vec_file` maps it onto
 a :class:`Vocab` instead.
+
+Taught in notebooks/03_audio_and_text_features.ipynb, sections 6 (words to frames: three rules) and 7 (the vocabulary and word vectors).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 :func:`build_windows` cuts every usable take of one split into windows of
 ``length`` frames at ``fps`` with hop ``stride`` (BEAT: 34 frames at 15 fps,
-stride 10; facts A.10) and returns a :class:`Windows` whose arrays follow the
+stride 10; HA2G §4.1, docs/reference_code.md#windows) and returns a :class:`Windows` whose arrays follow the
 batch contract of ``docs/architecture.md``:
 
 =============  =======================  =============================================================
@@ -35,6 +35,8 @@ The log-mel is computed once per take (``center=True``, ``ref=max`` over the
 take, as HA2G does per clip) and sliced: a window starting at audio sample
 ``a0`` takes the 70 mel frames from ``floor(a0 / 512)``. No window is dropped
 (the reference drops near-static training windows; beatlite keeps them).
+
+Taught in notebooks/05_camn.ipynb, section 1 (a batch of training windows); its audio features in notebooks/03_audio_and_text_features.ipynb, sections 2 (the mel spectrogram) and 5 (the raw wave for CaMN).
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ WINDOW_KEYS = (
     "take",
     "start",
 )
-#: HA2G log-mel settings (facts C.7).
+#: HA2G log-mel settings (HA2G §4.2, docs/reference_code.md#ha2g-audio).
 MEL_SETTINGS = {"n_mels": 128, "n_fft": 1024, "hop_length": 512, "power": 2.0}
 POSE_SUBSET = "spine_neck_141"
 #: Bump when the content of the cache changes.
@@ -229,7 +231,7 @@ def take_features(
 
     The frame count is the one :func:`beatlite.io.load_take` aligned every modality to: the
     smallest of the motion frames, ``floor(audio seconds * fps)`` and the face frames (BEAT:
-    truncate to the shortest modality, facts A.9).
+    truncate to the shortest modality, docs/reference_code.md#audio).
     """
     from beatlite.io import load_take, words_to_frames
     from beatlite.skeleton import subset_columns
@@ -251,7 +253,7 @@ def take_features(
         pos = world[:, skel.indices(JOINT_SUBSETS[POSE_SUBSET])].astype(np.float32)
     face = np.zeros((n, 51), np.float32) if take.face is None else np.asarray(take.face, np.float32)[:n]
     if take.words is not None and vocab is not None:
-        # the TextGrid of a "_b" half keeps the whole sequence's times (facts A.5)
+        # the TextGrid of a "_b" half keeps the whole sequence's times (docs/reference_code.md#textgrid)
         offset = 0.0 if record.half != "b" else (300.0 if record.conversation else 30.0)
         word = words_to_frames(take.words, n, fps, vocab, rule=word_rule, offset=offset).astype(np.int64)
     else:

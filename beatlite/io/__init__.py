@@ -16,6 +16,8 @@ or field for a malformed file. Every writer is atomic.
 ``textfile``        :func:`open_text`, :func:`read_text`, :func:`resolve`
 ``atomic``          :func:`atomic_write`
 ==================  ====================================================
+
+Taught in notebooks/01_beat_formats.ipynb (BEAT's file formats), sections 1-11.
 """
 
 from beatlite.io.atomic import atomic_write

@@ -1,7 +1,11 @@
 """Atomic file writing: a reader never sees a half-written file.
 
+Usage (skipped by the doctests: it writes ``out.txt`` in the current folder):
+
 >>> with atomic_write("out.txt") as f:  # doctest: +SKIP
 ...     f.write("hello\\n")
+
+Not taught in a notebook: every writer of :mod:`beatlite.io` uses it (``docs/architecture.md``, Conventions).
 """
 
 from __future__ import annotations

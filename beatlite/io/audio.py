@@ -11,6 +11,8 @@ difference, not in timing.
 The first bytes are sniffed before libsndfile sees the file, so an MP3 saved
 as ``.wav``, a Git-LFS pointer or an HTML error page gives a
 :class:`FormatError` saying what the bytes look like.
+
+Taught in notebooks/01_beat_formats.ipynb, section 8 (the audio read beside the face).
 """
 
 from __future__ import annotations

@@ -11,7 +11,9 @@ Frame rates: ``Frame Time`` is printed with few digits (BEAT writes
 ``0.008333``), so the reader snaps it to an integer frame rate when
 ``1/n`` agrees with the printed value to within one unit of its last digit
 (``0.008333`` -> 120.0, ``0.0333333`` -> 30.0). Real BEAT files sometimes carry a
-wrong Frame Time (facts A.3); pass ``fps=`` to override it.
+wrong Frame Time (docs/reference_code.md#bvh-header); pass ``fps=`` to override it.
+
+Taught in notebooks/01_beat_formats.ipynb, sections 2 (the BVH file) and 3 (reading the motion); writing in notebooks/08_visualisation_3d.ipynb, section 6 (export to Blender: BVH).
 """
 
 from __future__ import annotations
@@ -466,7 +468,7 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: 
         The file. Gzip is detected from the content.
     fps : float, optional
         Frame rate to use instead of the file's ``Frame Time`` (some real BEAT
-        files have a wrong one, facts A.3). By default the rate comes from
+        files have a wrong one, docs/reference_code.md#bvh-header). By default the rate comes from
         :func:`parse_frame_time`, which snaps e.g. ``0.008333`` to 120.
     strict : bool
         If True, a ``Frames:`` value that differs from the number of rows
@@ -484,6 +486,47 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: 
     FormatError
         For any malformed content, naming the file and line (and column for a
         bad number).
+
+    Examples
+    --------
+    A two-joint BVH file: a root with 6 channels and a child 10 cm above it with 3.
+
+    >>> import pathlib, tempfile
+    >>> from beatlite.io.bvh import read_bvh
+    >>> text = '''HIERARCHY
+    ... ROOT Hips
+    ... {
+    ...   OFFSET 0 0 0
+    ...   CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+    ...   JOINT Spine
+    ...   {
+    ...     OFFSET 0 10 0
+    ...     CHANNELS 3 Zrotation Xrotation Yrotation
+    ...     End Site
+    ...     {
+    ...       OFFSET 0 5 0
+    ...     }
+    ...   }
+    ... }
+    ... MOTION
+    ... Frames: 2
+    ... Frame Time: 0.008333
+    ... 0 95 0 0 0 0 0 0 0
+    ... 4 95 0 0 0 0 0 0 0
+    ... '''
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "tiny.bvh"
+    ...     _ = path.write_text(text)
+    ...     motion = read_bvh(path)
+    >>> motion
+    Motion(2 frames @ 120 fps = 0.02 s, 2 joints, 9 channels)
+    >>> motion.skeleton.names, motion.skeleton.channels[1]
+    (('Hips', 'Spine'), ('Zrotation', 'Xrotation', 'Yrotation'))
+    >>> motion.channels.shape  # (T, C): positions in cm, rotations in degrees
+    (2, 9)
+    >>> motion.positions()[1]  # frame 1: the root moved 4 cm along x; Spine sits 10 cm above
+    array([[  4.,  95.,   0.],
+           [  4., 105.,   0.]])
     """
     p = Path(path)
     if fps is not None:

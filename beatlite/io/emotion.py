@@ -1,7 +1,9 @@
-"""BEAT emotion annotations (``.csv``, comma-separated, no header; facts A.7).
+"""BEAT emotion annotations (``.csv``, comma-separated, no header; docs/reference_code.md#emotion-annotations).
 
 Each line is ``name,start,end,duration,class`` with ``class`` in 0..7
 (neutral, happiness, anger, sadness, contempt, surprise, fear, disgust).
+
+Taught in notebooks/01_beat_formats.ipynb, section 10 (semantic relevance and emotion annotations).
 """
 
 from __future__ import annotations

@@ -1,4 +1,7 @@
-"""Errors raised by the readers of :mod:`beatlite.io`."""
+"""Errors raised by the readers of :mod:`beatlite.io`.
+
+Not taught in a notebook; ``docs/architecture.md`` (Conventions) states the error contract.
+"""
 
 from __future__ import annotations
 

@@ -1,8 +1,10 @@
 """Facial blendshape weights (ARKit, 60 fps) stored as BEAT's JSON.
 
 The format is ``{"names": [51 names], "frames": [{"time": t, "weights": [51 floats]}, ...]}``
-with ``time`` in seconds (facts A.4). BEAT has 51 weights: ARKit's 52 minus
+with ``time`` in seconds (docs/reference_code.md#facial-json). BEAT has 51 weights: ARKit's 52 minus
 ``tongueOut``.
+
+Taught in notebooks/01_beat_formats.ipynb, section 8 (the face: 51 ARKit blendshapes at 60 fps).
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ ARKIT_52: tuple[str, ...] = (
     "cheekSquintRight", "noseSneerLeft", "noseSneerRight", "tongueOut",
 )  # fmt: skip
 
-#: BEAT's 51 facial channels: :data:`ARKIT_52` without ``tongueOut`` (facts A.4).
+#: BEAT's 51 facial channels: :data:`ARKIT_52` without ``tongueOut`` (docs/reference_code.md#facial-json).
 ARKIT_51: tuple[str, ...] = tuple(n for n in ARKIT_52 if n != "tongueOut")
 
 DEFAULT_FPS = 60.0

@@ -1,4 +1,7 @@
-"""The :class:`Motion` container returned by the BVH reader."""
+"""The :class:`Motion` container returned by the BVH reader.
+
+Taught in notebooks/01_beat_formats.ipynb, section 3 (reading the motion).
+"""
 
 from __future__ import annotations
 

@@ -1,9 +1,11 @@
-"""BEAT take names such as ``2_scott_0_1_1`` and what they imply (facts A.1, A.2, A.8).
+"""BEAT take names such as ``2_scott_0_1_1`` and what they imply (BEAT §3.1; docs/reference_code.md#take-names, #splits).
 
 ``<speaker id>_<speaker name>_<session type>_<start seq>_<end seq>[_a|_b]``:
 session types 0..7 are (English, Chinese, Spanish, Japanese) x (speech,
 conversation); speech sequence ids imply the emotion; the train/val/test
 split is within each speaker, by sequence id.
+
+Taught in notebooks/00_setup_and_tour.ipynb, section 2 (what is in the data folder: take names, emotions, splits) and its Exercises.
 """
 
 from __future__ import annotations
@@ -65,7 +67,7 @@ _MAX_CONVERSATION = 12
 
 
 def emotion_of(sequence: int, conversation: bool = False) -> int:
-    """Emotion class implied by a speech sequence id (facts A.2): 1-64 neutral, 65-72 happiness, ...
+    """Emotion class implied by a speech sequence id (docs/reference_code.md#take-names): 1-64 neutral, 65-72 happiness, ...
 
     Conversation is always neutral (0); ids 0 and 1-64 are neutral.
     """
@@ -78,7 +80,7 @@ def emotion_of(sequence: int, conversation: bool = False) -> int:
 
 
 def split_of(speaker_id: int, conversation: bool, sequence: int, half: str | None = None) -> str:
-    """Train/val/test split of one sequence (facts A.8).
+    """Train/val/test split of one sequence (docs/reference_code.md#splits).
 
     Parameters
     ----------

@@ -1,8 +1,10 @@
-"""BEAT semantic-relevance annotations (``.txt``, tab-separated, no header; facts A.6).
+"""BEAT semantic-relevance annotations (``.txt``, tab-separated, no header; docs/reference_code.md#semantic-annotations).
 
 Each line is ``type  start  end  duration  score  [keywords]``, e.g.
 ``08_metaphoric_l\\t31.931\\t34.035\\t2.104\\t0.8\\tlove``: a gesture type, its
 time span in seconds and a relevance score in [0, 1].
+
+Taught in notebooks/01_beat_formats.ipynb, section 10 (semantic relevance and emotion annotations).
 """
 
 from __future__ import annotations

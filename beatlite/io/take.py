@@ -13,7 +13,7 @@ Resampling phase
   (frames 0, r, 2r, ...); otherwise the two neighbouring source frames are
   interpolated linearly (rotation channels along the shorter way round the
   circle, so 179 -> -179 passes through 180, not 0).
-- ``phase="beat"``: BEAT's preprocessing (facts A.3): motion keeps source frames
+- ``phase="beat"``: BEAT's preprocessing (docs/reference_code.md#downsampling): motion keeps source frames
   1, 1 + r, 1 + 2r, ... (120 -> 15 fps keeps frames 1, 9, 17, ...), i.e. output
   frame ``i`` is at ``t = i / fps + 1 / source_fps``; the face is decimated from
   frame 0 (frames 0, 4, 8, ... at 60 fps), as BEAT does.
@@ -21,6 +21,8 @@ Resampling phase
 Modalities of different lengths are truncated to the shortest, with an
 :class:`~beatlite.io.errors.AlignmentWarning` (a ``UserWarning``) naming each
 duration when they differ by more than one frame.
+
+Taught in notebooks/01_beat_formats.ipynb, section 11 (one timeline: ``load_take`` at 15 fps).
 """
 
 from __future__ import annotations
@@ -222,7 +224,7 @@ def load_take(
     audio_sr : int
         Audio rate in Hz.
     bvh_fps : float, optional
-        Override of the BVH's ``Frame Time`` (some real BEAT files are wrong, facts A.3).
+        Override of the BVH's ``Frame Time`` (some real BEAT files are wrong, docs/reference_code.md#bvh-header).
 
     Returns
     -------

@@ -2,6 +2,8 @@
 
 Every reader of :mod:`beatlite.io` goes through these helpers, so ``take.bvh``
 and ``take.bvh.gz`` are read the same way.
+
+Used in notebooks/01_beat_formats.ipynb, section 2 (``read_text`` prints the raw BVH header).
 """
 
 from __future__ import annotations

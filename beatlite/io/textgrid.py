@@ -12,14 +12,16 @@ rules, all vectorised with :func:`numpy.searchsorted`:
 - ``"span"`` (beatlite's default): frame ``i`` at ``t = i / fps`` gets the word
   whose half-open ``[start, end)`` contains ``t``; PAD (0) in silence, UNK (3)
   for a word missing from the vocabulary.
-- ``"onset"`` (HA2G / Trimodal, facts A.5): only frame ``floor(start * fps)``
+- ``"onset"`` (HA2G / Trimodal, docs/reference_code.md#textgrid): only frame ``floor(start * fps)``
   of each word gets its id; every other frame is PAD.
-- ``"beat"`` (BEAT/CaMN's loader, facts A.5): the *first* interval with
+- ``"beat"`` (BEAT/CaMN's loader, docs/reference_code.md#textgrid): the *first* interval with
   ``start <= t <= end`` (closed) wins, silence included. A mark equal to
   ``" "`` is PAD, but an empty mark ``""`` (MFA silence) is looked up in the
   vocabulary like a word (the reference's ``build_vocab`` indexes ``""``), so
   it gets ``vocab[""]`` if present and UNK otherwise. A frame outside every
   interval is UNK.
+
+Taught in notebooks/01_beat_formats.ipynb, section 9 (the words: a Praat TextGrid); ``words_to_frames`` in notebooks/03_audio_and_text_features.ipynb, section 6 (words to frames: three rules).
 """
 
 from __future__ import annotations

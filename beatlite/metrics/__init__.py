@@ -10,6 +10,8 @@
 ``evaluate``                    the one evaluation path: metrics by name and variant -> ``Evaluation``
 ``load_extractor``              the shipped FGD feature extractor (imports torch lazily)
 ==============================  ===================================================================
+
+Taught in notebooks/04_metrics.ipynb (metrics), sections 1-5.
 """
 
 from __future__ import annotations

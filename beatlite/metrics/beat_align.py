@@ -4,7 +4,7 @@
 
 with audio beats ``B_a`` (onsets) and motion beats ``B_m`` (local minima of speed). Higher is
 better, in [0, 1]. The paper calls it a Chamfer distance between beat sets; the code
-(``utils/metric.py``, facts C.3) averages over audio beats as written above.
+(``utils/metric.py``, docs/reference_code.md#beatalign-reference) averages over audio beats as written above.
 
 Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BeatAlignVariant`)
 --------------------------------------------------------------------------------------
@@ -18,7 +18,7 @@ Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BeatAlignVariant
   with librosa's default 22050 Hz (times x 0.726 at 16 kHz). Each piece is a field of
   :class:`BeatAlignVariant`: ``dataclasses.replace(VARIANTS["reference"], window=None)`` mixes them.
 
-Taught in ``notebooks/03_audio_and_text_features.ipynb`` (beats) and ``notebooks/04_metrics.ipynb``.
+Taught in notebooks/04_metrics.ipynb, section 3 (BeatAlign and beat consistency); the idea first in notebooks/03_audio_and_text_features.ipynb, section 4.
 """
 
 from __future__ import annotations
@@ -148,6 +148,34 @@ def beat_align(
         without audio beats are skipped; NaN if no take has any. Within a take, a scored
         joint/triplet without any motion beat is left out of the joint mean; a take whose
         joints have no motion beat at all (a frozen pose) scores 0.
+
+    Examples
+    --------
+    Four seconds of audio with a click every 0.8 s (0.8 s = 12 frames at 15 fps = 25 STFT
+    hops of 512 samples at 16 kHz), and one joint swinging back and forth, turning round
+    (speed 0) at frames 12, 24, 36 and 48. librosa reports each click one hop (0.032 s)
+    late, so every audio beat is 0.032 s from a motion beat:
+    ``BeatAlign = exp(-0.032^2 / (2 * 0.3^2)) = 0.9943``.
+
+    >>> import numpy as np
+    >>> from beatlite.metrics.beat_align import beat_align
+    >>> sr, fps = 16000, 15
+    >>> audio = np.zeros(4 * sr, dtype=np.float32)
+    >>> audio[[12800, 25600, 38400, 51200]] = 1.0
+    >>> frames = np.arange(60)
+    >>> motion = np.zeros((60, 1, 3))
+    >>> motion[:, 0, 0] = 10 * np.cos(np.pi * frames / 12)  # (T, J, 3) cm, turns every 12 frames
+    >>> round(beat_align(audio, sr, motion, fps, sigma=0.3), 4)
+    0.9943
+    >>> round(float(np.exp(-(0.032**2) / (2 * 0.3**2))), 4)
+    0.9943
+
+    With the swing shifted by 6 frames (turns at 0.4, 1.2, 2.0 and 2.8 s), the nearest
+    motion beat is 0.4 - 0.032 = 0.368 s away: ``exp(-0.368^2 / 0.18) = 0.4713``.
+
+    >>> motion[:, 0, 0] = 10 * np.sin(np.pi * frames / 12)
+    >>> round(beat_align(audio, sr, motion, fps, sigma=0.3), 4)
+    0.4713
     """
     v = _variant(variant)
     fps = positive(fps, "fps")

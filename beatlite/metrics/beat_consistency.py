@@ -17,7 +17,7 @@ Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BCVariant`): HA2
 weighted by their number of audio beats, skipping clips without motion beats, with librosa's
 own peak picking; beatlite's default (``"beatlite"``) scores the whole take at once.
 
-Taught in ``notebooks/04_metrics.ipynb``.
+Taught in notebooks/04_metrics.ipynb, section 3 (BeatAlign and beat consistency).
 """
 
 from __future__ import annotations
@@ -176,6 +176,33 @@ def beat_consistency(
     Returns
     -------
     float in [0, 1]; NaN when no clip/take has both audio and motion beats.
+
+    Examples
+    --------
+    Clicks every 0.8 s as in :func:`beatlite.metrics.beat_align.beat_align`'s example
+    (librosa reports each one 0.032 s late), and 42 bone directions turning about the
+    vertical axis, each at its own rate, by an angle ``phi`` that reverses between frames
+    11 and 12, 23 and 24, ... Every included angle stops changing there, so the motion
+    beats are frames 12, 24, 36, 48 (0.8, 1.6, 2.4, 3.2 s) and
+    ``BC = exp(-0.032^2 / (2 * 0.1^2)) = 0.9501``.
+
+    >>> import numpy as np
+    >>> from beatlite.metrics.beat_consistency import beat_consistency
+    >>> sr, fps = 16000, 15
+    >>> audio = np.zeros(4 * sr, dtype=np.float32)
+    >>> audio[[12800, 25600, 38400, 51200]] = 1.0
+    >>> phi = np.cos(np.pi * (np.arange(60) - 11.5) / 12)  # phi[11] == phi[12], ...
+    >>> rng = np.random.default_rng(0)
+    >>> base, rate = rng.normal(size=(42, 3)), rng.uniform(0.5, 1.5, size=42)
+    >>> angle = rate * phi[:, None]  # (T, 42) rotation about z, radians
+    >>> x, y, z = base.T
+    >>> directions = np.stack(
+    ...     [np.cos(angle) * x - np.sin(angle) * y, np.sin(angle) * x + np.cos(angle) * y,
+    ...      np.broadcast_to(z, angle.shape)], axis=-1)  # (T, 42, 3)
+    >>> round(beat_consistency(audio, sr, directions, fps, sigma=0.1), 4)
+    0.9501
+    >>> round(float(np.exp(-(0.032**2) / (2 * 0.1**2))), 4)
+    0.9501
     """
     v = VARIANTS.get(variant) if isinstance(variant, str) else variant
     if not isinstance(v, BCVariant):

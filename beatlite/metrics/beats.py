@@ -8,6 +8,8 @@ mean change of the angles between bones (HA2G). The score of one set against ano
 
 i.e. for every *query* beat the Gaussian of its distance to the nearest *reference* beat.
 Both reference codes query with the audio beats (audio -> motion).
+
+Taught in notebooks/03_audio_and_text_features.ipynb, sections 3-4 (onsets; onsets and pauses in the motion) and notebooks/04_metrics.ipynb, section 3.2 (the beats of a take).
 """
 
 from __future__ import annotations

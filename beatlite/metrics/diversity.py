@@ -1,9 +1,11 @@
 """Diversity metrics: BEAT's L1 diversity and HA2G's feature-space Diversity.
 
-``l1_diversity`` (BEAT, facts C.4) measures how far the poses of a generated take wander from
-that take's mean pose; ``diversity`` (HA2G, facts C.6) measures how different the features of
+``l1_diversity`` (BEAT, docs/reference_code.md#l1-diversity) measures how far the poses of a generated take wander from
+that take's mean pose; ``diversity`` (HA2G §4.3, docs/reference_code.md#ha2g-diversity) measures how different the features of
 randomly paired generated clips are. Higher means more varied motion for both; neither says
 the motion is *right*.
+
+Taught in notebooks/04_metrics.ipynb, section 4 (4.1 BEAT's L1 diversity, 4.2 HA2G's diversity).
 """
 
 from __future__ import annotations
@@ -44,6 +46,20 @@ def l1_diversity(
     Returns
     -------
     float, units of ``motion`` summed over channels.
+
+    Examples
+    --------
+    A take of one channel, 0, 2, 4, 6 degrees, has mean pose 3 and distances 3, 1, 1, 3:
+    ``L1div = 8 / 4 = 2``. A constant channel adds nothing. A second, frozen take of two
+    frames pools frame-weighted: ``(8 + 0) / 6``.
+
+    >>> import numpy as np
+    >>> from beatlite.metrics.diversity import l1_diversity
+    >>> take = np.array([[0.0, 10.0], [2.0, 10.0], [4.0, 10.0], [6.0, 10.0]])  # (T, D) degrees
+    >>> l1_diversity(take)
+    2.0
+    >>> round(l1_diversity([take, np.full((2, 2), 5.0)]), 6)
+    1.333333
     """
     items, _ = as_list(motion, "motion")
     total, frames = 0.0, 0
@@ -93,6 +109,20 @@ def diversity(
     Returns
     -------
     float, feature units (L1).
+
+    Examples
+    --------
+    Three clip features whose pairwise L1 distances are all 2: every random pair of
+    distinct clips contributes 2, whatever the seed. With two clips, every pair is the
+    same pair.
+
+    >>> import numpy as np
+    >>> from beatlite.metrics.diversity import diversity
+    >>> features = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]])  # (N, F)
+    >>> diversity(features)
+    2.0
+    >>> diversity(np.array([[0.0, 0.0], [3.0, 4.0]]))
+    7.0
     """
     rng = np.random.default_rng(seed)
     if n_pairs < 1:

@@ -1,7 +1,7 @@
 """The FGD feature extractor: a small BEAT-style convolutional motion autoencoder (torch).
 
 FGD compares *features* of motion windows, so it needs a network that maps a 34-frame
-window to a vector. BEAT trains a convolutional autoencoder (facts B.7) and uses its
+window to a vector. BEAT trains a convolutional autoencoder (docs/reference_code.md#fgd-autoencoder) and uses its
 encoder output; beatlite does the same at a laptop scale:
 
 - encoder: Conv1d(D -> c, k3) -> BN -> LeakyReLU(0.2) -> Conv1d(c -> 2c, k3) -> BN -> LReLU
@@ -11,7 +11,7 @@ encoder output; beatlite does the same at a laptop scale:
   L = 32 by default, with a real LeakyReLU: a 300-d Gaussian is badly estimated from the few
   thousand windows of ``data_samples/``, the covariance alone having 45150 parameters.)
 - decoder: the mirror (Linear, then ConvTranspose1d 12 -> 14 -> 30 -> 32 -> 34).
-- loss: ``L1(x^, x) + w * MSE(diff_t x^, diff_t x)`` (reconstruction + velocity, facts B.7) with
+- loss: ``L1(x^, x) + w * MSE(diff_t x^, diff_t x)`` (reconstruction + velocity, docs/reference_code.md#fgd-autoencoder) with
   BEAT's ``w = 0.1`` for the "pose" extractor and ``w = 10`` for "dirvec": direction vectors move
   little per frame, and with 0.1 the dirvec encoder ignored timing (on ``data_samples/`` test vs
   val windows, FGD ratios frame-shuffled/held-out 0.9 and noisy/held-out 0.3 with w = 0.1;
@@ -23,6 +23,8 @@ deterministic with ``--seed``); the shipped checkpoints are ``checkpoints/fgd_di
 (TED-43 direction vectors, 126-d, the common evaluation space) and
 ``checkpoints/fgd_euler141.pt`` (z-scored Euler angles, 141-d, BEAT's space).
 :func:`load_extractor` returns a callable ``windows (N, 34, D) -> features (N, L)``.
+
+Taught in notebooks/04_metrics.ipynb, section 1.3 (FGD on motion: the features decide what it sees).
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from torch import nn
 FORMAT = "beatlite-fgd-extractor/1"
 #: Window key of ``beatlite.data.windows`` for each extractor space, and the shipped file name.
 SPACES = {"dirvec": ("dirvec", "fgd_dirvec.pt"), "pose": ("pose", "fgd_euler141.pt")}
-#: Weight of the velocity MSE per space. BEAT's 0.1 (facts B.7) for "pose"; for "dirvec" 0.1 leaves
+#: Weight of the velocity MSE per space. BEAT's 0.1 (docs/reference_code.md#fgd-autoencoder) for "pose"; for "dirvec" 0.1 leaves
 #: the encoder blind to timing (FGD of frame-shuffled test windows 0.9x that of held-out real
 #: windows on data_samples), 10 makes it see it (2.4x) — measured, see the module docstring.
 VELOCITY_WEIGHT = {"dirvec": 10.0, "pose": 0.1}
@@ -64,8 +66,8 @@ class ExtractorConfig:
         Base conv width c (default 32).
     epochs, batch_size, lr, seed : training settings.
     velocity_weight, velocity_loss : float, "mse" or "l1"
-        Weight and kind of the frame-difference term: BEAT's AE uses ``0.1 * MSE`` (facts B.7),
-        HA2G's MotionAE ``1 * L1`` (facts C.6).
+        Weight and kind of the frame-difference term: BEAT's AE uses ``0.1 * MSE`` (docs/reference_code.md#fgd-autoencoder),
+        HA2G's MotionAE ``1 * L1`` (docs/reference_code.md#ha2g-feature-extractor).
     """
 
     input_dim: int

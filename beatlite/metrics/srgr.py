@@ -13,7 +13,7 @@ Two variants:
 with ``lambda_t`` in [0, 1] the frame's semantic score and ``delta`` in cm. A perfect
 prediction scores ``mean_t lambda_t``. Use it to compare methods on positions (any skeleton).
 
-``variant="reference"`` — what BEAT's ``utils/metric.py`` computes (facts C.2), on **Euler
+``variant="reference"`` — what BEAT's ``utils/metric.py`` computes (docs/reference_code.md#srgr-reference), on **Euler
 angles in degrees**, J = C/3 joints::
 
     hit_{t,j} = 1[ sum_{xyz} |r_{t,j} - r^_{t,j}| < 4 ],
@@ -24,6 +24,8 @@ about 1 there). Use it to reproduce numbers reported with the BEAT code (0.239 f
 
 Several takes are pooled frame-weighted (``sum_takes T_k SRGR_k / sum_takes T_k``), as the
 reference code does.
+
+Taught in notebooks/04_metrics.ipynb, section 2 (2.1 from PCK, 2.2 the paper's SRGR vs the released code's).
 """
 
 from __future__ import annotations
@@ -68,6 +70,32 @@ def srgr(
     -------
     float
         Paper variant in [0, max lambda]; reference variant in [0, max lambda / 0.165].
+
+    Examples
+    --------
+    Four frames of two joints; the generated second joint is 20 cm off in every frame, so
+    half of the joints are recalled (delta = 10 cm). Only the first two frames are
+    semantically relevant (score 1): ``SRGR = (1 + 1 + 0 + 0) / 4 * 1/2 = 0.25``.
+
+    >>> import numpy as np
+    >>> from beatlite.metrics.srgr import srgr
+    >>> truth = np.zeros((4, 2, 3))
+    >>> generated = truth.copy()
+    >>> generated[:, 1, 0] = 20.0
+    >>> semantic = np.array([1.0, 1.0, 0.0, 0.0])
+    >>> srgr(generated, truth, semantic)
+    0.25
+    >>> srgr(truth, truth, semantic)  # a perfect prediction scores mean(semantic)
+    0.5
+
+    The reference variant works on Euler angles: joint 1 is off by 1 degree per axis
+    (3 < 4 summed degrees: recalled), joint 2 by 2 degrees per axis (6: missed); with
+    every semantic score at 0.165 the weight ``0.165 / 0.165`` is 1.
+
+    >>> truth = np.zeros((3, 6))
+    >>> generated = truth + [1.0, 1.0, 1.0, 2.0, 2.0, 2.0]
+    >>> round(srgr(generated, truth, np.full(3, 0.165), variant="reference"), 6)
+    0.5
     """
     if variant not in VARIANTS:
         raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")

@@ -1,5 +1,7 @@
 """Gesture models (CaMN, HA2G and baselines), built by name; torch is imported lazily.
 
+Usage (skipped by the doctests: building a network is covered by ``tests/test_models_*.py``):
+
 >>> from beatlite.models import build_model          # doctest: +SKIP
 >>> model = build_model("camn", preset="tiny", use_audio=False)  # doctest: +SKIP
 
@@ -17,6 +19,8 @@ name                class                                          representatio
 ``mean_pose``       :class:`beatlite.models.baselines.MeanPose`    euler141
 ``random_clip``     :class:`beatlite.models.baselines.RandomClip`  euler141
 ==================  =============================================  ===============
+
+Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
 """
 
 from __future__ import annotations

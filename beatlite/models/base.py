@@ -35,6 +35,8 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
   numpy window dict (used by the untrained baselines to store a mean pose / clip bank).
 
 Torch is imported at module import time here; :mod:`beatlite.models` itself stays lazy.
+
+Taught in notebooks/05_camn.ipynb, sections 2 (the seed input) and 3 (the semantic-weighted Huber loss).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@
 - :class:`S2G`: audio-only convolutional model in the style of Speech2Gesture
   (Ginosar et al. 2019): log-mel encoder + 1-D U-Net, no seed pose, regression + NS-GAN.
 - :class:`Trimodal`: text + audio + speaker GRU in the style of Trimodal / MultiContext
-  (Yoon et al. 2020; facts G): 4-conv wave encoder, TCN text encoder, reparameterised
+  (Yoon et al. 2020; docs/reference_code.md#trimodal): 4-conv wave encoder, TCN text encoder, reparameterised
   speaker style z, bidirectional GRU (directions summed), seed pose.
 
 Common objective of the learned baselines, as CaMN's (so differences come from the
@@ -14,6 +14,8 @@ architectures): ``rec_weight * Huber_0.1(pred, target)`` (no semantic weighting;
 z-scored error sizes Huber_0.1 is L1 minus 0.05, i.e. S2G's L1 loss) plus NS-GAN from
 ``no_adv_epochs`` on. Trimodal adds ``kld_weight * KLD`` of its speaker z; its
 diversity regulariser is not implemented.
+
+Taught in notebooks/07_benchmark.ipynb, section 1 (one evaluation, one common space: the baselines).
 """
 
 from __future__ import annotations
@@ -264,7 +266,7 @@ class S2G(_Adversarial):
 
 @dataclasses.dataclass
 class TrimodalConfig(ModelConfig):
-    """Trimodal / MultiContext-style hyper-parameters (defaults = ``paper``: facts G, hidden 300, 4 layers)."""
+    """Trimodal / MultiContext-style hyper-parameters (defaults = ``paper``: docs/reference_code.md#trimodal, hidden 300, 4 layers)."""
 
     preset: str = "paper"
     vocab_size: int = 5793

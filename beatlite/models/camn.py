@@ -21,11 +21,13 @@ variant: no fusion MLPs (encoder features go straight into the decoder) and one
 decoder LSTM predicting all 141 channels; ``semantic_weighting=False`` drops the
 (1 + semantic) loss weighting.
 
-Losses (facts B.5): ``rec_weight * Huber_0.1((1+s) * pred, (1+s) * target)`` and, from
+Losses (docs/reference_code.md#camn-losses): ``rec_weight * Huber_0.1((1+s) * pred, (1+s) * target)`` and, from
 epoch ``no_adv_epochs`` on, ``adv_weight * -log D(pred)`` (NS-GAN) with a working
 :class:`~beatlite.models.layers.ConvDiscriminator`. ``squared_adv_loss=True`` reproduces
 the reference's generator term ``adv_weight * D(pred)**2`` (a bug: minimising it pushes
 D(pred) towards 0, i.e. it rewards looking *fake*); it exists only for comparison.
+
+Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece).
 """
 
 from __future__ import annotations
@@ -57,7 +59,7 @@ POSE_DIM = 141
 
 @dataclasses.dataclass
 class CaMNConfig(ModelConfig):
-    """CaMN hyper-parameters (defaults = the ``paper`` preset, facts B.2-B.6).
+    """CaMN hyper-parameters (defaults = the ``paper`` preset, BEAT §4, docs/reference_code.md#camn).
 
     Sizes are feature channels per frame; ``hidden``/``n_layers`` are the decoder LSTMs'.
     ``no_adv_epochs`` is the 0-based epoch from which the adversarial term is on.
@@ -130,7 +132,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "d_layers": 1,
     },
 }
-"""Preset name -> overrides of :class:`CaMNConfig` (``paper``: facts B; ``tiny``: CPU minutes).
+"""Preset name -> overrides of :class:`CaMNConfig` (``paper``: docs/reference_code.md#camn; ``tiny``: CPU minutes).
 
 ``tiny`` keeps every component of ``paper`` (six-block WavEncoder, TCN text encoder, face,
 emotion and speaker encoders, the cascade, body-then-hands decoders, discriminator) with
@@ -148,7 +150,7 @@ def _assembly_index() -> torch.Tensor:
     """(141,) index into ``cat[body27, hands114]`` giving the reference's 141-d layout.
 
     Computed by :func:`beatlite.skeleton.beat.camn_assemble` on index arrays when that
-    module is available, else from facts B.3: out[0:18] = body[0:18], out[18:75] =
+    module is available, else from docs/reference_code.md#camn-decoders: out[0:18] = body[0:18], out[18:75] =
     hands[0:57], out[75:84] = body[18:27], out[84:141] = hands[57:114].
     """
     body = np.arange(BODY_DIM, dtype=np.float64)
@@ -212,7 +214,7 @@ class EmotionEncoder(nn.Module):
 class FaceEncoder(nn.Module):
     """51 ARKit weights -> ``channels[-1]`` features per frame with 4 length-preserving BasicBlocks.
 
-    Blocks (facts B.2): (51 -> c0, k7, p3)*, (c0 -> c1, k3, p1)*, (c1 -> c2, k3, p1), (c2 -> c3, k3, p1)*.
+    Blocks (docs/reference_code.md#camn-encoders): (51 -> c0, k7, p3)*, (c0 -> c1, k3, p1)*, (c1 -> c2, k3, p1), (c2 -> c3, k3, p1)*.
     Shapes: (B, T, 51) -> (B, T, channels[-1]).
     """
 

@@ -17,6 +17,8 @@ zero padding. The weight gradient and every other case use torch's own
 ``convolution_backward``. Gradients agree with torch's to float rounding
 (``tests/test_models_fast_conv.py`` runs ``gradcheck``); ``bench/bench_models.py`` times CaMN
 and HA2G epochs with and without them.
+
+Not taught in a notebook (a speed detail of the models' convolutions).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ A style coordinator turns z into softmax weights over the three audio levels for
 body level (paper eq. 3). The pose inferer runs one bidirectional GRU per body level
 (``beatlite.skeleton.ted.HA2G_LEVELS``: spine/shoulders/head -> upper arms -> forearms ->
 three rings of finger phalanges, 24/30/36/66/96/126 channels); level k's seed input
-carries level k-1's prediction in the channels they share (facts C.7). Losses: hierarchical
+carries level k-1's prediction in the channels they share (HA2G §3.3, eq. 4; docs/reference_code.md#ha2g-levels). Losses: hierarchical
 Huber, NS-GAN on the last level, style diverging, KL, multi-level audio-text contrastive
 and the bone-angle physical constraint (:mod:`beatlite.models.ha2g_losses`).
 
@@ -32,6 +32,8 @@ the discriminator returns logits (NS-GAN through ``logsigmoid``); the contrastiv
 ``1 / distance`` have the distance floored at ``contrastive_min_distance``; the text
 encoders use learned word embeddings (no FastText); the spectrogram is scaled by
 ``mel / 40 + 1`` before the first convolution.
+
+Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy) to 8 (generation and evaluation).
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ AUDIO_MODES = ("blend", *AUDIO_LEVELS)
 
 @dataclasses.dataclass
 class HA2GConfig(ModelConfig):
-    """HA2G hyper-parameters (defaults = the ``paper`` preset, facts C.7).
+    """HA2G hyper-parameters (defaults = the ``paper`` preset, docs/reference_code.md#ha2g-hyperparameters).
 
     Switches: ``hierarchical`` (False = "holistic": one level with all 42 bones),
     ``audio_mode`` (``"blend"`` = style-coordinated mix of the 3 levels; ``"low"``/``"mid"``/
@@ -169,7 +171,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "d_layers": 1,
     },
 }
-"""Preset name -> overrides of :class:`HA2GConfig` (``paper``: facts C.7; ``tiny``: CPU minutes).
+"""Preset name -> overrides of :class:`HA2GConfig` (``paper``: docs/reference_code.md#ha2g-hyperparameters; ``tiny``: CPU minutes).
 
 ``tiny``'s GRUs have 48 units: with 32, training from seed 1 reached a validation FGD of 5.7 in
 30 epochs and a test FGD of 7.19; with 48 the same seed reached 3.28 and 4.60 (issue 6 notes),

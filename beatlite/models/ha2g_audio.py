@@ -1,7 +1,7 @@
 """HA2G's hierarchical audio learner and style coordinator (torch).
 
 The audio encoder is a compact SE-ResNet (the reference uses SE-ResNet-34 "V2",
-blocks ``[3, 4, 6, 3]``, channels ``[32, 64, 128, 256]``; facts C.7) on a log-mel
+blocks ``[3, 4, 6, 3]``, channels ``[32, 64, 128, 256]``; HA2G §4.2, docs/reference_code.md#ha2g-audio) on a log-mel
 spectrogram. Three streams read three depths of the backbone and are each mapped
 to one feature vector per pose frame:
 
@@ -18,6 +18,8 @@ exactly 34 time steps (70 -> 35 -> 34, 70 -> 18 -> 36 -> 34, 70 -> 9 -> 36 -> 34
 
 The style coordinator turns a speaker style vector into softmax weights over the
 three audio levels for each body level (paper eq. 3).
+
+Taught in notebooks/06_ha2g.ipynb, sections 3 (the hierarchical audio learner) and 5 (the style coordinator).
 """
 
 from __future__ import annotations

@@ -1,11 +1,13 @@
 """HA2G's training losses (torch) and the bone-angle statistics of the physical constraint.
 
-All losses are means (scalars); the model multiplies them by its weights (facts C.7):
+All losses are means (scalars); the model multiplies them by its weights (docs/reference_code.md#ha2g-losses):
 hierarchical Huber 250, GAN 5, KL 0.1, style diverging 0.05, contrastive 0.2 (positive)
 and 0.005 (negative), physical constraint 0.01.
 
 Angles are in units of pi radians (``arccos(cos) / pi`` in [0, 1]), as in the reference
 and :func:`beatlite.metrics.beats.included_angles`.
+
+Taught in notebooks/06_ha2g.ipynb, sections 4 (the multi-level contrastive loss) and 6 (the physical constraint).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from beatlite.models.base import huber
 
 N_BONES = 42
 PALM_BONES: tuple[tuple[int, int], ...] = ((11, 17), (28, 34))
-"""TED-43 direction-vector pairs whose cross products are the left / right palm normals (facts C.5)."""
+"""TED-43 direction-vector pairs whose cross products are the left / right palm normals (docs/reference_code.md#palm-normals)."""
 
 
 def default_angle_pairs() -> np.ndarray:
@@ -172,7 +174,7 @@ def directions_with_palms(dirvec: torch.Tensor, mean_dirvec: torch.Tensor) -> to
     """Mean-subtracted 126-d direction vectors -> 44 unit vectors (42 bones + 2 palm normals).
 
     Adds ``mean_dirvec`` back, normalises each bone, appends ``cross(v11, v17)`` and
-    ``cross(v28, v34)`` normalised (facts C.5/C.7).
+    ``cross(v28, v34)`` normalised (docs/reference_code.md#palm-normals).
 
     Parameters
     ----------

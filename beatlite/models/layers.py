@@ -8,6 +8,8 @@ upstream in PantoMatrix PR #52). beatlite uses the corrected slopes: 0.1 in fusi
 MLPs, output heads and the discriminator, 0.01 (torch's default, as the reference)
 inside the residual :class:`BasicBlock1d`, 0.3 in the emotion encoder and the
 Trimodal wave encoder.
+
+Taught in notebooks/05_camn.ipynb, sections 2.1 (audio: from 36266 samples to 34 frames) and 2.2 (text, speaker, emotion and face).
 """
 
 from __future__ import annotations
@@ -87,7 +89,7 @@ class BasicBlock1d(nn.Module):
 class WavEncoder(nn.Module):
     """CaMN's raw-waveform encoder: 6 residual blocks, 16 kHz audio -> 15 fps features.
 
-    Block layout (in, out, kernel, stride, padding; facts B.2):
+    Block layout (in, out, kernel, stride, padding; docs/reference_code.md#camn-encoders):
     (1, c0, 15, 5, 1600)*, (c0, c1, 15, 6, 0)*, (c1, c2, 15, 1, 7), (c2, c3, 15, 6, 0)*,
     (c3, c4, 15, 1, 7), (c4, c5, 15, 6, 0)* (* = conv shortcut); the paper widths are
     ``channels = (32, 32, 32, 64, 64, 128)``. The total stride is 5 * 6 * 6 * 6 = 1080
@@ -128,7 +130,7 @@ class WavEncoder(nn.Module):
 
 
 class PlainWavEncoder(nn.Module):
-    """Trimodal's waveform encoder: 4 plain convolutions (facts G), 36266 samples -> 34 frames.
+    """Trimodal's waveform encoder: 4 plain convolutions (docs/reference_code.md#trimodal), 36266 samples -> 34 frames.
 
     ``Conv1d(1, c0, 15, stride 5, padding 1600) -> BN -> LReLU(0.3)``, then three
     ``Conv1d(k15, stride 6)`` layers (the last without BN/activation); reference widths

@@ -2,6 +2,8 @@
 
 The values are random (seeded) but respect each key's type and range, so a
 model's forward/backward pass can be unit-tested without the data pipeline.
+
+Not taught in a notebook: fake windows and batches for the tests.
 """
 
 from __future__ import annotations

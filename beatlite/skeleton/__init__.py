@@ -8,6 +8,8 @@
 ``directions``               unit bone vectors <-> joint positions
 ``ted``                      the TED-Expressive 43-joint body for HA2G (bones, levels, angle pairs)
 ==========================  ==================================================================
+
+Taught in notebooks/01_beat_formats.ipynb, sections 2 and 4-7 (the skeleton, Euler angles, forward kinematics, joint subsets).
 """
 
 from __future__ import annotations

@@ -11,6 +11,8 @@ toe joints) is at ``y = -HIPS_HEIGHT_CM``.
 
 The BEAT Euler values are degrees with CHANNELS ``Xrotation Yrotation Zrotation`` (intrinsic,
 ``R = Rx @ Ry @ Rz``); ``Hips`` also has ``Xposition Yposition Zposition`` (centimetres) first.
+
+Taught in notebooks/01_beat_formats.ipynb, sections 2 (the BVH skeleton) and 7 (joint subsets).
 """
 
 from __future__ import annotations

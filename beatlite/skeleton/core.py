@@ -1,4 +1,7 @@
-"""The :class:`Skeleton` data structure shared by every part of beatlite."""
+"""The :class:`Skeleton` data structure shared by every part of beatlite.
+
+Taught in notebooks/01_beat_formats.ipynb, section 2 (the BVH file: a skeleton, then one row of numbers per frame).
+"""
 
 from __future__ import annotations
 

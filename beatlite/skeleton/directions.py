@@ -1,4 +1,7 @@
-"""Bone direction vectors (the HA2G / Trimodal pose representation) and back to positions."""
+"""Bone direction vectors (the HA2G / Trimodal pose representation) and back to positions.
+
+Taught in notebooks/06_ha2g.ipynb, section 1 (poses as unit bone directions).
+"""
 
 from __future__ import annotations
 

@@ -12,6 +12,8 @@ For the root ``R_world[p] = I`` and ``x_world[p] = 0``.
 Implementation: the loop runs over joints only. Frames are processed in blocks of
 ``_BLOCK`` with the frame axis last, so every NumPy call works on contiguous rows that stay
 in cache, and the local rotations of all joints of one Euler order are built at once.
+
+Taught in notebooks/01_beat_formats.ipynb, section 5 (forward kinematics, by hand for one arm).
 """
 
 from __future__ import annotations
@@ -242,6 +244,36 @@ def forward_kinematics(
     Returns
     -------
     (T, J, 3) float64, centimetres; (T, J + E, 3) with ``end_sites=True``.
+
+    Examples
+    --------
+    A shoulder-elbow-wrist chain along +x (upper arm 30 cm, forearm 25 cm). Turning the
+    shoulder 90 degrees about z swings the whole arm onto +y; turning only the elbow
+    swings the forearm.
+
+    >>> import numpy as np
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> from beatlite.skeleton.kinematics import forward_kinematics
+    >>> zxy = ("Zrotation", "Xrotation", "Yrotation")
+    >>> arm = Skeleton(
+    ...     names=("Shoulder", "Elbow", "Wrist"), parents=[-1, 0, 1],
+    ...     offsets=[[0, 0, 0], [30, 0, 0], [25, 0, 0]], channels=(zxy, zxy, ()))
+    >>> channels = np.array([[0.0, 0, 0, 0, 0, 0], [90, 0, 0, 0, 0, 0], [0, 0, 0, 90, 0, 0]])
+    >>> positions = forward_kinematics(arm, channels)  # (T, J, 3) cm
+    >>> positions.shape
+    (3, 3, 3)
+    >>> positions[0]
+    array([[ 0.,  0.,  0.],
+           [30.,  0.,  0.],
+           [55.,  0.,  0.]])
+    >>> positions[1].round(6) + 0.0  # shoulder at 90 degrees
+    array([[ 0.,  0.,  0.],
+           [ 0., 30.,  0.],
+           [ 0., 55.,  0.]])
+    >>> positions[2].round(6) + 0.0  # elbow at 90 degrees
+    array([[ 0.,  0.,  0.],
+           [30.,  0.,  0.],
+           [30., 25.,  0.]])
     """
     ch = _check_inputs(skeleton, channels, position_mode)
     n_joints = skeleton.n_joints

@@ -15,6 +15,8 @@ Conventions
 - **Axis-angle** is a rotation vector ``(..., 3)``: unit axis times angle in **radians**.
 - **6D** (Zhou et al., CVPR 2019) is the first two *columns* of the matrix, ``(..., 6)`` =
   ``[R[:, 0], R[:, 1]]``; :func:`sixd_to_matrix` re-orthonormalises with Gram-Schmidt.
+
+Taught in notebooks/01_beat_formats.ipynb, section 4 (Euler angles: many numbers for one rotation).
 """
 
 from __future__ import annotations

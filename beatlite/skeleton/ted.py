@@ -1,7 +1,7 @@
 """A TED-Expressive-style 43-joint upper body for HA2G, built from the BEAT skeleton.
 
 TED Expressive (HA2G, CVPR 2022) describes a pose by 43 joints and 42 unit bone vectors
-(reference facts C.7). Joint ids::
+(HA2G §4.1; docs/reference_code.md#ted-expressive). Joint ids::
 
     0 spine, 1 neck, 2/3 left/right shoulder, 4/5 left/right elbow, 6/7 left/right wrist,
     8-22  left fingers  index, middle, pinky, ring, thumb (3 joints each),
@@ -17,6 +17,8 @@ distal joints; for the thumb ``Thumb1..3``).
 and turn with the head. They need the head's world rotation, which :func:`beat_to_ted43` takes
 from forward kinematics when given channels, or from ``rotations``; from positions alone the
 head frame is estimated (see there).
+
+Taught in notebooks/06_ha2g.ipynb, sections 1 (poses as unit bone directions), 2 (the body hierarchy) and 6 (the angle pairs of the physical constraint).
 """
 
 from __future__ import annotations
@@ -138,7 +140,7 @@ def _v(parent: str, child: str) -> int:
 
 
 def _levels() -> tuple[tuple[int, ...], ...]:
-    """HA2G's six cumulative levels of vector indices, built from names (facts C.7 table)."""
+    """HA2G's six cumulative levels of vector indices, built from names (docs/reference_code.md#ha2g-levels)."""
     head = [_v("neck", "nose"), _v("nose", "right_eye"), _v("nose", "left_eye")]
     head += [_v("right_eye", "right_ear"), _v("left_eye", "left_ear")]
     torso = [_v("spine", "neck"), _v("neck", "left_shoulder"), _v("neck", "right_shoulder")]

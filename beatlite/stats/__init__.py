@@ -9,6 +9,8 @@
 ``correlations``            gesture energy vs audio, face, emotion, speaker, with p-values
 ``emotion_classifier``      Table 6 analog: :class:`EmotionClassifier` on motion windows
 =========================  ================================================================
+
+Taught in notebooks/02_dataset_statistics.ipynb (dataset statistics), sections 1-6.
 """
 
 from __future__ import annotations

@@ -2,6 +2,8 @@
 
 :func:`load_corpus` loads every usable take of an index once at 15 fps and keeps
 only what the statistics need, so all figures/tables share one pass over the data.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 3 (``load_corpus`` loads the takes the analyses share).
 """
 
 from __future__ import annotations

@@ -14,6 +14,8 @@ over non-overlapping windows (2 s by default) to tame autocorrelation.
 - categorical factors (emotion, speaker): one-way ANOVA of the take-mean energy
   across groups (one value per take, so takes are the independent units), its
   effect size eta^2, and a permutation p-value from shuffling the take labels.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 5 (the correlation claims of §3.3).
 """
 
 from __future__ import annotations

@@ -1,6 +1,8 @@
 """Figure 2 analogs: emotion proportions, language share, per-speaker duration (from the index only).
 
 Shares are fractions of the summed take durations (seconds of motion), not of take counts.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 2 (Figure 2: emotions, languages and speakers).
 """
 
 from __future__ import annotations

@@ -6,6 +6,8 @@ uses a random forest (or a standardised logistic regression) on per-channel
 window statistics (:func:`beatlite.stats.emotion_clusters.window_features`) of
 the 9 body joints (``body27``) of the 141-d rotation windows, which trains in
 about a second on CPU.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 6 (Table 6: an emotion classifier on motion) and notebooks/07_benchmark.ipynb, section 5 (does generated motion carry the emotion?).
 """
 
 from __future__ import annotations
@@ -50,6 +52,8 @@ class EmotionClassifier:
 
     Examples
     --------
+    Skipped by the doctests: ``train_windows``, ``train_labels``, ... stand for your own windows and labels.
+
     >>> clf = EmotionClassifier().fit(train_windows, train_labels)  # doctest: +SKIP
     >>> clf.per_class_accuracy(test_windows, test_labels)["avg"]  # doctest: +SKIP
     """

@@ -8,6 +8,8 @@ k-NN accuracy and balanced accuracy, next to their chance levels (majority-class
 share; 1 / number of classes), with a permutation test. Folds are grouped by
 take (windows of one take never sit in both train and test), otherwise
 neighbouring windows of the same take would inflate the accuracy.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 3 (Figure 3a: do gestures differ by emotion?).
 """
 
 from __future__ import annotations

@@ -1,4 +1,7 @@
-"""Figure 4 analogs: distribution of semantic-relevance scores, per frequent word, per speaker."""
+"""Figure 4 analogs: distribution of semantic-relevance scores, per frequent word, per speaker.
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 4 (Figure 4: semantic relevance).
+"""
 
 from __future__ import annotations
 

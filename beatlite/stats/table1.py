@@ -3,6 +3,8 @@
 The paper's rows are copied from Table 1 of Liu et al., "BEAT: A Large-Scale
 Semantic and Emotional Multi-Modal Dataset for Conversational Gestures
 Synthesis", ECCV 2022 (``/work/shared/papers/beat_camn_eccv2022.txt``).
+
+Taught in notebooks/02_dataset_statistics.ipynb, section 1 (Table 1: what kind of dataset is this?).
 """
 
 from __future__ import annotations

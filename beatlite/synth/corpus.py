@@ -1,4 +1,7 @@
-"""The take list of ``data_samples/`` and the generation of one take or the whole corpus."""
+"""The take list of ``data_samples/`` and the generation of one take or the whole corpus.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
+"""
 
 from __future__ import annotations
 

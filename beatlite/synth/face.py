@@ -6,6 +6,8 @@
 - Expression: each emotion adds a fixed profile (:data:`EMOTION_FACES`), cross-faded over 0.5 s
   where the emotion changes.
 - Eyes: blinks (``eyeBlinkLeft/Right`` to ~0.95 for 0.15 s) every 3-5 s, slow gaze drift.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

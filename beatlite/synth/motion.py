@@ -22,6 +22,8 @@ Arm joint angles come from an analytic two-bone IK (the elbow swivels towards a 
 below, behind and outside the shoulder), fingers from blended hand shapes (open, relaxed, fist,
 point, pinch), and the spine, neck and head from small sinusoids (breathing, sway), beat nods and
 the emotion's head pitch. Everything is a smooth function of time evaluated at the frame times.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

@@ -9,6 +9,8 @@ as ``librosa.onset.onset_strength(center=True)`` does; then the peak picking of
 ±100 ms mean by 0.07 of the normalised envelope, at least 3 frames after the previous onset).
 It finds the events ``librosa.onset.onset_detect`` (and so BeatAlign and BC) finds, to within a
 frame: the onsets of words and of stressed syllables.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

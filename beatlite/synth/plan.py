@@ -15,6 +15,8 @@ Rules (all times in seconds):
   0.25 s after any semantic gesture and after 0.3 s; words of one or two letters only half of the
   time. Beats come ~1.5-2.5 per second of speech and every beat sits on an audio onset: the hand
   speed is zero there (:func:`beatlite.synth.motion.beat_lift`).
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

@@ -9,6 +9,8 @@ into phones and those phones share the word's duration equally.
 
 Audio leaves this module at 16 kHz (espeak's 22050 Hz output is resampled with
 :func:`scipy.signal.resample_poly`, up 320 / down 441).
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

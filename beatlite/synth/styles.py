@@ -2,6 +2,8 @@
 
 Everything the generator varies by emotion or speaker is a number in this file,
 so the README, the tests and the generator agree on them.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
 """
 
 from __future__ import annotations

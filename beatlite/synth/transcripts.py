@@ -1,4 +1,7 @@
-"""Transcripts: everyday sentences whose keywords carry scripted semantic gestures."""
+"""Transcripts: everyday sentences whose keywords carry scripted semantic gestures.
+
+Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (``data_samples/README.md`` describes its rules).
+"""
 
 from __future__ import annotations
 

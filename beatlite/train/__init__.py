@@ -12,6 +12,8 @@
 
 ``import beatlite.train`` does not import torch; the names above import their module on
 first access. Command line: ``python -m beatlite.train {retrain-all,results,seeds}``.
+
+Taught in notebooks/05_camn.ipynb, sections 4-6 (training, generating a whole take, evaluation on the test split).
 """
 
 from __future__ import annotations

@@ -13,6 +13,8 @@ A checkpoint is a ``torch.save`` dict::
 
 Files are written to a temporary file in the same folder and moved into place with
 :func:`os.replace`, so a crash never leaves a half-written checkpoint.
+
+Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkpoint) and notebooks/07_benchmark.ipynb, section 1 (exporting one).
 """
 
 from __future__ import annotations

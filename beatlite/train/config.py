@@ -1,4 +1,7 @@
-"""The training configuration :class:`TrainConfig` (no torch import)."""
+"""The training configuration :class:`TrainConfig` (no torch import).
+
+Taught in notebooks/05_camn.ipynb, section 4 (training).
+"""
 
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ LR_SCHEDULES = ("constant", "cosine")
 
 @dataclasses.dataclass
 class TrainConfig:
-    """Settings of :func:`beatlite.train.fit` (defaults follow CaMN's reference, facts B.6).
+    """Settings of :func:`beatlite.train.fit` (defaults follow CaMN's reference, docs/reference_code.md#camn-training).
 
     Attributes
     ----------

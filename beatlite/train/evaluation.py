@@ -1,5 +1,7 @@
 """Evaluate gesture models on whole test takes: the results table of BEAT Tables 4/5 and HA2G Tables 1/3/4.
 
+Usage (skipped by the doctests: it loads every shipped checkpoint and runs for minutes):
+
 >>> from beatlite.train.evaluation import evaluate_models      # doctest: +SKIP
 >>> res = evaluate_models(["mean_pose", "camn_tiny", "s2g_tiny"])  # doctest: +SKIP
 >>> print(res.to_markdown())                                     # doctest: +SKIP
@@ -33,6 +35,8 @@ Two ground-truth rows: ``Ground truth`` (the dataset's TED-43 directions, the FG
 FGD 0 by definition) and ``Ground truth (141 Euler channels)`` (only the channels the Euler
 models predict, the rest at rest pose: the floor an Euler model can reach).
 Nothing is cached outside ``build/`` (the window caches of :mod:`beatlite.data.windows`).
+
+Taught in notebooks/05_camn.ipynb, section 6 (evaluation on the test split) and notebooks/07_benchmark.ipynb, section 1 (one evaluation, one common space).
 """
 
 from __future__ import annotations
@@ -416,7 +420,7 @@ def fgd_scorer(
     """A ``val_score`` for :func:`beatlite.train.fit`: FGD of a model's generation of ``split``'s whole takes.
 
     BEAT's reference trainer validates every epoch by FGD on the validation set and keeps the
-    best epoch (docs/reference_code.md); this is that score, computed exactly as the ``FGD``
+    best epoch (docs/reference_code.md#camn-training); this is that score, computed exactly as the ``FGD``
     column of :func:`evaluate_models` but on the ``val`` takes (so the test split stays unseen).
 
     Parameters

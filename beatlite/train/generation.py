@@ -1,12 +1,14 @@
 """Generation of whole takes of any length with any :class:`~beatlite.models.base.GestureModel`.
 
-The take is cut into 34-frame units with stride 30 (facts C.7 "Inference"): unit ``k``
+The take is cut into 34-frame units with stride 30 (docs/reference_code.md#ha2g-inference): unit ``k``
 covers frames ``[30 k, 30 k + 34)``; its seed (first ``n_pre = 4`` frames) is the
 ground-truth seed for ``k = 0`` and the previous unit's last 4 output frames
 afterwards; the 4 overlapping frames are linearly cross-faded
 (weights ``linspace(0, 1, 4)`` for the new unit). Audio and mel slices follow the
 unit's *time* axis (the reference sliced the spectrogram along its mel axis, a bug).
 The last unit is padded (edge frames, silent audio) and the result cropped to T frames.
+
+Taught in notebooks/05_camn.ipynb, section 5 (generating a whole take).
 """
 
 from __future__ import annotations

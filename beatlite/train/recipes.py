@@ -1,5 +1,7 @@
 """How every shipped checkpoint is trained: one table of recipes and one :func:`retrain`.
 
+Usage (skipped by the doctests: ``retrain`` trains a model for minutes):
+
 >>> from beatlite.train.recipes import RECIPES, retrain     # doctest: +SKIP
 >>> RECIPES["camn_tiny"].epochs                              # doctest: +SKIP
 40
@@ -19,6 +21,8 @@ HA2G 25 epochs at lr 2e-3 (:data:`HA2G_EPOCHS`). That is 32x the reference's bat
 6.25e-5: the reference trains 100+ epochs on 30 h of data, we have minutes. All use batch 32
 (48 and 64 were hardly faster per epoch, CaMN 202 s for 60 epochs at 48 vs 216 s at 32 on 2 threads: the
 convolutions over raw audio cost the same per window).
+
+Taught in notebooks/05_camn.ipynb, sections 4 (training) and 7 (the ablation study), and notebooks/07_benchmark.ipynb, section 1.
 """
 
 from __future__ import annotations

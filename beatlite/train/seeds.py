@@ -1,5 +1,7 @@
 """The results table over several training seeds: mean ± standard deviation per model and metric.
 
+Usage (skipped by the doctests: it trains models for minutes):
+
 >>> from beatlite.train.seeds import train_seeds, evaluate_seeds    # doctest: +SKIP
 >>> train_seeds(["camn_tiny", "s2g_tiny"], seeds=[2022, 2023], jobs=2)   # doctest: +SKIP
 >>> table = evaluate_seeds(["camn_tiny", "s2g_tiny"], seeds=[2021, 2022, 2023])  # doctest: +SKIP
@@ -12,6 +14,8 @@ Trimodal on FGD" is therefore checked on the mean over seeds, against the spread
 Seed :data:`beatlite.train.recipes.SEED` is the shipped checkpoint (``checkpoints/<name>.pt``);
 every other seed ``s`` is trained by :func:`beatlite.train.recipes.retrain` into
 ``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``).
+
+Taught in notebooks/07_benchmark.ipynb, section 2 (one run is one draw: the table over three seeds) and notebooks/05_camn.ipynb, section 7.
 """
 
 from __future__ import annotations

@@ -1,4 +1,7 @@
-"""The training loop :func:`fit`, shared by every :class:`~beatlite.models.base.GestureModel`."""
+"""The training loop :func:`fit`, shared by every :class:`~beatlite.models.base.GestureModel`.
+
+Taught in notebooks/05_camn.ipynb, section 4 (training).
+"""
 
 from __future__ import annotations
 

@@ -20,6 +20,8 @@ Rendering backends: pyvista needs an off-screen OpenGL (EGL or OSMesa on a
 headless Linux, see :mod:`beatlite.viz.probe` and ``scripts/system_deps.sh``);
 when it is missing every pyvista function warns once and draws with matplotlib.
 ``BEATLITE_PYVISTA=off`` forces matplotlib.
+
+Taught in notebooks/08_visualisation_3d.ipynb (seeing gestures), sections 1-6.
 """
 
 from __future__ import annotations

@@ -6,10 +6,14 @@ a heat map), and the current word as a caption. Lines are updated in place
 (``set_data_3d``); axes are never rebuilt, and frames are subsampled to the
 playback rate asked (``out_fps``).
 
+Usage (skipped by the doctests: ``gt``, ``camn``, ``y`` and ``take`` stand for your own data; it writes a file):
+
 >>> anim = animate_skeletons({"ground truth": gt, "CaMN": camn}, skeleton, fps=15,
 ...                          audio=y, sr=16000, words=take.words)        # doctest: +SKIP
 >>> anim                        # in JupyterLab: shown inline as JS/HTML (to_jshtml)  # doctest: +SKIP
 >>> anim.save_as("build/clip.gif")     # or .mp4 (needs ffmpeg) or .html             # doctest: +SKIP
+
+Taught in notebooks/08_visualisation_3d.ipynb, section 3 (one clock for everything: the synced animation).
 """
 
 from __future__ import annotations

@@ -18,6 +18,8 @@ Opening the file in Blender (2.8 to 4.x)
    - Rotation: Euler (the default).
 3. Press *Space* to play. The root is at the origin, so the feet are ``HIPS_HEIGHT_CM`` (95 cm)
    below the floor unless you pass ``root_position=(0, 95, 0)``.
+
+Taught in notebooks/08_visualisation_3d.ipynb, section 6 (export to Blender: BVH).
 """
 
 from __future__ import annotations

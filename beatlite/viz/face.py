@@ -3,6 +3,8 @@
 BEAT's faces are 51 ARKit blendshape weights in [0, 1] at 60 fps (ARKit's 52
 without ``tongueOut``). The animation panel of the same data is the
 ``face=`` option of :func:`beatlite.viz.animation.animate_skeletons`.
+
+Taught in notebooks/08_visualisation_3d.ipynb, section 5 (the face in sync with the voice); first used in notebooks/01_beat_formats.ipynb, section 8.
 """
 
 from __future__ import annotations

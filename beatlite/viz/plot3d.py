@@ -7,6 +7,8 @@ the character's right hand on the viewer's left.
 
 Every function takes the skeleton as a :class:`beatlite.skeleton.core.Skeleton`
 (joints coloured body / hands / head by name) or as a ``(J,)`` parents array.
+
+Taught in notebooks/01_beat_formats.ipynb, section 6 (looking at the skeleton in 3D) and notebooks/08_visualisation_3d.ipynb, section 2 (key frames).
 """
 
 from __future__ import annotations

@@ -21,6 +21,8 @@ An X virtual frame buffer also works (``xvfb-run -a jupyter lab`` sets
 ``$DISPLAY``, then candidate 2 is used). Set ``BEATLITE_PYVISTA=off`` to skip
 pyvista entirely (matplotlib everywhere), e.g. on a machine where the probe
 itself is too slow. Install the libraries with ``scripts/system_deps.sh``.
+
+Taught in notebooks/00_setup_and_tour.ipynb, section 1 (can this machine draw 3D skeletons with pyvista?) and notebooks/08_visualisation_3d.ipynb, section 4.
 """
 
 from __future__ import annotations

@@ -8,6 +8,8 @@ kernel never crashes. Pass ``backend="matplotlib"`` to skip pyvista.
 
 Headless machines: see :mod:`beatlite.viz.probe` (EGL first, then OSMesa,
 then X/Xvfb) and ``scripts/system_deps.sh``.
+
+Taught in notebooks/08_visualisation_3d.ipynb, section 4 (pyvista: tubes and spheres, rendered off-screen).
 """
 
 from __future__ import annotations

@@ -4,12 +4,16 @@ Nothing here changes matplotlib's global state at import time: apply the style
 for a block of code with :func:`figure_style` (a ``plt.rc_context``), or pass
 :data:`STYLE` to ``plt.rc_context`` yourself.
 
+Usage (the doctests skip the ``with`` block: it writes files under ``build/``):
+
 >>> import matplotlib.pyplot as plt
 >>> from beatlite.viz.style import figure_style, save_figure
 >>> with figure_style():                                  # doctest: +SKIP
 ...     fig, ax = plt.subplots()
 ...     ax.plot([0, 1], [0, 1])
 ...     save_figure(fig, "build/figures/line")           # -> line.png, line.svg
+
+Used by every figure of the notebooks; first in notebooks/00_setup_and_tour.ipynb, section 2 (``save_figure``).
 """
 
 from __future__ import annotations
