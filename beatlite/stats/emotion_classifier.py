@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from beatlite.constants import WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.stats.distributions import EMOTION_NAMES
 from beatlite.stats.emotion_clusters import subset_dims, window_features
 
@@ -130,6 +131,67 @@ class EmotionClassifier:
         out["avg"] = float(np.mean(list(out.values())))
         out["overall"] = float(np.mean(pred == y))
         return out
+
+
+def table6_windows(
+    euler: list[np.ndarray], emotion: list[np.ndarray], *, length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE
+) -> tuple[np.ndarray, np.ndarray]:
+    """BEAT Table 6's samples: motion windows of whole takes, each labelled with its middle frame's emotion.
+
+    The one definition every Table 6 of beatlite uses (notebooks 02 and 07): 34-frame windows,
+    stride 10, of the 141 ``spine_neck_141`` Euler channels (the model output space, so real and
+    generated motion are cut the same way).
+
+    Parameters
+    ----------
+    euler : list of (T_k, 141) float, degrees
+        One array per take (real, or generated and denormalised).
+    emotion : list of (T_k,) int
+        The take's per-frame emotion ids (the ground truth's, also for generated motion).
+
+    Returns
+    -------
+    windows : (N, length, 141) float
+    labels : (N,) int64
+        The emotion at frame ``length // 2`` of each window.
+
+    Examples
+    --------
+    >>> w, y = table6_windows([np.zeros((54, 141))], [np.repeat([0, 5], 27)])
+    >>> w.shape, y.tolist()  # starts 0, 10, 20: middle frames 17, 27, 37
+    ((3, 34, 141), [0, 5, 5])
+    """
+    from beatlite.data.windows import sliding_windows
+
+    if len(euler) != len(emotion):
+        raise ValueError(f"table6_windows: {len(euler)} motion takes but {len(emotion)} emotion tracks")
+    windows = sliding_windows([np.asarray(e) for e in euler], length, stride)
+    mids = sliding_windows([np.asarray(e, dtype=np.int64) for e in emotion], length, stride)[:, length // 2]
+    return windows, mids
+
+
+def table6(
+    train: tuple[list[np.ndarray], list[np.ndarray]],
+    rows: dict[str, tuple[list[np.ndarray], list[np.ndarray]]],
+    *,
+    seed: int = 0,
+) -> dict[str, dict[str, float]]:
+    """BEAT Table 6 analog: per-class accuracy of an emotion classifier trained on real train takes.
+
+    Parameters
+    ----------
+    train : (euler, emotion) lists of the real **train** takes (see :func:`table6_windows`)
+    rows : dict of row name -> (euler, emotion) lists
+        E.g. ``{"real": real test takes, "CaMN": CaMN's generation of the same takes}``.
+    seed : int
+        The classifier's seed.
+
+    Returns
+    -------
+    dict row name -> :meth:`EmotionClassifier.per_class_accuracy` (fractions, with ``"avg"``).
+    """
+    clf = EmotionClassifier(seed=seed).fit(*table6_windows(*train))
+    return {name: clf.per_class_accuracy(*table6_windows(*takes)) for name, takes in rows.items()}
 
 
 def table6_markdown(real: dict[str, float], generated: dict[str, float] | None = None) -> str:
