@@ -134,7 +134,11 @@ class EmotionClassifier:
 
 
 def table6_windows(
-    euler: list[np.ndarray], emotion: list[np.ndarray], *, length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE
+    euler: list[np.ndarray],
+    emotion: list[np.ndarray],
+    *,
+    length: int = WINDOW_LENGTH,
+    stride: int = WINDOW_STRIDE,
 ) -> tuple[np.ndarray, np.ndarray]:
     """BEAT Table 6's samples: motion windows of whole takes, each labelled with its middle frame's emotion.
 
