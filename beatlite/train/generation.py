@@ -151,12 +151,39 @@ def generate_sequences(
     -------
     list of (T_i, D) float32
     """
-    target_key, dim, n_pre = model.target_key, model.pose_dim, model.n_pre
-    keys = tuple(k for k in dict.fromkeys(model.input_keys) if k != target_key)
-    if not 1 <= stride <= UNIT - n_pre:
-        raise ValueError(f"stride must be in [1, {UNIT - n_pre}], got {stride}")
-    plans, seeds, outs, lengths = [], [], [], []
-    for n, streams in enumerate(takes):
+    keys = tuple(k for k in dict.fromkeys(model.input_keys) if k != model.target_key)
+    if not 1 <= stride <= UNIT - model.n_pre:
+        raise ValueError(f"stride must be in [1, {UNIT - model.n_pre}], got {stride}")
+    plans = [_UnitPlan.of(model, streams, keys, stride, n) for n, streams in enumerate(takes)]
+    for i in range(max((len(p.starts) for p in plans), default=0)):
+        active = [p for p in plans if i < len(p.starts)]
+        batches = [p.unit_batch(i, keys, model) for p in active]
+        units = model.generate({k: torch.cat([b[k] for b in batches]) for k in batches[0]}).numpy()
+        for unit, plan in zip(units, active, strict=True):
+            plan.place(i, unit, stride)
+    return [p.out[: p.n_frames] for p in plans]
+
+
+@dataclasses.dataclass(eq=False)
+class _UnitPlan:
+    """One take's generation units: their starts, the running seed and the output being assembled."""
+
+    streams: Mapping[str, np.ndarray]
+    starts: list[int]
+    seed: np.ndarray
+    out: np.ndarray
+    n_frames: int
+
+    @classmethod
+    def of(
+        cls,
+        model: GestureModel,
+        streams: Mapping[str, np.ndarray],
+        keys: tuple[str, ...],
+        stride: int,
+        n: int,
+    ) -> _UnitPlan:
+        target_key, dim, n_pre = model.target_key, model.pose_dim, model.n_pre
         missing = [k for k in (*keys, target_key) if k not in streams]
         if missing:
             raise KeyError(f"generate_sequence: streams lack {missing} needed by {type(model).__name__}")
@@ -169,30 +196,28 @@ def generate_sequences(
         starts = [0]
         while starts[-1] + UNIT < t:
             starts.append(starts[-1] + stride)
-        plans.append(starts)
-        seeds.append(target[:n_pre])
-        outs.append(np.zeros((starts[-1] + UNIT, dim), dtype=np.float32))
-        lengths.append(t)
-    fade = np.linspace(0.0, 1.0, n_pre, dtype=np.float32)[:, None]
-    for i in range(max((len(p) for p in plans), default=0)):
-        active = [b for b in range(len(plans)) if i < len(plans[b])]
-        parts = []
-        for b in active:
-            batch = unit_batch(takes[b], plans[b][i], keys)
-            seed = np.zeros((1, UNIT, dim), np.float32)
-            seed[0, :n_pre] = seeds[b]
-            batch[target_key] = torch.from_numpy(seed)
-            parts.append(batch)
-        units = model.generate({k: torch.cat([p[k] for p in parts]) for k in parts[0]}).numpy()
-        for unit, b in zip(units, active, strict=True):
-            start, out = plans[b][i], outs[b]
-            if i == 0:
-                out[:UNIT] = unit
-            else:
-                out[start : start + n_pre] = (1 - fade) * out[start : start + n_pre] + fade * unit[:n_pre]
-                out[start + n_pre : start + UNIT] = unit[n_pre:]
-            seeds[b] = unit[stride : stride + n_pre]
-    return [out[:t] for out, t in zip(outs, lengths, strict=True)]
+        return cls(streams, starts, target[:n_pre], np.zeros((starts[-1] + UNIT, dim), np.float32), t)
+
+    def unit_batch(self, i: int, keys: tuple[str, ...], model: GestureModel) -> dict[str, torch.Tensor]:
+        """Unit ``i``'s one-window batch, its target holding only the seed frames."""
+        batch = unit_batch(self.streams, self.starts[i], keys)
+        seed = np.zeros((1, UNIT, model.pose_dim), np.float32)
+        seed[0, : model.n_pre] = self.seed
+        batch[model.target_key] = torch.from_numpy(seed)
+        return batch
+
+    def place(self, i: int, unit: np.ndarray, stride: int) -> None:
+        """Write unit ``i`` into the output, cross-fading the seed frames, and take the next seed."""
+        n_pre, start = len(self.seed), self.starts[i]
+        if i == 0:
+            self.out[:UNIT] = unit
+        else:
+            fade = np.linspace(0.0, 1.0, n_pre, dtype=np.float32)[:, None]
+            self.out[start : start + n_pre] = (1 - fade) * self.out[start : start + n_pre] + fade * unit[
+                :n_pre
+            ]
+            self.out[start + n_pre : start + UNIT] = unit[n_pre:]
+        self.seed = unit[stride : stride + n_pre]
 
 
 def generate(

@@ -346,16 +346,43 @@ def evaluate_seeds(
     seeds = [int(s) for s in seeds]
     if not seeds:
         raise ValueError("seeds must not be empty")
+    if missing not in ("error", "skip"):
+        raise ValueError(f"missing must be 'error' or 'skip', got {missing!r}")
+    names = _seed_names(names, seeds, missing)
+    test = load_test_set() if test is None else test
+    extractor = load_extractor("dirvec") if extractor is None else extractor
+    values: dict[str, dict[str, list[float]]] = {}
+    info: dict[str, Any] = {}
+    for i, seed in enumerate(seeds):
+        present = [n for n in names if checkpoint_path(n, seed).is_file()]
+        paths = [str(checkpoint_path(n, seed)) for n in present]
+        res = evaluate_models(paths, test=test, extractor=extractor, ground_truth=i == 0)
+        info = dict(res.info)
+        for row in res.rows:
+            slot = values.setdefault(row.label, {})
+            for metric, v in row.metrics.items():
+                slot.setdefault(metric, []).append(float(v))
+        for name in set(names) - set(present):  # a skipped checkpoint is a NaN: value k is always seed k
+            for vals in values[label_of(name)].values():
+                vals.append(math.nan)
+        if progress:
+            print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
+    info["checkpoints"] = {
+        n: [str(checkpoint_path(n, s)) for s in seeds if checkpoint_path(n, s).is_file()] for n in names
+    }
+    return SeedResults(values, seeds, info)
+
+
+def _seed_names(names: Sequence[str] | None, seeds: list[int], missing: str) -> list[str]:
+    """The checkpoints to score: ``names`` checked to exist (all seeds, or the first with ``"skip"``),
+    or by default every recipe whose checkpoints exist."""
     if names is None:
-        names = [
+        return [
             n
             for n in RECIPES
             if checkpoint_path(n, seeds[0]).is_file()
             and (missing == "skip" or all(checkpoint_path(n, s).is_file() for s in seeds))
         ]
-    names = list(names)
-    if missing not in ("error", "skip"):
-        raise ValueError(f"missing must be 'error' or 'skip', got {missing!r}")
     for name in names:
         for seed in seeds:
             path = checkpoint_path(name, seed)
@@ -364,33 +391,7 @@ def evaluate_seeds(
                     f"{path}: no checkpoint of {name!r} for seed {seed}; train it with "
                     f"`python -m beatlite.train seeds --seeds {seed} --only {name}`"
                 )
-    test = load_test_set() if test is None else test
-    extractor = load_extractor("dirvec") if extractor is None else extractor
-    values: dict[str, dict[str, list[float]]] = {}
-    info: dict[str, Any] = {}
-    for i, seed in enumerate(seeds):
-        present = [n for n in names if checkpoint_path(n, seed).is_file()]
-        res = evaluate_models(
-            [str(checkpoint_path(n, seed)) for n in present],
-            test=test,
-            extractor=extractor,
-            ground_truth=i == 0,
-        )
-        info = dict(res.info)
-        for row in res.rows:
-            slot = values.setdefault(row.label, {})
-            for metric, v in row.metrics.items():
-                slot.setdefault(metric, []).append(float(v))
-        for name in names:  # a skipped checkpoint is a NaN, so that value k is always seed k
-            if name not in present:
-                for vals in values[label_of(name)].values():
-                    vals.append(math.nan)
-        if progress:
-            print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
-    info["checkpoints"] = {
-        n: [str(checkpoint_path(n, s)) for s in seeds if checkpoint_path(n, s).is_file()] for n in names
-    }
-    return SeedResults(values, seeds, info)
+    return list(names)
 
 
 def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
