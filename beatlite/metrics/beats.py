@@ -143,6 +143,14 @@ def position_speed(positions: np.ndarray, fps: float) -> np.ndarray:
 
     ``v_t = ||p_{t+1} - p_{t-1}|| * fps / 2`` (``numpy.gradient``).
 
+    Why central differences here: a motion beat is a *time* (the frame where the joint pauses).
+    The central difference is the speed *at* frame t, so a pause at frame t gives its minimum at t;
+    a forward difference ``||p_{t+1} - p_t||`` is the speed between t and t + 1 and would time every
+    beat half a frame (33 ms at 15 fps) late. :func:`euler_speed` keeps the forward differences of
+    BEAT's reference code on purpose; :func:`beatlite.metrics.extras.velocity_stats` uses them too,
+    because it summarises magnitudes, where the half-frame shift does not matter and the n-th
+    difference family (speed, jerk) stays consistent.
+
     Parameters
     ----------
     positions : (T, J, 3) float, centimetres

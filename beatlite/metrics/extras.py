@@ -73,7 +73,9 @@ def mpjpe(generated: np.ndarray, ground_truth: np.ndarray) -> float:
 def velocity_stats(positions: np.ndarray, fps: float) -> dict[str, float]:
     """Speed statistics of joint positions (forward differences).
 
-    ``v_{t,j} = ||p_{t+1,j} - p_{t,j}|| * fps``.
+    ``v_{t,j} = ||p_{t+1,j} - p_{t,j}|| * fps``: the first of the finite differences that
+    :func:`jerk_stats` takes to order 3. For *timing* (motion beats) beatlite uses central differences
+    instead, see :func:`beatlite.metrics.beats.position_speed`.
 
     Parameters
     ----------
