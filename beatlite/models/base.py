@@ -32,7 +32,12 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
   of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
 - ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
 - optional ``prepare(train_windows)``: called once by ``fit`` before training with the
-  numpy window dict (used by the untrained baselines to store a mean pose / clip bank).
+  numpy window dict (used by the untrained baselines to store a mean pose / clip bank);
+- optional classmethod ``keys_for(config)`` when config switches change ``input_keys``.
+
+Adding a model: write the class in its own module, then ``beatlite.models.register_model(name,
+"module:Class")`` and ``beatlite.train.recipes.register_recipe(checkpoint, Recipe(name, label, ...))``;
+nothing else changes (``docs/architecture.md``, "Adding a model and a metric").
 
 Torch is imported at module import time here; :mod:`beatlite.models` itself stays lazy.
 
@@ -49,13 +54,12 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import N_PRE
+
 Batch = dict[str, torch.Tensor]
 
 REPRESENTATIONS: dict[str, tuple[str, int]] = {"euler141": ("pose", 141), "dirvec126": ("dirvec", 126)}
 """Representation name -> (window key of its target, channels D)."""
-
-N_POSES = 34
-N_PRE = 4
 
 
 @dataclasses.dataclass
