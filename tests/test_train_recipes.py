@@ -209,3 +209,36 @@ def test_train_seeds_keeps_current_checkpoints_and_retrains_stale_ones(tmp_path,
     asked.clear()
     seeds.train_seeds(["s2g_tiny"], seeds=[7], force=True, verbose=False)
     assert [(name, seed) for name, seed, _ in asked] == [("s2g_tiny", 7)]
+
+
+@pytest.mark.slow
+def test_fit_command_writes_only_under_out(tmp_path):
+    """``python -m beatlite.train fit`` on data_samples/: checkpoints and caches under --out, the repository untouched."""
+    import subprocess
+    import sys
+
+    from beatlite.paths import checkpoints_dir, repo_root
+
+    before = {p.name: p.stat().st_mtime_ns for p in checkpoints_dir().iterdir()}
+    out = tmp_path / "run"
+    cmd = [
+        sys.executable,
+        "-m",
+        "beatlite.train",
+        "fit",
+        "s2g_tiny",
+        "--data",
+        str(repo_root() / "data_samples"),
+    ]
+    env = {k: v for k, v in __import__("os").environ.items() if k != "BEATLITE_BUILD"}
+    subprocess.run(
+        [*cmd, "--out", str(out), "--epochs", "1", "--device", "cpu"], check=True, env=env, timeout=600
+    )
+    assert (out / "s2g_tiny.pt").is_file() and (out / "train" / "s2g_tiny.pt").is_file()
+    assert list((out / "build" / "cache").rglob("*.npz"))  # window caches went under --out
+    assert {p.name: p.stat().st_mtime_ns for p in checkpoints_dir().iterdir()} == before
+    from beatlite.train.checkpoint import load_checkpoint
+
+    full = load_checkpoint(out / "train" / "s2g_tiny.pt")
+    assert full["epoch"] == 1 and full["train_config"]["device"] == "cpu"
+    assert full["best"] is not None  # the validation FGD scored the epoch

@@ -1,4 +1,10 @@
-"""Command line: ``python -m beatlite.train {retrain-all,results,seeds}``.
+"""Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
+
+``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume]`` trains one recipe
+on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
+float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
+are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
+for the per-epoch validation FGD.
 
 ``retrain-all [--only NAME ...] [--seed S] [--jobs J]`` rebuilds every shipped checkpoint of
 :data:`beatlite.train.recipes.RECIPES` (CaMN and its ablations, the baselines, HA2G and its
@@ -22,6 +28,7 @@ all seeds (shipped = seed 2021) to ``build/results_seeds.md`` and ``.json``
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 from collections.abc import Sequence
@@ -47,6 +54,14 @@ def _record_times(seconds: dict[str, float]) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m beatlite.train", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
+    f = sub.add_parser("fit", help="train one recipe on a BEAT-format folder, writing under --out")
+    f.add_argument("recipe", choices=sorted(RECIPES))
+    f.add_argument("--data", required=True, help="BEAT-format folder ({speaker_id}/{stem}.bvh, .wav, ...)")
+    f.add_argument("--out", required=True, help="output folder (created; the repository is never written)")
+    f.add_argument("--epochs", type=int, help="default: the recipe's")
+    f.add_argument("--seed", type=int, default=SEED)
+    f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
+    f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
     p.add_argument("--seed", type=int, default=SEED)
     p.add_argument("--epochs", type=int, help="override every recipe's epochs (for quick checks)")
@@ -68,6 +83,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--force", action="store_true", help="retrain checkpoints that exist and match their recipe"
     )
     args = parser.parse_args(argv)
+    if args.command == "fit":
+        return _fit_command(args)
     if args.command == "results":
         from beatlite.train.evaluation import evaluate_models, write_results
 
@@ -100,6 +117,37 @@ def main(argv: Sequence[str] | None = None) -> int:
             subprocess.run(
                 [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", space], check=True
             )
+    return 0
+
+
+def _fit_command(args: argparse.Namespace) -> int:
+    """``fit``: one recipe on ``--data``, every file under ``--out``."""
+    from pathlib import Path
+
+    from beatlite.paths import repo_root
+    from beatlite.train.recipes import retrain, training_data
+
+    data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    os.environ.setdefault("BEATLITE_BUILD", str(out / "build"))  # window caches under --out too
+    extractor = None
+    if data_dir != (repo_root() / "data_samples").resolve():
+        extractor = out / "fgd_dirvec.pt"
+        if not extractor.is_file():
+            print(f"training the FGD extractor on {data_dir} -> {extractor}", flush=True)
+            cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", "dirvec"]
+            subprocess.run([*cmd, "--data", str(data_dir), "--out", str(extractor)], check=True)
+    seconds = retrain(
+        args.recipe,
+        seed=args.seed,
+        epochs=args.epochs,
+        out_dir=out,
+        data=training_data(data_dir),
+        resume=args.resume,
+        device=args.device,
+        extractor=extractor,
+    )
+    print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
     return 0
 
 

@@ -52,6 +52,12 @@ class TrainConfig:
         Continue from ``checkpoint`` if it exists (same data fingerprint required).
     progress : bool
         Show a tqdm bar.
+    device : {"cpu", "cuda", "auto"} or str
+        Where the model trains (``"auto"``: CUDA when available, else the CPU). Checkpoints are
+        always written and read on the CPU, so they load on any device.
+    amp : bool
+        Mixed precision (bfloat16 autocast) for the forward pass and losses on CUDA; ignored on the
+        CPU, where training stays float32 and bitwise deterministic.
     """
 
     epochs: int = 30
@@ -68,6 +74,8 @@ class TrainConfig:
     checkpoint: str | Path | None = None
     resume: bool = False
     progress: bool = True
+    device: str = "cpu"
+    amp: bool = False
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -85,6 +93,18 @@ class TrainConfig:
         if self.threads is not None and self.threads < 1:
             raise ValueError(f"TrainConfig: threads must be >= 1, got {self.threads}")
         self.betas = (float(self.betas[0]), float(self.betas[1]))
+
+    def torch_device(self) -> Any:
+        """The resolved ``torch.device`` (imports torch); ``ValueError`` for CUDA on a machine without it."""
+        import torch
+
+        name = ("cuda" if torch.cuda.is_available() else "cpu") if self.device == "auto" else self.device
+        device = torch.device(name)
+        if device.type == "cuda" and not torch.cuda.is_available():
+            raise ValueError(
+                f"TrainConfig: device {self.device!r} asked for CUDA, which this machine does not have"
+            )
+        return device
 
     @property
     def learning_rate(self) -> float:

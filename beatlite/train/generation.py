@@ -24,6 +24,7 @@ from beatlite.data.normalize import Normalizers
 from beatlite.data.windows import MEL_SETTINGS, mel_frames
 from beatlite.io.motion import Motion
 from beatlite.models.base import GestureModel
+from beatlite.train.training import model_device
 
 UNIT = WINDOW_LENGTH
 STRIDE = GENERATION_STRIDE
@@ -155,10 +156,12 @@ def generate_sequences(
     if not 1 <= stride <= UNIT - model.n_pre:
         raise ValueError(f"stride must be in [1, {UNIT - model.n_pre}], got {stride}")
     plans = [_UnitPlan.of(model, streams, keys, stride, n) for n, streams in enumerate(takes)]
+    device = model_device(model)
     for i in range(max((len(p.starts) for p in plans), default=0)):
         active = [p for p in plans if i < len(p.starts)]
         batches = [p.unit_batch(i, keys, model) for p in active]
-        units = model.generate({k: torch.cat([b[k] for b in batches]) for k in batches[0]}).numpy()
+        batch = {k: torch.cat([b[k] for b in batches]).to(device) for k in batches[0]}
+        units = model.generate(batch).float().cpu().numpy()
         for unit, plan in zip(units, active, strict=True):
             plan.place(i, unit, stride)
     return [p.out[: p.n_frames] for p in plans]

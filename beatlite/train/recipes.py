@@ -237,6 +237,8 @@ def retrain(
     data: TrainingData | None = None,
     resume: bool = False,
     progress: bool = True,
+    device: str = "cpu",
+    extractor: str | Path | None = None,
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -258,6 +260,11 @@ def retrain(
         Continue the full training checkpoint up to ``epochs`` (same losses as one run).
     progress : bool
         Show the tqdm bar.
+    device : str
+        :attr:`beatlite.train.TrainConfig.device` (``"cpu"``, ``"cuda"``, ``"auto"``).
+    extractor : str or Path, optional
+        The FGD extractor of the per-epoch validation score (default the shipped
+        ``checkpoints/fgd_dirvec.pt``, trained on ``data_samples/``).
 
     Returns
     -------
@@ -285,12 +292,15 @@ def retrain(
         checkpoint=full,
         resume=resume,
         progress=progress,
+        device=device,
     )
     score = None
     if recipe.select_best and config.epochs > 0:
+        from beatlite.metrics.extractor import load_extractor
         from beatlite.train.evaluation import fgd_scorer
 
-        score = fgd_scorer(normalizers=data.train.normalizers, takes=data.val_takes)
+        features = load_extractor("dirvec", extractor)
+        score = fgd_scorer(normalizers=data.train.normalizers, takes=data.val_takes, extractor=features)
     start = time.perf_counter()
     fit(model, data.train, config, data.val, meta=data.meta, val_score=score)
     seconds = time.perf_counter() - start

@@ -108,15 +108,21 @@ def _n_windows(arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], who: str
 
 
 def _batch(
-    arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], idx: np.ndarray
+    arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], idx: np.ndarray, device: Any = None
 ) -> dict[str, torch.Tensor]:
     out = {}
     for k in keys:
         a = np.asarray(arrays[k])[idx]
-        out[k] = torch.from_numpy(
-            np.ascontiguousarray(a.astype(np.int64 if a.dtype.kind in "iu" else np.float32))
-        )
+        t = torch.from_numpy(np.ascontiguousarray(a.astype(np.int64 if a.dtype.kind in "iu" else np.float32)))
+        out[k] = t if device is None else t.to(device, non_blocking=True)
     return out
+
+
+def model_device(model: torch.nn.Module) -> torch.device:
+    """The device of a model's parameters (or buffers); the CPU for a model without either."""
+    for tensor in (*model.parameters(), *model.buffers()):
+        return tensor.device
+    return torch.device("cpu")
 
 
 def _needed_keys(model: GestureModel, arrays: Mapping[str, np.ndarray], who: str) -> tuple[str, ...]:
@@ -160,10 +166,11 @@ def evaluate_losses(
     was_training = model.training
     model.eval()
     sums: dict[str, float] = {}
+    device = model_device(model)
     try:
         for start in range(0, n, batch_size):
             idx = np.arange(start, min(n, start + batch_size))
-            batch = _batch(arrays, keys, idx)
+            batch = _batch(arrays, keys, idx, device)
             _accumulate(sums, model.losses(batch, model(batch), epoch=epoch), len(idx))
     finally:
         model.train(was_training)
@@ -295,7 +302,7 @@ class _Run:
             )
         if data["model"] != self.model.to_config():
             raise ValueError(f"fit: cannot resume from {self.path}: model config differs ({data['model']})")
-        self.model.load_state_dict(data["state"])
+        self.model.load_state_dict(data["state"])  # load_state_dict copies onto the model's device
         for opt, key in ((self.g_opt, "optimizer"), (self.d_opt, "d_optimizer")):
             if opt is not None and data.get(key) is not None:
                 opt.load_state_dict(data[key])
@@ -322,22 +329,25 @@ class _Run:
             idx = np.sort(order[start : start + config.batch_size])
             if len(idx) < 2:
                 continue
-            self.step(_batch(data.arrays, data.keys, idx), len(idx), epoch, sums)
+            self.step(_batch(data.arrays, data.keys, idx, self.device), len(idx), epoch, sums)
             seen += len(idx)
         return _mean_losses(sums, seen)
 
     def step(self, batch: dict[str, torch.Tensor], weight: int, epoch: int, sums: dict[str, float]) -> None:
         """The discriminator step (when adversarial) then the generator step on one batch of ``weight`` windows."""
         model, config = self.model, self.config
-        out = model(batch)
+        with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+            out = model(batch)
         if self.d_opt is not None and model.adversarial_active(epoch):
-            d_losses = model.discriminator_losses(batch, out)
+            with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+                d_losses = model.discriminator_losses(batch, out)
             self.d_opt.zero_grad(set_to_none=True)
             d_losses["total"].backward()
             torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
             self.d_opt.step()
             _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
-        losses = model.losses(batch, out, epoch=epoch)
+        with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+            losses = model.losses(batch, out, epoch=epoch)
         self.g_opt.zero_grad(set_to_none=True)
         losses["total"].backward()
         torch.nn.utils.clip_grad_norm_(self.g_params, config.grad_clip)
@@ -351,7 +361,7 @@ class _Run:
             score = float(val_score(self.model))
         entry["val_score"] = score
         if math.isfinite(score) and (self.best is None or score < self.best["score"]):
-            state = {k: v.detach().clone() for k, v in self.model.state_dict().items()}
+            state = {k: v.detach().cpu().clone() for k, v in self.model.state_dict().items()}
             self.best = {"epoch": epoch, "score": score, "state": state}
 
     def save(self, epoch_done: int) -> None:
@@ -363,14 +373,14 @@ class _Run:
             {
                 "format": FORMAT,
                 "model": self.model.to_config(),
-                "state": self.model.state_dict(),
+                "state": {k: v.detach().cpu() for k, v in self.model.state_dict().items()},
                 "optimizer": None if self.g_opt is None else self.g_opt.state_dict(),
                 "d_optimizer": None if self.d_opt is None else self.d_opt.state_dict(),
                 "epoch": epoch_done,
                 "history": self.history,
                 "fingerprint": self.fingerprint,
                 "train_config": self.config.to_dict(),
-                "rng": torch.get_rng_state(),
+                "rng": torch.get_rng_state(),  # the CPU generator; CUDA kernels are not bitwise reproducible
                 "meta": self.meta,
                 "best": self.best,
             },
