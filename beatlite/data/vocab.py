@@ -43,6 +43,24 @@ def normalize_word(word: str) -> str:
     return word.strip(_STRIP).lower()
 
 
+def _checked_words(words: Sequence[str]) -> list[str]:
+    """``words`` normalised (:func:`normalize_word`); ``TypeError`` for a single str, ``ValueError`` for
+    an empty word, duplicates or a special token."""
+    if isinstance(words, str):
+        raise TypeError("Vocab: words must be a sequence of str, got a single str")
+    normalised = [normalize_word(w) for w in words]
+    if "" in normalised:
+        raise ValueError("Vocab: empty word (after normalisation) in words")
+    counts = Counter(normalised)
+    dupes = [w for w, c in counts.items() if c > 1]
+    if dupes:
+        raise ValueError(f"Vocab: duplicate words after normalisation: {dupes[:5]}")
+    clash = [w for w in normalised if w in SPECIAL_TOKENS]
+    if clash:
+        raise ValueError(f"Vocab: words clash with special tokens: {clash}")
+    return normalised
+
+
 class Vocab(Mapping[str, int]):
     """Word <-> id table with PAD=0, SOS=1, EOS=2, UNK=3.
 
@@ -66,18 +84,7 @@ class Vocab(Mapping[str, int]):
     """
 
     def __init__(self, words: Sequence[str]) -> None:
-        if isinstance(words, str):
-            raise TypeError("Vocab: words must be a sequence of str, got a single str")
-        normalised = [normalize_word(w) for w in words]
-        if any(not w for w in normalised):
-            raise ValueError("Vocab: empty word (after normalisation) in words")
-        counts = Counter(normalised)
-        dupes = [w for w, c in counts.items() if c > 1]
-        if dupes:
-            raise ValueError(f"Vocab: duplicate words after normalisation: {dupes[:5]}")
-        clash = [w for w in normalised if w in SPECIAL_TOKENS]
-        if clash:
-            raise ValueError(f"Vocab: words clash with special tokens: {clash}")
+        normalised = _checked_words(words)
         self.itos: tuple[str, ...] = (*SPECIAL_TOKENS, *normalised)
         self._stoi = {w: i for i, w in enumerate(self.itos)}
 
@@ -336,28 +343,9 @@ def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarra
     (len(vocab), D) float32
     """
     from beatlite.io.errors import FormatError
-    from beatlite.io.textfile import open_text
 
     path = Path(path)
-    out: np.ndarray | None = None
-    found = np.zeros(len(vocab), dtype=bool)
-    with open_text(path) as f:
-        for lineno, line in enumerate(f, start=1):
-            parts = line.rstrip().split(" ")
-            if lineno == 1 and len(parts) == 2 and all(p.isdigit() for p in parts):
-                continue  # "n_words dim" header
-            if out is None:
-                out = np.zeros((len(vocab), len(parts) - 1), dtype=np.float64)
-            if len(parts) - 1 != out.shape[1]:
-                raise FormatError(path, f"expected {out.shape[1]} numbers, got {len(parts) - 1}", line=lineno)
-            i = vocab.get(normalize_word(parts[0]))
-            if i is None or i <= UNK or found[i]:
-                continue
-            try:
-                out[i] = np.array(parts[1:], dtype=np.float64)
-            except ValueError:
-                raise FormatError(path, "non-numeric vector entry", line=lineno) from None
-            found[i] = True
+    out, found = _vectors_of_vocab(path, vocab)
     if out is None:
         raise FormatError(path, "no vectors in the file")
     rng = np.random.default_rng(seed)
@@ -365,3 +353,43 @@ def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarra
     missing[PAD] = False
     out[missing] = rng.normal(0.0, 1.0 / np.sqrt(out.shape[1]), size=(int(missing.sum()), out.shape[1]))
     return out.astype(np.float32)
+
+
+def _vectors_of_vocab(path: Path, vocab: Vocab) -> tuple[np.ndarray | None, np.ndarray]:
+    """Read a ``.vec`` file: the (len(vocab), D) float64 rows of the vocabulary's ordinary words
+    (first occurrence wins, zeros elsewhere; None for a file without vectors) and which were found."""
+    from beatlite.io.errors import FormatError
+    from beatlite.io.textfile import open_text
+
+    out: np.ndarray | None = None
+    found = np.zeros(len(vocab), dtype=bool)
+    with open_text(path) as f:
+        for lineno, line in enumerate(f, start=1):
+            parts = line.rstrip().split(" ")
+            if lineno == 1 and _is_vec_header(parts):
+                continue
+            if out is None:
+                out = np.zeros((len(vocab), len(parts) - 1), dtype=np.float64)
+            if len(parts) - 1 != out.shape[1]:
+                raise FormatError(path, f"expected {out.shape[1]} numbers, got {len(parts) - 1}", line=lineno)
+            i = vocab.get(normalize_word(parts[0]))
+            if i is None or i <= UNK or found[i]:
+                continue
+            out[i] = _vec_numbers(path, lineno, parts[1:])
+            found[i] = True
+    return out, found
+
+
+def _is_vec_header(parts: list[str]) -> bool:
+    """Whether a first line split on spaces is the ``n_words dim`` header of a ``.vec`` file."""
+    return len(parts) == 2 and all(p.isdigit() for p in parts)
+
+
+def _vec_numbers(path: Path, lineno: int, numbers: list[str]) -> np.ndarray:
+    """(D,) float64 of a ``.vec`` line's numbers; ``FormatError`` naming the line when one is not a number."""
+    from beatlite.io.errors import FormatError
+
+    try:
+        return np.array(numbers, dtype=np.float64)
+    except ValueError:
+        raise FormatError(path, "non-numeric vector entry", line=lineno) from None

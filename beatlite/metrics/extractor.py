@@ -254,21 +254,8 @@ def _train(
     history = []
     t0 = time.perf_counter()
     for epoch in range(config.epochs):
-        model.train()
-        perm = torch.randperm(len(x), generator=gen)
-        total, n = 0.0, 0
-        for i in range(0, len(x), config.batch_size):
-            idx = perm[i : i + config.batch_size]
-            if len(idx) < 2:  # BatchNorm needs 2 samples
-                continue
-            loss = autoencoder_loss(model(x[idx]), x[idx], config.velocity_weight, config.velocity_loss)
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-            total += float(loss.detach()) * len(idx)
-            n += len(idx)
+        row = {"epoch": epoch + 1, "train": _train_epoch(model, opt, x, config, gen)}
         sched.step()
-        row = {"epoch": epoch + 1, "train": total / n}
         if xv is not None and len(xv) >= 1:
             model.eval()
             with torch.no_grad():
@@ -281,6 +268,30 @@ def _train(
             print(f"epoch {epoch + 1:3d}: train {row['train']:.4f}{extra}", flush=True)
     model.eval()
     return model, {"mean": mean, "std": std, "history": history, "seconds": time.perf_counter() - t0}
+
+
+def _train_epoch(
+    model: MotionAutoencoder,
+    opt: torch.optim.Optimizer,
+    x: torch.Tensor,
+    config: ExtractorConfig,
+    gen: torch.Generator,
+) -> float:
+    """One pass over the (N, 34, D) windows ``x`` in shuffled mini-batches; the mean training loss."""
+    model.train()
+    perm = torch.randperm(len(x), generator=gen)
+    total, n = 0.0, 0
+    for i in range(0, len(x), config.batch_size):
+        idx = perm[i : i + config.batch_size]
+        if len(idx) < 2:  # BatchNorm needs 2 samples
+            continue
+        loss = autoencoder_loss(model(x[idx]), x[idx], config.velocity_weight, config.velocity_loss)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        total += float(loss.detach()) * len(idx)
+        n += len(idx)
+    return total / n
 
 
 def save_extractor(

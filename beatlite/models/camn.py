@@ -259,6 +259,42 @@ class _Decoder(nn.Module):
         return self.head(sum_directions(seq, self.hidden))
 
 
+def _context_encoders(
+    cfg: CaMNConfig,
+) -> tuple[SpeakerEncoder | None, EmotionEncoder | None, TextEncoderTCN | None]:
+    """The speaker, emotion and text encoders (None where switched off), built in that order."""
+    speaker = SpeakerEncoder(cfg.n_speakers, cfg.speaker_features, cfg.slope) if cfg.use_speaker else None
+    emotion = EmotionEncoder(cfg.n_emotions, cfg.emotion_features) if cfg.use_emotion else None
+    text = (
+        TextEncoderTCN(
+            cfg.vocab_size, cfg.word_dim, cfg.text_hidden, cfg.text_layers, cfg.text_features, cfg.dropout
+        )
+        if cfg.use_text
+        else None
+    )
+    return speaker, emotion, text
+
+
+def _context_width(cfg: CaMNConfig) -> int:
+    """Width of the shared context [speaker, emotion, text] (the features switched on)."""
+    widths = (
+        (cfg.use_speaker, cfg.speaker_features),
+        (cfg.use_emotion, cfg.emotion_features),
+        (cfg.use_text, cfg.text_features),
+    )
+    return sum(width for on, width in widths if on)
+
+
+def _fused_widths(cfg: CaMNConfig) -> tuple[int, int]:
+    """Widths of the audio and face features the decoder receives (0 where switched off).
+
+    In the cascade they are the fusion MLPs' outputs, otherwise the encoders' last channels.
+    """
+    if cfg.cascade:
+        return (cfg.audio_fused if cfg.use_audio else 0), (cfg.face_fused if cfg.use_face else 0)
+    return (cfg.audio_channels[-1] if cfg.use_audio else 0), (cfg.face_channels[-1] if cfg.use_face else 0)
+
+
 class CaMN(GestureModel):
     """Cascaded Motion Network (see the module docstring).
 
@@ -282,40 +318,22 @@ class CaMN(GestureModel):
         super().__init__(config)
         cfg = config
         self.register_buffer("assembly", _assembly_index(), persistent=False)
-        ctx = 0  # width of the shared context [emo, spk, text]
-        self.speaker_encoder = (
-            SpeakerEncoder(cfg.n_speakers, cfg.speaker_features, cfg.slope) if cfg.use_speaker else None
-        )
-        ctx += cfg.speaker_features if cfg.use_speaker else 0
-        self.emotion_encoder = (
-            EmotionEncoder(cfg.n_emotions, cfg.emotion_features) if cfg.use_emotion else None
-        )
-        ctx += cfg.emotion_features if cfg.use_emotion else 0
-        self.text_encoder = (
-            TextEncoderTCN(
-                cfg.vocab_size, cfg.word_dim, cfg.text_hidden, cfg.text_layers, cfg.text_features, cfg.dropout
-            )
-            if cfg.use_text
-            else None
-        )
-        ctx += cfg.text_features if cfg.use_text else 0
-
+        # modules are built in this order (it fixes the random initialisation and the state_dict order)
+        self.speaker_encoder, self.emotion_encoder, self.text_encoder = _context_encoders(cfg)
+        ctx = _context_width(cfg)  # width of the shared context [emo, spk, text]
         self.audio_encoder = WavEncoder(cfg.audio_channels) if cfg.use_audio else None
         self.face_encoder = FaceEncoder(cfg.face_channels) if cfg.use_face else None
-        wav_f = cfg.audio_channels[-1]
-        face_f = cfg.face_channels[-1]
+        audio_out, face_out = _fused_widths(cfg)
         self.audio_fusion: nn.Module | None = None
         self.face_fusion: nn.Module | None = None
         if cfg.cascade:
-            audio_out = cfg.audio_fused if cfg.use_audio else 0
             if cfg.use_audio:
-                self.audio_fusion = mlp([wav_f + ctx, cfg.audio_fused, cfg.audio_fused], cfg.slope)
+                self.audio_fusion = mlp(
+                    [cfg.audio_channels[-1] + ctx, cfg.audio_fused, cfg.audio_fused], cfg.slope
+                )
             if cfg.use_face:
-                self.face_fusion = mlp([face_f + audio_out + ctx, cfg.audio_fused, cfg.face_fused], cfg.slope)
-            face_out = cfg.face_fused if cfg.use_face else 0
-        else:
-            audio_out = wav_f if cfg.use_audio else 0
-            face_out = face_f if cfg.use_face else 0
+                widths = [cfg.face_channels[-1] + audio_out + ctx, cfg.audio_fused, cfg.face_fused]
+                self.face_fusion = mlp(widths, cfg.slope)
         in_size = POSE_DIM + 1 + ctx + audio_out + face_out
         self.decoder_in = in_size
         if cfg.cascade:
@@ -377,7 +395,16 @@ class CaMN(GestureModel):
         pose = batch["pose"]
         if pose.ndim != 3 or pose.shape[-1] != POSE_DIM:
             raise ValueError(f"CaMN: batch['pose'] must be (B, T, {POSE_DIM}), got shape {tuple(pose.shape)}")
-        feats = self.encode(batch)
+        x = self._decoder_input(pose, self.encode(batch))
+        if self.hands_decoder is None:
+            out = self.body_decoder(x)
+            return {"pose": out, **self._split(out)}
+        body = self.body_decoder(x)
+        hands = self.hands_decoder(torch.cat([x, body], -1))
+        return {"pose": torch.cat([body, hands], -1)[..., self.assembly], "body": body, "hands": hands}
+
+    def _decoder_input(self, pose: torch.Tensor, feats: dict[str, torch.Tensor]) -> torch.Tensor:
+        """(B, T, decoder_in): seed frames, context, then the audio and face features (fused in the cascade)."""
         ctx = [feats[k] for k in ("emotion", "speaker", "text") if k in feats]
         parts = [
             seed_input(pose, self.n_pre),
@@ -397,13 +424,7 @@ class CaMN(GestureModel):
                 parts.append(self.face_fusion(torch.cat([feats["face"], *extra, *ctx], -1)))
             else:
                 parts.append(feats["face"])
-        x = torch.cat(parts, -1)
-        if self.hands_decoder is None:
-            out = self.body_decoder(x)
-            return {"pose": out, **self._split(out)}
-        body = self.body_decoder(x)
-        hands = self.hands_decoder(torch.cat([x, body], -1))
-        return {"pose": torch.cat([body, hands], -1)[..., self.assembly], "body": body, "hands": hands}
+        return torch.cat(parts, -1)
 
     def _split(self, pose: torch.Tensor) -> dict[str, torch.Tensor]:
         """Inverse assembly: the body (27) and hands (114) channels of a 141-d pose."""

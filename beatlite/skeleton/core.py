@@ -13,6 +13,22 @@ POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
 
 
+def _check_hierarchy(
+    names: tuple[str, ...], parents: np.ndarray, offsets: np.ndarray, channels: tuple[tuple[str, ...], ...]
+) -> None:
+    """Raise ``ValueError`` unless the sizes agree (J names, (J,) parents, (J, 3) offsets, J channel
+    lists) and the joints are in depth-first order (root parent -1, ``0 <= parents[j] < j``)."""
+    n = len(names)
+    if parents.shape != (n,) or offsets.shape != (n, 3) or len(channels) != n:
+        raise ValueError(
+            f"Skeleton: {n} names but parents {parents.shape}, offsets {offsets.shape}, "
+            f"{len(channels)} channel lists"
+        )
+    for j, p in enumerate(parents):
+        if (j == 0 and p != -1) or (j > 0 and not 0 <= p < j):
+            raise ValueError(f"Skeleton: joint {j} ({names[j]!r}) has invalid parent {p}")
+
+
 @dataclass(frozen=True, eq=False)
 class Skeleton:
     """A joint hierarchy as a BVH HIERARCHY block describes it.
@@ -46,15 +62,7 @@ class Skeleton:
     def __post_init__(self) -> None:
         parents = np.asarray(self.parents, dtype=np.int64)
         offsets = np.asarray(self.offsets, dtype=np.float64).reshape(-1, 3)
-        n = len(self.names)
-        if parents.shape != (n,) or offsets.shape != (n, 3) or len(self.channels) != n:
-            raise ValueError(
-                f"Skeleton: {n} names but parents {parents.shape}, offsets {offsets.shape}, "
-                f"{len(self.channels)} channel lists"
-            )
-        for j, p in enumerate(parents):
-            if (j == 0 and p != -1) or (j > 0 and not 0 <= p < j):
-                raise ValueError(f"Skeleton: joint {j} ({self.names[j]!r}) has invalid parent {p}")
+        _check_hierarchy(self.names, parents, offsets, self.channels)
         object.__setattr__(self, "parents", parents)
         object.__setattr__(self, "offsets", offsets)
         object.__setattr__(self, "names", tuple(self.names))

@@ -96,13 +96,9 @@ def directions_to_positions(
     -------
     (..., J, 3) float64 with ``J = bones.max() + 1``.
     """
-    d = np.asarray(dirs, dtype=np.float64)
     b = _as_bones(bones)
     n_bones = b.shape[0]
-    if d.ndim >= 1 and d.shape[-1] == 3 * n_bones and n_bones != 1:
-        d = d.reshape(d.shape[:-1] + (n_bones, 3))  # flat (..., 3B) bone-major vectors
-    if d.ndim < 2 or d.shape[-2:] != (n_bones, 3):
-        raise ValueError(f"dirs must have shape (..., {n_bones}, 3) for {n_bones} bones, got {d.shape}")
+    d = _as_bone_vectors(dirs, n_bones)
     ln = np.asarray(lengths, dtype=np.float64)
     if ln.shape != (n_bones,):
         raise ValueError(f"lengths must have shape ({n_bones},), got {ln.shape}")
@@ -115,16 +111,8 @@ def directions_to_positions(
         if np.any(norm < 1e-12):
             raise ValueError("dirs contains zero vectors, which have no direction")
         d = d / norm
-    n_joints = int(b.max()) + 1
-    children = set(b[:, 1].tolist())
-    roots = {int(p) for p in b[:, 0] if int(p) not in children}
-    if len(roots) != 1 or len(children) != n_bones or len(children | roots) != n_joints:
-        raise ValueError(
-            f"bones must form one tree over joints 0..{n_joints - 1} with a single root and each joint "
-            f"the child of one bone; roots found: {sorted(roots)}"
-        )
+    root_joint, n_joints = _tree_root(b)
     out = np.full(lead + (n_joints, 3), np.nan)
-    (root_joint,) = roots
     out[..., root_joint, :] = r
     placed = {root_joint}
     for k, (p, c) in enumerate(b.tolist()):
@@ -133,3 +121,29 @@ def directions_to_positions(
         out[..., c, :] = out[..., p, :] + ln[k] * d[..., k, :]
         placed.add(c)
     return out
+
+
+def _as_bone_vectors(dirs: np.ndarray, n_bones: int) -> np.ndarray:
+    """``dirs`` as (..., B, 3) float64; a flat (..., 3B) last axis is read bone-major."""
+    d = np.asarray(dirs, dtype=np.float64)
+    if d.ndim >= 1 and d.shape[-1] == 3 * n_bones and n_bones != 1:
+        d = d.reshape(d.shape[:-1] + (n_bones, 3))  # flat (..., 3B) bone-major vectors
+    if d.ndim < 2 or d.shape[-2:] != (n_bones, 3):
+        raise ValueError(f"dirs must have shape (..., {n_bones}, 3) for {n_bones} bones, got {d.shape}")
+    return d
+
+
+def _tree_root(b: np.ndarray) -> tuple[int, int]:
+    """The root joint and the joint count J of bones ``b`` (B, 2); ``ValueError`` unless they form
+    one tree over joints ``0 .. J-1`` in which every joint but the root is the child of one bone."""
+    n_bones = b.shape[0]
+    n_joints = int(b.max()) + 1
+    children = set(b[:, 1].tolist())
+    roots = {int(p) for p in b[:, 0] if int(p) not in children}
+    if len(roots) != 1 or len(children) != n_bones or len(children | roots) != n_joints:
+        raise ValueError(
+            f"bones must form one tree over joints 0..{n_joints - 1} with a single root and each joint "
+            f"the child of one bone; roots found: {sorted(roots)}"
+        )
+    (root_joint,) = roots
+    return root_joint, n_joints

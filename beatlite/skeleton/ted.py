@@ -307,31 +307,47 @@ def beat_to_ted43(
     -------
     (T, 43, 3) float64, centimetres, in :data:`TED43_JOINTS` order.
     """
-    if isinstance(source, Skeleton):
-        if channels is None:
-            raise ValueError("beat_to_ted43(skeleton, channels): channels (T, C) is required with a Skeleton")
-        names = source.names
-        rotations, pos = global_transforms(source, channels)
-    elif hasattr(source, "skeleton") and hasattr(source, "channels"):
-        names = source.skeleton.names  # type: ignore[attr-defined]
-        rotations, pos = global_transforms(source.skeleton, source.channels)  # type: ignore[attr-defined]
-    else:
-        names = (skeleton or beat_skeleton()).names
-        pos = np.asarray(source, dtype=np.float64)
-        if pos.ndim != 3 or pos.shape[1:] != (len(names), 3):
-            raise ValueError(f"positions must have shape (T, {len(names)}, 3), got {pos.shape}")
-        if rotations is not None:
-            rotations = np.asarray(rotations, dtype=np.float64)
-            if rotations.shape != pos.shape + (3,):
-                raise ValueError(f"rotations must have shape {pos.shape + (3,)}, got {rotations.shape}")
-    missing = [n for n in TED43_FROM_BEAT if n is not None and n not in names] + [
-        n for n in ("Head", "HeadEnd", "RightArm", "LeftArm") if n not in names
-    ]
-    if missing:
-        raise ValueError(f"the skeleton lacks the BEAT joints {missing[:5]} needed for the TED-43 mapping")
+    names, pos, rotations = _source_positions(source, channels, rotations, skeleton)
+    _check_ted_joints(names)
     body = [names.index(n) for n in TED43_FROM_BEAT if n is not None]
     head = names.index("Head")
     head_rot = rotations[:, head] if rotations is not None else _head_frame_from_positions(pos, names)
     offsets = np.array([HEAD_LANDMARK_OFFSETS[n] for n in TED43_JOINTS[38:]])  # (5, 3)
     face = pos[:, head, None, :] + np.einsum("tkl,ml->tmk", head_rot, offsets)
     return np.concatenate([pos[:, body], face], axis=1)
+
+
+def _source_positions(
+    source: Skeleton | np.ndarray | object,
+    channels: np.ndarray | None,
+    rotations: np.ndarray | None,
+    skeleton: Skeleton | None,
+) -> tuple[tuple[str, ...], np.ndarray, np.ndarray | None]:
+    """The joint names, world positions (T, J, 3) cm and world rotations (T, J, 3, 3) or None
+    of each way of calling :func:`beat_to_ted43`."""
+    if isinstance(source, Skeleton):
+        if channels is None:
+            raise ValueError("beat_to_ted43(skeleton, channels): channels (T, C) is required with a Skeleton")
+        rotations, pos = global_transforms(source, channels)
+        return source.names, pos, rotations
+    if hasattr(source, "skeleton") and hasattr(source, "channels"):
+        rotations, pos = global_transforms(source.skeleton, source.channels)  # type: ignore[attr-defined]
+        return source.skeleton.names, pos, rotations  # type: ignore[attr-defined]
+    names = (skeleton or beat_skeleton()).names
+    pos = np.asarray(source, dtype=np.float64)
+    if pos.ndim != 3 or pos.shape[1:] != (len(names), 3):
+        raise ValueError(f"positions must have shape (T, {len(names)}, 3), got {pos.shape}")
+    if rotations is not None:
+        rotations = np.asarray(rotations, dtype=np.float64)
+        if rotations.shape != pos.shape + (3,):
+            raise ValueError(f"rotations must have shape {pos.shape + (3,)}, got {rotations.shape}")
+    return names, pos, rotations
+
+
+def _check_ted_joints(names: tuple[str, ...]) -> None:
+    """``ValueError`` unless ``names`` holds every BEAT joint the TED-43 mapping and the head frame use."""
+    missing = [n for n in TED43_FROM_BEAT if n is not None and n not in names] + [
+        n for n in ("Head", "HeadEnd", "RightArm", "LeftArm") if n not in names
+    ]
+    if missing:
+        raise ValueError(f"the skeleton lacks the BEAT joints {missing[:5]} needed for the TED-43 mapping")

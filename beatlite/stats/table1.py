@@ -107,33 +107,36 @@ def corpus_row(
     """
     usable = index.where(usable=True)
     joints = _joint_counts(usable)
-    face = _face_dims(usable)
-    languages = sorted({r.language for r in usable if r.language}, key=list(_LANGUAGE_CODES).index)
-    emotions = sorted({r.emotion for r in usable if r.emotion is not None})
-    has_text = any("text" in r.files for r in usable)
-    has_sem = any("semantic" in r.files for r in usable)
-    hours = usable.total_duration / 3600.0
+    counts = {
+        "n_speakers": len(usable.speaker_ids()),
+        "n_sequences": len(usable),
+        "hours": usable.total_duration / 3600.0,
+        "n_body": None if joints is None else joints[0],
+        "n_hand": None if joints is None else joints[1],
+        "n_face": _face_dims(usable),
+        "n_emotions": len({r.emotion for r in usable if r.emotion is not None}),
+        "languages": sorted({r.language for r in usable if r.language}, key=list(_LANGUAGE_CODES).index),
+    }
+    has = {kind: any(kind in r.files for r in usable) for kind in ("text", "semantic")}
+    return {**_table1_cells(name, quality, counts, has), **counts}
+
+
+def _table1_cells(name: str, quality: str, counts: dict[str, Any], has: dict[str, bool]) -> dict[str, str]:
+    """The string cells of :data:`TABLE1_COLUMNS` from :func:`corpus_row`'s numeric ``counts``
+    ("-" where a modality is absent); ``has`` says whether any take has ``text`` / ``semantic`` files."""
     return {
         "dataset": name,
         "quality": quality,
-        "body": "-" if joints is None else str(joints[0]),
-        "hand": "-" if joints is None else str(joints[1]),
-        "face": "-" if face is None else f"{face} BSW",
-        "audio": "/".join(_LANGUAGE_CODES[lang] for lang in languages) or "-",
-        "text": "yes" if has_text else "-",
-        "speakers": str(len(usable.speaker_ids())),
-        "emotions": str(len(emotions)) if emotions else "-",
-        "semantic": "yes" if has_sem else "-",
-        "sequences": str(len(usable)),
-        "duration": f"{hours:.2f}h",
-        "n_speakers": len(usable.speaker_ids()),
-        "n_sequences": len(usable),
-        "hours": hours,
-        "n_body": None if joints is None else joints[0],
-        "n_hand": None if joints is None else joints[1],
-        "n_face": face,
-        "n_emotions": len(emotions),
-        "languages": languages,
+        "body": "-" if counts["n_body"] is None else str(counts["n_body"]),
+        "hand": "-" if counts["n_hand"] is None else str(counts["n_hand"]),
+        "face": "-" if counts["n_face"] is None else f"{counts['n_face']} BSW",
+        "audio": "/".join(_LANGUAGE_CODES[lang] for lang in counts["languages"]) or "-",
+        "text": "yes" if has["text"] else "-",
+        "speakers": str(counts["n_speakers"]),
+        "emotions": str(counts["n_emotions"]) if counts["n_emotions"] else "-",
+        "semantic": "yes" if has["semantic"] else "-",
+        "sequences": str(counts["n_sequences"]),
+        "duration": f"{counts['hours']:.2f}h",
     }
 
 

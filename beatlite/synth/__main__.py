@@ -8,12 +8,12 @@ import time
 from collections import Counter
 from collections.abc import Sequence
 
-from beatlite.synth.corpus import corpus_specs, generate_corpus
+from beatlite.synth.corpus import TakeSpec, corpus_specs, generate_corpus
 from beatlite.synth.speech import EspeakNotFoundError
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Generate the synthetic BEAT-format corpus; returns the exit status."""
+def _parser() -> argparse.ArgumentParser:
+    """The command line's options."""
     parser = argparse.ArgumentParser(
         prog="python -m beatlite.synth",
         description="Generate beatlite's synthetic BEAT-format corpus (see data_samples/README.md).",
@@ -30,13 +30,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--workers", type=int, default=None, help="processes (default min(2, CPUs))")
     parser.add_argument("--only", nargs="*", default=None, help="generate only these take names")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _selected_specs(parser: argparse.ArgumentParser, only: Sequence[str] | None) -> list[TakeSpec]:
+    """The corpus takes named in ``only`` (all when empty); unknown names are a usage error."""
     specs = corpus_specs()
-    if args.only:
-        unknown = sorted(set(args.only) - {s.name for s in specs})
+    if only:
+        unknown = sorted(set(only) - {s.name for s in specs})
         if unknown:
             parser.error(f"unknown take names {unknown}; known: {[s.name for s in specs]}")
-        specs = [s for s in specs if s.name in args.only]
+        specs = [s for s in specs if s.name in only]
+    return specs
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Generate the synthetic BEAT-format corpus; returns the exit status."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    specs = _selected_specs(parser, args.only)
     tic = time.perf_counter()
     try:
         results = generate_corpus(

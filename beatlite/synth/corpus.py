@@ -11,12 +11,13 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from beatlite.io.names import emotion_of, split_of
 from beatlite.synth.onsets import speech_onsets
-from beatlite.synth.plan import TimedWord, make_plan, semantic_segments
+from beatlite.synth.plan import Plan, TimedWord, make_plan, semantic_segments
 from beatlite.synth.speech import (
     ESPEAK_SR,
     OUTPUT_SR,
@@ -28,6 +29,9 @@ from beatlite.synth.speech import (
 )
 from beatlite.synth.styles import EMOTION_NAMES, EMOTION_STYLES, SPEAKERS, SpeakerStyle
 from beatlite.synth.transcripts import sentence_order
+
+if TYPE_CHECKING:
+    from beatlite.io import Motion
 
 DURATION_STEP_S = 0.2
 """Take durations are rounded up to a multiple of this (integer frames at 15/30/60/120 fps and 16 kHz)."""
@@ -167,10 +171,39 @@ def synthesize_speech(spec: TakeSpec, rng: np.random.Generator) -> Speech:
     -------
     Speech
     """
-    speaker = spec.speaker
+    placed, words, turn_bounds = _lay_out_words(spec, rng)
+    end = words[-1].end + 0.8
+    duration = math.ceil(round(end / DURATION_STEP_S, 6)) * DURATION_STEP_S
+    duration = round(duration, 6)
+    audio = _mix_words(placed, duration, rng)
+    phones: list[tuple[float, float, str]] = []
+    for (_, sw, _), w in zip(placed, words):
+        step = (w.end - w.start) / len(sw.phones)
+        for i, ph in enumerate(sw.phones):
+            phones.append((round(w.start + i * step, 4), round(w.start + (i + 1) * step, 4), ph))
+    emotions = []
+    for i, (t0, e) in enumerate(turn_bounds):
+        t1 = turn_bounds[i + 1][0] if i + 1 < len(turn_bounds) else duration
+        emotions.append((round(t0, 3), round(t1, 3), e))
+    return Speech(audio, tuple(words), tuple(phones), tuple(emotions), duration)
+
+
+def _lay_out_words(
+    spec: TakeSpec, rng: np.random.Generator
+) -> tuple[list[tuple[int, SpokenWord, int]], list[TimedWord], list[tuple[float, int]]]:
+    """Speak the take's sentences turn by turn and place them in time (see :func:`synthesize_speech`).
+
+    Returns
+    -------
+    placed : list of (first sample at ESPEAK_SR, SpokenWord, emotion id)
+    words : list of TimedWord
+        The same words, timed in seconds.
+    turn_bounds : list of (start s, emotion id)
+        Where each speaking turn's emotion begins (the first at 0).
+    """
     sentences = sentence_order(rng)
     cache: dict[tuple[str, Voice], SpokenWord] = {}
-    placed: list[tuple[int, SpokenWord, int]] = []  # (sample, word, emotion)
+    placed: list[tuple[int, SpokenWord, int]] = []
     words: list[TimedWord] = []
     turn_bounds: list[tuple[float, int]] = []
     cursor = rng.uniform(0.6, 1.2)
@@ -179,7 +212,7 @@ def synthesize_speech(spec: TakeSpec, rng: np.random.Generator) -> Speech:
         if turn > 0:
             cursor += rng.uniform(2.0, 3.5)
         turn_bounds.append((cursor - 0.3 if turn else 0.0, emotion))
-        voice = _voice(speaker, emotion)
+        voice = _voice(spec.speaker, emotion)
         pause = EMOTION_STYLES[emotion].pause
         start = cursor
         while cursor - start < target:
@@ -194,25 +227,19 @@ def synthesize_speech(spec: TakeSpec, rng: np.random.Generator) -> Speech:
             if cursor - start < target:
                 long = rng.random() < 0.25
                 cursor += pause * (rng.uniform(1.0, 1.5) if long else rng.uniform(0.35, 0.7))
-    end = words[-1].end + 0.8
-    duration = math.ceil(round(end / DURATION_STEP_S, 6)) * DURATION_STEP_S
-    duration = round(duration, 6)
+    return placed, words, turn_bounds
+
+
+def _mix_words(
+    placed: Sequence[tuple[int, SpokenWord, int]], duration: float, rng: np.random.Generator
+) -> np.ndarray:
+    """The take's waveform: the placed words summed with a faint noise floor, (duration * 16 kHz,) float32."""
     raw = np.zeros(int(round(duration * ESPEAK_SR)) + 1, dtype=np.float64)
     for s0, sw, _ in placed:
         raw[s0 : s0 + sw.audio.size] += sw.audio
     raw += rng.normal(0.0, 2e-4, size=raw.size)  # a faint noise floor
     audio = np.clip(0.9 * resample_to_output(raw), -1.0, 1.0).astype(np.float32)
-    audio = audio[: int(round(duration * OUTPUT_SR))]
-    phones: list[tuple[float, float, str]] = []
-    for (_, sw, _), w in zip(placed, words):
-        step = (w.end - w.start) / len(sw.phones)
-        for i, ph in enumerate(sw.phones):
-            phones.append((round(w.start + i * step, 4), round(w.start + (i + 1) * step, 4), ph))
-    emotions = []
-    for i, (t0, e) in enumerate(turn_bounds):
-        t1 = turn_bounds[i + 1][0] if i + 1 < len(turn_bounds) else duration
-        emotions.append((round(t0, 3), round(t1, 3), e))
-    return Speech(audio, tuple(words), tuple(phones), tuple(emotions), duration)
+    return audio[: int(round(duration * OUTPUT_SR))]
 
 
 def _tier(items: Sequence[tuple[float, float, str]], duration: float) -> list[tuple[float, float, str]]:
@@ -275,46 +302,75 @@ def generate_take(
     -------
     TakeResult
     """
-    from beatlite.io import Motion, write_bvh
-    from beatlite.io.audio import write_wav
-    from beatlite.io.facial import ARKIT_51, write_facial
-    from beatlite.skeleton.beat import beat_skeleton
-    from beatlite.synth import _annotations
-    from beatlite.synth.face import face_weights
-    from beatlite.synth.motion import body_channels, emotion_ids
-
     if not isinstance(spec, TakeSpec):
         raise TypeError(f"generate_take: spec must be a TakeSpec, got {type(spec).__name__}")
     out = Path(out_dir)
     if not out.is_dir():
         raise FileNotFoundError(f"generate_take: output folder {out} does not exist")
-    if not isinstance(fps, int) or isinstance(fps, bool) or fps <= 0 or fps % 5:
-        raise ValueError(f"generate_take: fps must be a positive integer multiple of 5, got {fps!r}")
+    _check_fps(fps, "generate_take")
     tic = time.perf_counter()
     streams = [np.random.default_rng([seed, spec.speaker_id, spec.session, spec.seq, k]) for k in range(4)]
     speech = synthesize_speech(spec, streams[0])
     onsets = speech_onsets(speech.audio, OUTPUT_SR)
     plan = make_plan(speech.words, spec.speaker, speech.duration, streams[1], onsets=onsets)
+    motion, precision = _take_motion(spec, plan, speech.duration, streams[2], fps=fps, full_rate=full_rate)
+    face = _take_face(speech, plan, streams[3])
+    paths = _write_take(out / spec.name, speech, plan, motion, precision, face, full_rate=full_rate)
+    return TakeResult(spec.name, paths, speech.duration, time.perf_counter() - tic)
+
+
+def _check_fps(fps: int, caller: str) -> None:
+    """Raise ``ValueError`` unless ``fps`` is a positive integer multiple of 5."""
+    if not isinstance(fps, int) or isinstance(fps, bool) or fps <= 0 or fps % 5:
+        raise ValueError(f"{caller}: fps must be a positive integer multiple of 5, got {fps!r}")
+
+
+def _take_motion(
+    spec: TakeSpec, plan: Plan, duration: float, rng: np.random.Generator, *, fps: int, full_rate: bool
+) -> tuple[Motion, int]:
+    """The take's body motion at ``fps`` (120 with ``full_rate``), rounded; and its BVH decimals."""
+    from beatlite.io import Motion
+    from beatlite.skeleton.beat import beat_skeleton
+    from beatlite.synth.motion import body_channels
+
     bvh_fps = 120 if full_rate else fps
-    n_frames = int(round(speech.duration * bvh_fps))
+    n_frames = int(round(duration * bvh_fps))
     t = np.arange(n_frames) / bvh_fps
     skeleton = beat_skeleton()
-    channels = body_channels(skeleton, t, plan, spec.speaker, streams[2])
+    channels = body_channels(skeleton, t, plan, spec.speaker, rng)
     precision = 6 if full_rate else BVH_PRECISION
     channels = np.round(channels, precision) + 0.0  # + 0.0 turns -0.0 into 0.0
+    return Motion(skeleton, channels, bvh_fps), precision
+
+
+def _take_face(speech: Speech, plan: Plan, rng: np.random.Generator) -> np.ndarray:
+    """The take's ARKit blendshape weights (T_face, 51) at :data:`FACE_FPS`."""
+    from beatlite.io.facial import ARKIT_51
+    from beatlite.synth.face import face_weights
+    from beatlite.synth.motion import emotion_ids
+
     n_face = int(round(speech.duration * FACE_FPS))
     t_face = np.arange(n_face) / FACE_FPS
-    face = face_weights(
-        ARKIT_51,
-        n_face,
-        FACE_FPS,
-        speech.audio,
-        OUTPUT_SR,
-        speech.phones,
-        emotion_ids(t_face, plan),
-        streams[3],
-    )
-    stem = out / spec.name
+    emotion = emotion_ids(t_face, plan)
+    return face_weights(ARKIT_51, n_face, FACE_FPS, speech.audio, OUTPUT_SR, speech.phones, emotion, rng)
+
+
+def _write_take(
+    stem: Path,
+    speech: Speech,
+    plan: Plan,
+    motion: Motion,
+    precision: int,
+    face: np.ndarray,
+    *,
+    full_rate: bool,
+) -> tuple[Path, ...]:
+    """Write the six files of a take at ``stem``: BVH, WAV, facial JSON, TextGrid, semantic TXT, emotion CSV."""
+    from beatlite.io import write_bvh
+    from beatlite.io.audio import write_wav
+    from beatlite.io.facial import ARKIT_51, write_facial
+    from beatlite.synth import _annotations
+
     paths = (
         Path(f"{stem}.bvh" if full_rate else f"{stem}.bvh.gz"),
         Path(f"{stem}.wav"),
@@ -323,7 +379,7 @@ def generate_take(
         Path(f"{stem}.txt"),
         Path(f"{stem}.csv"),
     )
-    write_bvh(paths[0], Motion(skeleton, channels, bvh_fps), precision=precision)
+    write_bvh(paths[0], motion, precision=precision)
     write_wav(paths[1], speech.audio, OUTPUT_SR)
     write_facial(paths[2], ARKIT_51, face, FACE_FPS)
     words = _tier([(w.start, w.end, w.word) for w in speech.words], speech.duration)
@@ -332,7 +388,7 @@ def generate_take(
     _annotations.write_semantic(paths[4], semantic_segments(plan))
     emotions = [(EMOTION_NAMES[e], s, t1, e) for s, t1, e in speech.emotions]
     _annotations.write_emotion(paths[5], emotions)
-    return TakeResult(spec.name, paths, speech.duration, time.perf_counter() - tic)
+    return paths
 
 
 # ----------------------------------------------------------------------------- whole corpus
@@ -369,8 +425,7 @@ def generate_corpus(
     -------
     list of TakeResult, in the order of ``specs``.
     """
-    if not isinstance(fps, int) or isinstance(fps, bool) or fps <= 0 or fps % 5:
-        raise ValueError(f"generate_corpus: fps must be a positive integer multiple of 5, got {fps!r}")
+    _check_fps(fps, "generate_corpus")
     espeak_path()  # fail early with the install hint
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -381,6 +436,11 @@ def generate_corpus(
     jobs = [(s, str(out), seed, fps, full_rate) for s in specs]
     if workers == 1:
         return [_run(j) for j in jobs]
+    return _run_in_pool(jobs, workers)
+
+
+def _run_in_pool(jobs: Sequence[tuple[TakeSpec, str, int, int, bool]], workers: int) -> list[TakeResult]:
+    """:func:`_run` each job in ``workers`` spawned processes, long takes first; results in job order."""
     import multiprocessing as mp
 
     order = sorted(range(len(jobs)), key=lambda i: -jobs[i][0].target_s)  # long takes first

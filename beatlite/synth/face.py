@@ -89,12 +89,41 @@ def face_weights(
         raise ValueError(f"face_weights: emotion must be ({n_frames},), got shape {emotion.shape}")
     t = np.arange(n_frames) / fps
     w = np.zeros((n_frames, len(names)))
+    env = _audio_envelope(audio, sr, t)
+    _add_mouth(w, index, t, env, phones)
+    # emotion expression, cross-faded
+    profile = np.zeros((8, len(names)))
+    for e, shapes in EMOTION_FACES.items():
+        for name, value in shapes.items():
+            if name in index:
+                profile[e, index[name]] = value
+    w += _smooth(profile[emotion], int(0.25 * fps))
+    _add_eyes(w, index, t, rng)
+    return np.round(np.clip(w, 0.0, 1.0), 3)
 
-    def add(name: str, value: np.ndarray | float) -> None:
-        if name in index:
-            w[:, index[name]] += value
 
-    # audio envelope: RMS over +-12.5 ms around each frame time
+def _add(w: np.ndarray, index: dict[str, int], name: str, value: np.ndarray | float) -> None:
+    """Add ``value`` to column ``name`` of the weights ``w`` (T, K) (nothing when it is not a column)."""
+    if name in index:
+        w[:, index[name]] += value
+
+
+def _audio_envelope(audio: np.ndarray, sr: int, t: np.ndarray) -> np.ndarray:
+    """Mouth-opening envelope: audio RMS over +-12.5 ms around each frame time.
+
+    Parameters
+    ----------
+    audio : (N,) float
+        Waveform in [-1, 1].
+    sr : int
+        Audio rate, Hz.
+    t : (T,) float
+        Frame times, seconds.
+
+    Returns
+    -------
+    (T,) float64 in [0, 1.2]: the RMS over its 95th percentile, clipped and lightly smoothed.
+    """
     y = np.asarray(audio, dtype=np.float64)
     centres = np.clip(np.round(t * sr).astype(np.int64), 0, max(y.size - 1, 0))
     half = int(0.0125 * sr)
@@ -103,48 +132,51 @@ def face_weights(
     hi = np.clip(centres + half, 0, y.size)
     rms = np.sqrt((csum[hi] - csum[lo]) / np.maximum(hi - lo, 1))
     ref = np.percentile(rms, 95) if rms.size and np.percentile(rms, 95) > 0 else 1.0
-    env = _smooth(np.clip(rms / ref, 0, 1.2), 2)
-    add("jawOpen", 0.45 * env**0.8)
-    add("mouthLowerDownLeft", 0.25 * env)
-    add("mouthLowerDownRight", 0.25 * env)
-    # visemes from the phones tier
-    lab = np.zeros(n_frames)
-    rnd = np.zeros(n_frames)
-    spr = np.zeros(n_frames)
+    return _smooth(np.clip(rms / ref, 0, 1.2), 2)
+
+
+def _add_mouth(
+    w: np.ndarray,
+    index: dict[str, int],
+    t: np.ndarray,
+    env: np.ndarray,
+    phones: Sequence[tuple[float, float, str]],
+) -> None:
+    """Jaw and lips: opening by the audio envelope ``env`` (T,), visemes from the timed phones."""
+    _add(w, index, "jawOpen", 0.45 * env**0.8)
+    _add(w, index, "mouthLowerDownLeft", 0.25 * env)
+    _add(w, index, "mouthLowerDownRight", 0.25 * env)
+    lab = np.zeros(t.size)
+    rnd = np.zeros(t.size)
+    spr = np.zeros(t.size)
     for start, end, ph in phones:
         sel = (t >= start) & (t < end)
         lab[sel] += ph in _BILABIAL
         rnd[sel] += ph in _ROUNDED
         spr[sel] += ph in _SPREAD
     lab, rnd, spr = _smooth(lab, 2), _smooth(rnd, 3), _smooth(spr, 3)
-    add("mouthClose", 0.3 * lab)
-    add("mouthPressLeft", 0.2 * lab)
-    add("mouthPressRight", 0.2 * lab)
-    add("jawOpen", -0.3 * lab * env)
-    add("mouthFunnel", 0.4 * rnd)
-    add("mouthPucker", 0.3 * rnd)
-    add("mouthStretchLeft", 0.2 * spr)
-    add("mouthStretchRight", 0.2 * spr)
-    # emotion expression, cross-faded
-    profile = np.zeros((8, len(names)))
-    for e, shapes in EMOTION_FACES.items():
-        for name, value in shapes.items():
-            if name in index:
-                profile[e, index[name]] = value
-    w += _smooth(profile[emotion], int(0.25 * fps))
-    # blinks every 3-5 s, 0.15 s long
-    blink = np.zeros(n_frames)
+    _add(w, index, "mouthClose", 0.3 * lab)
+    _add(w, index, "mouthPressLeft", 0.2 * lab)
+    _add(w, index, "mouthPressRight", 0.2 * lab)
+    _add(w, index, "jawOpen", -0.3 * lab * env)
+    _add(w, index, "mouthFunnel", 0.4 * rnd)
+    _add(w, index, "mouthPucker", 0.3 * rnd)
+    _add(w, index, "mouthStretchLeft", 0.2 * spr)
+    _add(w, index, "mouthStretchRight", 0.2 * spr)
+
+
+def _add_eyes(w: np.ndarray, index: dict[str, int], t: np.ndarray, rng: np.random.Generator) -> None:
+    """Blinks every 3-5 s (0.15 s long) and a slow gaze drift, at frame times ``t`` (T,) seconds."""
+    blink = np.zeros(t.size)
     tb = rng.uniform(0.5, 3.0)
-    while tb < t[-1] if n_frames else False:
+    while tb < t[-1] if t.size else False:
         amp = rng.uniform(0.85, 1.0)
         blink += amp * np.clip(np.sin(np.pi * np.clip((t - tb) / 0.15, 0, 1)), 0, 1)
         tb += rng.uniform(3.0, 5.0)
-    add("eyeBlinkLeft", blink)
-    add("eyeBlinkRight", blink)
-    # slow gaze drift
+    _add(w, index, "eyeBlinkLeft", blink)
+    _add(w, index, "eyeBlinkRight", blink)
     gaze = np.sin(2 * np.pi * rng.uniform(0.05, 0.15) * t + rng.uniform(0, 2 * np.pi))
-    add("eyeLookOutLeft", 0.15 * np.clip(gaze, 0, None))
-    add("eyeLookInRight", 0.15 * np.clip(gaze, 0, None))
-    add("eyeLookInLeft", 0.15 * np.clip(-gaze, 0, None))
-    add("eyeLookOutRight", 0.15 * np.clip(-gaze, 0, None))
-    return np.round(np.clip(w, 0.0, 1.0), 3)
+    _add(w, index, "eyeLookOutLeft", 0.15 * np.clip(gaze, 0, None))
+    _add(w, index, "eyeLookInRight", 0.15 * np.clip(gaze, 0, None))
+    _add(w, index, "eyeLookInLeft", 0.15 * np.clip(-gaze, 0, None))
+    _add(w, index, "eyeLookOutRight", 0.15 * np.clip(-gaze, 0, None))

@@ -28,6 +28,8 @@ Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (`
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from beatlite.skeleton.core import Skeleton
@@ -364,6 +366,23 @@ def _hand_role(speaker: SpeakerStyle, side: str) -> float:
     return 0.35
 
 
+class _HandDrive(NamedTuple):
+    """Per-frame signals shared by both hands, each (T,) float64 (see :func:`wrist_paths`)."""
+
+    amp_e: np.ndarray
+    """Emotion amplitude."""
+    tremor_e: np.ndarray
+    """Emotion tremor, centimetres."""
+    env: np.ndarray
+    """Phrase envelope in [0, 1]."""
+    lift: np.ndarray
+    """Beat-loop height, centimetres."""
+    loop: np.ndarray
+    """Beat-loop width, centimetres."""
+    angry: np.ndarray
+    """Smoothed share of anger in [0, 1]."""
+
+
 def wrist_paths(
     t: np.ndarray, plan: Plan, speaker: SpeakerStyle, rng: np.random.Generator
 ) -> dict[str, dict[str, np.ndarray]]:
@@ -381,79 +400,132 @@ def wrist_paths(
     dict side -> {"wrist": (T, 3) cm chest frame, "curl": (T, 5) in [0, 1], "roll": (T,) degrees,
     "flex": (T,) degrees}, sides ``"right"``, ``"left"``.
     """
-    amp_e = emotion_track(t, plan, "amplitude")
-    tremor_e = emotion_track(t, plan, "tremor")
-    env = phrase_envelope(t, plan)
     lift, loop = beat_lift(t, plan)
-    angry = _smooth_track(t, (emotion_ids(t, plan) == 2).astype(np.float64))
-    out: dict[str, dict[str, np.ndarray]] = {}
-    for side in ("right", "left"):
-        role = _hand_role(speaker, side)
-        rest = _mirror(speaker.rest, side)
-        centre = _mirror(speaker.gesture_center, side)
-        # gesture space follows the emotion amplitude: sad speakers stay low and near the body
-        reach = role * np.clip(0.4 + 0.6 * amp_e, 0.5, 1.4)
-        wrist = rest[None, :] + (env * reach)[:, None] * (centre - rest)[None, :]
-        direction = _mirror(speaker.beat_direction, side)
-        direction = direction / np.linalg.norm(direction)
-        # the loop's second axis: outwards and forwards (the elbow then loops too, it does not
-        # stop and turn back mid-way); right is -x
-        outward = _mirror(np.array([-1.0, 0.0, 0.6]), side)
-        across = outward - np.dot(outward, direction) * direction
-        across = across / max(float(np.linalg.norm(across)), 1e-9)
-        wrist = wrist - (role * lift)[:, None] * direction[None, :] + (role * loop)[:, None] * across[None, :]
-        # slow, small drift (no sharp speed minima between beats) and the favourite movement
-        for _ in range(3):
-            f = rng.uniform(0.05, 0.15)
-            phase = rng.uniform(0, 2 * np.pi, size=3)
-            wrist += DRIFT_CM * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
-        shape_fav = np.array(HAND_SHAPES[_FAVOURITE_SHAPE[speaker.favourite]])
-        curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[
-            :, None
-        ] * shape_fav
-        # anger clenches the gesturing hand towards a fist
-        fist = (0.6 * env * role * angry)[:, None]
-        curl = (1 - fist) * curl + fist * np.array(HAND_SHAPES["fist"])
-        # the wrist pulses with the beat loop in two components (flexion ~ height, roll ~ across)
-        # so the hand's rotation, too, is still only at the beats
-        pulse = _FAVOURITE_FLEX[speaker.favourite] * role / 5.0
-        roll = env * role * _FAVOURITE_ROLL[speaker.favourite] + 0.5 * pulse * loop
-        flex = 8.0 + pulse * lift
-        # semantic gestures
-        weight_sum = np.zeros_like(t)
-        g_wrist = np.zeros_like(wrist)
-        g_curl = np.zeros_like(curl)
-        g_roll = np.zeros_like(roll)
-        for g in plan.gestures:
-            target, hands, shape, g_roll_deg = GESTURE_TARGETS[g.kind]
-            if hands == "dominant" and role < 1.0:
-                continue
-            if hands == "dominant" and speaker.handedness == "both" and side == "left":
-                continue
-            w = gesture_weight(t, g)
-            tgt = centre + g.amplitude * (_mirror(target, side) - centre)
-            path = np.broadcast_to(tgt, wrist.shape).copy()
-            if g.kind == "circle":
-                dur = g.hold_end - g.onset
-                phi = loop_phase(t, g.onset, g.onset + dur)
-                sign = -1.0 if side == "left" else 1.0
-                path[:, 0] += sign * CIRCLE_RADIUS_CM * np.sin(phi)
-                path[:, 1] += CIRCLE_RADIUS_CM * (np.cos(phi) - 1.0)
-            weight_sum += w
-            g_wrist += w[:, None] * path
-            g_curl += w[:, None] * np.array(HAND_SHAPES[shape])
-            g_roll += w * g_roll_deg
-        norm = np.maximum(weight_sum, 1.0)
-        ws = np.clip(weight_sum, 0.0, 1.0)
-        wrist = (1 - ws)[:, None] * wrist + g_wrist / norm[:, None]
-        curl = (1 - ws)[:, None] * curl + g_curl / norm[:, None]
-        roll = (1 - ws) * roll + g_roll / norm
-        if np.any(tremor_e > 0):
-            for axis in range(3):
-                f = rng.uniform(8.0, 11.0)
-                wrist[:, axis] += tremor_e * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
-        out[side] = {"wrist": wrist, "curl": np.clip(curl, 0.0, 1.0), "roll": roll, "flex": flex}
-    return out
+    drive = _HandDrive(
+        amp_e=emotion_track(t, plan, "amplitude"),
+        tremor_e=emotion_track(t, plan, "tremor"),
+        env=phrase_envelope(t, plan),
+        lift=lift,
+        loop=loop,
+        angry=_smooth_track(t, (emotion_ids(t, plan) == 2).astype(np.float64)),
+    )
+    return {side: _hand_path(t, plan, speaker, side, drive, rng) for side in ("right", "left")}
+
+
+def _hand_path(
+    t: np.ndarray,
+    plan: Plan,
+    speaker: SpeakerStyle,
+    side: str,
+    drive: _HandDrive,
+    rng: np.random.Generator,
+) -> dict[str, np.ndarray]:
+    """One hand of :func:`wrist_paths`: beat loops and drift, blended into the semantic gestures."""
+    role = _hand_role(speaker, side)
+    wrist = _beat_wrist(t, speaker, side, role, drive, rng)
+    shape_fav = np.array(HAND_SHAPES[_FAVOURITE_SHAPE[speaker.favourite]])
+    env = drive.env
+    curl = (1 - env * role)[:, None] * np.array(HAND_SHAPES["relaxed"]) + (env * role)[:, None] * shape_fav
+    # anger clenches the gesturing hand towards a fist
+    fist = (0.6 * env * role * drive.angry)[:, None]
+    curl = (1 - fist) * curl + fist * np.array(HAND_SHAPES["fist"])
+    # the wrist pulses with the beat loop in two components (flexion ~ height, roll ~ across)
+    # so the hand's rotation, too, is still only at the beats
+    pulse = _FAVOURITE_FLEX[speaker.favourite] * role / 5.0
+    roll = env * role * _FAVOURITE_ROLL[speaker.favourite] + 0.5 * pulse * drive.loop
+    flex = 8.0 + pulse * drive.lift
+    wrist, curl, roll = _blend_gestures(t, plan, speaker, side, role, wrist, curl, roll)
+    if np.any(drive.tremor_e > 0):
+        for axis in range(3):
+            f = rng.uniform(8.0, 11.0)
+            wrist[:, axis] += drive.tremor_e * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+    return {"wrist": wrist, "curl": np.clip(curl, 0.0, 1.0), "roll": roll, "flex": flex}
+
+
+def _beat_wrist(
+    t: np.ndarray, speaker: SpeakerStyle, side: str, role: float, drive: _HandDrive, rng: np.random.Generator
+) -> np.ndarray:
+    """Wrist (T, 3) cm, chest frame: rest to gesture space by the envelope, beat loops, slow drift."""
+    rest = _mirror(speaker.rest, side)
+    centre = _mirror(speaker.gesture_center, side)
+    # gesture space follows the emotion amplitude: sad speakers stay low and near the body
+    reach = role * np.clip(0.4 + 0.6 * drive.amp_e, 0.5, 1.4)
+    wrist = rest[None, :] + (drive.env * reach)[:, None] * (centre - rest)[None, :]
+    direction = _mirror(speaker.beat_direction, side)
+    direction = direction / np.linalg.norm(direction)
+    # the loop's second axis: outwards and forwards (the elbow then loops too, it does not
+    # stop and turn back mid-way); right is -x
+    outward = _mirror(np.array([-1.0, 0.0, 0.6]), side)
+    across = outward - np.dot(outward, direction) * direction
+    across = across / max(float(np.linalg.norm(across)), 1e-9)
+    wrist = (
+        wrist
+        - (role * drive.lift)[:, None] * direction[None, :]
+        + (role * drive.loop)[:, None] * across[None, :]
+    )
+    # slow, small drift (no sharp speed minima between beats) and the favourite movement
+    for _ in range(3):
+        f = rng.uniform(0.05, 0.15)
+        phase = rng.uniform(0, 2 * np.pi, size=3)
+        wrist += DRIFT_CM * np.sin(2 * np.pi * f * t[:, None] + phase[None, :])
+    return wrist
+
+
+def _blend_gestures(
+    t: np.ndarray,
+    plan: Plan,
+    speaker: SpeakerStyle,
+    side: str,
+    role: float,
+    wrist: np.ndarray,
+    curl: np.ndarray,
+    roll: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Blend one hand's ``wrist`` (T, 3), ``curl`` (T, 5) and ``roll`` (T,) into the plan's gestures.
+
+    Each gesture this hand takes part in pulls towards its target with weight
+    :func:`gesture_weight`; overlapping gestures share by weight.
+    """
+    centre = _mirror(speaker.gesture_center, side)
+    weight_sum = np.zeros_like(t)
+    g_wrist = np.zeros_like(wrist)
+    g_curl = np.zeros_like(curl)
+    g_roll = np.zeros_like(roll)
+    for g in plan.gestures:
+        target, hands, shape, g_roll_deg = GESTURE_TARGETS[g.kind]
+        if hands == "dominant" and (role < 1.0 or (speaker.handedness == "both" and side == "left")):
+            continue
+        w = gesture_weight(t, g)
+        weight_sum += w
+        g_wrist += w[:, None] * _gesture_path(t, g, side, centre, target, wrist.shape)
+        g_curl += w[:, None] * np.array(HAND_SHAPES[shape])
+        g_roll += w * g_roll_deg
+    norm = np.maximum(weight_sum, 1.0)
+    ws = np.clip(weight_sum, 0.0, 1.0)
+    wrist = (1 - ws)[:, None] * wrist + g_wrist / norm[:, None]
+    curl = (1 - ws)[:, None] * curl + g_curl / norm[:, None]
+    roll = (1 - ws) * roll + g_roll / norm
+    return wrist, curl, roll
+
+
+def _gesture_path(
+    t: np.ndarray,
+    g: Gesture,
+    side: str,
+    centre: np.ndarray,
+    target: tuple[float, float, float],
+    shape: tuple[int, ...],
+) -> np.ndarray:
+    """Wrist path (T, 3) cm of gesture ``g``: its scaled target, circling during the hold for ``circle``."""
+    tgt = centre + g.amplitude * (_mirror(target, side) - centre)
+    path = np.broadcast_to(tgt, shape).copy()
+    if g.kind == "circle":
+        dur = g.hold_end - g.onset
+        phi = loop_phase(t, g.onset, g.onset + dur)
+        sign = -1.0 if side == "left" else 1.0
+        path[:, 0] += sign * CIRCLE_RADIUS_CM * np.sin(phi)
+        path[:, 1] += CIRCLE_RADIUS_CM * (np.cos(phi) - 1.0)
+    return path
 
 
 # ----------------------------------------------------------------------------- IK
@@ -582,6 +654,27 @@ def _sines(
     return out
 
 
+class _BodyDrive(NamedTuple):
+    """Per-frame signals shared by the trunk, head and arms, each (T,) float64 (see :func:`body_channels`)."""
+
+    t: np.ndarray
+    """Frame times, seconds."""
+    head_pitch: np.ndarray
+    """Emotion head pitch, degrees."""
+    amp_e: np.ndarray
+    """Emotion amplitude."""
+    nod: np.ndarray
+    """Beat-loop height / 5 (~1 at the top of a typical loop)."""
+    side_nod: np.ndarray
+    """Its quadrature component: nod and side_nod never stop together between beats."""
+    bob_up: np.ndarray
+    """Speech-rhythm pulse (at rest only on the syllable onsets), see :func:`syllable_pulse`."""
+    bob_side: np.ndarray
+    """Its quadrature component."""
+    breath: np.ndarray
+    """Breathing, a 0.25-Hz sine in [-1, 1]."""
+
+
 def body_channels(
     skeleton: Skeleton, t: np.ndarray, plan: Plan, speaker: SpeakerStyle, rng: np.random.Generator
 ) -> np.ndarray:
@@ -604,18 +697,34 @@ def body_channels(
         unwrapped along time.
     """
     t = np.asarray(t, dtype=np.float64)
-    n = t.size
-    ch = np.zeros((n, skeleton.n_channels))
-    zero = np.zeros_like(t)
-    head_pitch = emotion_track(t, plan, "head_pitch")
-    amp_e = emotion_track(t, plan, "amplitude")
+    ch = np.zeros((t.size, skeleton.n_channels))
+    _put_hips_and_legs(ch, skeleton, t, rng)
     lift, loop = beat_lift(t, plan)
-    nod = lift / 5.0  # ~1 at the top of a typical beat loop
-    side_nod = loop / 5.0  # its quadrature component: nod and side_nod never stop together between beats
-    bob_up, bob_side = syllable_pulse(t, plan)  # speech rhythm: at rest only on the syllable onsets
+    bob_up, bob_side = syllable_pulse(t, plan)
+    drive = _BodyDrive(
+        t=t,
+        head_pitch=emotion_track(t, plan, "head_pitch"),
+        amp_e=emotion_track(t, plan, "amplitude"),
+        nod=lift / 5.0,
+        side_nod=loop / 5.0,
+        bob_up=bob_up,
+        bob_side=bob_side,
+        breath=np.sin(2 * np.pi * 0.25 * t + rng.uniform(0, 2 * np.pi)),
+    )
+    _put_spine(ch, skeleton, drive, speaker, rng)
+    _put_neck_and_head(ch, skeleton, drive, rng)
+    paths = wrist_paths(t, plan, speaker, rng)
+    for side in ("right", "left"):
+        _put_arm(ch, skeleton, side, paths[side], drive)
+    return ch
 
-    # hips: small translation sway and weight shift; legs counter-rotate so they stay vertical
-    # (slow: idle sway must not add speed minima between beats)
+
+def _put_hips_and_legs(ch: np.ndarray, skeleton: Skeleton, t: np.ndarray, rng: np.random.Generator) -> None:
+    """Hips: small translation sway and weight shift; the legs counter-rotate so they stay vertical.
+
+    Slow: idle sway must not add speed minima between beats.
+    """
+    zero = np.zeros_like(t)
     hips_pos = np.stack(
         [_sines(t, rng, 1.6, 0.03, 0.1), _sines(t, rng, 0.4, 0.05, 0.12), _sines(t, rng, 1.0, 0.03, 0.1)],
         axis=1,
@@ -631,58 +740,66 @@ def body_channels(
         _put(ch, skeleton, f"{side}Leg", _euler(zero + 2.0, zero, zero))
         _put(ch, skeleton, f"{side}Foot", _euler(zero - 2.0, zero, zero))
 
-    # spine: lean, breathing, beat emphasis, a little twist
-    breath = np.sin(2 * np.pi * 0.25 * t + rng.uniform(0, 2 * np.pi))
-    lean = speaker.lean + 1.5 * np.clip(head_pitch, 0, None) / 14.0 * 4.0
+
+def _put_spine(
+    ch: np.ndarray, skeleton: Skeleton, d: _BodyDrive, speaker: SpeakerStyle, rng: np.random.Generator
+) -> None:
+    """Spine: lean, breathing, beat emphasis, a little twist (shared by the four spine joints)."""
+    t = d.t
+    lean = speaker.lean + 1.5 * np.clip(d.head_pitch, 0, None) / 14.0 * 4.0
     twist = _sines(t, rng, 3.0, 0.03, 0.1)
     spine_rot = _euler(
-        (lean + 0.3 * breath + 0.8 * bob_up * amp_e) / 4.0,
-        (twist + 0.8 * bob_side * amp_e) / 4.0,
+        (lean + 0.3 * d.breath + 0.8 * d.bob_up * d.amp_e) / 4.0,
+        (twist + 0.8 * d.bob_side * d.amp_e) / 4.0,
         _sines(t, rng, 1.0, 0.03, 0.1) / 4.0,
     )
     for name in ("Spine", "Spine1", "Spine2", "Spine3"):
         _put(ch, skeleton, name, spine_rot)
 
-    # neck and head: emotion head pitch, nods at beats, slow looking around
+
+def _put_neck_and_head(ch: np.ndarray, skeleton: Skeleton, d: _BodyDrive, rng: np.random.Generator) -> None:
+    """Neck and head: emotion head pitch, nods at beats, slow looking around."""
+    t = d.t
     look = _sines(t, rng, 10.0, 0.03, 0.1)
     tilt = _sines(t, rng, 3.0, 0.04, 0.12)
-    head_x = head_pitch + 2.5 * nod * amp_e + _sines(t, rng, 1.5, 0.05, 0.15) - 0.3 * breath
-    look = look + 2.5 * side_nod * amp_e
-    neck_rot = _euler(head_x * 0.3, look * 0.3, tilt * 0.3)
-    _put(ch, skeleton, "Neck", neck_rot)
+    head_x = d.head_pitch + 2.5 * d.nod * d.amp_e + _sines(t, rng, 1.5, 0.05, 0.15) - 0.3 * d.breath
+    look = look + 2.5 * d.side_nod * d.amp_e
+    _put(ch, skeleton, "Neck", _euler(head_x * 0.3, look * 0.3, tilt * 0.3))
     _put(ch, skeleton, "Neck1", _euler(head_x * 0.2, look * 0.2, tilt * 0.2))
     _put(ch, skeleton, "Head", _euler(head_x * 0.5, look * 0.5, tilt * 0.5))
 
-    # arms
-    paths = wrist_paths(t, plan, speaker, rng)
-    for side, cap in (("right", "Right"), ("left", "Left")):
-        sgn = 1.0 if side == "right" else -1.0
-        p = paths[side]
-        shrug = -sgn * (1.5 + 0.3 * breath + 2.0 * bob_up * amp_e)
-        protract = sgn * 2.0 * bob_side * amp_e
-        clav = _euler(zero, protract, shrug)
-        _put(ch, skeleton, f"{cap}Shoulder", clav)
-        j_sh = skeleton.index(f"{cap}Shoulder")
-        j_arm = skeleton.index(f"{cap}Arm")
-        j_fore = skeleton.index(f"{cap}ForeArm")
-        j_hand = skeleton.index(f"{cap}Hand")
-        # wrist target (chest frame) -> clavicle frame
-        local_target = np.einsum("tji,tj->ti", clav, p["wrist"] - skeleton.offsets[j_sh][None, :])
-        pole = np.einsum("tji,j->ti", clav, _mirror(_ELBOW_POLE, side))
-        shoulder, elbow = two_bone_ik(
-            local_target, skeleton.offsets[j_arm], skeleton.offsets[j_fore], skeleton.offsets[j_hand], pole
-        )
-        _put(ch, skeleton, f"{cap}Arm", shoulder)
-        _put(ch, skeleton, f"{cap}ForeArm", elbow)
-        # wrist: roll about the forearm axis (supination), flexion towards the palm
-        axis = _normalize(skeleton.offsets[skeleton.index(f"{cap}HandMiddle1")])
-        palm_normal = np.array([0.0, -1.0, 0.0])
-        flex_axis = _normalize(np.cross(axis, palm_normal))
-        roll = axis_angle_to_matrix(np.deg2rad(sgn * p["roll"])[:, None] * axis[None, :])
-        flex = axis_angle_to_matrix(np.deg2rad(p["flex"])[:, None] * flex_axis[None, :])
-        _put(ch, skeleton, f"{cap}Hand", roll @ flex)
-        _fingers(ch, skeleton, cap, p["curl"], palm_normal)
-    return ch
+
+def _put_arm(ch: np.ndarray, skeleton: Skeleton, side: str, p: dict[str, np.ndarray], d: _BodyDrive) -> None:
+    """One arm: clavicle shrug, two-bone IK to the wrist target, wrist roll and flexion, fingers.
+
+    ``p`` is the side's entry of :func:`wrist_paths`.
+    """
+    cap = side.capitalize()
+    sgn = 1.0 if side == "right" else -1.0
+    shrug = -sgn * (1.5 + 0.3 * d.breath + 2.0 * d.bob_up * d.amp_e)
+    protract = sgn * 2.0 * d.bob_side * d.amp_e
+    clav = _euler(np.zeros_like(d.t), protract, shrug)
+    _put(ch, skeleton, f"{cap}Shoulder", clav)
+    j_sh = skeleton.index(f"{cap}Shoulder")
+    j_arm = skeleton.index(f"{cap}Arm")
+    j_fore = skeleton.index(f"{cap}ForeArm")
+    j_hand = skeleton.index(f"{cap}Hand")
+    # wrist target (chest frame) -> clavicle frame
+    local_target = np.einsum("tji,tj->ti", clav, p["wrist"] - skeleton.offsets[j_sh][None, :])
+    pole = np.einsum("tji,j->ti", clav, _mirror(_ELBOW_POLE, side))
+    shoulder, elbow = two_bone_ik(
+        local_target, skeleton.offsets[j_arm], skeleton.offsets[j_fore], skeleton.offsets[j_hand], pole
+    )
+    _put(ch, skeleton, f"{cap}Arm", shoulder)
+    _put(ch, skeleton, f"{cap}ForeArm", elbow)
+    # wrist: roll about the forearm axis (supination), flexion towards the palm
+    axis = _normalize(skeleton.offsets[skeleton.index(f"{cap}HandMiddle1")])
+    palm_normal = np.array([0.0, -1.0, 0.0])
+    flex_axis = _normalize(np.cross(axis, palm_normal))
+    roll = axis_angle_to_matrix(np.deg2rad(sgn * p["roll"])[:, None] * axis[None, :])
+    flex = axis_angle_to_matrix(np.deg2rad(p["flex"])[:, None] * flex_axis[None, :])
+    _put(ch, skeleton, f"{cap}Hand", roll @ flex)
+    _fingers(ch, skeleton, cap, p["curl"], palm_normal)
 
 
 def _fingers(ch: np.ndarray, skeleton: Skeleton, cap: str, curl: np.ndarray, palm_normal: np.ndarray) -> None:

@@ -22,7 +22,7 @@ Part of the corpus generator :mod:`beatlite.synth`, which no notebook teaches (`
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -175,6 +175,20 @@ def find_phrases(words: Sequence[TimedWord], gap: float = PHRASE_GAP_S) -> list[
     return phrases
 
 
+@dataclass
+class _PlanState:
+    """What :func:`make_plan` has placed so far (mutated word by word)."""
+
+    beats: list[Beat] = field(default_factory=list)
+    gestures: list[Gesture] = field(default_factory=list)
+    last_beat: float = -np.inf
+    """Last zero-speed point of the hand: a beat or a gesture's retraction end, seconds."""
+    busy_until: float = -np.inf
+    """End of the last semantic gesture's retraction, seconds."""
+    pending: list[float] = field(default_factory=list)
+    """Onsets since the last beat: accents of the next beat's loop, seconds."""
+
+
 def make_plan(
     words: Sequence[TimedWord],
     speaker: SpeakerStyle,
@@ -201,82 +215,125 @@ def make_plan(
     Plan
     """
     onset_arr = None if onsets is None else merge_onsets(onsets)
-    beats: list[Beat] = []
-    gestures: list[Gesture] = []
-    last_beat = -np.inf  # last zero-speed point of the hand: a beat or a gesture's retraction end
-    busy_until = -np.inf  # end of the last semantic gesture's retraction
+    state = _PlanState()
     min_gap = MIN_BEAT_GAP_S / min(speaker.tempo, 1.0)
-    pending: list[float] = []  # onsets since the last beat: accents of the next beat's loop
     for w in words:
-        emo = EMOTION_STYLES[w.emotion]
-        speed = emo.speed * speaker.tempo
+        candidates = _word_onsets(w, onset_arr)
         kw = KEYWORDS.get(w.word)
-        if onset_arr is None:
-            candidates = [w.start]
-        else:
-            inside = (onset_arr >= w.start - ONSET_SNAP_S) & (onset_arr <= w.end - 0.05)
-            candidates = [float(x) for x in onset_arr[inside]]
-        if kw is not None:
-            slow = SLOW_KINDS.get(kw[0], 1.0)
-            onset = candidates[0] if candidates else w.start
-            ramp_in = _snap_ramp(onset, -PREP_S * slow / speed, onset_arr)
-            start = onset - ramp_in
-            accept = start >= busy_until + GESTURE_GAP_S and start >= 0.05
-            if kw[0] == "chest":  # "I" is frequent: not every one gets the gesture
-                accept = accept and rng.random() < 0.7
-            if accept:
-                while beats and beats[-1].time > start:  # the preparation starts from the last beat
-                    beats.pop()
-                hold_end = max(w.end, onset + MIN_HOLD_S)
-                if kw[0] == "circle":
-                    hold_end = max(hold_end, onset + 0.9 / speed)
-                hold_end = _snap_later(hold_end, onset_arr)
-                ramp_out = _snap_ramp(hold_end, RETRACT_S * slow / speed, onset_arr)
-                g = Gesture(
-                    kind=kw[0],
-                    onset=onset,
-                    hold_end=hold_end,
-                    ramp_in=ramp_in,
-                    ramp_out=ramp_out,
-                    word=w.word,
-                    label=kw[1],
-                    amplitude=float(np.clip(emo.amplitude * speaker.amplitude, 0.6, 1.3)),
-                    accents=_accents(onset_arr, start, onset)
-                    + _accents(onset_arr, hold_end, hold_end + ramp_out),
-                )
-                gestures.append(g)
-                busy_until = last_beat = g.end
-                pending = []
-                continue
-        short_ok = len(w.word) >= 3 or rng.random() < 0.5
-        for k, time in enumerate(candidates):
-            if (
-                (k > 0 or short_ok)
-                and time - last_beat >= min_gap
-                and time >= busy_until + min_gap
-                and time > 0.3
-            ):
-                amp = 5.0 * emo.amplitude * speaker.amplitude * rng.uniform(0.8, 1.2)
-                loop = min(LOOP_S / speed, time - last_beat)
-                early = [a for a in pending if time - a <= 1.6 * LOOP_S / speed]
-                if loop < time - last_beat and early and time - early[0] > loop:
-                    loop = time - early[0]  # after a pause the loop starts on an onset too
-                accents = tuple(a for a in pending if time - loop + ACCENT_GAP_S <= a <= time - ACCENT_GAP_S)
-                beats.append(
-                    Beat(time=time, amplitude=amp, stroke=0.5 * loop, prep=0.5 * loop, accents=accents)
-                )
-                last_beat = time
-                pending = []
-            elif time >= max([last_beat, *pending]) + ACCENT_GAP_S and time >= busy_until + ACCENT_GAP_S:
-                pending.append(time)
+        if kw is not None and _add_gesture(state, w, kw, candidates, speaker, onset_arr, rng):
+            continue
+        _add_beats(state, w, candidates, speaker, min_gap, rng)
     return Plan(
         words=tuple(words),
         phrases=tuple(find_phrases(words)),
-        beats=tuple(beats),
-        gestures=tuple(gestures),
+        beats=tuple(state.beats),
+        gestures=tuple(state.gestures),
         duration=float(duration),
         syllables=_accents(onset_arr, 0.3 - ACCENT_GAP_S, float(duration) + ACCENT_GAP_S),
     )
+
+
+def _word_onsets(w: TimedWord, onsets: np.ndarray | None) -> list[float]:
+    """The onsets (s) that belong to word ``w`` (see :data:`ONSET_SNAP_S`); ``[w.start]`` without onsets."""
+    if onsets is None:
+        return [w.start]
+    inside = (onsets >= w.start - ONSET_SNAP_S) & (onsets <= w.end - 0.05)
+    return [float(x) for x in onsets[inside]]
+
+
+def _add_gesture(
+    state: _PlanState,
+    w: TimedWord,
+    kw: tuple[str, str],
+    candidates: list[float],
+    speaker: SpeakerStyle,
+    onsets: np.ndarray | None,
+    rng: np.random.Generator,
+) -> bool:
+    """Give keyword ``w`` its semantic gesture ``kw = (kind, label)`` when there is room.
+
+    The gesture replaces the beats after its preparation start. Returns whether it was added.
+    """
+    emo = EMOTION_STYLES[w.emotion]
+    speed = emo.speed * speaker.tempo
+    slow = SLOW_KINDS.get(kw[0], 1.0)
+    onset = candidates[0] if candidates else w.start
+    ramp_in = _snap_ramp(onset, -PREP_S * slow / speed, onsets)
+    start = onset - ramp_in
+    accept = start >= state.busy_until + GESTURE_GAP_S and start >= 0.05
+    if kw[0] == "chest":  # "I" is frequent: not every one gets the gesture
+        accept = accept and rng.random() < 0.7
+    if not accept:
+        return False
+    while state.beats and state.beats[-1].time > start:  # the preparation starts from the last beat
+        state.beats.pop()
+    hold_end = max(w.end, onset + MIN_HOLD_S)
+    if kw[0] == "circle":
+        hold_end = max(hold_end, onset + 0.9 / speed)
+    hold_end = _snap_later(hold_end, onsets)
+    ramp_out = _snap_ramp(hold_end, RETRACT_S * slow / speed, onsets)
+    g = Gesture(
+        kind=kw[0],
+        onset=onset,
+        hold_end=hold_end,
+        ramp_in=ramp_in,
+        ramp_out=ramp_out,
+        word=w.word,
+        label=kw[1],
+        amplitude=float(np.clip(emo.amplitude * speaker.amplitude, 0.6, 1.3)),
+        accents=_accents(onsets, start, onset) + _accents(onsets, hold_end, hold_end + ramp_out),
+    )
+    state.gestures.append(g)
+    state.busy_until = state.last_beat = g.end
+    state.pending = []
+    return True
+
+
+def _add_beats(
+    state: _PlanState,
+    w: TimedWord,
+    candidates: list[float],
+    speaker: SpeakerStyle,
+    min_gap: float,
+    rng: np.random.Generator,
+) -> None:
+    """Put a beat on each of word ``w``'s onsets that is far enough from the last beat and gesture.
+
+    The other onsets become accents of the next beat's loop (``state.pending``).
+    """
+    emo = EMOTION_STYLES[w.emotion]
+    speed = emo.speed * speaker.tempo
+    short_ok = len(w.word) >= 3 or rng.random() < 0.5
+    for k, time in enumerate(candidates):
+        if (
+            (k > 0 or short_ok)
+            and time - state.last_beat >= min_gap
+            and time >= state.busy_until + min_gap
+            and time > 0.3
+        ):
+            amp = 5.0 * emo.amplitude * speaker.amplitude * rng.uniform(0.8, 1.2)
+            state.beats.append(_beat(time, amp, speed, state.last_beat, state.pending))
+            state.last_beat = time
+            state.pending = []
+        elif (
+            time >= max([state.last_beat, *state.pending]) + ACCENT_GAP_S
+            and time >= state.busy_until + ACCENT_GAP_S
+        ):
+            state.pending.append(time)
+
+
+def _beat(time: float, amp: float, speed: float, last_beat: float, pending: list[float]) -> Beat:
+    """The beat at ``time`` (s): its loop spans at most ``LOOP_S / speed`` s since ``last_beat``.
+
+    After a pause the loop starts on one of the ``pending`` onsets; those inside the loop
+    become its accents.
+    """
+    loop = min(LOOP_S / speed, time - last_beat)
+    early = [a for a in pending if time - a <= 1.6 * LOOP_S / speed]
+    if loop < time - last_beat and early and time - early[0] > loop:
+        loop = time - early[0]  # after a pause the loop starts on an onset too
+    accents = tuple(a for a in pending if time - loop + ACCENT_GAP_S <= a <= time - ACCENT_GAP_S)
+    return Beat(time=time, amplitude=amp, stroke=0.5 * loop, prep=0.5 * loop, accents=accents)
 
 
 def merge_onsets(onsets: Sequence[float] | np.ndarray, gap: float | None = None) -> np.ndarray:
@@ -355,19 +412,33 @@ def semantic_segments(plan: Plan) -> list[tuple[str, float, float, float, str]]:
     list of (label, start, end, score, keyword)
         Contiguous, non-overlapping, rounded to milliseconds.
     """
-    marks: list[tuple[float, float, str, str]] = []
-    for g in plan.gestures:
-        marks.append((max(g.start, 0.0), min(g.end, plan.duration), g.label, g.word))
-    # beat runs: consecutive beats closer than 1.2 s, cut by semantic gestures
+    marks = [(max(g.start, 0.0), min(g.end, plan.duration), g.label, g.word) for g in plan.gestures]
+    for start, end in _beat_runs(plan.beats):
+        marks.append((max(start, 0.0), min(end + 0.2, plan.duration), "01_beat_align", ""))
+    marks.sort()
+    out = _tile(marks, plan.duration)
+    return [(lab, round(s, 3), round(e, 3), sc, kw) for lab, s, e, sc, kw in out]
+
+
+def _beat_runs(beats: Sequence[Beat]) -> list[list[float]]:
+    """Runs of consecutive beats closer than 1.2 s: ``[first loop start, last beat time]``, seconds."""
     runs: list[list[float]] = []
-    for b in plan.beats:
+    for b in beats:
         if runs and b.time - runs[-1][1] < 1.2:
             runs[-1][1] = b.time
         else:
             runs.append([b.time - b.stroke - b.prep, b.time])
-    for start, end in runs:
-        marks.append((max(start, 0.0), min(end + 0.2, plan.duration), "01_beat_align", ""))
-    marks.sort()
+    return runs
+
+
+def _tile(
+    marks: Sequence[tuple[float, float, str, str]], duration: float
+) -> list[tuple[str, float, float, float, str]]:
+    """Sorted ``(start, end, label, word)`` marks cut into a tiling of ``[0, duration]`` seconds.
+
+    A mark starts where the previous one ended at the earliest; marks shorter than 0.05 s are
+    dropped; gaps of 0.01 s or more become ``00_nogesture``, shorter ones widen the next mark.
+    """
     out: list[tuple[str, float, float, float, str]] = []
     t = 0.0
     for start, end, label, word in marks:
@@ -380,6 +451,6 @@ def semantic_segments(plan: Plan) -> list[tuple[str, float, float, float, str]]:
             start = t
         out.append((label, start, end, SEMANTIC_SCORES[label], word))
         t = end
-    if plan.duration - t >= 0.01:
-        out.append(("00_nogesture", t, plan.duration, 0.0, ""))
-    return [(lab, round(s, 3), round(e, 3), sc, kw) for lab, s, e, sc, kw in out]
+    if duration - t >= 0.01:
+        out.append(("00_nogesture", t, duration, 0.0, ""))
+    return out

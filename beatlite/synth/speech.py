@@ -205,16 +205,20 @@ def speak_words(
         return [spoken[(w, voice)] for w in words]
     with tempfile.TemporaryDirectory(prefix="beatlite_espeak_") as tmp:
         for k, word in enumerate(todo):
-            wav = Path(tmp) / f"w{k}.wav"
-            cmd = [exe, "-x", "-v", voice.name, "-s", str(voice.rate), "-p", str(voice.pitch)]
-            cmd += ["-a", str(voice.amplitude), "-w", str(wav), "--", word]
-            proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-            if proc.returncode != 0 or not wav.exists():
-                raise RuntimeError(f"espeak-ng failed on {word!r} ({' '.join(cmd)}): {proc.stderr.strip()}")
-            audio = trim_silence(_read_wav(wav))
-            phones = split_phonemes(proc.stdout) or (word,)
-            spoken[(word, voice)] = SpokenWord(word, audio, phones)
+            spoken[(word, voice)] = _speak_one(exe, word, voice, Path(tmp) / f"w{k}.wav")
     return [spoken[(w, voice)] for w in words]
+
+
+def _speak_one(exe: str, word: str, voice: Voice, wav: Path) -> SpokenWord:
+    """One espeak-ng call: ``word`` spoken into the scratch file ``wav``, silence trimmed, with its phonemes."""
+    cmd = [exe, "-x", "-v", voice.name, "-s", str(voice.rate), "-p", str(voice.pitch)]
+    cmd += ["-a", str(voice.amplitude), "-w", str(wav), "--", word]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0 or not wav.exists():
+        raise RuntimeError(f"espeak-ng failed on {word!r} ({' '.join(cmd)}): {proc.stderr.strip()}")
+    audio = trim_silence(_read_wav(wav))
+    phones = split_phonemes(proc.stdout) or (word,)
+    return SpokenWord(word, audio, phones)
 
 
 def resample_to_output(y: np.ndarray) -> np.ndarray:
