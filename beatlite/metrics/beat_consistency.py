@@ -9,7 +9,9 @@ a joint moves in space:
     BC = (1/|A|) sum_{a in A} exp(-min_m (a - m)^2 / (2 sigma^2)),     sigma = 0.1 s
 
 with MAAC_p the mean absolute frame-to-frame change of pair p on the training data (HA2G
-eq. 10) and A the audio onsets. Vectors are the 42 TED bone directions (not mean-subtracted)
+eq. 10) and A the audio onsets. Pairs whose MAAC is (near) zero never move and are left out
+of the mean (:func:`beatlite.metrics.beats.drop_rigid_pairs`: ``MAAC_p <= 1e-5 max_q MAAC_q``);
+dividing by their round-off MAAC would let round-off decide the beats. Vectors are the 42 TED bone directions (not mean-subtracted)
 plus the two palm normals; the pairs are ``beatlite.skeleton.ted.ANGLE_PAIRS``.
 
 HA2G scores each 34-frame validation clip with its own audio and averages the clips weighted
@@ -28,6 +30,7 @@ from beatlite.metrics.beats import (
     angle_change_curve,
     append_palm_normals,
     audio_beats,
+    drop_rigid_pairs,
     mean_angle_change,
 )
 
@@ -121,7 +124,8 @@ def beat_consistency(
     change_angle : (P,) float, optional
         MAAC per pair from the **training** data (:func:`beatlite.metrics.beats.mean_angle_change`).
         Default: computed from the given directions themselves (a fallback; pass the
-        ground-truth / training values when comparing models).
+        ground-truth / training values when comparing models). Pairs with a (near) zero MAAC
+        are dropped (:func:`beatlite.metrics.beats.drop_rigid_pairs`).
     threshold : float
         Minimum drop of a motion beat (0.03).
     mean_direction, palm_normals
@@ -137,6 +141,7 @@ def beat_consistency(
     legacy : bool
         The HA2G protocol: ``clip_length=34`` (if not given), ``peak_pick="librosa"``
         (HA2G's ``onset_detect(y=clip, sr=16000, units="time")``), sigma and threshold as given.
+        With HA2G's own ``change_angle`` no pair is rigid, so the score is HA2G's formula exactly.
 
     Returns
     -------
@@ -159,6 +164,7 @@ def beat_consistency(
         if change_angle is None
         else as_array(change_angle, "change_angle", ndim=1)
     )
+    pr, ca = drop_rigid_pairs(pr, ca)  # rigid pairs carry no motion beat
     total, weight = 0.0, 0
     for y, v in zip(audios, vecs):
         y = as_array(y, "audio", ndim=1, dtype=np.float32)
