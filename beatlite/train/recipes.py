@@ -30,6 +30,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
+
 SEED = 2021
 """Seed of every shipped checkpoint (the reference's ``random_seed``)."""
 
@@ -100,14 +102,12 @@ HA2G_LR = 2e-3
 
 
 HA2G_ABLATIONS: dict[str, dict[str, Any]] = {
-    "ha2g_tiny": {},
-    "ha2g_tiny_holistic": {"hierarchical": False},
-    "ha2g_tiny_single_audio": {"audio_mode": "low"},
-    "ha2g_tiny_no_contrastive": {"use_contrastive": False},
-    "ha2g_tiny_no_physical": {"use_physical": False},
+    ("ha2g_tiny" if name == "full" else f"ha2g_tiny_{name}"): dict(overrides)
+    for name, overrides in HA2G_SWITCHES.items()
 }
-"""Shipped HA2G checkpoints: name -> config overrides of the ``tiny`` preset (HA2G Tables 3-4;
-the same switches as :data:`beatlite.models.ha2g.ABLATIONS`)."""
+"""Shipped HA2G checkpoints: name -> config overrides of the ``tiny`` preset (HA2G Tables 3-4), one
+per switch of :data:`beatlite.models.ha2g_ablations.ABLATIONS`. HA2G-ASR (Table 3) has none: it
+needs a pretrained ASR network."""
 
 
 RECIPES: dict[str, Recipe] = {
