@@ -291,6 +291,144 @@ def test_bc_default_pairs_come_from_the_ted_skeleton():
     np.testing.assert_allclose(included_angles(append_palm_normals(d), pairs), ted.pair_angles(d) / np.pi)
 
 
+# HA2G's hard-coded MAAC of its 41 angle pairs on TED Expressive (``change_angle`` in HA2G's
+# scripts/train_expressive.py), in the order of beatlite.skeleton.ted.ANGLE_PAIRS.
+HA2G_CHANGE_ANGLE = np.array(
+    [
+        0.0027804733254015446, 0.002761547453701496, 0.005953566171228886, 0.013764726929366589,
+        0.022748252376914024, 0.039307352155447006, 0.03733552247285843, 0.03775784373283386,
+        0.0485558956861496, 0.032914578914642334, 0.03800227493047714, 0.03757007420063019,
+        0.027338404208421707, 0.01640886254608631, 0.003166505601257086, 0.0017252820543944836,
+        0.0018696568440645933, 0.0016072227153927088, 0.005681346170604229, 0.013287615962326527,
+        0.021516695618629456, 0.033936675637960434, 0.03094293735921383, 0.03378918394446373,
+        0.044323261827230453, 0.034706637263298035, 0.03369896858930588, 0.03573163226246834,
+        0.02628341130912304, 0.014071882702410221, 0.0029828345868736506, 0.0015706412959843874,
+        0.0017107439925894141, 0.0014634154504165053, 0.004873405676335096, 0.002998138777911663,
+        0.0030240598134696484, 0.0009890805231407285, 0.0012279648799449205, 0.047324635088443756,
+        0.04472292214632034,
+    ]
+)  # fmt: skip
+EAR_PAIR = 37  # (38, 40): nose->left eye vs left eye->left ear; bone 40 is in no other pair
+
+
+def ear_swinging_skeleton(theta: np.ndarray, seed: int = 0) -> np.ndarray:
+    """(T, 42, 3) fixed random unit bones, except bone 40 at angle ``pi theta_t`` from bone 38."""
+    rng = np.random.default_rng(seed)
+    base = rng.normal(size=(42, 3))
+    base /= np.linalg.norm(base, axis=-1, keepdims=True)
+    u = base[38]
+    w = np.cross(u, [0.0, 0.0, 1.0])
+    w /= np.linalg.norm(w)
+    d = np.repeat(base[None], len(theta), axis=0)
+    d[:, 40] = np.cos(np.pi * theta)[:, None] * u + np.sin(np.pi * theta)[:, None] * w
+    return d
+
+
+def test_angle_change_curve_with_ha2g_constants_hand_computed():
+    # only pair 37 moves: theta/pi = .25, .30, .30, .20 -> |diffs| .05, 0, .10, divided by its
+    # MAAC and averaged over HA2G's 41 pairs (none is rigid: smallest / largest MAAC = 0.02)
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+
+    d = prepare_directions(ear_swinging_skeleton(np.array([0.25, 0.30, 0.30, 0.20])))
+    ca = HA2G_CHANGE_ANGLE[EAR_PAIR]
+    want = [0.0, 0.05 / ca / 41, 0.0, 0.10 / ca / 41]
+    np.testing.assert_allclose(
+        angle_change_curve(d, default_angle_pairs(), HA2G_CHANGE_ANGLE), want, rtol=1e-9
+    )
+
+
+def _ha2g_bc_formula(audio, dirs, change_angle, sigma=0.1, length=34, stride=10):
+    """HA2G's BC written out (HA2G supplementary / code protocol): 34-frame clips, librosa onsets."""
+    import librosa
+
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+
+    v = prepare_directions(dirs)
+    total = weight = 0.0
+    for start in range(0, len(v) - length + 1, stride):
+        a0 = int(round(start / FPS * SR))
+        clip = audio[a0 : a0 + int(round(length / FPS * SR))]
+        onsets = librosa.onset.onset_detect(y=clip, sr=SR, units="time")
+        c = np.zeros(length)
+        for t in range(1, length):
+            for p, (i, j) in enumerate(default_angle_pairs()):
+                angle = [
+                    np.arccos(np.clip(v[start + s, i] @ v[start + s, j], -1, 1)) / np.pi for s in (t - 1, t)
+                ]
+                c[t] += abs(angle[1] - angle[0]) / change_angle[p] / 41
+        beats = [
+            t / FPS
+            for t in range(2, length - 1)
+            if c[t] < c[t - 1] and c[t] < c[t + 1] and max(c[t - 1] - c[t], c[t + 1] - c[t]) >= 0.03
+        ]
+        if not beats or not len(onsets):
+            continue
+        score = np.mean([np.exp(-min((a - m) ** 2 for m in beats) / (2 * sigma**2)) for a in onsets])
+        total += score * len(onsets)
+        weight += len(onsets)
+    return total / weight
+
+
+def test_bc_legacy_with_ha2g_constants_equals_ha2g_formula():
+    t = np.arange(int(5.0 * FPS)) / FPS
+    theta = 0.3 + 0.1 * np.cos(np.pi * (t + 0.5 / FPS) / PERIOD)
+    dirs = ear_swinging_skeleton(theta)
+    audio = AUDIO[: int(5.0 * SR)]
+    got = beat_consistency(audio, SR, dirs, FPS, change_angle=HA2G_CHANGE_ANGLE, legacy=True)
+    assert got == pytest.approx(_ha2g_bc_formula(audio, dirs, HA2G_CHANGE_ANGLE), rel=1e-12)
+    assert 0.5 < got <= 1.0
+
+
+def rigid_pair_skeleton(duration: float = 11.0) -> np.ndarray:
+    """(T, 3, 3): :func:`rotating_bone`'s pair plus a third vector rigidly at 1 rad from vector 0,
+    all turned by a slowly varying global rotation, so the rigid pair's angle moves only by
+    round-off (MAAC ~ 1e-17)."""
+    from scipy.spatial.transform import Rotation
+
+    d = rotating_bone(duration=duration)
+    t = np.arange(d.shape[0]) / FPS
+    third = np.repeat([[np.cos(1.0), 0.0, np.sin(1.0)]], d.shape[0], axis=0)
+    v = np.concatenate([d, third[:, None]], axis=1)
+    rot = Rotation.from_rotvec(np.outer(0.3 * np.sin(2 * np.pi * t / 7.0), [0.2, 0.5, 0.8]))
+    return np.stack([rot.apply(v[:, k]) for k in range(3)], axis=1)
+
+
+def test_bc_is_stable_when_a_rigid_pair_is_perturbed():
+    # Without the rigid-pair rule the 1e-9 noise divided by a MAAC of ~1e-17 decides the beats:
+    # the old code scored 0.893 unperturbed and 0.862 / 0.833 / 0.861 with three noise draws.
+    pairs = np.array([[0, 1], [0, 2]])
+    v = rigid_pair_skeleton()
+    ca = mean_angle_change(v, pairs)
+    assert ca[1] < 1e-12 * ca[0]  # the second pair is rigid
+    kw = {"pairs": pairs, "palm_normals": False, "change_angle": ca}
+    clean = beat_consistency(AUDIO, SR, v, FPS, **kw)
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        noisy = beat_consistency(AUDIO, SR, v + 1e-9 * rng.standard_normal(v.shape), FPS, **kw)
+        assert abs(noisy - clean) < 0.005
+    # the rigid pair is left out: the score is the moving pair's alone
+    assert clean == beat_consistency(
+        AUDIO, SR, v, FPS, pairs=pairs[:1], palm_normals=False, change_angle=ca[:1]
+    )
+
+
+def test_drop_rigid_pairs_threshold_is_relative():
+    from beatlite.metrics.beats import drop_rigid_pairs
+
+    pairs = np.array([[0, 1], [1, 2], [2, 3]])
+    for scale in (1.0, 1e-6, 1e6):  # units do not matter
+        p, ca = drop_rigid_pairs(pairs, scale * np.array([1e-2, 1e-8, 1e-5]))
+        np.testing.assert_array_equal(p, [[0, 1], [2, 3]])
+        np.testing.assert_allclose(ca, scale * np.array([1e-2, 1e-5]))
+    assert len(drop_rigid_pairs(pairs, np.array([1e-2, 1e-8, 0.0]), rtol=0)[0]) == 2  # 0 keeps MAAC > 0
+    with pytest.raises(ValueError, match="no moving pair"):
+        drop_rigid_pairs(pairs, np.zeros(3))
+    with pytest.raises(ValueError, match="one entry per pair"):
+        drop_rigid_pairs(pairs, np.ones(2))
+    with pytest.raises(ValueError, match=">= 0"):
+        drop_rigid_pairs(pairs, np.array([1.0, -1.0, 1.0]))
+
+
 # ----------------------------------------------------------------------------- librosa oracles
 def test_stft_magnitude_equals_librosa():
     import librosa

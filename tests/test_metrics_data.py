@@ -94,6 +94,20 @@ def test_beat_consistency_ground_truth_beats_shuffled(takes):
     assert shuffled < gt - 0.03
 
 
+def test_beat_consistency_ground_truth_is_stable_under_round_off(takes):
+    # Two of HA2G's pairs (nose->eye vs eye->ear) are rigid on BEAT's skeleton (MAAC ~ 1e-16);
+    # without drop_rigid_pairs, 1e-9 noise moved the evaluation's GT BC from 0.7325 to 0.7383.
+    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+
+    audio = [t.audio for t in takes]
+    dirs = [ted_directions(t) for t in takes]
+    maac = mean_angle_change([prepare_directions(d) for d in dirs], default_angle_pairs())
+    gt = beat_consistency(audio, takes[0].sr, dirs, takes[0].fps, change_angle=maac)
+    rng = np.random.default_rng(0)
+    noisy = [d + 1e-9 * rng.standard_normal(d.shape) for d in dirs]
+    assert abs(beat_consistency(audio, takes[0].sr, noisy, takes[0].fps, change_angle=maac) - gt) < 0.005
+
+
 def test_fgd_zero_and_frozen_pose_has_the_least_diversity(takes):
     from beatlite.data.windows import sliding_windows
 

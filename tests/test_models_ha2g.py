@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -12,7 +13,6 @@ torch = pytest.importorskip("torch")
 from beatlite.models import build_model  # noqa: E402
 from beatlite.models.ha2g import (  # noqa: E402
     ABLATIONS,
-    CHECKPOINTS,
     HA2G,
     PRESETS,
     HA2GDiscriminator,
@@ -20,7 +20,9 @@ from beatlite.models.ha2g import (  # noqa: E402
     recover_dirvec_mean,
 )
 from beatlite.models.ha2g_audio import HierarchicalAudioEncoder, StyleCoordinator, blend_audio  # noqa: E402
+from beatlite.models.ha2g_losses import aligned_against_level_ce, style_diverging_loss  # noqa: E402
 from beatlite.models.testing import fake_batch, fake_windows  # noqa: E402
+from beatlite.train.recipes import HA2G_ABLATIONS  # noqa: E402
 
 PAPER_LEVEL_DIMS = (24, 30, 36, 66, 96, 126)  # docs/reference_code.md#ha2g-levels: 8/10/12/22/32/42 bones x 3
 
@@ -216,18 +218,24 @@ def test_loss_terms_follow_the_switches_and_warmup() -> None:
     assert bare.discriminator is None and bare.contrastive_text is None
 
 
-def test_style_decode_in_the_forward_batch_equals_a_separate_decode() -> None:
-    """Training forward runs the random-speaker cascade in the same 2B batch: same output as alone."""
-    model = _model()
+@pytest.mark.parametrize("style", ["reference", "shared"])
+def test_style_decode_in_the_forward_batch_equals_a_separate_decode(style: str) -> None:
+    """Training forward runs the other-speaker cascade in the same 2B batch: same output as alone."""
+    model = _model(style=style)
     model.train()
     batch = fake_batch(3)
     out = model(batch)
     assert tuple(out["pose_other"].shape) == (3, 34, 126) and tuple(out["z_other"].shape) == (3, 8)
+    assert tuple(out["z_levels"].shape) == tuple(out["z_levels_other"].shape) == (3, 6, 8)
     audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
     texts = [out[f"text{k}"] for k in range(len(model.text_encoders))]
-    alone, _ = model._decode(batch["dirvec"], audio, texts, out["z_other"])
+    if style == "reference":  # the coordinator keeps the true speakers (HA2G's code)
+        coord = coord_other = model.coordinator_embedding(batch["speaker"])
+    else:  # one z drives everything
+        coord, coord_other = out["z"], out["z_other"]
+    alone, _ = model._decode(batch["dirvec"], audio, texts, coord_other, out["z_levels_other"])
     torch.testing.assert_close(out["pose_other"], alone[-1], rtol=1e-5, atol=1e-6)
-    mine, _ = model._decode(batch["dirvec"], audio, texts, out["z"])
+    mine, _ = model._decode(batch["dirvec"], audio, texts, coord, out["z_levels"])
     torch.testing.assert_close(out["level5"], mine[-1], rtol=1e-5, atol=1e-6)
     assert not torch.allclose(out["pose_other"], out["level5"])  # another style, another output
     model.eval()
@@ -235,9 +243,131 @@ def test_style_decode_in_the_forward_batch_equals_a_separate_decode() -> None:
     assert "style" in model.losses(batch, model(batch), epoch=0)  # an eval output still gets it
 
 
-@pytest.mark.parametrize("ablation", sorted(ABLATIONS))
-def test_every_switched_on_component_receives_gradient(ablation: str) -> None:
+def test_reference_style_has_a_coordinator_embedding_and_one_code_per_level() -> None:
+    model = _model()  # the tiny preset: style="reference"
+    assert model.config.style == "reference" and model.config.slope == 0.01
+    assert not hasattr(model, "speaker_embedding") and len(model.level_styles) == model.n_levels
+    model.eval()
+    batch = fake_batch(3)
+    out = model(batch)
+    # eval: every level reads its own mu; the KL's mu / logvar / z are the last level's
+    for k, style in enumerate(model.level_styles):
+        mu, logvar, z = style(batch["speaker"], sample=False)
+        torch.testing.assert_close(out["z_levels"][:, k], mu)
+    torch.testing.assert_close(out["mu"], mu)
+    torch.testing.assert_close(out["logvar"], logvar)
+    assert not torch.allclose(out["z_levels"][:, 0], out["z_levels"][:, -1])  # codes differ per level
+    # the coordinator reads its own embedding: changing it changes the weights only through it
+    w = model.coordinator(model.coordinator_embedding(batch["speaker"]))
+    torch.testing.assert_close(out["style_weights"], w)
+    with torch.no_grad():
+        model.level_styles[-1].mu.bias += 1.0
+    torch.testing.assert_close(model(batch)["style_weights"], w)
+
+
+def test_reference_style_loss_is_per_sample_and_detaches_the_other_output() -> None:
+    # two samples: pose gaps of 0.2 (> beta 0.05: Huber = 0.2 - 0.025 = 0.175) over one element each;
+    # per-sample z distances 0.5 and 0.25 -> -(0.175/0.5 + 0.175/0.25) / 2 (1e-5 aside)
+    pose = torch.zeros(2, 1, 1, requires_grad=True)
+    other = torch.full((2, 1, 1), 0.2, requires_grad=True)
+    z, z_other = torch.zeros(2, 2), torch.tensor([[0.5, 0.5], [0.25, 0.25]])
+    loss = style_diverging_loss(pose, other, z, z_other, reference=True)
+    want = -(0.175 / (0.5 + 1e-5) + 0.175 / (0.25 + 1e-5)) / 2
+    assert float(loss.detach()) == pytest.approx(want, rel=1e-6)
+    loss.backward()
+    assert other.grad is None and pose.grad is not None
+    shared = style_diverging_loss(pose, other, z, z_other)  # batch-mean distance 0.375
+    assert float(shared.detach()) == pytest.approx(-0.175 / (0.375 + 1e-5), rel=1e-6)
+
+
+def test_contrastive_without_high_negatives_hand_computed() -> None:
+    # rows q = e0, e1; positives = q (logit 1 / max(0, 1) = 1); negatives -e0, -e1 at distances
+    # 2 and sqrt 2 from each row (logits 1/2 and 1/sqrt 2): CE = log(e + e^0.5 + e^0.7071) - 1
+    q = torch.eye(2)[None]
+    loss = aligned_against_level_ce(q, q, -q, min_distance=1.0)
+    want = math.log(math.e + math.exp(0.5) + math.exp(1 / math.sqrt(2))) - 1.0
+    assert float(loss) == pytest.approx(want, rel=1e-6)
+    model = _model(**ABLATIONS["no_high_negatives"])
+    batch = fake_batch(2)
+    out = model(batch)
+    terms = model.losses(batch, out, epoch=0)
+    text, high, low = out["text_contrast"], out["audio_high"], out["audio_low"]
+    torch.testing.assert_close(terms["contrastive_pos"], aligned_against_level_ce(text, high, low))
+
+
+def test_hierarchy_ablations_merge_body_or_hand_levels() -> None:
+    no_hand = _model(**ABLATIONS["no_hand_hierarchy"])
+    assert no_hand.level_dims == (24, 30, 36, 126)  # body levels 1-3, then every finger at once
+    no_body = _model(**ABLATIONS["no_body_hierarchy"])
+    assert no_body.level_dims == (36, 66, 96, 126)  # spine to wrists at once, then 3 finger rings
+    out = no_body(fake_batch(2))
+    assert tuple(out["style_weights"].shape) == (2, 3, 4) and "level4" not in out
+
+
+def test_no_text_reads_no_words_and_has_no_text_encoder() -> None:
+    model = _model(**ABLATIONS["no_text"])
+    assert "word" not in model.input_keys
+    assert len(model.text_encoders) == 0 and model.contrastive_text is None
+    batch = {k: v for k, v in fake_batch(2).items() if k != "word"}
+    out = model(batch)
+    assert tuple(out["pose"].shape) == (2, 34, 126)
+    assert "contrastive_pos" not in model.losses(batch, out, epoch=0)
+    with pytest.raises(ValueError, match="use_contrastive needs use_text"):
+        build_model("ha2g", use_text=False)
+
+
+@pytest.mark.parametrize(("ablation", "level"), [("mid_only", 1), ("high_only", 2)])
+def test_mid_and_high_only_read_one_audio_level(ablation: str, level: int) -> None:
     model = _model(**ABLATIONS[ablation])
+    assert model.coordinator is None
+    w = model(fake_batch(2))["style_weights"]
+    np.testing.assert_array_equal(w[:, level].numpy(), 1.0)
+    assert float(w.sum()) == 2 * model.n_levels
+
+
+@pytest.mark.parametrize("style", ["reference", "shared"])
+def test_sampled_protocol_is_seeded_and_draws_from_the_given_speakers(style: str) -> None:
+    model = _model(style=style).eval()
+    batch = fake_batch(3)
+    det = model.generate(batch)
+    torch.testing.assert_close(det, model.generate(batch, protocol="deterministic"))
+    a = model.generate(batch, protocol="sampled", speakers=[1, 3], generator=torch.Generator().manual_seed(4))
+    b = model.generate(batch, protocol="sampled", speakers=[1, 3], generator=torch.Generator().manual_seed(4))
+    c = model.generate(batch, protocol="sampled", speakers=[1, 3], generator=torch.Generator().manual_seed(5))
+    torch.testing.assert_close(a, b)
+    assert not torch.allclose(a, c) and not torch.allclose(a, det)
+    # with no variance left and a single speaker, sampling gives the deterministic output of that speaker
+    logvars = [s.logvar for s in model.level_styles] if style == "reference" else [model.speaker_logvar]
+    with torch.no_grad():
+        for lin in logvars:
+            lin.weight.zero_()
+            lin.bias.fill_(-200.0)
+    one = dict(batch, speaker=torch.full((3,), 7))
+    torch.testing.assert_close(model.generate(batch, protocol="sampled", speakers=[7]), model.generate(one))
+    with pytest.raises(ValueError, match="speakers="):
+        model.generate(batch, protocol="sampled")
+    with pytest.raises(ValueError, match="protocol must be one of"):
+        model.generate(batch, protocol="random")
+    with pytest.raises(ValueError, match="speakers must be"):
+        model.generate(batch, protocol="sampled", speakers=[99])
+
+
+def test_checkpoint_configs_without_style_load_the_shared_design() -> None:
+    model = _model(style="shared", slope=0.1).eval()
+    old = json.loads(json.dumps(model.to_config()))
+    del old["style"], old["body_hierarchy"], old["hand_hierarchy"], old["use_text"]
+    del old["contrastive_high_negatives"]
+    old["d_lr_scale"] = 0.2  # a retired field of older checkpoints
+    clone = HA2G.from_config(old)
+    assert clone.config.style == "shared" and hasattr(clone, "speaker_embedding")
+    clone.load_state_dict(model.state_dict())  # strict: the same parameters
+    batch = fake_batch(2)
+    torch.testing.assert_close(clone.eval()(batch)["pose"], model(batch)["pose"])
+
+
+@pytest.mark.parametrize("ablation", [*sorted(ABLATIONS), "shared_style"])
+def test_every_switched_on_component_receives_gradient(ablation: str) -> None:
+    model = _model(**ABLATIONS.get(ablation, {"style": "shared"}))
     batch = fake_batch(4)
     out = model(batch)
     losses = model.losses(batch, out, epoch=model.config.no_adv_epochs)
@@ -303,7 +433,6 @@ def test_recover_dirvec_mean_round_trip_and_failure() -> None:
 def test_registry_presets_ablations_and_config_round_trip() -> None:
     assert set(PRESETS) == {"tiny", "paper"}
     assert {"full", "holistic", "single_audio", "no_contrastive", "no_physical"} <= set(ABLATIONS)
-    assert all(name.startswith("ha2g") for name in CHECKPOINTS)
     model = _model(**ABLATIONS["holistic"])
     assert model.representation == "dirvec126" and model.target_key == "dirvec"
     config = json.loads(json.dumps(model.to_config()))
@@ -368,14 +497,7 @@ def test_paper_preset_builds_and_runs_one_forward() -> None:
     assert tuple(out["audio_high"].shape) == (2, 34, 32)
 
 
-def test_retrain_rejects_unknown_checkpoint_names_before_loading_data() -> None:
-    from beatlite.models.ha2g import retrain
-
-    with pytest.raises(ValueError, match="unknown HA2G checkpoint"):
-        retrain(["ha2g_tiny_typo"])
-
-
-@pytest.mark.parametrize("name", sorted(CHECKPOINTS))
+@pytest.mark.parametrize("name", sorted(HA2G_ABLATIONS))
 def test_shipped_checkpoint_loads_and_generates(name: str) -> None:
     from beatlite.paths import checkpoints_dir
     from beatlite.train import load_model
@@ -385,8 +507,10 @@ def test_shipped_checkpoint_loads_and_generates(name: str) -> None:
         pytest.skip(f"{path} not trained yet (python -m beatlite.train retrain-all --only {name})")
     model, data = load_model(path)
     assert isinstance(model, HA2G) and model.config.preset == "tiny"
-    for field, value in CHECKPOINTS[name].items():
+    for field, value in HA2G_ABLATIONS[name][1].items():
         assert getattr(model.config, field) == value
+    if "style" not in data["model"]:  # saved before the field existed: the shared-z design
+        assert model.config.style == "shared" and hasattr(model, "speaker_embedding")
     assert bool(model.statistics_ready)
     np.testing.assert_allclose(model.mean_dirvec.numpy(), data["meta"]["dirvec_mean"], atol=1e-3)  # float16
     assert path.stat().st_size < 2_000_000

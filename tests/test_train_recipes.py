@@ -22,23 +22,36 @@ def test_every_recipe_builds_a_registered_model_and_has_a_table_label():
 
 
 def test_each_ablation_switches_off_exactly_one_thing():
-    for table, full in ((CAMN_ABLATIONS, "camn_tiny"), (HA2G_ABLATIONS, "ha2g_tiny")):
-        assert table[full][1] == {}
-        for name, (_, overrides) in table.items():
-            if name != full:
-                assert len(overrides) == 1, name
-                assert all(v in (False, "low") for v in overrides.values()), name
+    assert CAMN_ABLATIONS["camn_tiny"][1] == {}
+    for name, (_, overrides) in CAMN_ABLATIONS.items():
+        if name != "camn_tiny":
+            assert len(overrides) == 1 and all(v is False for v in overrides.values()), name
 
 
-def test_ha2g_recipes_use_the_model_modules_switches():
+def test_ha2g_recipes_are_the_model_modules_switches():
+    from beatlite.models.ha2g_ablations import ABLATIONS
+
+    assert HA2G_ABLATIONS["ha2g_tiny"][1] == ABLATIONS["full"] == {}
+    assert {name: HA2G_ABLATIONS[f"ha2g_tiny_{name}"][1] for name in ABLATIONS if name != "full"} == {
+        name: kw for name, kw in ABLATIONS.items() if name != "full"
+    }
+    assert len(HA2G_ABLATIONS) == len(ABLATIONS)
+    # the shipped names did not change
+    for name in ("holistic", "single_audio", "no_contrastive", "no_physical"):
+        assert f"ha2g_tiny_{name}" in RECIPES
+    # one switch per row, except "w/o text", which also drops the contrastive loss (it needs text)
+    for name, overrides in ABLATIONS.items():
+        assert len(overrides) == (2 if name == "no_text" else 0 if name == "full" else 1), name
+
+
+def test_ha2g_ablations_really_switch_something():
     pytest.importorskip("torch")
-    from beatlite.models.ha2g import ABLATIONS, CHECKPOINTS
+    from beatlite.models.ha2g import PRESETS, HA2GConfig
 
-    assert CHECKPOINTS == {name: kw for name, (_, kw) in HA2G_ABLATIONS.items()}
-    assert HA2G_ABLATIONS["ha2g_tiny_holistic"][1] == ABLATIONS["holistic"]
-    assert HA2G_ABLATIONS["ha2g_tiny_single_audio"][1] == ABLATIONS["single_audio"]
-    assert HA2G_ABLATIONS["ha2g_tiny_no_contrastive"][1] == ABLATIONS["no_contrastive"]
-    assert HA2G_ABLATIONS["ha2g_tiny_no_physical"][1] == ABLATIONS["no_physical"]
+    tiny = HA2GConfig(**PRESETS["tiny"])
+    for name, (_, overrides) in HA2G_ABLATIONS.items():
+        for field, value in overrides.items():
+            assert getattr(tiny, field) != value, (name, field)
 
 
 def test_unknown_names_and_bad_jobs_are_rejected_before_any_work():

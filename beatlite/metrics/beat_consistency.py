@@ -9,7 +9,9 @@ a joint moves in space:
     BC = (1/|A|) sum_{a in A} exp(-min_m (a - m)^2 / (2 sigma^2)),     sigma = 0.1 s
 
 with MAAC_p the mean absolute frame-to-frame change of pair p on the training data (HA2G
-eq. 10) and A the audio onsets. Vectors are the 42 TED bone directions (not mean-subtracted)
+eq. 10) and A the audio onsets. Pairs whose MAAC is (near) zero never move and are left out
+of the mean (:func:`beatlite.metrics.beats.drop_rigid_pairs`: ``MAAC_p <= 1e-5 max_q MAAC_q``);
+dividing by their round-off MAAC would let round-off decide the beats. Vectors are the 42 TED bone directions (not mean-subtracted)
 plus the two palm normals; the pairs are ``beatlite.skeleton.ted.ANGLE_PAIRS``.
 
 Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BCVariant`): HA2G's code
@@ -29,11 +31,13 @@ import numpy as np
 from beatlite.constants import FPS, WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.metrics._checks import as_array, as_list, positive
 from beatlite.metrics.beats import (
+    RIGID_RTOL,
     alignment_score,
     angle_change_beats,
     angle_change_curve,
     append_palm_normals,
     audio_beats,
+    drop_rigid_pairs,
     mean_angle_change,
 )
 
@@ -69,6 +73,9 @@ class BCVariant:
         See :func:`beatlite.metrics.beats.alignment_score`.
     backtrack, peak_pick, hop_length
         Audio onset options of :func:`beatlite.metrics.beats.audio_beats`.
+    rigid_rtol : float
+        Angle pairs whose MAAC is at most ``rigid_rtol`` times the largest are rigid and left out
+        (:func:`beatlite.metrics.beats.drop_rigid_pairs`); 0 keeps every moving pair.
     """
 
     threshold: float = 0.03
@@ -80,6 +87,7 @@ class BCVariant:
     backtrack: str | None = None
     peak_pick: str = "beatlite"
     hop_length: int = 512
+    rigid_rtol: float = RIGID_RTOL
 
     def angle_pairs(self) -> np.ndarray:
         """(P, 2) int64 pairs (the default ones when ``pairs`` is None)."""
@@ -166,7 +174,9 @@ def beat_consistency(
     change_angle : (P,) float, optional
         MAAC per pair from the **training** data (:func:`beatlite.metrics.beats.mean_angle_change`).
         Default: computed from the given directions themselves (a fallback; pass the
-        ground-truth / training values when comparing models).
+        ground-truth / training values when comparing models). Pairs with a (near) zero MAAC
+        are left out (:func:`beatlite.metrics.beats.drop_rigid_pairs`, the variant's ``rigid_rtol``);
+        with HA2G's own ``change_angle`` no pair is rigid, so the score is HA2G's formula exactly.
     variant : str or BCVariant
         A name of :data:`VARIANTS` (``"beatlite"``, ``"ha2g"``) or a custom variant.
     audio_beats : (A,) float or list, optional
@@ -216,9 +226,14 @@ def beat_consistency(
         if change_angle is None
         else as_array(change_angle, "change_angle", ndim=1)
     )
+    pairs, ca = drop_rigid_pairs(
+        pairs, ca, rtol=v.rigid_rtol
+    )  # once, not per clip: rigid pairs carry no beat
     total, weight = 0.0, 0
     for a_times, vec in _scored_pieces(audio, sr, audio_beats, vecs, many, fps, v):
-        m_times = angle_change_beats(angle_change_curve(vec, pairs, ca), fps, threshold=v.threshold)
+        m_times = angle_change_beats(
+            angle_change_curve(vec, pairs, ca, rigid_rtol=0.0), fps, threshold=v.threshold
+        )
         if a_times.size == 0 or m_times.size == 0:
             continue
         total += alignment_score(a_times, m_times, sigma, v.direction) * a_times.size

@@ -284,7 +284,8 @@ def mean_angle_change(directions: list[np.ndarray] | np.ndarray, pairs: np.ndarr
     """MAAC: per-pair mean absolute frame-to-frame change of the included angles (HA2G eq. 10).
 
     ``MAAC_p = sum_s sum_t |theta_{p,s,t+1} - theta_{p,s,t}| / (sum_s (T_s - 1))`` over clips ``s``.
-    Compute it on *training* data and pass it to :func:`angle_change_curve`.
+    Compute it on *training* data and pass it to :func:`angle_change_curve`. Pairs that never
+    move get a MAAC of round-off size; :func:`drop_rigid_pairs` leaves them out of the curve.
 
     Parameters
     ----------
@@ -308,30 +309,93 @@ def mean_angle_change(directions: list[np.ndarray] | np.ndarray, pairs: np.ndarr
     return total / count
 
 
-def angle_change_curve(directions: np.ndarray, pairs: np.ndarray, change_angle: np.ndarray) -> np.ndarray:
+RIGID_RTOL = 1e-5
+"""Relative MAAC below which an angle pair counts as rigid (:func:`drop_rigid_pairs`)."""
+
+
+def drop_rigid_pairs(
+    pairs: np.ndarray, change_angle: np.ndarray, *, rtol: float = RIGID_RTOL
+) -> tuple[np.ndarray, np.ndarray]:
+    """Keep the angle pairs that move: ``MAAC_p > rtol * max_q MAAC_q``.
+
+    HA2G divides every pair's angle change by its MAAC (:func:`angle_change_curve`). A pair
+    whose two vectors are rigidly linked (on BEAT's skeleton: nose->eye vs eye->ear, both
+    sides) has a MAAC of pure round-off (1e-16 on float64 takes, 9e-10 on the float32 training
+    windows), and dividing by it turns round-off, or any jitter of a generated head, into
+    normalised changes of order 1 to 1e7 that create or remove motion beats. Such pairs carry
+    no motion beat and are left out of the mean.
+
+    The threshold is relative, so it does not depend on the angle unit or the frame rate:
+    ``rtol = 1e-5`` is about 100 float32 epsilons (1.19e-7), below which a pair's typical change
+    cannot be told from rounding of float32-stored directions. On ``data_samples/`` the rigid
+    pairs sit at 1e-7 of the largest MAAC and the slowest real pair (left finger bases) at
+    9e-4 of it, two orders of magnitude on either side. HA2G's own TED Expressive statistics
+    (smallest / largest MAAC = 0.02) lose no pair, so its legacy protocol is unchanged.
+
+    Parameters
+    ----------
+    pairs : (P, 2) int
+        Angle pairs.
+    change_angle : (P,) float >= 0
+        MAAC per pair (:func:`mean_angle_change` on training data).
+    rtol : float >= 0
+        Relative threshold; 0 keeps every pair with a positive MAAC.
+
+    Returns
+    -------
+    pairs : (P', 2) int64
+        The moving pairs, in their order.
+    change_angle : (P',) float64
+        Their MAAC.
+
+    Examples
+    --------
+    >>> p, ca = drop_rigid_pairs(np.array([[0, 1], [1, 2]]), np.array([0.01, 3e-18]))
+    >>> p.tolist(), ca.tolist()
+    ([[0, 1]], [0.01])
+    """
+    pr = np.asarray(pairs, dtype=np.int64)
+    ca = as_array(change_angle, "change_angle", ndim=1)
+    if pr.ndim != 2 or pr.shape[1] != 2:
+        raise ValueError(f"pairs must be (P, 2) indices, got shape {pr.shape}")
+    if ca.shape[0] != pr.shape[0]:
+        raise ValueError(f"change_angle must have one entry per pair ({pr.shape[0]}), got shape {ca.shape}")
+    if not np.all(np.isfinite(ca)) or np.any(ca < 0):
+        raise ValueError("change_angle must be finite and >= 0 for every pair")
+    if float(rtol) < 0:
+        raise ValueError(f"rtol must be >= 0, got {rtol}")
+    keep = ca > float(rtol) * (ca.max() if ca.size else 0.0)
+    if not keep.any():
+        raise ValueError(
+            "change_angle has no moving pair (was it computed from motion in which no pair ever moves?)"
+        )
+    return pr[keep], ca[keep]
+
+
+def angle_change_curve(
+    directions: np.ndarray, pairs: np.ndarray, change_angle: np.ndarray, *, rigid_rtol: float = RIGID_RTOL
+) -> np.ndarray:
     """HA2G's normalised angle change rate per frame.
 
-    ``c_t = (1/P) sum_p |theta_{t,p} - theta_{t-1,p}| / MAAC_p`` for t >= 1, ``c_0 = 0``.
+    ``c_t = (1/P') sum_p |theta_{t,p} - theta_{t-1,p}| / MAAC_p`` for t >= 1, ``c_0 = 0``, over
+    the P' pairs that move (:func:`drop_rigid_pairs`; HA2G averages all P, which is the same
+    whenever no pair is rigid, as with HA2G's own statistics).
 
     Parameters
     ----------
     directions : (T, V, 3) float
     pairs : (P, 2) int
-    change_angle : (P,) float > 0
+    change_angle : (P,) float >= 0
         MAAC per pair (:func:`mean_angle_change` on training data).
+    rigid_rtol : float
+        ``rtol`` of :func:`drop_rigid_pairs`.
 
     Returns
     -------
     (T,) float64, dimensionless (1 = a typical frame).
     """
-    th = included_angles(directions, pairs)
-    ca = as_array(change_angle, "change_angle", ndim=1)
-    if ca.shape[0] != th.shape[1]:
-        raise ValueError(f"change_angle must have one entry per pair ({th.shape[1]}), got shape {ca.shape}")
-    if np.any(ca <= 0):
-        raise ValueError(
-            "change_angle must be positive for every pair (was it computed from motion in which a pair never moves?)"
-        )
+    pr, ca = drop_rigid_pairs(pairs, change_angle, rtol=rigid_rtol)
+    th = included_angles(directions, pr)
     c = (np.abs(np.diff(th, axis=0)) / ca).mean(axis=1)
     return np.concatenate([[0.0], c])
 

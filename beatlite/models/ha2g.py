@@ -9,29 +9,45 @@ The model predicts 34-frame windows of TED-43 bone directions (``windows["dirvec
 - a speaker id (``"speaker"`` (B,)) through a reparameterised style vector z (mu, logvar),
 - the first ``n_pre = 4`` frames of ``"dirvec"`` (the seed poses).
 
-A style coordinator turns z into softmax weights over the three audio levels for each
-body level (paper eq. 3). The pose inferer runs one bidirectional GRU per body level
+The speaker's style drives two things (paper Sec. 3.3): a style coordinator that turns it into
+softmax weights over the three audio levels for each body level (paper eq. 3), and the pose
+generators. Two designs, chosen by ``HA2GConfig.style``:
+
+- ``"reference"`` (the ``tiny`` and ``paper`` presets; HA2G's code): the coordinator has its own
+  speaker embedding (``Embedding -> Linear``), and every level generator its own reparameterised
+  style code ``z_k`` (``Embedding -> Linear -> (mu_k, logvar_k)``). The KL term and the style
+  diverging loss read the last level's code; the style loss compares each sample with the
+  output for another speaker of the batch (a permutation of the batch's speakers; same
+  coordinator weights), per-sample z distances, the other output detached.
+- ``"shared"`` (the design of checkpoints trained before the field existed, which lack it):
+  one reparameterised z (``Embedding -> Linear -> LeakyReLU -> (mu, logvar)``) drives the
+  coordinator and all generators; the style loss divides by the batch-mean z distance, uses
+  uniformly random speaker ids and back-propagates through both outputs.
+
+The pose inferer runs one bidirectional GRU per body level
 (``beatlite.skeleton.ted.HA2G_LEVELS``: spine/shoulders/head -> upper arms -> forearms ->
 three rings of finger phalanges, 24/30/36/66/96/126 channels); level k's seed input
-carries level k-1's prediction in the channels they share (HA2G §3.3, eq. 4; docs/reference_code.md#ha2g-levels). Losses: hierarchical
-Huber, NS-GAN on the last level, style diverging, KL, multi-level audio-text contrastive
+carries level k-1's prediction in the channels they share (HA2G §3.3, eq. 4; docs/reference_code.md#ha2g-levels).
+Losses: hierarchical Huber, NS-GAN on the last level, style diverging, KL, multi-level audio-text contrastive
 and the bone-angle physical constraint (:mod:`beatlite.models.ha2g_losses`).
 
-Ablations (paper Tables 3-4) are config switches, named in :data:`ABLATIONS`:
-``holistic`` (one level with all 42 bones), ``single_audio`` (low-level audio only),
-``same_audio`` (one coordinator column for all levels), ``no_contrastive``,
-``no_physical``.
+Ablations (paper Tables 3-4) are config switches, named in :data:`ABLATIONS`
+(:mod:`beatlite.models.ha2g_ablations`, which lists the paper row of each).
+
+Inference follows one of two protocols (:meth:`HA2G.generate`): ``"deterministic"`` (z = mu
+of the true speaker; beatlite's tables) or ``"sampled"`` (HA2G's evaluation code: a random
+training speaker per window and a sampled z, seeded by a ``torch.Generator``).
 
 Call :meth:`HA2G.prepare` with the training windows before training (``fit`` does): it
 stores the mean direction vectors and the bone-angle statistics of the physical constraint
 as buffers (saved in the checkpoint's state dict).
 
-Differences from the reference, on purpose: the output heads and the discriminator use
-``LeakyReLU(slope)`` with a real slope (the reference's ``LeakyReLU(True)`` is an identity);
-the discriminator returns logits (NS-GAN through ``logsigmoid``); the contrastive logits
-``1 / distance`` have the distance floored at ``contrastive_min_distance``; the text
-encoders use learned word embeddings (no FastText); the spectrogram is scaled by
-``mel / 40 + 1`` before the first convolution.
+Differences from the reference, on purpose: the discriminator returns logits (NS-GAN through
+``logsigmoid``); the contrastive logits ``1 / distance`` have the distance floored at
+``contrastive_min_distance``; the text encoders use learned word embeddings (no FastText); the
+spectrogram is scaled by ``mel / 40 + 1`` before the first convolution. The output heads and
+the discriminator use ``LeakyReLU(slope)``: the reference's ``nn.LeakyReLU(inplace=True)`` has
+PyTorch's default slope 0.01, the presets' value (checkpoints trained before used 0.1).
 
 Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy) to 8 (generation and evaluation).
 """
@@ -48,6 +64,7 @@ import torch
 from torch import nn
 
 from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.ha2g_ablations import ABLATIONS
 from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
 from beatlite.models.ha2g_losses import (
     N_BONES,
@@ -67,22 +84,34 @@ from beatlite.models.layers import (
     ns_gan_g_loss,
     sum_directions,
 )
-from beatlite.train.recipes import HA2G_ABLATIONS
 
 AUDIO_MODES = ("blend", *AUDIO_LEVELS)
+STYLES = ("reference", "shared")
+"""Values of :attr:`HA2GConfig.style` (see the module docstring)."""
+PROTOCOLS = ("deterministic", "sampled")
+"""Inference protocols of :meth:`HA2G.generate`."""
+RETIRED_FIELDS = ("d_lr_scale",)
+"""Config fields of older checkpoints that are ignored on load (the discriminator's learning rate
+is :attr:`beatlite.train.TrainConfig.d_lr_weight`)."""
 
 
 @dataclasses.dataclass
 class HA2GConfig(ModelConfig):
-    """HA2G hyper-parameters (defaults = the ``paper`` preset, docs/reference_code.md#ha2g-hyperparameters).
+    """HA2G hyper-parameters (defaults + the ``paper`` preset = HA2G's code, docs/reference_code.md#ha2g-hyperparameters).
 
+    ``style``: ``"reference"`` (separate coordinator embedding, per-level style codes) or
+    ``"shared"`` (one z for everything); the default ``"shared"`` is what checkpoints saved
+    before the field existed were trained with, the presets set ``"reference"``.
     Switches: ``hierarchical`` (False = "holistic": one level with all 42 bones),
-    ``audio_mode`` (``"blend"`` = style-coordinated mix of the 3 levels; ``"low"``/``"mid"``/
-    ``"high"`` = that level only), ``same_audio`` (one coordinator column shared by every body
-    level), ``use_contrastive``, ``use_physical``, ``adversarial``, ``use_style_loss``.
+    ``body_hierarchy`` / ``hand_hierarchy`` (False: the body bones (spine to wrists) / the finger
+    bones in one level instead of 3), ``audio_mode`` (``"blend"`` = style-coordinated mix of the
+    3 levels; ``"low"``/``"mid"``/``"high"`` = that level only), ``same_audio`` (one coordinator
+    column shared by every body level), ``use_text`` (word input), ``use_contrastive`` (needs
+    ``use_text``), ``contrastive_high_negatives`` (False: the positive term has no other
+    high-level features as negatives), ``use_physical``, ``adversarial``, ``use_style_loss``.
     ``no_adv_epochs`` is the 0-based epoch from which the GAN term is on (reference: epoch >
-    ``loss_warmup`` = 10). ``d_lr_scale`` is the discriminator's learning rate relative to the
-    generator's (reference 0.2). ``audio_freq_stride`` is the frequency stride of the audio
+    ``loss_warmup`` = 10). ``slope`` is the LeakyReLU slope of the output heads and the
+    discriminator (reference 0.01). ``audio_freq_stride`` is the frequency stride of the audio
     learner's first convolution (reference 1; ``tiny`` 2).
     """
 
@@ -104,11 +133,16 @@ class HA2GConfig(ModelConfig):
     hidden: int = 300
     n_layers: int = 4
     dropout: float = 0.3
-    slope: float = 0.1
+    slope: float = 0.01
+    style: str = "shared"
     hierarchical: bool = True
+    body_hierarchy: bool = True
+    hand_hierarchy: bool = True
     audio_mode: str = "blend"
     same_audio: bool = False
+    use_text: bool = True
     use_contrastive: bool = True
+    contrastive_high_negatives: bool = True
     use_physical: bool = True
     adversarial: bool = True
     use_style_loss: bool = True
@@ -127,7 +161,6 @@ class HA2GConfig(ModelConfig):
     angle_var_floor: float = 1e-4
     d_hidden: int = 64
     d_layers: int = 4
-    d_lr_scale: float = 0.2
     n_frames: int = 34
 
     def __post_init__(self) -> None:
@@ -140,6 +173,10 @@ class HA2GConfig(ModelConfig):
             )
         if self.audio_mode not in AUDIO_MODES:
             raise ValueError(f"audio_mode must be one of {AUDIO_MODES}, got {self.audio_mode!r}")
+        if self.style not in STYLES:
+            raise ValueError(f"style must be one of {STYLES}, got {self.style!r}")
+        if self.use_contrastive and not self.use_text:
+            raise ValueError("use_contrastive needs use_text (the contrastive loss aligns text and audio)")
         if self.n_frames <= N_PRE + 6:
             raise ValueError(f"n_frames must be > {N_PRE + 6}, got {self.n_frames}")
         for name in ("vocab_size", "n_speakers", "z_dim", "hidden", "n_layers", "audio_features"):
@@ -148,8 +185,9 @@ class HA2GConfig(ModelConfig):
 
 
 PRESETS: dict[str, dict[str, Any]] = {
-    "paper": {},
+    "paper": {"style": "reference"},
     "tiny": {
+        "style": "reference",
         "vocab_size": 1000,
         "word_dim": 16,
         "text_hidden": 24,
@@ -171,7 +209,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "d_layers": 1,
     },
 }
-"""Preset name -> overrides of :class:`HA2GConfig` (``paper``: docs/reference_code.md#ha2g-hyperparameters; ``tiny``: CPU minutes).
+"""Preset name -> overrides of :class:`HA2GConfig` (``paper``: HA2G's code, docs/reference_code.md#ha2g-hyperparameters; ``tiny``: CPU minutes).
 
 ``tiny``'s GRUs have 48 units: with 32, training from seed 1 reached a validation FGD of 5.7 in
 30 epochs and a test FGD of 7.19; with 48 the same seed reached 3.28 and 4.60 (issue 6 notes),
@@ -182,38 +220,32 @@ then runs on 64 x 70 instead of 128 x 70, and the audio learner's training step 
 less time (37 vs 93 ms for 32 windows on 2 threads).
 """
 
-ABLATIONS: dict[str, dict[str, Any]] = {
-    "full": {},
-    "holistic": {"hierarchical": False},
-    "single_audio": {"audio_mode": "low"},
-    "same_audio": {"same_audio": True},
-    "no_contrastive": {"use_contrastive": False},
-    "no_physical": {"use_physical": False},
-}
-"""Ablation switch name -> config overrides (HA2G Tables 3-4)."""
 
-CHECKPOINTS: dict[str, dict[str, Any]] = {name: dict(kw) for name, (_, kw) in HA2G_ABLATIONS.items()}
-"""Shipped checkpoint name (``checkpoints/<name>.pt``, tiny preset) -> config overrides."""
-
-
-def body_levels(hierarchical: bool = True) -> list[np.ndarray]:
+def body_levels(hierarchical: bool = True, *, body: bool = True, hand: bool = True) -> list[np.ndarray]:
     """Bone indices of each body level.
 
     Parameters
     ----------
     hierarchical : bool
-        True: the 6 levels of ``beatlite.skeleton.ted.HA2G_LEVELS`` (8/10/12/22/32/42 bones);
-        False: one level with all 42 bones ("holistic").
+        True: the levels of ``beatlite.skeleton.ted.HA2G_LEVELS`` (8/10/12/22/32/42 bones);
+        False: one level with all 42 bones ("holistic", paper Table 4).
+    body : bool
+        False ("w/o body hierarchy"): the body bones up to the wrists in one level (HA2G level 3)
+        instead of levels 1-3.
+    hand : bool
+        False ("w/o hand hierarchy"): every finger bone at once (HA2G level 6) instead of
+        levels 4-6.
 
     Returns
     -------
-    list of (K_l,) int64 arrays
+    list of (K_l,) int64 arrays, each level a superset of the previous one.
     """
     if not hierarchical:
         return [np.arange(N_BONES, dtype=np.int64)]
     from beatlite.skeleton import ted
 
-    return [np.asarray(level, dtype=np.int64) for level in ted.HA2G_LEVELS]
+    chosen = ([0, 1, 2] if body else [2]) + ([3, 4, 5] if hand else [5])
+    return [np.asarray(ted.HA2G_LEVELS[k], dtype=np.int64) for k in chosen]
 
 
 def _bone_columns(bones: np.ndarray) -> np.ndarray:
@@ -225,7 +257,8 @@ class LevelGenerator(nn.Module):
     """One body level's pose generator (``Hierarchical_PoseGenerator``).
 
     ``cat[pre_seq (D+1), audio F_a, text F_t, z Z] -> bidirectional GRU (directions summed)
-    -> Linear(H, H/2) -> LeakyReLU(slope) -> Linear(H/2, D)``.
+    -> Linear(H, H/2) -> LeakyReLU(slope) -> Linear(H/2, D)`` (reference slope 0.01;
+    ``F_t = 0`` without text).
 
     Shapes
     ------
@@ -256,6 +289,41 @@ class LevelGenerator(nn.Module):
         return self.head(sum_directions(seq, self.hidden))
 
 
+def reparameterise(
+    mu: torch.Tensor, logvar: torch.Tensor, sample: bool, generator: torch.Generator | None = None
+) -> torch.Tensor:
+    """``mu + eps * exp(logvar / 2)`` with ``eps ~ N(0, I)`` (drawn from ``generator`` if given) or ``mu``."""
+    if not sample:
+        return mu
+    if generator is None:
+        eps = torch.randn_like(mu)
+    else:
+        eps = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+    return mu + eps * torch.exp(0.5 * logvar)
+
+
+class SpeakerStyle(nn.Module):
+    """A level generator's own style code (reference design): ``Embedding -> Linear -> (mu, logvar)``.
+
+    Shapes
+    ------
+    speaker (B,) int64 -> mu, logvar, z (B, Z); z is sampled when ``sample`` else ``mu``.
+    """
+
+    def __init__(self, n_speakers: int, z_dim: int) -> None:
+        super().__init__()
+        self.embedding = nn.Sequential(nn.Embedding(n_speakers, z_dim), nn.Linear(z_dim, z_dim))
+        self.mu = nn.Linear(z_dim, z_dim)
+        self.logvar = nn.Linear(z_dim, z_dim)
+
+    def forward(
+        self, speaker: torch.Tensor, sample: bool, generator: torch.Generator | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        h = self.embedding(speaker)
+        mu, logvar = self.mu(h), self.logvar(h)
+        return mu, logvar, reparameterise(mu, logvar, sample, generator)
+
+
 class HA2GDiscriminator(ConvDiscriminator):
     """HA2G's ``Hierarchical_ConvDiscriminator`` on the last level (126 channels), returning logits.
 
@@ -281,31 +349,40 @@ class HA2G(GestureModel):
     ----------
     config : HA2GConfig
 
-    ``forward(batch)`` returns
+    ``forward(batch, *, sample_style=None, generator=None)`` returns
         ``"pose"`` (B, T, 126) the last level's prediction in the 126-d layout;
         ``"level0"`` ... ``"level{H-1}"`` (B, T, D_k) every level's prediction (bones of
-        :attr:`level_bones`);
-        ``"mu"``, ``"logvar"``, ``"z"`` (B, Z) the speaker style distribution and sample;
+        :func:`body_levels`);
+        ``"mu"``, ``"logvar"``, ``"z"`` (B, Z) the KL-regularised style distribution and code
+        (``"shared"``: the one z; ``"reference"``: the last level's);
+        ``"z_levels"`` (B, H, Z) the code each level generator read;
         ``"style_weights"`` (B, 3, H) audio-level weights per body level;
         ``"audio_low"`` / ``"audio_mid"`` / ``"audio_high"`` (B, T, F) the levels computed;
-        ``"text_contrast"`` (B, T, F) the contrastive text features (when used);
-        in training mode with ``use_style_loss``: ``"z_other"`` (B, Z) random speakers' style
-        vectors and ``"pose_other"`` (B, T, 126) the last level's prediction with them (the
-        style diverging loss' second output, decoded in the same cascade pass as a batch of 2B).
+        ``"text0"``... (B, T, F_t) the generators' text features and ``"text_contrast"`` the
+        contrastive ones (when used);
+        in training mode with ``use_style_loss``: ``"z_other"`` (B, Z) / ``"z_levels_other"``
+        (B, H, Z) other speakers' codes and ``"pose_other"`` (B, T, 126) the last level's
+        prediction with them (the style diverging loss' second output, decoded in the same
+        cascade pass as a batch of 2B).
+        Codes are sampled when ``sample_style`` (default: in training mode), from
+        ``generator`` when given.
     """
 
     name = "ha2g"
     representation = "dirvec126"
     config_class = HA2GConfig
-    input_keys = ("mel", "word", "speaker", "dirvec")
+
+    @property
+    def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
+        """Batch keys the forward pass reads (no ``"word"`` without text)."""
+        return ("mel", "word", "speaker", "dirvec") if self.config.use_text else ("mel", "speaker", "dirvec")
 
     def __init__(self, config: HA2GConfig) -> None:
         super().__init__(config)
         c = config
-        levels = body_levels(c.hierarchical)
+        levels = body_levels(c.hierarchical, body=c.body_hierarchy, hand=c.hand_hierarchy)
         if not np.array_equal(np.sort(levels[-1]), np.arange(N_BONES)):
             raise ValueError("the last body level must hold all 42 bones")
-        self.level_bones: tuple[tuple[int, ...], ...] = tuple(tuple(int(b) for b in lv) for lv in levels)
         self.n_levels = len(levels)
         self.level_dims: tuple[int, ...] = tuple(3 * len(lv) for lv in levels)
         for k, lv in enumerate(levels):
@@ -338,28 +415,39 @@ class HA2G(GestureModel):
             c.n_frames,
             c.audio_freq_stride,
         )
-        # speaker style: Embedding -> Linear -> LReLU -> (mu, logvar)
-        self.speaker_embedding = nn.Sequential(
-            nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim), nn.LeakyReLU(c.slope)
-        )
-        self.speaker_mu = nn.Linear(c.z_dim, c.z_dim)
-        self.speaker_logvar = nn.Linear(c.z_dim, c.z_dim)
+        n_columns = 1 if c.same_audio else self.n_levels
         self.coordinator: StyleCoordinator | None = None
         if c.audio_mode == "blend":
-            self.coordinator = StyleCoordinator(c.z_dim, c.style_hidden, 1 if c.same_audio else self.n_levels)
+            self.coordinator = StyleCoordinator(c.z_dim, c.style_hidden, n_columns)
+        if c.style == "shared":
+            # one style for everything: Embedding -> Linear -> LReLU -> (mu, logvar)
+            self.speaker_embedding = nn.Sequential(
+                nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim), nn.LeakyReLU(c.slope)
+            )
+            self.speaker_mu = nn.Linear(c.z_dim, c.z_dim)
+            self.speaker_logvar = nn.Linear(c.z_dim, c.z_dim)
+        else:
+            # reference: the coordinator's own speaker embedding, one style code per level
+            self.coordinator_embedding = (
+                nn.Sequential(nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim))
+                if self.coordinator is not None
+                else None
+            )
+            self.level_styles = nn.ModuleList([SpeakerStyle(c.n_speakers, c.z_dim) for _ in levels])
 
         def text_encoder() -> TextEncoderTCN:
             return TextEncoderTCN(
                 c.vocab_size, c.word_dim, c.text_hidden, c.text_layers, c.text_features, c.dropout
             )
 
-        n_text = self.n_levels if c.text_per_level else 1
+        n_text = (self.n_levels if c.text_per_level else 1) if c.use_text else 0
         self.text_encoders = nn.ModuleList([text_encoder() for _ in range(n_text)])
         self.contrastive_text = text_encoder() if c.use_contrastive else None
+        text_features = c.text_features if c.use_text else 0
         self.generators = nn.ModuleList(
             [
                 LevelGenerator(
-                    d + 1 + c.audio_features + c.text_features + c.z_dim,
+                    d + 1 + c.audio_features + text_features + c.z_dim,
                     d,
                     c.hidden,
                     c.n_layers,
@@ -434,7 +522,9 @@ class HA2G(GestureModel):
         check_batch(batch, self.input_keys, "HA2G")
         b = batch["dirvec"].shape[0]
         t = self.config.n_frames
-        want = {"dirvec": (b, t, 3 * N_BONES), "word": (b, t), "speaker": (b,)}
+        want = {"dirvec": (b, t, 3 * N_BONES), "speaker": (b,)}
+        if self.config.use_text:
+            want["word"] = (b, t)
         for key, shape in want.items():
             if tuple(batch[key].shape) != shape:
                 raise ValueError(
@@ -450,31 +540,66 @@ class HA2G(GestureModel):
                 f"got range [{int(spk.min())}, {int(spk.max())}]"
             )
 
-    def speaker_style(self, speaker: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Speaker ids (B,) -> (mu, logvar, z), each (B, Z); z is sampled in training, mu in eval."""
-        h = self.speaker_embedding(speaker)
-        mu, logvar = self.speaker_mu(h), self.speaker_logvar(h)
-        z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
-        return mu, logvar, z
+    def speaker_style(
+        self, speaker: torch.Tensor, *, sample: bool | None = None, generator: torch.Generator | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Speaker ids (B,) -> (mu, logvar, z), each (B, Z): the KL-regularised style code.
 
-    def _style_weights(self, z: torch.Tensor) -> torch.Tensor:
-        """(B, Z) -> (B, 3, H) audio-level weights (fixed one-hot for a single audio level)."""
-        if self.coordinator is None:
-            w = z.new_zeros(z.shape[0], 3, self.n_levels)
+        ``"shared"``: the one code of every level; ``"reference"``: the last level's. ``z`` is
+        sampled when ``sample`` (default: in training mode), else ``mu``.
+        """
+        style = self._styles(speaker, self.training if sample is None else sample, generator)
+        return style["mu"], style["logvar"], style["z"]
+
+    def _styles(
+        self, speaker: torch.Tensor, sample: bool, generator: torch.Generator | None = None
+    ) -> dict[str, torch.Tensor | None]:
+        """Speaker ids (B,) -> ``coord`` (B, Z) coordinator input (None without coordinator),
+        ``levels`` (B, H, Z) each generator's code, ``mu``/``logvar``/``z`` (B, Z) the KL's."""
+        if self.config.style == "shared":
+            h = self.speaker_embedding(speaker)
+            mu, logvar = self.speaker_mu(h), self.speaker_logvar(h)
+            z = reparameterise(mu, logvar, sample, generator)
+            levels = z[:, None, :].expand(-1, self.n_levels, -1)
+            return {"coord": z, "levels": levels, "mu": mu, "logvar": logvar, "z": z}
+        codes = [style(speaker, sample, generator) for style in self.level_styles]
+        coord = None if self.coordinator_embedding is None else self.coordinator_embedding(speaker)
+        mu, logvar, z = codes[-1]
+        return {
+            "coord": coord,
+            "levels": torch.stack([c[2] for c in codes], 1),
+            "mu": mu,
+            "logvar": logvar,
+            "z": z,
+        }
+
+    def _style_weights(self, coord: torch.Tensor | None, b: int, like: torch.Tensor) -> torch.Tensor:
+        """Coordinator input (B, Z) -> (B, 3, H) audio-level weights (one-hot for a single audio level)."""
+        if self.coordinator is None or coord is None:
+            w = like.new_zeros(b, 3, self.n_levels)
             w[:, AUDIO_LEVELS.index(self.config.audio_mode)] = 1.0
             return w
-        w = self.coordinator(z)
+        w = self.coordinator(coord)
         return w.expand(-1, -1, self.n_levels) if self.config.same_audio else w
 
     def _decode(
-        self, dirvec: torch.Tensor, audio: dict[str, torch.Tensor], texts: list[torch.Tensor], z: torch.Tensor
+        self,
+        dirvec: torch.Tensor,
+        audio: dict[str, torch.Tensor],
+        texts: list[torch.Tensor],
+        coord: torch.Tensor | None,
+        levels: torch.Tensor,
     ) -> tuple[list[torch.Tensor], torch.Tensor]:
-        """Run the cascade of level generators; returns (per-level predictions, style weights)."""
-        weights = self._style_weights(z)
+        """Run the cascade of level generators; returns (per-level predictions, style weights).
+
+        ``coord`` (B, Z) is the coordinator's input, ``levels`` (B, H, Z) the generators' codes.
+        """
+        b, t, _ = dirvec.shape
+        weights = self._style_weights(coord, b, dirvec)
         full = {lv: audio.get(lv, audio[next(iter(audio))]) for lv in AUDIO_LEVELS}
         level_audio = blend_audio(full, weights)  # (B, H, T, F)
-        b, t, _ = dirvec.shape
         n_pre = self.n_pre
+        no_text = dirvec.new_zeros(b, t, 0)
         preds: list[torch.Tensor] = []
         for k, gen in enumerate(self.generators):
             cols = getattr(self, f"_cols{k}")
@@ -485,42 +610,52 @@ class HA2G(GestureModel):
                 dst, src = getattr(self, f"_dst{k}"), getattr(self, f"_src{k}")
                 rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src])
             pre_seq = torch.cat([seed, rest], dim=1)
-            text = texts[k] if len(texts) > 1 else texts[0]
-            preds.append(gen(pre_seq, level_audio[:, k], text, z))
+            text = (texts[k] if len(texts) > 1 else texts[0]) if texts else no_text
+            preds.append(gen(pre_seq, level_audio[:, k], text, levels[:, k]))
         return preds, weights
 
-    def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
+    def forward(
+        self, batch: Batch, *, sample_style: bool | None = None, generator: torch.Generator | None = None
+    ) -> dict[str, torch.Tensor]:
         """See the class docstring; reads ``mel``, ``word``, ``speaker`` and seed frames of ``dirvec``."""
         self._check_inputs(batch)
         dirvec = batch["dirvec"]
         audio = self.audio(batch["mel"])
-        mu, logvar, z = self.speaker_style(batch["speaker"])
+        sample = self.training if sample_style is None else bool(sample_style)
+        style = self._styles(batch["speaker"], sample, generator)
         texts = [enc(batch["word"]) for enc in self.text_encoders]
         b = dirvec.shape[0]
         if self.training and self.config.use_style_loss:
-            # the style diverging loss needs the cascade run again with random speakers' z:
+            # the style diverging loss needs the cascade run again with other speakers' codes:
             # both runs go through the cascade as one batch of 2B (same result, half the
             # per-time-step GRU calls)
-            _, _, z_other = self.speaker_style(self._random_speakers(b, z.device))
+            coord_other, other_style = self._other_style(batch["speaker"], style, sample)
+            coord = None if style["coord"] is None else torch.cat([style["coord"], coord_other])
             both, weights = self._decode(
                 dirvec.repeat(2, 1, 1),
                 {lv: f.repeat(2, 1, 1) for lv, f in audio.items()},
                 [text.repeat(2, 1, 1) for text in texts],
-                torch.cat([z, z_other]),
+                coord,
+                torch.cat([style["levels"], other_style["levels"]]),
             )
             preds, weights = [p[:b] for p in both], weights[:b]
-            other = {"pose_other": both[-1][b:], "z_other": z_other}
+            other = {
+                "pose_other": both[-1][b:],
+                "z_other": other_style["z"],
+                "z_levels_other": other_style["levels"],
+            }
         else:
-            preds, weights = self._decode(dirvec, audio, texts, z)
+            preds, weights = self._decode(dirvec, audio, texts, style["coord"], style["levels"])
             other = {}
         pose = dirvec.new_zeros(dirvec.shape).index_copy(
             -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1]
         )
         out: dict[str, torch.Tensor] = {
             "pose": pose,
-            "mu": mu,
-            "logvar": logvar,
-            "z": z,
+            "mu": style["mu"],
+            "logvar": style["logvar"],
+            "z": style["z"],
+            "z_levels": style["levels"],
             "style_weights": weights,
         }
         out.update({f"level{k}": p for k, p in enumerate(preds)})
@@ -532,8 +667,80 @@ class HA2G(GestureModel):
         out.update(other)
         return out
 
-    def _random_speakers(self, b: int, device: torch.device) -> torch.Tensor:
-        return torch.randint(0, self.config.n_speakers, (b,), device=device)
+    def _other_style(
+        self, speaker: torch.Tensor, style: dict[str, Any], sample: bool
+    ) -> tuple[torch.Tensor | None, dict[str, Any]]:
+        """The style diverging loss' other speakers: (coordinator input, their styles).
+
+        ``"reference"``: a permutation of the batch's speakers, the coordinator input unchanged
+        (HA2G's code reuses the blended audio of the true speakers); ``"shared"``: uniformly
+        random speaker ids, driving the coordinator too.
+        """
+        if self.config.style == "shared":
+            ids = torch.randint(0, self.config.n_speakers, speaker.shape, device=speaker.device)
+            other = self._styles(ids, sample)
+            return other["coord"], other
+        other = self._styles(speaker[torch.randperm(speaker.shape[0], device=speaker.device)], sample)
+        return style["coord"], other
+
+    @torch.no_grad()
+    def generate(
+        self,
+        batch: Batch,
+        *,
+        protocol: str = "deterministic",
+        speakers: Sequence[int] | torch.Tensor | None = None,
+        generator: torch.Generator | None = None,
+    ) -> torch.Tensor:
+        """Inference seeded by the first ``n_pre`` frames of ``batch["dirvec"]`` (see :class:`GestureModel`).
+
+        Parameters
+        ----------
+        batch : dict of tensors
+            A window batch; frames ``>= n_pre`` of ``"dirvec"`` are zeroed before the forward pass.
+        protocol : "deterministic" or "sampled"
+            ``"deterministic"`` (beatlite's tables): the batch's speakers, z = mu.
+            ``"sampled"`` (HA2G's evaluation code): each window gets a speaker drawn uniformly
+            from ``speakers`` and sampled style codes (z = mu + eps sigma), dropout off.
+        speakers : sequence of int, required for ``"sampled"``
+            The training speakers' ids to draw from.
+        generator : torch.Generator, optional
+            Source of the ``"sampled"`` draws (speakers, then eps): the same seed gives the same
+            output; default torch's global generator.
+
+        Returns
+        -------
+        (B, T, 126) float tensor
+        """
+        if protocol not in PROTOCOLS:
+            raise ValueError(f"protocol must be one of {PROTOCOLS}, got {protocol!r}")
+        if protocol == "deterministic":
+            return super().generate(batch)
+        if speakers is None:
+            raise ValueError('protocol "sampled" needs speakers= (the training speaker ids to draw from)')
+        pool = torch.as_tensor(speakers, dtype=torch.int64).reshape(-1)
+        if pool.numel() == 0 or int(pool.min()) < 0 or int(pool.max()) >= self.config.n_speakers:
+            raise ValueError(
+                f"speakers must be non-empty ids in [0, {self.config.n_speakers}), got {pool.tolist()}"
+            )
+        check_batch(batch, ("dirvec",), "HA2G.generate")
+        seeded = dict(batch)
+        seeded["dirvec"] = batch["dirvec"].clone()
+        seeded["dirvec"][:, self.n_pre :] = 0.0
+        pick = torch.randint(0, pool.numel(), (seeded["dirvec"].shape[0],), generator=generator)
+        seeded["speaker"] = pool[pick].to(seeded["dirvec"].device)
+        was_training = self.training
+        self.eval()
+        try:
+            return self.forward(seeded, sample_style=True, generator=generator)["pose"]
+        finally:
+            if was_training:
+                self.train()
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any]) -> GestureModel:
+        """:meth:`GestureModel.from_config`, ignoring :data:`RETIRED_FIELDS` of older checkpoints."""
+        return super().from_config({k: v for k, v in config.items() if k not in RETIRED_FIELDS})
 
     # ------------------------------------------------------------------ losses
     def losses(self, batch: Batch, out: dict[str, torch.Tensor], *, epoch: int) -> dict[str, torch.Tensor]:
@@ -562,7 +769,10 @@ class HA2G(GestureModel):
         if c.use_contrastive:
             audio = {lv: out[f"audio_{lv}"] for lv in ("low", "high")}
             con = multilevel_contrastive_loss(
-                out["text_contrast"], audio, min_distance=c.contrastive_min_distance
+                out["text_contrast"],
+                audio,
+                min_distance=c.contrastive_min_distance,
+                high_negatives=c.contrastive_high_negatives,
             )
             terms["contrastive_pos"] = con["positive"]
             terms["contrastive_neg"] = con["negative"]
@@ -583,18 +793,20 @@ class HA2G(GestureModel):
         return terms
 
     def _style_loss(self, batch: Batch, out: dict[str, torch.Tensor]) -> torch.Tensor:
-        """Style diverging loss against the outputs for random speakers' style vectors.
+        """Style diverging loss against the outputs for other speakers' style codes.
 
         Training-mode forward passes already carry them (``"pose_other"``, ``"z_other"``);
-        otherwise (an eval-mode ``out``) the cascade is run here with new random speakers.
+        otherwise (an eval-mode ``out``) the cascade is run here with new other speakers.
         """
         if "pose_other" in out:
             pose_other, z_other = out["pose_other"], out["z_other"]
         else:
-            _, _, z_other = self.speaker_style(self._random_speakers(out["z"].shape[0], out["z"].device))
+            style = self._styles(batch["speaker"], self.training)
+            coord, other = self._other_style(batch["speaker"], style, self.training)
             audio = {lv[6:]: v for lv, v in out.items() if lv.startswith("audio_")}
             texts = [out[f"text{k}"] for k in range(len(self.text_encoders))]
-            pose_other = self._decode(batch["dirvec"], audio, texts, z_other)[0][-1]
+            pose_other = self._decode(batch["dirvec"], audio, texts, coord, other["levels"])[0][-1]
+            z_other = other["z"]
         return style_diverging_loss(
             out[f"level{self.n_levels - 1}"],
             pose_other,
@@ -602,6 +814,7 @@ class HA2G(GestureModel):
             z_other,
             beta=self.config.style_beta,
             clip=self.config.style_clip,
+            reference=self.config.style == "reference",
         )
 
     def discriminator_losses(self, batch: Batch, out: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
@@ -693,20 +906,3 @@ def build_ha2g(preset: str = "tiny", ablation: str = "full", **overrides: Any) -
     if ablation not in ABLATIONS:
         raise ValueError(f"ablation must be one of {sorted(ABLATIONS)}, got {ablation!r}")
     return HA2G(config_from_preset(HA2GConfig, PRESETS, preset, **{**ABLATIONS[ablation], **overrides}))
-
-
-def retrain(names: Sequence[str] | None = None, **kwargs: Any) -> dict[str, float]:
-    """Retrain shipped HA2G checkpoints (default all of :data:`CHECKPOINTS`).
-
-    Each is trained by :func:`beatlite.train.recipes.retrain` (keyword arguments go there:
-    ``seed``, ``epochs``, ``out_dir``, ``progress``); returns name -> seconds of training.
-    """
-    from beatlite.train.recipes import retrain as _retrain
-    from beatlite.train.recipes import training_data
-
-    chosen = list(CHECKPOINTS) if names is None else list(names)
-    unknown = sorted(set(chosen) - set(CHECKPOINTS))
-    if unknown:
-        raise ValueError(f"unknown HA2G checkpoint(s) {unknown}; known: {sorted(CHECKPOINTS)}")
-    data = training_data()
-    return {name: _retrain(name, data=data, **kwargs) for name in chosen}

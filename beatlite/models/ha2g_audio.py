@@ -16,7 +16,7 @@ level       backbone output             stream                             per f
 For the 34-frame window the spectrogram has M = 70 frames and every stream ends with
 exactly 34 time steps (70 -> 35 -> 34, 70 -> 18 -> 36 -> 34, 70 -> 9 -> 36 -> 34).
 
-The style coordinator turns a speaker style vector into softmax weights over the
+The style coordinator turns a speaker's style input into softmax weights over the
 three audio levels for each body level (paper eq. 3).
 
 Taught in notebooks/06_ha2g.ipynb, sections 3 (the hierarchical audio learner) and 5 (the style coordinator).
@@ -218,10 +218,12 @@ def _match_length(x: torch.Tensor, n: int) -> torch.Tensor:
 
 
 class StyleCoordinator(nn.Module):
-    """Speaker style vector -> softmax weights of the three audio levels for each body level.
+    """Speaker style input -> softmax weights of the three audio levels for each body level.
 
     ``ELU -> Linear(z_dim, hidden) -> ELU -> Linear(hidden, 3 * n_body_levels)``, reshaped to
-    ``(B, 3, H)`` and soft-maxed over the 3 audio levels (reference: hidden 32, H = 6).
+    ``(B, 3, H)`` and soft-maxed over the 3 audio levels (paper eq. 3; reference: hidden 32,
+    H = 6). Its input is the coordinator's own speaker embedding (``Embedding -> Linear``, not
+    sampled) in HA2G's design (``HA2GConfig.style="reference"``), the shared style z otherwise.
 
     Shapes
     ------

@@ -67,6 +67,38 @@ def contrastive_ce(query: torch.Tensor, key: torch.Tensor, *, min_distance: floa
     return nn.functional.cross_entropy(logits, target)
 
 
+def aligned_against_level_ce(
+    query: torch.Tensor, positive: torch.Tensor, negative: torch.Tensor, *, min_distance: float = 1e-2
+) -> torch.Tensor:
+    """Cross-entropy of each query row's aligned ``positive`` row against every row of ``negative``.
+
+    Row i's candidates are ``positive_i`` (the correct class) and ``negative_j`` for all j, with
+    :func:`contrastive_ce`'s logits ``1 / max(|q - k|, min_distance)`` on L2-normalised rows: paper
+    eq. 2 without the other rows of the positive's own level ("w/o f_a-^high", Table 3).
+
+    Parameters
+    ----------
+    query, positive, negative : (B, T, F) float tensors
+
+    Returns
+    -------
+    scalar tensor >= 0
+    """
+    if query.ndim != 3 or query.shape != positive.shape or query.shape != negative.shape:
+        raise ValueError(
+            f"aligned_against_level_ce: query, positive and negative must be equal (B, T, F) shapes, got "
+            f"{tuple(query.shape)}, {tuple(positive.shape)} and {tuple(negative.shape)}"
+        )
+    q = nn.functional.normalize(query.reshape(-1, query.shape[-1]), dim=1)
+    p = nn.functional.normalize(positive.reshape(-1, positive.shape[-1]), dim=1)
+    n = nn.functional.normalize(negative.reshape(-1, negative.shape[-1]), dim=1)
+    floor = min_distance**2
+    aligned = torch.rsqrt(torch.clamp(2.0 - 2.0 * (q * p).sum(dim=1, keepdim=True), min=floor))
+    others = torch.rsqrt(torch.clamp(2.0 - 2.0 * q @ n.T, min=floor))
+    logits = torch.cat([aligned, others], dim=1)
+    return nn.functional.cross_entropy(logits, torch.zeros(q.shape[0], dtype=torch.int64, device=q.device))
+
+
 def multilevel_contrastive_loss(
     text: torch.Tensor,
     audio: dict[str, torch.Tensor],
@@ -74,11 +106,13 @@ def multilevel_contrastive_loss(
     positive: str = "high",
     negative: str = "low",
     min_distance: float = 1e-2,
+    high_negatives: bool = True,
 ) -> dict[str, torch.Tensor]:
     """Paper eq. 2 as implemented: text is pulled towards one audio level and pushed from another.
 
     Returns ``{"positive": CE(text, audio[positive]), "negative": CE(text, audio[negative])}``;
     the model adds ``w_pos * positive - w_neg * negative`` (reference 0.2 and 0.005).
+    ``w_neg = 0`` is the paper's "w/o f_a-^low,mid" (Table 3).
 
     Parameters
     ----------
@@ -86,14 +120,20 @@ def multilevel_contrastive_loss(
         Text features (a separate text encoder).
     audio : dict level -> (B, T, F)
         Audio features with at least the ``positive`` and ``negative`` levels.
+    high_negatives : bool
+        False ("w/o f_a-^high", Table 3): the positive term's candidates are the aligned
+        ``positive`` feature and the ``negative`` level's features
+        (:func:`aligned_against_level_ce`), not the other frames' ``positive`` features.
     """
     for level in (positive, negative):
         if level not in audio:
             raise KeyError(f"multilevel_contrastive_loss: audio has no level {level!r} (has {sorted(audio)})")
-    return {
-        "positive": contrastive_ce(text, audio[positive], min_distance=min_distance),
-        "negative": contrastive_ce(text, audio[negative], min_distance=min_distance),
-    }
+    pos = (
+        contrastive_ce(text, audio[positive], min_distance=min_distance)
+        if high_negatives
+        else aligned_against_level_ce(text, audio[positive], audio[negative], min_distance=min_distance)
+    )
+    return {"positive": pos, "negative": contrastive_ce(text, audio[negative], min_distance=min_distance)}
 
 
 # ----------------------------------------------------------------------------- regression, KL, style
@@ -142,18 +182,22 @@ def style_diverging_loss(
     *,
     beta: float = 0.05,
     clip: float = 1000.0,
+    reference: bool = False,
 ) -> torch.Tensor:
-    """Paper eq. 7 (Trimodal's diversity regulariser): reward outputs that move with the style vector.
+    """Paper eq. 7 (Trimodal's diversity regulariser): reward outputs that move with the style code.
 
-    ``-mean_b min(sum_{t,d} Huber_beta(pose_b, pose_other_b) / (mean|z - z_other| + 1e-5), clip)``;
-    the z distance is detached.
+    ``-mean_b min(sum_{t,d} Huber_beta(pose_b, pose_other_b) / (zdist + 1e-5), clip)`` with the
+    z distance detached. ``reference=True`` (HA2G's code): ``zdist_b = mean_z |z_b - z_other_b|``
+    per sample and ``pose_other`` detached (only ``pose`` is pushed away). ``reference=False``
+    (the ``"shared"`` style design): ``zdist`` = the batch mean of ``|z - z_other|`` and both
+    outputs receive gradient.
 
     Parameters
     ----------
     pose, pose_other : (B, T, D)
-        Outputs for the batch's style vectors and for other (random speakers') style vectors.
+        Outputs for the batch's style codes and for other speakers' codes.
     z, z_other : (B, Z)
-        The two style vectors.
+        The two style codes.
 
     Returns
     -------
@@ -163,9 +207,12 @@ def style_diverging_loss(
         raise ValueError(
             f"pose {tuple(pose.shape)} and pose_other {tuple(pose_other.shape)} must be (B, T, D)"
         )
+    if reference:
+        pose_other = pose_other.detach()
     diff = nn.functional.smooth_l1_loss(pose / beta, pose_other / beta, reduction="none") * beta
     per_clip = diff.sum(dim=(1, 2))
-    z_l1 = (z - z_other).abs().mean().detach()
+    gap = (z - z_other).abs().detach()
+    z_l1 = gap.mean(dim=1) if reference else gap.mean()
     return -torch.clamp(per_clip / (z_l1 + 1e-5), max=clip).mean()
 
 

@@ -34,6 +34,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
+
 SEED = 2021
 """Seed of every shipped checkpoint (the reference's ``random_seed``)."""
 
@@ -115,14 +117,30 @@ HA2G_LR = 2e-3
 6.6 at epoch 24, 3.71 at 29; test FGD 5.45); at 2e-3 the same seed reached 2.57 (test 3.52)."""
 
 
-HA2G_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
-    "ha2g_tiny": ("HA2G", {}),
-    "ha2g_tiny_holistic": ("HA2G w/o hierarchy (holistic)", {"hierarchical": False}),
-    "ha2g_tiny_single_audio": ("HA2G single audio feature", {"audio_mode": "low"}),
-    "ha2g_tiny_no_contrastive": ("HA2G w/o contrastive loss", {"use_contrastive": False}),
-    "ha2g_tiny_no_physical": ("HA2G w/o physical loss", {"use_physical": False}),
+HA2G_LABELS: dict[str, str] = {
+    "full": "HA2G",
+    "holistic": "HA2G w/o hierarchy (holistic)",
+    "single_audio": "HA2G single audio feature",
+    "mid_only": "HA2G f_a^mid only",
+    "high_only": "HA2G f_a^high only",
+    "no_high_negatives": "HA2G w/o f_a-^high (high-level negatives)",
+    "no_low_mid_negatives": "HA2G w/o f_a-^low,mid (low/mid-level negatives)",
+    "no_text": "HA2G w/o text",
+    "no_hand_hierarchy": "HA2G w/o hand hierarchy",
+    "no_body_hierarchy": "HA2G w/o body hierarchy",
+    "same_audio": "HA2G same audio f_a^h",
+    "no_contrastive": "HA2G w/o contrastive loss",
+    "no_physical": "HA2G w/o physical loss",
 }
-"""Shipped HA2G checkpoints: name -> (row label, config overrides of the ``tiny`` preset) (HA2G Tables 3-4)."""
+"""Table row label of each HA2G ablation switch (the rows of HA2G Tables 3-4)."""
+
+HA2G_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
+    ("ha2g_tiny" if name == "full" else f"ha2g_tiny_{name}"): (HA2G_LABELS[name], dict(overrides))
+    for name, overrides in HA2G_SWITCHES.items()
+}
+"""Shipped HA2G checkpoints: name -> (row label, config overrides of the ``tiny`` preset) (HA2G Tables 3-4),
+one per switch of :data:`beatlite.models.ha2g_ablations.ABLATIONS`. HA2G-ASR (Table 3) has none: it
+needs a pretrained ASR network."""
 
 
 RECIPES: dict[str, Recipe] = {
