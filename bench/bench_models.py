@@ -10,8 +10,7 @@ best epoch by it), the extrapolated time of the shipped training (its recipe in
 adversarial, plus one scoring per epoch; target <= 180 s per model on 2 cores), and the time to
 generate a 60 s take with the harness (34-frame units, stride 30; target <= 2 s) next to one
 single forward pass over the whole take (the straightforward alternative, no seeding between
-units). CaMN tiny and HA2G tiny are also timed with torch's own convolution backward in place of
-:mod:`beatlite.models.fast_conv` (the straightforward alternative), measured in the same run.
+units).
 Run it with ``BEATLITE_THREADS=2`` for the 2-core figure.
 Timings on a shared machine are noisy: repeat when idle.
 """
@@ -24,7 +23,7 @@ import time
 import numpy as np
 import torch
 
-from beatlite.models import build_model, fast_conv
+from beatlite.models import build_model
 from beatlite.models.testing import fake_windows
 from beatlite.paths import data_dir, n_threads
 from beatlite.train import TrainConfig, fit
@@ -32,24 +31,12 @@ from beatlite.train.generation import generate_sequence
 from beatlite.train.recipes import RECIPES
 
 MODELS = (
-    ("camn_tiny", "camn tiny", False),
-    ("camn_tiny", "camn torch-conv", True),
-    ("s2g_tiny", "s2g tiny", False),
-    ("trimodal_tiny", "trimodal tiny", False),
-    ("ha2g_tiny", "ha2g tiny", False),
-    ("ha2g_tiny", "ha2g torch-conv", True),
+    ("camn_tiny", "camn tiny"),
+    ("s2g_tiny", "s2g tiny"),
+    ("trimodal_tiny", "trimodal tiny"),
+    ("ha2g_tiny", "ha2g tiny"),
 )
-"""(recipe name, label, use torch's convolution classes instead of beatlite.models.fast_conv)."""
-
-
-def _torch_convolutions(model: torch.nn.Module) -> torch.nn.Module:
-    """The same model with every fast_conv layer turned back into its torch class (same weights)."""
-    for module in model.modules():
-        if isinstance(module, fast_conv.Conv1d):
-            module.__class__ = torch.nn.Conv1d
-        elif isinstance(module, fast_conv.Conv2d):
-            module.__class__ = torch.nn.Conv2d
-    return model
+"""(recipe name, label) of the timed models."""
 
 
 def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str]:
@@ -96,8 +83,7 @@ def main() -> None:
     except (OSError, ValueError) as exc:
         print(f"(no validation takes: {exc}; validation FGD not timed)")
         score = None
-    epoch_times = {}
-    for recipe_name, label, torch_conv in MODELS:
+    for recipe_name, label in MODELS:
         recipe = RECIPES[recipe_name]
         name, epochs = recipe.model, recipe.epochs
         kw = dict(recipe.overrides)
@@ -107,8 +93,6 @@ def main() -> None:
         for adversarial in (False, True):  # plain and adversarial epochs (with the D step)
             torch.manual_seed(0)
             model = build_model(name, preset="tiny", no_adv_epochs=0 if adversarial else 1, **kw)
-            if torch_conv:
-                _torch_convolutions(model)
             times = []
             for _ in range(args.repeats):  # the fastest of a few: the least disturbed by the machine
                 config = TrainConfig(epochs=1, batch_size=recipe.batch_size, lr=recipe.lr, progress=False)
@@ -119,7 +103,6 @@ def main() -> None:
         n_adv = max(0, epochs - int(build_model(name, preset="tiny", **kw).config.no_adv_epochs))
         total_s = per_kind[False] * (epochs - n_adv) + per_kind[True] * n_adv
         epoch_s = per_kind[True]
-        epoch_times[label] = per_kind[True]
         model.eval()
         val_s = 0.0
         if score is not None and recipe.select_best:
@@ -146,9 +129,6 @@ def main() -> None:
             f"generate {args.seconds:g}s take={gen_s:5.2f}s (target <= 2)  "
             f"single pass={one_s:5.2f}s  ratio={gen_s / one_s:4.1f}x"
         )
-    for model_name in ("camn", "ha2g"):
-        ratio = epoch_times[f"{model_name} torch-conv"] / epoch_times[f"{model_name} tiny"]
-        print(f"{model_name} tiny adversarial-epoch speed-up from beatlite.models.fast_conv: {ratio:.2f}x")
 
 
 if __name__ == "__main__":

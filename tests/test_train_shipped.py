@@ -98,16 +98,17 @@ CLAIMS = (
     ("CaMN", "S2G-style", "SRGR", "better"),
     ("HA2G", "S2G-style", "SRGR", "better"),
     ("CaMN", "Random clip", "SRGR", "better"),
-    ("HA2G", "Trimodal-style", "BC", "better"),
     ("CaMN w/o cascade", "CaMN", "FGD", "worse"),
     ("CaMN w/o text", "CaMN", "FGD", "worse"),
     ("CaMN w/o audio", "CaMN", "FGD", "worse"),
     ("CaMN w/o speaker ID", "CaMN", "SRGR", "worse"),
-    ("HA2G single audio feature", "HA2G", "BC", "worse"),
 )
 """Claims that hold on the recorded seeds (2021-2023) beyond 2 standard errors. Not here because they hold
 only on the means (within 2 SE): FGD HA2G 3.75 ± 1.73 vs S2G 4.65 ± 0.23 and Trimodal 5.29 ± 0.20 (HA2G's
-seeds give 5.53, 3.64 and 2.07), and every HA2G ablation's FGD against the full model."""
+seeds give 5.53, 3.64 and 2.07), and every HA2G ablation's FGD against the full model. Gone with the
+stable BC (rigid angle pairs left out): "HA2G beats Trimodal on BC" and "HA2G with a single audio feature is
+worse on BC" rested on two rigid head pairs whose round-off MAAC dominated HA2G's angle-change curve; BC is
+re-recorded for seed 2021 only until `make seeds` retrains the other seeds, so no BC claim is tested."""
 
 
 @pytest.mark.parametrize(("model", "reference", "metric", "verdict"), CLAIMS)

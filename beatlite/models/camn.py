@@ -140,8 +140,7 @@ narrower layers. The WavEncoder dominates the cost (its first blocks run at 7891
 window), so its first block has 4 channels: with ``(4, 8, 8, 16, 16, 32)`` a generator step
 on 32 windows is about 1.2x faster than with ``(8, 8, 8, 16, 16, 32)`` (0.29 vs 0.35 s on one
 thread of a busy machine, interleaved A/B; whole-epoch timings on a shared machine are too noisy
-to show it), and its stride-1 convolutions are :mod:`beatlite.models.fast_conv` layers (the
-input gradient as a forward convolution). The shipped training schedule is in
+to show it). The shipped training schedule is in
 ``beatlite.train.recipes.RECIPES`` (40 epochs at lr 2e-3, best epoch by validation FGD).
 """
 

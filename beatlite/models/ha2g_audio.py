@@ -29,8 +29,6 @@ from collections.abc import Sequence
 import torch
 from torch import nn
 
-from beatlite.models.fast_conv import Conv2d
-
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
 
@@ -69,14 +67,14 @@ class SEBasicBlock2d(nn.Module):
 
     def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int) -> None:
         super().__init__()
-        self.conv1 = Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
+        self.conv1 = nn.Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
         self.bn1 = nn.BatchNorm2d(out_ch)
-        self.conv2 = Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
+        self.conv2 = nn.Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
         self.bn2 = nn.BatchNorm2d(out_ch)
         self.se = SEBlock2d(out_ch, reduction)
         self.relu = nn.ReLU(inplace=True)
         self.shortcut: nn.Module = (
-            nn.Sequential(Conv2d(in_ch, out_ch, 1, stride=stride, bias=False), nn.BatchNorm2d(out_ch))
+            nn.Sequential(nn.Conv2d(in_ch, out_ch, 1, stride=stride, bias=False), nn.BatchNorm2d(out_ch))
             if stride != 1 or in_ch != out_ch
             else nn.Identity()
         )
@@ -105,7 +103,7 @@ class _Stream(nn.Module):
             )
         self.shuffle: nn.Module = nn.PixelShuffle(upscale) if upscale > 1 else nn.Identity()
         ch = channels // (upscale * upscale)
-        self.conv = Conv2d(ch, ch, kernel)
+        self.conv = nn.Conv2d(ch, ch, kernel)
         freq = freq_in * upscale - kernel + 1
         self.proj = nn.Linear(freq * ch, out_features)
 
@@ -170,7 +168,7 @@ class HierarchicalAudioEncoder(nn.Module):
         if fs not in (1, 2, 4):
             raise ValueError(f"freq_stride must be 1, 2 or 4, got {freq_stride}")
         self.stem = nn.Sequential(
-            Conv2d(1, c[0], 3, stride=(fs, 1), padding=1, bias=False),
+            nn.Conv2d(1, c[0], 3, stride=(fs, 1), padding=1, bias=False),
             nn.BatchNorm2d(c[0]),
             nn.ReLU(inplace=True),
         )

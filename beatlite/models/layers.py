@@ -20,8 +20,6 @@ import torch
 from torch import nn
 from torch.nn.utils.parametrizations import weight_norm
 
-from beatlite.models.fast_conv import Conv1d
-
 
 class BasicBlock1d(nn.Module):
     """timm-style residual block on 1-D sequences (CaMN's ``BasicBlock``).
@@ -66,14 +64,14 @@ class BasicBlock1d(nn.Module):
                 f"BasicBlock1d: an identity shortcut needs in_ch == out_ch, stride 1 and 'same' padding; "
                 f"got in_ch={in_ch}, out_ch={out_ch}, stride={stride}, padding={padding}, kernel={kernel}"
             )
-        self.conv1 = Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False)
+        self.conv1 = nn.Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False)
         self.bn1 = nn.BatchNorm1d(out_ch)
-        self.conv2 = Conv1d(out_ch, out_ch, kernel, padding=kernel // 2, bias=False)
+        self.conv2 = nn.Conv1d(out_ch, out_ch, kernel, padding=kernel // 2, bias=False)
         self.bn2 = nn.BatchNorm1d(out_ch)
         self.act = nn.LeakyReLU(slope)
         self.shortcut: nn.Module = (
             nn.Sequential(
-                Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False),
+                nn.Conv1d(in_ch, out_ch, kernel, stride=stride, padding=padding, bias=False),
                 nn.BatchNorm1d(out_ch),
             )
             if downsample

@@ -454,8 +454,10 @@ def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
     """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``)."""
+    from beatlite.metrics.scoring import describe
     from beatlite.paths import build_dir
     from beatlite.report import write_markdown_and_json
+    from beatlite.train.evaluation import COLUMNS
 
     stem = Path(stem) if stem is not None else build_dir() / "results_seeds"
     info = results.info
@@ -465,6 +467,9 @@ def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> 
         f"{info.get('windows', '?')} FGD windows; ground-truth rows do not depend on a seed). "
         f"Seed {SEED} is the shipped checkpoint; the others are in `build/seeds/<seed>/`.\n\n"
         + results.to_markdown()
+        + "\n\n"
+        + describe(COLUMNS)
+        + (f"\n\nNote: {info['notes']}" if info.get("notes") else "")
         + "\n"
     )
     return write_markdown_and_json(stem, text, results.to_dict())
