@@ -29,7 +29,7 @@ from beatlite.metrics import (
     srgr,
     velocity_stats,
 )
-from beatlite.metrics.srgr import srgr_per_frame
+from beatlite.metrics.recall import srgr_per_frame
 
 
 def test_import_does_not_import_torch():
@@ -307,8 +307,8 @@ def test_evaluate_rejects_mismatched_takes():
 
 
 def test_evaluate_variants_equal_the_metric_functions_on_beat_skeleton_motion():
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
     from beatlite.metrics.beats import mean_angle_change
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
     from beatlite.skeleton.directions import positions_to_directions
     from beatlite.skeleton.kinematics import forward_kinematics

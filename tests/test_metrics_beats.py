@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 from beatlite.metrics import audio_beats, beat_align, beat_consistency, gaussian_alignment
-from beatlite.metrics.beat_align import REFERENCE_COLUMNS_141, VARIANTS, BeatAlignVariant, motion_beat_times
-from beatlite.metrics.beat_consistency import BCVariant
+from beatlite.metrics.alignment import REFERENCE_COLUMNS_141, VARIANTS, BeatAlignVariant, motion_beat_times
 from beatlite.metrics.beats import (
     alignment_score,
     angle_change_beats,
@@ -21,6 +20,7 @@ from beatlite.metrics.beats import (
     mean_angle_change,
     nearest_distance,
 )
+from beatlite.metrics.consistency import BCVariant
 
 SR = 16000
 FPS = 15.0
@@ -279,8 +279,8 @@ def test_bc_clip_protocol_runs_and_stays_high_when_aligned():
 
 
 def test_bc_default_pairs_come_from_the_ted_skeleton():
-    from beatlite.metrics.beat_consistency import default_angle_pairs
     from beatlite.metrics.beats import included_angles
+    from beatlite.metrics.consistency import default_angle_pairs
     from beatlite.skeleton import ted
 
     pairs = default_angle_pairs()
@@ -327,7 +327,7 @@ def ear_swinging_skeleton(theta: np.ndarray, seed: int = 0) -> np.ndarray:
 def test_angle_change_curve_with_ha2g_constants_hand_computed():
     # only pair 37 moves: theta/pi = .25, .30, .30, .20 -> |diffs| .05, 0, .10, divided by its
     # MAAC and averaged over HA2G's 41 pairs (none is rigid: smallest / largest MAAC = 0.02)
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
     d = prepare_directions(ear_swinging_skeleton(np.array([0.25, 0.30, 0.30, 0.20])))
     ca = HA2G_CHANGE_ANGLE[EAR_PAIR]
@@ -341,7 +341,7 @@ def _ha2g_bc_formula(audio, dirs, change_angle, sigma=0.1, length=34, stride=10)
     """HA2G's BC written out (HA2G supplementary / code protocol): 34-frame clips, librosa onsets."""
     import librosa
 
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
     v = prepare_directions(dirs)
     total = weight = 0.0

@@ -78,7 +78,7 @@ def test_beat_align_ground_truth_beats_shuffled(takes):
 def test_beat_consistency_ground_truth_beats_shuffled(takes):
     audio = [t.audio for t in takes]
     dirs = [ted_directions(t) for t in takes]
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
     maac = mean_angle_change([prepare_directions(d) for d in dirs], default_angle_pairs())
     gt = beat_consistency(audio, takes[0].sr, dirs, takes[0].fps, change_angle=maac)
@@ -97,7 +97,7 @@ def test_beat_consistency_ground_truth_beats_shuffled(takes):
 def test_beat_consistency_ground_truth_is_stable_under_round_off(takes):
     # Two of HA2G's pairs (nose->eye vs eye->ear) are rigid on BEAT's skeleton (MAAC ~ 1e-16);
     # without drop_rigid_pairs, 1e-9 noise moved the evaluation's GT BC from 0.7325 to 0.7383.
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
     audio = [t.audio for t in takes]
     dirs = [ted_directions(t) for t in takes]

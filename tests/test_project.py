@@ -132,3 +132,20 @@ def test_notebook_imports_are_declared(path):
         if not owners & declared:
             missing.append(f"{mod} (from {sorted(owners)})")
     assert not missing, f"{path.name} imports undeclared packages: {missing}"
+
+
+def test_no_module_is_shadowed_by_a_function_of_its_name():
+    """``beatlite.metrics.srgr`` is the function, and no submodule of that name hides behind it."""
+    import importlib
+    import pkgutil
+    import types
+
+    shadowed = []
+    for pkg in ("io", "skeleton", "data", "stats", "metrics", "models", "train", "viz", "synth"):
+        package = importlib.import_module(f"beatlite.{pkg}")
+        for sub in pkgutil.iter_modules(package.__path__):
+            if sub.name in getattr(package, "__all__", ()):
+                value = getattr(package, sub.name)
+                if not isinstance(value, types.ModuleType):
+                    shadowed.append(f"beatlite.{pkg}.{sub.name}")
+    assert not shadowed, shadowed

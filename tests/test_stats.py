@@ -9,6 +9,7 @@ import pytest
 
 from beatlite.data.index import TakeIndex, TakeRecord
 from beatlite.stats.corpus import CorpusTake, frame_rms, joint_speed
+from beatlite.stats.corpus_table import PAPER_TABLE1
 from beatlite.stats.correlations import (
     correlation_test,
     gesture_correlations,
@@ -27,7 +28,6 @@ from beatlite.stats.distributions import (
 from beatlite.stats.emotion_classifier import PAPER_TABLE6, EmotionClassifier, plot_table6, table6_markdown
 from beatlite.stats.emotion_clusters import plot_emotion_tsne, rotation_windows, separability, window_features
 from beatlite.stats.semantic import plot_figure4, score_histogram, speaker_scores, word_scores
-from beatlite.stats.table1 import PAPER_TABLE1
 
 
 def make_take(

@@ -18,14 +18,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from beatlite.metrics.beat_align import beat_align
-from beatlite.metrics.beat_consistency import beat_consistency
+from beatlite.metrics.alignment import beat_align
 from beatlite.metrics.beats import audio_beats, gaussian_alignment, mean_angle_change
-from beatlite.metrics.diversity import diversity, l1_diversity
+from beatlite.metrics.consistency import beat_consistency
 from beatlite.metrics.extras import jerk_stats, mae, mpjpe, pck, velocity_stats
-from beatlite.metrics.fgd import fgd, fit_gaussian, frechet_distance
+from beatlite.metrics.frechet import fgd, fit_gaussian, frechet_distance
+from beatlite.metrics.recall import srgr
 from beatlite.metrics.scoring import METRICS, Evaluation, GroundTruth, MetricResult, Takes, evaluate
-from beatlite.metrics.srgr import srgr
+from beatlite.metrics.variation import diversity, l1_diversity
 
 __all__ = [
     "METRICS",

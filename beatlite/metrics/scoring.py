@@ -228,37 +228,37 @@ def _check_pairing(gen: Takes, truth: GroundTruth) -> None:
 
 # --------------------------------------------------------------------------- the metrics
 def _fgd(reference: bool) -> Callable[[Takes, GroundTruth, int], float]:
-    from beatlite.metrics.fgd import fgd
+    from beatlite.metrics.frechet import fgd
 
     return lambda g, t, seed: fgd(g.features, t.takes.features, reference=reference)
 
 
 def _srgr_paper(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.srgr import srgr
+    from beatlite.metrics.recall import srgr
 
     return srgr(g.positions, t.takes.positions, t.semantic, variant="paper", delta=10.0)
 
 
 def _srgr_reference(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.srgr import srgr
+    from beatlite.metrics.recall import srgr
 
     return srgr(g.euler, t.takes.euler, t.semantic, variant="reference")
 
 
 def _beat_align(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.beat_align import beat_align
+    from beatlite.metrics.alignment import beat_align
 
     return beat_align(None, t.sr, g.positions, t.fps, audio_beats=t.beats())
 
 
 def _beat_align_reference(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.beat_align import beat_align
+    from beatlite.metrics.alignment import beat_align
 
     return beat_align(t.audio, t.sr, g.euler, t.fps, variant="reference")
 
 
 def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
-    from beatlite.metrics.beat_consistency import beat_consistency
+    from beatlite.metrics.consistency import beat_consistency
 
     def compute(g: Takes, t: GroundTruth, seed: int) -> float:
         if variant == "beatlite":
@@ -273,13 +273,13 @@ def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
 
 
 def _diversity(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.diversity import diversity
+    from beatlite.metrics.variation import diversity
 
     return diversity(g.features, n_pairs=500, seed=seed)
 
 
 def _l1div(windowed: bool) -> Callable[[Takes, GroundTruth, int], float]:
-    from beatlite.metrics.diversity import l1_diversity
+    from beatlite.metrics.variation import l1_diversity
 
     if windowed:
         return lambda g, t, seed: l1_diversity(g.euler, windowed=True)

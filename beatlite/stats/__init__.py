@@ -16,6 +16,7 @@ Taught in notebooks/02_dataset_statistics.ipynb (dataset statistics), sections 1
 from __future__ import annotations
 
 from beatlite.stats.corpus import CorpusTake, load_corpus
+from beatlite.stats.corpus_table import PAPER_TABLE1, corpus_row, table1, table1_markdown
 from beatlite.stats.correlations import gesture_correlations, plot_correlations, speed_by_emotion
 from beatlite.stats.distributions import emotion_shares, language_shares, plot_figure2, speaker_durations
 from beatlite.stats.emotion_classifier import (
@@ -27,7 +28,6 @@ from beatlite.stats.emotion_classifier import (
 )
 from beatlite.stats.emotion_clusters import emotion_separability, plot_emotion_tsne, rotation_windows
 from beatlite.stats.semantic import plot_figure4, score_histogram, speaker_scores, word_scores
-from beatlite.stats.table1 import PAPER_TABLE1, corpus_row, table1, table1_markdown
 
 __all__ = [
     "PAPER_TABLE1",

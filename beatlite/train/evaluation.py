@@ -342,8 +342,8 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
 
 def train_change_angle(train: Any) -> np.ndarray:
     """(41,) MAAC per HA2G angle pair over the train windows (beat consistency's normaliser, HA2G eq. 10)."""
-    from beatlite.metrics.beat_consistency import default_angle_pairs, prepare_directions
     from beatlite.metrics.beats import mean_angle_change
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
     # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
     dirs = train.normalizers.dirvec.inverse_transform(np.asarray(train["dirvec"], np.float64))

@@ -130,7 +130,7 @@ def frechet_distance(
     ``||mu1 - mu2||^2 + sum_d (sqrt(a_d) - sqrt(b_d))^2 = 25 + 2 * (1 - 2)^2 = 27``.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.fgd import frechet_distance
+    >>> from beatlite.metrics.frechet import frechet_distance
     >>> round(frechet_distance(np.zeros(2), np.eye(2), np.array([3.0, 4.0]), 4 * np.eye(2)), 6)
     27.0
     >>> round(frechet_distance(np.zeros(2), np.eye(2), np.zeros(2), np.eye(2)), 6)
@@ -210,7 +210,7 @@ def fgd(
     scales the covariance by 4 (FGD = 2 * (sqrt(8/3) - sqrt(2/3))^2 = 4/3).
 
     >>> import numpy as np
-    >>> from beatlite.metrics.fgd import fgd
+    >>> from beatlite.metrics.frechet import fgd
     >>> real = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0], [0.0, 1.0]])
     >>> round(fgd(real + [2.0, 0.0], real), 6)
     4.0

@@ -189,7 +189,7 @@ def beat_consistency(
 
     Examples
     --------
-    Clicks every 0.8 s as in :func:`beatlite.metrics.beat_align.beat_align`'s example
+    Clicks every 0.8 s as in :func:`beatlite.metrics.alignment.beat_align`'s example
     (librosa reports each one 0.032 s late), and 42 bone directions turning about the
     vertical axis, each at its own rate, by an angle ``phi`` that reverses between frames
     11 and 12, 23 and 24, ... Every included angle stops changing there, so the motion
@@ -197,7 +197,7 @@ def beat_consistency(
     ``BC = exp(-0.032^2 / (2 * 0.1^2)) = 0.9501``.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.beat_consistency import beat_consistency
+    >>> from beatlite.metrics.consistency import beat_consistency
     >>> sr, fps = 16000, 15
     >>> audio = np.zeros(4 * sr, dtype=np.float32)
     >>> audio[[12800, 25600, 38400, 51200]] = 1.0

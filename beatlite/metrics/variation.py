@@ -15,7 +15,7 @@ import numpy as np
 from beatlite.constants import WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.data.windows import sliding_windows
 from beatlite.metrics._checks import as_array, as_list
-from beatlite.metrics.fgd import Extractor
+from beatlite.metrics.frechet import Extractor
 
 
 def l1_diversity(
@@ -54,7 +54,7 @@ def l1_diversity(
     frames pools frame-weighted: ``(8 + 0) / 6``.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.diversity import l1_diversity
+    >>> from beatlite.metrics.variation import l1_diversity
     >>> take = np.array([[0.0, 10.0], [2.0, 10.0], [4.0, 10.0], [6.0, 10.0]])  # (T, D) degrees
     >>> l1_diversity(take)
     2.0
@@ -117,7 +117,7 @@ def diversity(
     same pair.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.diversity import diversity
+    >>> from beatlite.metrics.variation import diversity
     >>> features = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]])  # (N, F)
     >>> diversity(features)
     2.0

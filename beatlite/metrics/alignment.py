@@ -158,7 +158,7 @@ def beat_align(
     ``BeatAlign = exp(-0.032^2 / (2 * 0.3^2)) = 0.9943``.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.beat_align import beat_align
+    >>> from beatlite.metrics.alignment import beat_align
     >>> sr, fps = 16000, 15
     >>> audio = np.zeros(4 * sr, dtype=np.float32)
     >>> audio[[12800, 25600, 38400, 51200]] = 1.0

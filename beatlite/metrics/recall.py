@@ -78,7 +78,7 @@ def srgr(
     semantically relevant (score 1): ``SRGR = (1 + 1 + 0 + 0) / 4 * 1/2 = 0.25``.
 
     >>> import numpy as np
-    >>> from beatlite.metrics.srgr import srgr
+    >>> from beatlite.metrics.recall import srgr
     >>> truth = np.zeros((4, 2, 3))
     >>> generated = truth.copy()
     >>> generated[:, 1, 0] = 20.0
