@@ -314,7 +314,7 @@ def _metrics() -> dict[str, Metric]:
                                         "BEAT's code: Euler speed of columns 36:39, 10-500 s, RMS backtrack, "
                                         "times at 22050 Hz"),
         "BC": Metric("BC", "beatlite", True, ("directions", "beats", "change_angle"), _bc("beatlite"),
-                     "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows"),
+                     "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows, rigid angle pairs left out"),
         "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),
                             "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s"),
         "Diversity": Metric("Diversity", "ha2g", True, ("features",), _diversity,

@@ -202,15 +202,18 @@ class SeedResults:
     def to_markdown(self) -> str:
         """A Markdown table of ``mean ± sd`` over seeds for every metric of :data:`COLUMNS`."""
         from beatlite.report import markdown_table
-        from beatlite.train.evaluation import COLUMNS, column_headers
+        from beatlite.train.evaluation import COLUMNS, GROUND_TRUTH, GROUND_TRUTH_141, column_headers
+        from beatlite.train.recipes import RECIPES
 
+        order = [GROUND_TRUTH, GROUND_TRUTH_141, *(r.label for r in RECIPES.values())]
+        labels = sorted(self.values, key=lambda r: order.index(r) if r in order else len(order))
         rows = [
             [
                 row,
-                *[self.cell(row, key) if key in metrics else "" for key in COLUMNS],
-                self.count(row, next(iter(metrics))),
+                *[self.cell(row, key) if key in self.values[row] else "" for key in COLUMNS],
+                self.count(row, "FGD" if "FGD" in self.values[row] else next(iter(self.values[row]))),
             ]
-            for row, metrics in self.values.items()
+            for row in labels
         ]
         return markdown_table(["method", *column_headers(COLUMNS), "seeds"], rows)
 
