@@ -100,7 +100,8 @@ def test_problem_takes_are_flagged_not_crashing(corpus: Path) -> None:
     assert any(p.startswith("unreadable motion file") for p in no_header.problems) and not no_header.usable
     broken = idx["2_scott_0_13_13"]
     assert any(p.startswith("unreadable face file 2_scott_0_13_13.json") for p in broken.problems)
-    assert "face" not in broken.durations and broken.usable  # face is optional for training
+    # face is optional, but a face file that is present and broken makes load_take raise: not usable
+    assert "face" not in broken.durations and not broken.usable
     # bad-name takes sort last
     assert idx.stems[-1] == "hello_world"
 
@@ -166,13 +167,21 @@ def test_rows_and_markdown(corpus: Path) -> None:
         idx.to_markdown(["nope"])
 
 
-def test_wrong_frame_time_shows_as_disagreement(tmp_path: Path) -> None:
-    # a BEAT quirk (facts A.3): 120-fps data with 'Frame Time: 0.041667' -> 5x too long
+def test_wrong_frame_time_is_reconciled_with_the_audio(tmp_path: Path) -> None:
+    # a BEAT quirk (facts A.3): 120-fps rows under 'Frame Time: 0.041667' (24 fps) -> the header says 10 s,
+    # the audio 2 s; 24 * 5 = 120 fps is the one clean factor that makes 240 rows last 2 s
     write_tiny_bvh(tmp_path / "2_scott_0_9_9.bvh", 120 * 2, frame_time=0.041667)
     write_wav(tmp_path / "2_scott_0_9_9.wav", np.zeros(2 * 16000, np.float32))
     r = index_folder(tmp_path)["2_scott_0_9_9"]
-    assert r.durations["motion"] == pytest.approx(240 * 0.041667)
-    assert any("durations disagree" in p for p in r.problems)
+    assert r.durations["motion"] == pytest.approx(2.0) and r.bvh_fps == 120.0
+    assert not any("durations disagree" in p for p in r.problems) and r.usable
+    assert any(p.startswith("warning:") and "120 fps" in p and "bvh_fps=" in p for p in r.problems)
+    # an explicit override wins: at 24 fps the take is 10 s long and disagrees with its audio
+    r24 = index_folder(tmp_path, bvh_fps={"2_scott_0_9_9": 24})["2_scott_0_9_9"]
+    assert r24.durations["motion"] == pytest.approx(10.0) and r24.bvh_fps == 24.0
+    assert any("durations disagree" in p for p in r24.problems) and not r24.usable
+    with pytest.raises(ValueError, match="2_scott_0_99_99"):
+        index_folder(tmp_path, bvh_fps={"2_scott_0_99_99": 24})
 
 
 def test_not_a_folder(tmp_path: Path) -> None:

@@ -60,8 +60,8 @@ _CHANNEL_LOOKUP = {c.lower(): c for c in CHANNEL_NAMES}
 _FRAMES_RE = re.compile(r"^\s*Frames\s*:\s*(\S+)\s*$", re.IGNORECASE)
 _FRAME_TIME_RE = re.compile(r"^\s*Frame\s+Time\s*:\s*(\S+)\s*$", re.IGNORECASE)
 _MAX_HEADER_LINES = 200_000
-#: Accepted ``Frame Time`` range in seconds (1 MHz .. one frame per 1000 s).
-FRAME_TIME_RANGE = (1e-6, 1e3)
+#: Accepted ``Frame Time`` range in seconds (100 kHz .. 1 fps; resampling to 15 fps stays bounded).
+FRAME_TIME_RANGE = (1e-5, 1.0)
 #: Largest integer factor between ``Frames`` and the row count that :func:`infer_row_rate` accepts.
 MAX_RATE_FACTOR = 16
 #: ``units=`` values of :func:`read_bvh` and their factor to centimetres.
@@ -563,7 +563,8 @@ def infer_row_rate(n_declared: int, header_fps: float, n_rows: int) -> float | N
     k = round(big / small)
     if not 2 <= k <= MAX_RATE_FACTOR or abs(big - k * small) > 0.01 * big:
         return None
-    return header_fps / k if n_declared > n_rows else header_fps * k
+    rate = header_fps / k if n_declared > n_rows else header_fps * k
+    return rate if rate >= 1.0 else None
 
 
 def _settle_rate(p: Path, n_declared: int, header_fps: float, n_rows: int, override: bool) -> float:

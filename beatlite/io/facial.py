@@ -50,7 +50,7 @@ ARKIT_51: tuple[str, ...] = tuple(n for n in ARKIT_52 if n != "tongueOut")
 
 DEFAULT_FPS = 60.0
 #: Frame rates the time stamps may imply (Hz).
-FPS_RANGE = (1e-3, 1e6)
+FPS_RANGE = (1.0, 1000.0)
 
 
 @dataclass(eq=False)
