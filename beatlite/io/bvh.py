@@ -567,26 +567,33 @@ def infer_row_rate(n_declared: int, header_fps: float, n_rows: int) -> float | N
     return rate if rate >= 1.0 else None
 
 
-def _settle_rate(p: Path, n_declared: int, header_fps: float, n_rows: int, override: bool) -> float:
-    """The rate to read the rows at, with the one warning that names both readings and the override."""
-    if n_rows == n_declared:
-        return header_fps
+def _settle_rate(
+    p: Path, n_declared: int, file_fps: float | None, n_rows: int, override: float | None
+) -> float:
+    """The rate to read the rows at, with the one warning that names both readings and the override.
+
+    ``file_fps`` is the ``Frame Time`` rate (None when unreadable, then ``override`` is set).
+    An override equal to the inferred rate is silent: the mismatch was already resolved.
+    """
+    inferred = None if file_fps is None else infer_row_rate(n_declared, file_fps, n_rows)
+    if n_rows == n_declared or (override is not None and override == inferred):
+        return float(override if override is not None else file_fps)  # type: ignore[arg-type]
     message = f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows"
-    inferred = None if override else infer_row_rate(n_declared, header_fps, n_rows)
-    if inferred is None:
+    if override is not None or inferred is None or file_fps is None:
+        rate = float(override if override is not None else file_fps)  # type: ignore[arg-type]
         hint = (
             ""
-            if override
+            if override is not None
             else " (pass fps= to read_bvh, bvh_fps= to load_take/index_folder if the rate is wrong)"
         )
         warnings.warn(
-            f"{p}: {message}; using the {n_rows} rows at {header_fps:g} fps{hint}", BVHWarning, stacklevel=3
+            f"{p}: {message}; using the {n_rows} rows at {rate:g} fps{hint}", BVHWarning, stacklevel=3
         )
-        return header_fps
+        return rate
     warnings.warn(
-        f"{p}: {message}: the header says {n_declared / header_fps:.2f} s at {header_fps:g} fps, so the rows "
-        f"are read at {inferred:g} fps ({n_rows / inferred:.2f} s), not at the header's {header_fps:g} fps "
-        f"({n_rows / header_fps:.2f} s); pass fps={header_fps:g} to read_bvh (bvh_fps= to load_take/"
+        f"{p}: {message}: the header says {n_declared / file_fps:.2f} s at {file_fps:g} fps, so the rows "
+        f"are read at {inferred:g} fps ({n_rows / inferred:.2f} s), not at the header's {file_fps:g} fps "
+        f"({n_rows / file_fps:.2f} s); pass fps={file_fps:g} to read_bvh (bvh_fps= to load_take/"
         "index_folder) to keep the header rate",
         BVHWarning,
         stacklevel=3,
@@ -681,14 +688,16 @@ def read_bvh(
             raise FormatError(p, f"cannot decompress gzip data: {exc}") from None
     factor = _check_units(p, skeleton, units)
     try:
-        header_fps = fps if fps is not None else parse_frame_time(time_text)
+        file_fps: float | None = parse_frame_time(time_text)
     except ValueError as exc:
-        raise FormatError(p, f"{exc} (pass fps= to override)", line=time_line) from None
+        if fps is None:
+            raise FormatError(p, f"{exc} (pass fps= to override)", line=time_line) from None
+        file_fps = None
     channels = _parse_motion(data, skeleton.n_channels, n_header + 1, p)
     n_rows = channels.shape[0]
     if strict and n_rows != n_declared:
         raise FormatError(p, f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows", field="Frames")
-    rate = _settle_rate(p, n_declared, header_fps, n_rows, override=fps is not None)
+    rate = _settle_rate(p, n_declared, file_fps, n_rows, fps)
     skeleton, channels = convert_units(skeleton, channels, factor)
     return Motion(skeleton=skeleton, channels=channels, fps=rate)
 
