@@ -623,8 +623,6 @@ def convert_units(skeleton: Skeleton, channels: np.ndarray, factor: float) -> tu
 
 def _check_units(p: Path, skeleton: Skeleton, units: str) -> float:
     """Factor to centimetres for ``units``; ``"auto"`` warns when the skeleton looks like metres."""
-    if units not in UNITS:
-        raise ValueError(f"read_bvh: units must be one of {sorted(UNITS)}, got {units!r}")
     if units == "auto":
         from beatlite.skeleton.kinematics import skeleton_extent
 
@@ -675,6 +673,8 @@ def read_bvh(
         bad number).
     """
     p = Path(path)
+    if units not in UNITS:
+        raise ValueError(f"read_bvh: units must be one of {sorted(UNITS)}, got {units!r}")
     if fps is not None:
         fps = float(fps)
         if not math.isfinite(fps) or fps <= 0:
