@@ -9,6 +9,7 @@ from __future__ import annotations
 import gzip
 import io
 import os
+import zlib
 from pathlib import Path
 from typing import IO
 
@@ -24,15 +25,45 @@ def is_gzip(path: str | os.PathLike[str]) -> bool:
         return f.read(2) == GZIP_MAGIC
 
 
+#: What a corrupt or truncated gzip stream raises while it is read.
+GZIP_ERRORS = (gzip.BadGzipFile, EOFError, zlib.error)
+
+
+class _CheckedGzip(gzip.GzipFile):
+    """A gzip stream whose corrupt or truncated data raises :class:`FormatError` naming the file."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(filename=path, mode="rb")
+        self.path = path
+
+    def _checked(self, method: str, *args: int) -> bytes:
+        try:
+            return getattr(super(), method)(*args)
+        except GZIP_ERRORS as exc:
+            raise FormatError(self.path, f"cannot decompress gzip data: {exc}") from None
+
+    def read(self, size: int = -1) -> bytes:
+        return self._checked("read", size)
+
+    def read1(self, size: int = -1) -> bytes:
+        return self._checked("read1", size)
+
+    def readline(self, size: int = -1) -> bytes:
+        return self._checked("readline", size)
+
+    def peek(self, n: int) -> bytes:
+        return self._checked("peek", n)
+
+
 def open_binary(path: str | os.PathLike[str]) -> IO[bytes]:
     """Open ``path`` for binary reading, decompressing gzip transparently.
 
     Gzip is recognised by its magic bytes, so a ``.gz`` file and a gzipped
-    file without the suffix both work.
+    file without the suffix both work. Corrupt gzip data raises :class:`FormatError`.
     """
     p = Path(path)
     if is_gzip(p):
-        return gzip.open(p, "rb")
+        return _CheckedGzip(p)
     return open(p, "rb")
 
 
@@ -42,7 +73,7 @@ def read_bytes(path: str | os.PathLike[str]) -> bytes:
     with open_binary(p) as f:
         try:
             return f.read()
-        except (OSError, EOFError) as exc:  # corrupt or truncated gzip stream
+        except (OSError, *GZIP_ERRORS) as exc:  # corrupt or truncated gzip stream
             raise FormatError(p, f"cannot decompress gzip data: {exc}") from None
 
 
