@@ -123,9 +123,9 @@ MUTATIONS: list[Callable[[bytes, np.random.Generator], bytes]] = [
 ]
 
 
-def mutate(data: bytes, rng: np.random.Generator) -> bytes:
-    """1-3 random mutations of ``data`` (deterministic for a generator state)."""
-    for _ in range(int(rng.integers(1, 4))):
+def mutate(data: bytes, rng: np.random.Generator, max_ops: int = 3) -> bytes:
+    """1 to ``max_ops`` random mutations of ``data`` (deterministic for a generator state)."""
+    for _ in range(int(rng.integers(1, max_ops + 1))):
         data = MUTATIONS[int(rng.integers(len(MUTATIONS)))](data, rng)
     return data
 
