@@ -27,7 +27,6 @@ raises for them.
 from __future__ import annotations
 
 import io
-import json
 import os
 import re
 import warnings
@@ -163,7 +162,7 @@ class TakeRecord:
             raise KeyError(f"take {self.stem!r} has no {modality} file (has {sorted(self.files)})") from None
 
     def to_row(self) -> dict[str, Any]:
-        """Flat dict of the record (one table row): fields, ``dur_<modality>``, ``has_<modality>``."""
+        """Flat dict of the record (one table row): fields, ``dur_<modality>``, ``has_<modality>``, ``bvh_fps``."""
         row: dict[str, Any] = {
             "stem": self.stem,
             "speaker_id": self.speaker_id,
@@ -181,6 +180,7 @@ class TakeRecord:
         for modality in TIMED:
             value = self.durations.get(modality)
             row[f"dur_{modality}"] = None if value is None else round(value, 3)
+        row["bvh_fps"] = self.bvh_fps
         row["problems"] = "; ".join(self.problems)
         return row
 
@@ -373,32 +373,14 @@ def wav_duration(path: str | Path) -> float:
 
 
 def face_duration(path: str | Path) -> float:
-    """Duration of a BEAT facial JSON: number of frames / fps, seconds.
+    """Duration of a BEAT facial JSON as :func:`beatlite.io.read_facial` reads it: frames / fps, seconds.
 
     The fps comes from the median spacing of the frames' ``time`` values (60 in BEAT).
     """
-    from beatlite.io.errors import FormatError
+    from beatlite.io import read_facial
 
-    path = Path(path)
-    with _open_text(path) as f:
-        try:
-            data = json.load(f)
-        except json.JSONDecodeError as e:
-            raise FormatError(path, f"invalid JSON: {e.msg}", line=e.lineno, column=e.colno) from None
-    frames = data.get("frames") if isinstance(data, dict) else None
-    if not isinstance(frames, list):
-        raise FormatError(path, "no 'frames' list", field="frames")
-    if len(frames) < 2:
-        return len(frames) / 60.0
-    try:
-        times = sorted(float(fr["time"]) for fr in frames)
-    except (KeyError, TypeError, ValueError):
-        raise FormatError(path, "a frame has no numeric 'time'", field="frames[].time") from None
-    gaps = sorted(b - a for a, b in zip(times[:-1], times[1:]))
-    dt = gaps[len(gaps) // 2]
-    if dt <= 0:
-        raise FormatError(path, "frame times do not increase", field="frames[].time")
-    return len(frames) * dt
+    facial = read_facial(path)
+    return facial.n_frames / facial.fps
 
 
 _XMAX = re.compile(r"^\s*xmax\s*=\s*([-+0-9.eE]+)")
