@@ -533,8 +533,13 @@ def _check_files(record: TakeRecord, bvh_fps: float | None) -> None:
                     record.durations[modality] = float(seconds)
             except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
                 record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
+    from beatlite.io.errors import AlignmentWarning, FormatWarning
+
     for w in caught:
-        record.problems.append(f"warning: {w.message}")
+        if issubclass(w.category, (FormatWarning, AlignmentWarning)):
+            record.problems.append(f"warning: {w.message}")
+        else:  # not about the files (e.g. a library's deprecation): pass it on
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def index_take(
