@@ -15,6 +15,7 @@ import contextlib
 import gzip
 import re
 import signal
+import threading
 import tracemalloc
 import warnings
 import zlib
@@ -193,8 +194,8 @@ class Hang(Exception):
 
 @contextlib.contextmanager
 def hang_guard(seconds: float) -> Iterator[None]:
-    """Raise :class:`Hang` in the main thread after ``seconds`` of wall time (POSIX; else no guard)."""
-    if not hasattr(signal, "setitimer"):
+    """Raise :class:`Hang` after ``seconds`` of wall time (POSIX main thread; elsewhere no guard)."""
+    if not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
         yield
         return
 
