@@ -65,7 +65,9 @@ def write_wav(path: Path, y: np.ndarray, sr: int = SR) -> None:
 
 def write_face_json(path: Path, weights: np.ndarray, fps: float = 60.0) -> None:
     """BEAT facial JSON: {"names": [...51], "frames": [{"time": t, "weights": [...]}, ...]}."""
-    names = [f"bs{k:02d}" for k in range(weights.shape[1])]
+    from beatlite.io import ARKIT_51  # load_take picks BEAT's 51 blendshapes by name
+
+    names = list(ARKIT_51) if weights.shape[1] == 51 else [f"bs{k:02d}" for k in range(weights.shape[1])]
     frames = [
         {"time": round(i / fps, 6), "weights": [float(v) for v in row]} for i, row in enumerate(weights)
     ]

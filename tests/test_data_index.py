@@ -100,7 +100,8 @@ def test_problem_takes_are_flagged_not_crashing(corpus: Path) -> None:
     assert any(p.startswith("unreadable motion file") for p in no_header.problems) and not no_header.usable
     broken = idx["2_scott_0_13_13"]
     assert any(p.startswith("unreadable face file 2_scott_0_13_13.json") for p in broken.problems)
-    assert "face" not in broken.durations and broken.usable  # face is optional for training
+    # face is optional, but a face file that is present and broken makes load_take raise: not usable
+    assert "face" not in broken.durations and not broken.usable
     # bad-name takes sort last
     assert idx.stems[-1] == "hello_world"
 
@@ -166,13 +167,21 @@ def test_rows_and_markdown(corpus: Path) -> None:
         idx.to_markdown(["nope"])
 
 
-def test_wrong_frame_time_shows_as_disagreement(tmp_path: Path) -> None:
-    # a BEAT quirk (docs/reference_code.md#bvh-header): 120-fps data with 'Frame Time: 0.041667' -> 5x too long
+def test_wrong_frame_time_is_reconciled_with_the_audio(tmp_path: Path) -> None:
+    # a BEAT quirk (docs/reference_code.md#bvh-header): 120-fps rows under 'Frame Time: 0.041667' (24 fps) -> the header says 10 s,
+    # the audio 2 s; 24 * 5 = 120 fps is the one clean factor that makes 240 rows last 2 s
     write_tiny_bvh(tmp_path / "2_scott_0_9_9.bvh", 120 * 2, frame_time=0.041667)
     write_wav(tmp_path / "2_scott_0_9_9.wav", np.zeros(2 * 16000, np.float32))
     r = index_folder(tmp_path)["2_scott_0_9_9"]
-    assert r.durations["motion"] == pytest.approx(240 * 0.041667)
-    assert any("durations disagree" in p for p in r.problems)
+    assert r.durations["motion"] == pytest.approx(2.0) and r.bvh_fps == 120.0
+    assert not any("durations disagree" in p for p in r.problems) and r.usable
+    assert any(p.startswith("warning:") and "120 fps" in p and "bvh_fps=" in p for p in r.problems)
+    # an explicit override wins: at 24 fps the take is 10 s long and disagrees with its audio
+    r24 = index_folder(tmp_path, bvh_fps={"2_scott_0_9_9": 24})["2_scott_0_9_9"]
+    assert r24.durations["motion"] == pytest.approx(10.0) and r24.bvh_fps == 24.0
+    assert any("durations disagree" in p for p in r24.problems) and not r24.usable
+    with pytest.raises(ValueError, match="2_scott_0_99_99"):
+        index_folder(tmp_path, bvh_fps={"2_scott_0_99_99": 24})
 
 
 def test_not_a_folder(tmp_path: Path) -> None:
@@ -199,3 +208,84 @@ def test_real_beat_files(real_samples: Path) -> None:
     assert others["beat_skeleton_2_scott_0_1_1_frame0"].durations["motion"] == pytest.approx(
         1 / 120, rel=1e-3
     )
+
+
+# ----------------------------------------------------------------------------- an honest index (issue 14)
+
+
+def test_gzip_is_sniffed_from_bytes_as_the_readers_do(tmp_path: Path) -> None:
+    from beatlite.io import load_take
+
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
+    tg = tmp_path / "2_scott_0_9_9.TextGrid"
+    tg.write_bytes(gzip.compress(tg.read_bytes()))  # gzipped content without the .gz suffix
+    face = tmp_path / "2_scott_0_9_9.json"
+    face.rename(tmp_path / "2_scott_0_9_9.json.gz")  # a .gz name over plain JSON
+    r = index_folder(tmp_path)["2_scott_0_9_9"]
+    assert r.ok and r.usable and r.durations["text"] == 3.0 and r.durations["face"] == pytest.approx(3.0)
+    take = load_take(r.path("motion"))
+    assert take.words is not None and take.face is not None and take.n_frames == 45
+
+
+@pytest.mark.parametrize(
+    ("ext", "content", "words"),
+    [
+        ("wav", b"ID3\x04\x00\x00\x00\x00\x00\x00" + bytes(200), "MP3 audio"),
+        ("txt", "01_beat\t0.0\t1.0\t1.0\t2.5\n", "score 2.5 is outside"),
+        ("csv", "", "no emotion rows"),
+        (
+            "TextGrid",
+            'File type = "ooTextFile"\nObject class = "TextGrid"\n0\n2\n<exists>\n1\n',
+            "more than the file holds",
+        ),
+    ],
+)
+def test_broken_bodies_make_a_take_unusable(
+    tmp_path: Path, ext: str, content: str | bytes, words: str
+) -> None:
+    from beatlite.io import FormatError, load_take
+
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
+    p = tmp_path / f"2_scott_0_9_9.{ext}"
+    p.write_bytes(content if isinstance(content, bytes) else content.encode("utf-8"))
+    r = index_folder(tmp_path)["2_scott_0_9_9"]
+    assert not r.usable and any(x.startswith("unreadable") and words in x for x in r.problems)
+    with pytest.raises(FormatError, match=words):
+        load_take(r.path("motion"))  # the index said what loading says
+
+
+def _mutated_corpus(root: Path, n: int, rng: np.random.Generator) -> None:
+    from test_io_fuzz import mutate
+
+    stems = [
+        f"{s}_{name}_0_{q}_{q}"
+        for s, name in ((2, "scott"), (4, "lawrence"), (6, "carla"))
+        for q in range(1, 119)
+    ]
+    for stem in stems[:n]:
+        folder = root / stem.split("_")[0]
+        make_tiny_take(folder, stem, float(rng.choice([2.0, 3.0, 4.0])))
+        victim = sorted(folder.glob(f"{stem}.*"))[int(rng.integers(6))]
+        victim.write_bytes(mutate(victim.read_bytes(), rng, max_ops=1))
+
+
+def test_usable_means_load_take_succeeds(tmp_path: Path) -> None:
+    """Property test over 240 takes with one mutated file each: every take the index calls usable loads."""
+    import warnings
+
+    from beatlite.io import load_take
+
+    _mutated_corpus(tmp_path, 240, np.random.default_rng(14))
+    idx = index_folder(tmp_path)
+    assert len(idx) == 240
+    usable = [r for r in idx if r.usable]
+    for r in usable:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                take = load_take(r.path("motion"), bvh_fps=r.bvh_fps)
+            except Exception as exc:  # noqa: BLE001 - any failure disproves the property
+                pytest.fail(f"{r.stem} is usable but load_take raised {type(exc).__name__}: {exc}")
+        assert abs(take.duration - r.duration) <= 1 / 15 + 1e-9, r.stem  # and it lasts what the index says
+    # the mutations leave some takes usable and break others (so the property is exercised both ways)
+    assert 40 <= len(usable) <= 200, len(usable)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from beatlite.io import ARKIT_51, ARKIT_52, FormatError, read_facial, write_facial
+from beatlite.io import ARKIT_51, ARKIT_52, FormatError, FormatWarning, load_take, read_facial, write_facial
 from beatlite.io.facial import estimate_fps
 
 
@@ -94,3 +94,55 @@ def test_write_validates(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"\(T, 2\)"):
         write_facial(tmp_path / "x.json", ["a", "b"], np.zeros((3, 3)))
     assert not (tmp_path / "x.json").exists()
+
+
+# ----------------------------------------------------------------------------- blendshapes by name
+
+
+def _weights(n_frames: int, names: tuple[str, ...]) -> np.ndarray:
+    """Weight of blendshape ``name`` in frame t: (index of name in ARKIT_52 + 1) / 100 + t / 1000."""
+    col = np.array([ARKIT_52.index(n) + 1 for n in names]) / 100
+    return np.round(col[None, :] + np.arange(n_frames)[:, None] / 1000, 6)
+
+
+def test_52_names_with_tongue_out_are_mapped_to_51(tmp_path: Path) -> None:
+    write_facial(tmp_path / "f.json", ARKIT_52, _weights(5, ARKIT_52))
+    assert read_facial(tmp_path / "f.json").weights.shape == (5, 52)  # as in the file by default
+    with pytest.warns(FormatWarning, match=r"dropping 1 blendshapes .*tongueOut") as record:
+        face = read_facial(tmp_path / "f.json", names=ARKIT_51)
+    assert len(record) == 1  # one warning: ARKit's order without tongueOut is BEAT's order
+    assert face.names == ARKIT_51 and face.weights.shape == (5, 51)
+    np.testing.assert_allclose(face.weights, _weights(5, ARKIT_51), rtol=1e-6)
+
+
+def test_other_order_is_reordered_by_name_with_a_warning(tmp_path: Path) -> None:
+    shuffled = tuple(np.random.default_rng(1).permutation(ARKIT_51))
+    write_facial(tmp_path / "f.json", shuffled, _weights(4, shuffled))
+    with pytest.warns(FormatWarning, match="reordered by name"):
+        face = read_facial(tmp_path / "f.json", names=ARKIT_51)
+    np.testing.assert_allclose(face.weights, _weights(4, ARKIT_51), rtol=1e-6)  # each name's values follow it
+    assert face.weights[0, ARKIT_51.index("jawOpen")] == pytest.approx((ARKIT_52.index("jawOpen") + 1) / 100)
+
+
+def test_missing_blendshape_is_named(tmp_path: Path) -> None:
+    names = tuple(n for n in ARKIT_51 if n != "jawOpen")
+    write_facial(tmp_path / "f.json", names, _weights(3, names))
+    with pytest.raises(FormatError, match="blendshape 'jawOpen' is missing") as err:
+        read_facial(tmp_path / "f.json", names=ARKIT_51)
+    assert err.value.field == "names"
+    twice = _bad(tmp_path, {"names": ["a", "a"], "frames": []})
+    assert "appear twice" in str(twice)
+
+
+def test_load_take_face_is_51_wide_by_name(tmp_path: Path) -> None:
+    from test_io_take import make_take
+
+    stem = make_take(tmp_path)
+    n = 120  # 2 s at 60 fps, as make_take writes
+    write_facial(tmp_path / f"{stem.name}.json", ARKIT_52, _weights(n, ARKIT_52))
+    with pytest.warns(FormatWarning, match="tongueOut"):
+        take = load_take(stem)
+    assert take.face is not None and take.face.shape == (30, 51) and take.face_names == ARKIT_51
+    np.testing.assert_allclose(take.face, _weights(n, ARKIT_51)[::4], rtol=1e-6)  # 60 -> 15 fps
+    raw = load_take(stem, blendshapes=None)  # the file's own columns
+    assert raw.face is not None and raw.face.shape == (30, 52)

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from beatlite.io import (
+    ARKIT_51,
     AlignmentWarning,
     EmotionSegment,
     FormatError,
@@ -68,7 +69,7 @@ def make_take(
     f_sec = seconds if face_seconds is None else face_seconds
     nf = int(round(60 * f_sec))
     face = np.repeat(np.arange(nf, dtype=np.float64)[:, None] / 1000, 51, axis=1)
-    write_facial(folder / f"{stem}.json", [f"s{i}" for i in range(51)], face, fps=60)
+    write_facial(folder / f"{stem}.json", ARKIT_51, face, fps=60)
     write_textgrid(
         folder / f"{stem}.TextGrid",
         {"words": [Interval(0.2, 0.6, "hello"), Interval(0.6, 1.0, "world")]},

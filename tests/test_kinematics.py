@@ -47,8 +47,11 @@ def naive_fk(skel: Skeleton, channels: np.ndarray) -> tuple[np.ndarray, np.ndarr
             if order:
                 angles = [vals[f"{a}rotation"] for a in order]
                 local = Rotation.from_euler(order, angles, degrees=True).as_matrix()
-            trans = skel.offsets[j] + np.array([vals.get(f"{a}position", 0.0) for a in "XYZ"])
             p = skel.parents[j]
+            # "add": OFFSET + position channels, except a root with position channels (absolute)
+            root_channels = p < 0 and any(c.endswith("position") for c in skel.channels[j])
+            base = np.zeros(3) if root_channels else skel.offsets[j]
+            trans = base + np.array([vals.get(f"{a}position", 0.0) for a in "XYZ"])
             if p < 0:
                 rots[t, j], pos[t, j] = local, trans
             else:

@@ -1,13 +1,23 @@
-"""Index a BEAT-format folder into a table of takes, reading only file headers.
+"""Index a BEAT-format folder into a table of takes that tells the truth about loading.
 
 A *take* is every file sharing one stem, e.g. ``2_scott_0_1_1.bvh``, ``.wav``,
-``.json``, ``.TextGrid``, ``.txt`` and ``.csv`` (each possibly ``.gz``). The
-index works on real BEAT's layout (``{speaker_id}/{stem}.*``, also nested as
-``beat_english_v0.2.1/2/...``) and on a flat folder. Problems (a ``.wav``
-without ``.bvh``, a name that does not parse, an unreadable file, modalities
-whose durations disagree by more than :data:`MAX_DURATION_GAP` seconds -- the
-TextGrid of an ``_a``/``_b`` half is not compared, it spans the whole sequence)
-are recorded in :attr:`TakeRecord.problems`; indexing never raises for them.
+``.json``, ``.TextGrid``, ``.txt`` and ``.csv`` (each possibly ``.gz``, detected
+from the bytes as the readers do). The index works on real BEAT's layout
+(``{speaker_id}/{stem}.*``, also nested as ``beat_english_v0.2.1/2/...``) and on a
+flat folder.
+
+Every file is checked by the code :func:`beatlite.io.load_take` runs: the BVH is
+read (rows included) at the frame rate loading will use
+(:func:`beatlite.io.take.read_take_motion`: clean-factor rates reconciled with the
+audio), the WAV header is sniffed and bounded (:func:`beatlite.io.audio.audio_info`,
+no samples decoded), the face JSON is mapped to :data:`~beatlite.io.ARKIT_51` by
+name, and TextGrid, ``.txt`` and ``.csv`` bodies are parsed (they are small). So
+``usable`` implies that ``load_take`` succeeds. Problems (a ``.wav`` without
+``.bvh``, a name that does not parse, an unreadable file, modalities whose
+durations disagree by more than :data:`MAX_DURATION_GAP` seconds -- the TextGrid
+of an ``_a``/``_b`` half is not compared, it spans the whole sequence -- and the
+readers' warnings) are recorded in :attr:`TakeRecord.problems`; indexing never
+raises for them.
 
 Usage (the doctests skip the last two lines: the path is relative to the repository root):
 
@@ -20,11 +30,11 @@ Taught in notebooks/00_setup_and_tour.ipynb, sections 2 (what is in the data fol
 
 from __future__ import annotations
 
-import gzip
-import json
+import io
 import os
 import re
-from collections.abc import Callable, Iterable, Iterator
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -80,10 +90,16 @@ class TakeRecord:
         Modality (``"motion"``, ``"audio"``, ``"face"``, ``"text"``, ``"semantic"``,
         ``"emotion"``) -> file path.
     durations : dict str -> float
-        Modality -> duration in seconds, read from headers (motion: ``Frames`` x
-        ``Frame Time``; audio: frames / samplerate; face: frames / fps; text: ``xmax``).
+        Modality -> duration in seconds as loading sees it (motion: rows / the rate
+        loading uses; audio: frames / samplerate; face: frames / fps; text: ``xmax``).
     problems : list of str
-        Human-readable explanations; empty when the take is consistent.
+        Human-readable explanations; empty when the take is consistent. Readers'
+        warnings appear as ``"warning: ..."``.
+    bvh_fps : float or None
+        Rate of the BVH rows to load the take with, when it is not the header's own:
+        the override given to :func:`index_folder`, or the rate reconciled from the
+        files (e.g. 15 for 15 fps rows under a 120 fps header). Windows and
+        statistics pass it to :func:`beatlite.io.load_take`.
     """
 
     stem: str
@@ -100,11 +116,18 @@ class TakeRecord:
     files: dict[str, Path] = field(default_factory=dict)
     durations: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    bvh_fps: float | None = None
 
     @property
     def duration(self) -> float:
-        """Take duration in seconds: the motion's if known, else the audio's, else 0.0."""
-        for modality in ("motion", "audio", "face", "text"):
+        """Seconds :func:`beatlite.io.load_take` produces (within one frame at the model rate).
+
+        The shortest of motion, audio and face when the motion duration is known (loading
+        cuts to the shortest); else the audio's, face's or TextGrid's; else 0.0.
+        """
+        if "motion" in self.durations:
+            return float(min(self.durations[m] for m in ("motion", "audio", "face") if m in self.durations))
+        for modality in ("audio", "face", "text"):
             if modality in self.durations:
                 return float(self.durations[modality])
         return 0.0
@@ -118,12 +141,13 @@ class TakeRecord:
     def usable(self) -> bool:
         """True when the take can feed training windows.
 
-        The name parsed, motion and audio files exist and their headers were readable
-        (or not read: ``read_durations=False``), and the timed modalities agree within
-        :data:`MAX_DURATION_GAP`. Missing optional files (face, text, annotations) are
-        problems but do not make a take unusable.
+        The name parsed, motion and audio files exist, every file present was read by
+        the code :func:`beatlite.io.load_take` runs (or not read: ``read_durations=False``),
+        and the timed modalities agree within :data:`MAX_DURATION_GAP`. So a usable take
+        loads. Missing optional files (face, text, annotations) are problems but do not
+        make a take unusable; an unreadable one does (loading would raise).
         """
-        blocking = ("durations disagree", "unreadable motion", "unreadable audio")
+        blocking = ("durations disagree", "unreadable")
         return (
             self.speaker_id is not None
             and all(m in self.files for m in REQUIRED)
@@ -142,7 +166,7 @@ class TakeRecord:
             raise KeyError(f"take {self.stem!r} has no {modality} file (has {sorted(self.files)})") from None
 
     def to_row(self) -> dict[str, Any]:
-        """Flat dict of the record (one table row): fields, ``dur_<modality>``, ``has_<modality>``."""
+        """Flat dict of the record (one table row): fields, ``dur_<modality>``, ``has_<modality>``, ``bvh_fps``."""
         row: dict[str, Any] = {
             "stem": self.stem,
             "speaker_id": self.speaker_id,
@@ -160,6 +184,7 @@ class TakeRecord:
         for modality in TIMED:
             value = self.durations.get(modality)
             row[f"dur_{modality}"] = None if value is None else round(value, 3)
+        row["bvh_fps"] = self.bvh_fps
         row["problems"] = "; ".join(self.problems)
         return row
 
@@ -319,22 +344,20 @@ class TakeIndex:
 
 
 # ---------------------------------------------------------------------- headers
-def _open_binary(path: Path) -> IO[bytes]:
-    return gzip.open(path, "rb") if path.suffix.lower() == ".gz" else open(path, "rb")
-
-
 def _open_text(path: Path) -> IO[str]:
-    if path.suffix.lower() == ".gz":
-        return gzip.open(path, "rt", encoding="utf-8", errors="replace")
-    return open(path, encoding="utf-8", errors="replace")
+    """Text stream of ``path``, gzip detected from the bytes as the readers do."""
+    from beatlite.io.textfile import open_binary
+
+    return io.TextIOWrapper(open_binary(path), encoding="utf-8", errors="replace")
 
 
 def bvh_duration(path: str | Path) -> float:
     """Duration of a BVH file from its header, ``Frames`` x ``Frame Time``, seconds.
 
     Uses :func:`beatlite.io.read_bvh_header` (reads the HIERARCHY, not the motion rows).
-    Note that some real BEAT files declare a wrong ``Frame Time`` (docs/reference_code.md#bvh-header); the
-    index then reports a duration disagreement with the audio.
+    This is what the header claims; the index itself reports the rows at the rate
+    loading uses (:func:`beatlite.io.take.read_take_motion`), which differs for files
+    whose ``Frame Time`` or ``Frames`` is wrong (docs/reference_code.md#bvh-header).
     """
     from beatlite.io import read_bvh_header
 
@@ -343,42 +366,25 @@ def bvh_duration(path: str | Path) -> float:
 
 
 def wav_duration(path: str | Path) -> float:
-    """Duration of a WAV (or ``.wav.gz``) file from its header, seconds (soundfile)."""
-    import soundfile as sf
+    """Duration of a WAV (or gzipped WAV) file from its header, seconds.
 
-    path = Path(path)
-    with _open_binary(path) as f:
-        info = sf.info(f)
-    return float(info.frames) / float(info.samplerate)
+    Checked exactly as :func:`beatlite.io.read_audio` checks it (:func:`beatlite.io.audio.audio_info`:
+    sniffed bytes, bounded rate, channels and size), decoding no samples.
+    """
+    from beatlite.io.audio import audio_info
+
+    return float(audio_info(path).duration)
 
 
 def face_duration(path: str | Path) -> float:
-    """Duration of a BEAT facial JSON: number of frames / fps, seconds.
+    """Duration of a BEAT facial JSON as :func:`beatlite.io.read_facial` reads it: frames / fps, seconds.
 
     The fps comes from the median spacing of the frames' ``time`` values (60 in BEAT).
     """
-    from beatlite.io.errors import FormatError
+    from beatlite.io import read_facial
 
-    path = Path(path)
-    with _open_text(path) as f:
-        try:
-            data = json.load(f)
-        except json.JSONDecodeError as e:
-            raise FormatError(path, f"invalid JSON: {e.msg}", line=e.lineno, column=e.colno) from None
-    frames = data.get("frames") if isinstance(data, dict) else None
-    if not isinstance(frames, list):
-        raise FormatError(path, "no 'frames' list", field="frames")
-    if len(frames) < 2:
-        return len(frames) / 60.0
-    try:
-        times = sorted(float(fr["time"]) for fr in frames)
-    except (KeyError, TypeError, ValueError):
-        raise FormatError(path, "a frame has no numeric 'time'", field="frames[].time") from None
-    gaps = sorted(b - a for a, b in zip(times[:-1], times[1:]))
-    dt = gaps[len(gaps) // 2]
-    if dt <= 0:
-        raise FormatError(path, "frame times do not increase", field="frames[].time")
-    return len(frames) * dt
+    facial = read_facial(path)
+    return facial.n_frames / facial.fps
 
 
 _XMAX = re.compile(r"^\s*xmax\s*=\s*([-+0-9.eE]+)")
@@ -407,11 +413,38 @@ def textgrid_duration(path: str | Path) -> float:
         raise FormatError(path, "no xmax in the first lines", field="xmax") from None
 
 
-_DURATION_READERS: dict[str, Callable[[Path], float]] = {
-    "motion": bvh_duration,
+def _check_face(path: Path) -> float:
+    from beatlite.io import ARKIT_51, read_facial
+
+    facial = read_facial(path, names=ARKIT_51)  # as load_take reads it
+    return facial.n_frames / facial.fps
+
+
+def _check_text(path: Path) -> float:
+    from beatlite.io.take import read_take_words
+
+    return float(read_take_words(path).xmax or 0.0)
+
+
+def _check_semantic(path: Path) -> None:
+    from beatlite.io import read_semantic
+
+    read_semantic(path)
+
+
+def _check_emotion(path: Path) -> None:
+    from beatlite.io import read_emotion
+
+    read_emotion(path)
+
+
+#: Modality -> the check load_take's reader makes, returning the duration (None: untimed).
+_CHECKS: dict[str, Callable[[Path], float | None]] = {
     "audio": wav_duration,
-    "face": face_duration,
-    "text": textgrid_duration,
+    "face": _check_face,
+    "text": _check_text,
+    "semantic": _check_semantic,
+    "emotion": _check_emotion,
 }
 
 
@@ -463,7 +496,59 @@ def _name_fields(stem: str) -> tuple[dict[str, Any], str | None]:
     return fields, None
 
 
-def index_take(stem: str, files: dict[str, list[Path]], *, read_durations: bool = True) -> TakeRecord:
+def _list_files(record: TakeRecord, files: dict[str, list[Path]]) -> None:
+    """Fill ``record.files``; duplicates and missing files become problems."""
+    for modality, paths in files.items():
+        record.files[modality] = paths[0]
+        if len(paths) > 1:
+            others = ", ".join(str(p) for p in paths[1:])
+            record.problems.append(f"duplicate {modality} files: using {paths[0]}, ignoring {others}")
+    for ext, modality in MODALITIES.items():
+        if modality not in record.files:
+            shown = "TextGrid" if ext == "textgrid" else ext
+            record.problems.append(f"missing {modality} (.{shown}) file")
+
+
+def _check_motion(record: TakeRecord, bvh_fps: float | None) -> None:
+    """Read the BVH as load_take will (rate reconciled with the other files); set duration and ``bvh_fps``."""
+    from beatlite.io.bvh import parse_frame_time, read_bvh_header
+    from beatlite.io.take import read_take_motion, reference_duration
+
+    path = record.files["motion"]
+    reference = reference_duration(record.durations, record.half)
+    motion = read_take_motion(path, bvh_fps=bvh_fps, reference_s=reference)
+    record.durations["motion"] = motion.duration
+    header_fps = parse_frame_time(repr(read_bvh_header(path)[2]))
+    if bvh_fps is not None or motion.fps != header_fps:
+        record.bvh_fps = motion.fps
+
+
+def _check_files(record: TakeRecord, bvh_fps: float | None) -> None:
+    """Run every reader load_take runs; failures are ``unreadable`` problems, warnings ``warning:`` notes."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for modality, check in [*_CHECKS.items(), ("motion", None)]:
+            if modality not in record.files:
+                continue
+            try:
+                if check is None:
+                    _check_motion(record, bvh_fps)
+                elif (seconds := check(record.files[modality])) is not None:
+                    record.durations[modality] = float(seconds)
+            except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
+                record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
+    from beatlite.io.errors import AlignmentWarning, FormatWarning
+
+    for w in caught:
+        if issubclass(w.category, (FormatWarning, AlignmentWarning)):
+            record.problems.append(f"warning: {w.message}")
+        else:  # not about the files (e.g. a library's deprecation): pass it on
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def index_take(
+    stem: str, files: dict[str, list[Path]], *, read_durations: bool = True, bvh_fps: float | None = None
+) -> TakeRecord:
     """Build the :class:`TakeRecord` of one take from its files; never raises for bad files.
 
     Parameters
@@ -473,42 +558,24 @@ def index_take(stem: str, files: dict[str, list[Path]], *, read_durations: bool 
     files : dict str -> list of Path
         Modality -> candidate files (the first is used, the rest flagged as duplicates).
     read_durations : bool
-        Read the headers of the timed modalities (default True).
+        Read every file as loading would (default True); False lists files only.
+    bvh_fps : float, optional
+        Rate of the BVH rows (an override, kept in :attr:`TakeRecord.bvh_fps`).
     """
     fields, problem = _name_fields(stem)
     record = TakeRecord(stem=stem, **fields)
     if problem:
         record.problems.append(problem)
-    for modality, paths in files.items():
-        record.files[modality] = paths[0]
-        if len(paths) > 1:
-            others = ", ".join(str(p) for p in paths[1:])
-            record.problems.append(f"duplicate {modality} files: using {paths[0]}, ignoring {others}")
-    for modality in REQUIRED:
-        if modality not in record.files:
-            ext = next(e for e, m in MODALITIES.items() if m == modality)
-            record.problems.append(f"missing {modality} (.{ext}) file")
-    for modality in ("face", "text", "semantic", "emotion"):
-        if modality not in record.files:
-            ext = next(e for e, m in MODALITIES.items() if m == modality)
-            ext = "TextGrid" if ext == "textgrid" else ext
-            record.problems.append(f"missing {modality} (.{ext}) file")
+    _list_files(record, files)
+    if bvh_fps is not None:
+        record.bvh_fps = float(bvh_fps)
     if read_durations:
-        for modality in TIMED:
-            if modality not in record.files:
-                continue
-            try:
-                record.durations[modality] = float(_DURATION_READERS[modality](record.files[modality]))
-            except Exception as e:  # noqa: BLE001 - any unreadable file becomes a problem, never a crash
-                record.problems.append(f"unreadable {modality} file {record.files[modality].name}: {e}")
+        _check_files(record, bvh_fps)
         # the TextGrid of an "_a"/"_b" half spans the whole sequence (docs/reference_code.md#textgrid): not compared
         compared = {m: d for m, d in record.durations.items() if not (m == "text" and record.half)}
-        if len(compared) >= 2:
-            lo = min(compared, key=compared.__getitem__)
-            hi = max(compared, key=compared.__getitem__)
-            if compared[hi] - compared[lo] > MAX_DURATION_GAP:
-                listing = ", ".join(f"{m} {d:.2f} s" for m, d in compared.items())
-                record.problems.append(f"durations disagree by more than {MAX_DURATION_GAP:g} s: {listing}")
+        if len(compared) >= 2 and max(compared.values()) - min(compared.values()) > MAX_DURATION_GAP:
+            listing = ", ".join(f"{m} {d:.2f} s" for m, d in compared.items())
+            record.problems.append(f"durations disagree by more than {MAX_DURATION_GAP:g} s: {listing}")
     return record
 
 
@@ -523,7 +590,11 @@ def _sort_key(record: TakeRecord) -> tuple:
 
 
 def index_folder(
-    root: str | Path | None = None, *, recursive: bool = True, read_durations: bool = True
+    root: str | Path | None = None,
+    *,
+    recursive: bool = True,
+    read_durations: bool = True,
+    bvh_fps: Mapping[str, float] | None = None,
 ) -> TakeIndex:
     """Index every take under ``root``.
 
@@ -535,8 +606,12 @@ def index_folder(
     recursive : bool
         Walk sub-folders (default True).
     read_durations : bool
-        Read the headers of BVH/WAV/JSON/TextGrid files for durations (default True;
-        False lists files only, which is instant).
+        Read every file as :func:`beatlite.io.load_take` would (default True: the BVH
+        rows, the WAV header, the face JSON, TextGrid and annotation bodies), so that
+        ``usable`` means loadable; False lists files only, which is instant.
+    bvh_fps : Mapping[str, float], optional
+        Per-take overrides of the BVH row rate, stem -> fps (e.g. ``{"29_hanieh_1_4_4":
+        120}``); stored in :attr:`TakeRecord.bvh_fps` and used by windows and statistics.
 
     Returns
     -------
@@ -556,6 +631,13 @@ def index_folder(
     if not root.is_dir():
         raise FileNotFoundError(f"index_folder: {root} is not a folder")
     found = _scan(root, recursive)
-    records = [index_take(stem, files, read_durations=read_durations) for stem, files in found.items()]
+    overrides = dict(bvh_fps or {})
+    unknown = sorted(set(overrides) - set(found))
+    if unknown:
+        raise ValueError(f"index_folder: bvh_fps names takes that are not in {root}: {unknown[:5]}")
+    records = [
+        index_take(stem, files, read_durations=read_durations, bvh_fps=overrides.get(stem))
+        for stem, files in found.items()
+    ]
     records.sort(key=_sort_key)
     return TakeIndex(records, root)

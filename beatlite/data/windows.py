@@ -239,7 +239,7 @@ def take_features(
     from beatlite.skeleton.directions import positions_to_directions
     from beatlite.skeleton.ted import TED_BONES, beat_to_ted43
 
-    take = load_take(record.path("motion"), fps=fps, audio_sr=sr)
+    take = load_take(record.path("motion"), fps=fps, audio_sr=sr, bvh_fps=record.bvh_fps)
     motion = take.motion
     audio = np.asarray(take.audio, dtype=np.float32)
     n = take.n_frames  # load_take already cut every modality to the shortest one
@@ -440,6 +440,8 @@ def _fingerprint(records: Sequence[TakeRecord], payload: dict[str, Any]) -> str:
             p = r.files[modality]
             st = p.stat()
             h.update(f"{r.stem}|{modality}|{p.name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+        if r.bvh_fps is not None:  # a per-take frame-rate override changes the windows
+            h.update(f"{r.stem}|bvh_fps|{r.bvh_fps!r}\n".encode())
     return h.hexdigest()
 
 

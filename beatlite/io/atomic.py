@@ -15,6 +15,7 @@ import gzip
 import io
 import os
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
@@ -28,10 +29,12 @@ def atomic_write(
 ) -> Iterator[IO[Any]]:
     """Open ``path`` for writing so that it appears complete or not at all.
 
-    Data go to a temporary file in the same folder, which is flushed,
-    ``fsync``-ed and renamed over ``path`` with :func:`os.replace` when the
-    ``with`` block ends normally. If the block raises, the temporary file is
-    removed and an existing ``path`` is left untouched.
+    Data go to a temporary file ``.{name}.{pid}.*.tmp`` in the same folder, which
+    is flushed, ``fsync``-ed and renamed over ``path`` with :func:`os.replace` when
+    the ``with`` block ends normally. If the block raises, the temporary file is
+    removed and an existing ``path`` is left untouched. Temporary files of ``path``
+    left by a process that was killed mid-write are removed first
+    (:func:`remove_stale_temps`).
 
     Parameters
     ----------
@@ -57,7 +60,8 @@ def atomic_write(
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"atomic_write: folder {folder} does not exist (writing {target})")
-    fd, tmp_name = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")
+    remove_stale_temps(target)
+    fd, tmp_name = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp")
     tmp = Path(tmp_name)
     raw = os.fdopen(fd, "wb")
     gz: gzip.GzipFile | None = None
@@ -115,3 +119,54 @@ def _fsync_dir(folder: Path) -> None:
             os.fsync(dfd)
         finally:
             os.close(dfd)
+
+
+STALE_AGE_S = 24 * 3600.0  # where process ids cannot be checked, a temp file this old is stale
+
+
+def _process_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine (POSIX); elsewhere assume it does."""
+    if os.name != "posix":
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # PermissionError: it exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
+    """Remove the temporary files of ``path`` that a killed writer left behind.
+
+    A temp file ``.{name}.{pid}.*.tmp`` is stale when process ``pid`` no longer exists
+    (or, where that cannot be checked, when it is older than a day). Temp files of live
+    writers are left alone.
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    removed = []
+    prefix = f".{target.name}."
+    with contextlib.suppress(OSError):
+        for cand in folder.iterdir():
+            name = cand.name
+            if not (name.startswith(prefix) and name.endswith(".tmp")):
+                continue
+            pid_text = name[len(prefix) :].split(".")[0]
+            if not (pid_text.isascii() and pid_text.isdigit()) or int(pid_text) == os.getpid():
+                continue
+            try:
+                age = time.time() - cand.stat().st_mtime
+            except OSError:
+                continue
+            if not _process_alive(int(pid_text)) or (os.name != "posix" and age > STALE_AGE_S):
+                with contextlib.suppress(OSError):
+                    cand.unlink()
+                    removed.append(cand)
+    return removed

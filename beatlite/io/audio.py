@@ -10,7 +10,10 @@ difference, not in timing.
 
 The first bytes are sniffed before libsndfile sees the file, so an MP3 saved
 as ``.wav``, a Git-LFS pointer or an HTML error page gives a
-:class:`FormatError` saying what the bytes look like.
+:class:`FormatError` saying what the bytes look like; then the header's rate,
+channel count and frame count are checked against sanity bounds before any
+sample is decoded or resampled (:func:`audio_info`, which the dataset index
+uses too).
 
 Taught in notebooks/01_beat_formats.ipynb, section 8 (the audio read beside the face).
 """
@@ -20,15 +23,18 @@ from __future__ import annotations
 import io
 import math
 import os
+import struct
+import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from beatlite.io.atomic import atomic_write
-from beatlite.io.errors import FormatError
+from beatlite.io.errors import FormatError, FormatWarning
 from beatlite.io.textfile import GZIP_MAGIC, describe_bytes, read_bytes
 
-__all__ = ["read_audio", "write_wav", "resample"]
+__all__ = ["read_audio", "audio_info", "AudioInfo", "write_wav", "resample"]
 
 _AUDIO_MAGIC = (b"RIFF", b"RF64", b"fLaC", b"OggS", b"FORM", b"riff")
 
@@ -75,6 +81,124 @@ def _check_rate(value: object, name: str) -> int:
     return int(value)
 
 
+#: Accepted sample rates, Hz (checked before any sample is decoded).
+RATE_RANGE = (1000, 768_000)
+#: Accepted channel counts.
+MAX_CHANNELS = 64
+#: Decoded float32 bytes allowed per byte of file (PCM needs at most 4; FLAC/OGG compress more).
+MAX_EXPANSION = 64
+_MIN_DECODED_BYTES = 64 * 2**20
+
+
+class AudioInfo(NamedTuple):
+    """What the header of an audio file says, checked against sanity bounds.
+
+    Attributes
+    ----------
+    frames : int
+        Sample frames present in the file (per channel).
+    samplerate : int
+        Hz.
+    channels : int
+    declared_frames : int or None
+        Frames the RIFF ``data`` chunk declares (``None`` when not a WAV or not stated);
+        more than ``frames`` means a truncated file.
+    """
+
+    frames: int
+    samplerate: int
+    channels: int
+    declared_frames: int | None
+
+    @property
+    def duration(self) -> float:
+        """``frames / samplerate`` seconds."""
+        return self.frames / self.samplerate
+
+
+def _declared_wav_frames(head: bytes) -> int | None:
+    """Frames the ``data`` chunk of a RIFF/WAVE header declares (chunks walked from byte 12)."""
+    if head[:4] != b"RIFF" or head[8:12] != b"WAVE":
+        return None
+    pos, block_align = 12, 0
+    while pos + 8 <= len(head):
+        chunk, size = head[pos : pos + 4], struct.unpack("<I", head[pos + 4 : pos + 8])[0]
+        if chunk == b"fmt " and pos + 22 <= len(head):
+            block_align = struct.unpack("<H", head[pos + 20 : pos + 22])[0]
+        if chunk == b"data":
+            unknown = size in (0, 0xFFFFFFFF) or block_align == 0
+            return None if unknown else size // block_align
+        pos += 8 + size + (size & 1)
+    return None
+
+
+def _audio_source(p: Path) -> tuple[str | io.BytesIO, bytes, int]:
+    """What libsndfile should open (path, or bytes for gzip), the first 64 KiB, and the file size."""
+    with open(p, "rb") as f:
+        head = f.read(65536)
+    source: str | io.BytesIO = str(p)
+    suffix = p.suffix.lower()
+    size = p.stat().st_size
+    if head[:2] == GZIP_MAGIC:
+        data = read_bytes(p)
+        head, source, size = data[:65536], io.BytesIO(data), len(data)
+        suffix = Path(p.stem).suffix.lower()
+    if not _looks_like_audio(head, suffix):
+        raise FormatError(p, f"not a WAV/audio file: the bytes look like {describe_bytes(head)}")
+    return source, head, size
+
+
+def _checked_info(p: Path, source: str | io.BytesIO, head: bytes, size: int) -> AudioInfo:
+    import soundfile as sf
+
+    try:
+        info = sf.info(source)
+    except (sf.LibsndfileError, RuntimeError, TypeError) as exc:
+        raise FormatError(p, f"cannot decode audio ({describe_bytes(head[:64])}): {exc}") from None
+    if isinstance(source, io.BytesIO):
+        source.seek(0)
+    rate, channels, frames = int(info.samplerate), int(info.channels), int(info.frames)
+    if not RATE_RANGE[0] <= rate <= RATE_RANGE[1]:
+        raise FormatError(
+            p, f"sample rate {rate} Hz is outside {RATE_RANGE[0]}..{RATE_RANGE[1]} Hz", field="samplerate"
+        )
+    if not 1 <= channels <= MAX_CHANNELS:
+        raise FormatError(p, f"{channels} channels is outside 1..{MAX_CHANNELS}", field="channels")
+    if frames <= 0:
+        raise FormatError(p, "no audio samples (an empty or header-only file)", field="frames")
+    if frames * channels * 4 > max(MAX_EXPANSION * size, _MIN_DECODED_BYTES):
+        raise FormatError(
+            p,
+            f"header claims {frames} frames x {channels} channels, too many for {size} bytes",
+            field="frames",
+        )
+    return AudioInfo(frames, rate, channels, _declared_wav_frames(head))
+
+
+def audio_info(path: str | os.PathLike[str]) -> AudioInfo:
+    """Check an audio file as :func:`read_audio` does, decoding no samples.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        WAV (or FLAC/OGG/AIFF), optionally gzipped.
+
+    Returns
+    -------
+    AudioInfo
+        ``frames``, ``samplerate`` (Hz), ``channels``, ``declared_frames``.
+
+    Raises
+    ------
+    FormatError
+        Bytes that are not audio, an undecodable header, a rate outside
+        :data:`RATE_RANGE`, more than :data:`MAX_CHANNELS` channels, no samples, or
+        more frames than the file size can hold.
+    """
+    p = Path(path)
+    return _checked_info(p, *_audio_source(p))
+
+
 def read_audio(
     path: str | os.PathLike[str], *, sr: int | None = 16000, mono: bool = True
 ) -> tuple[np.ndarray, int]:
@@ -101,28 +225,29 @@ def read_audio(
     Raises
     ------
     FormatError
-        If the bytes are not audio (naming what they look like) or libsndfile
-        cannot decode them.
+        If the bytes are not audio (naming what they look like), the header fails
+        the checks of :func:`audio_info` (checked before any sample is decoded), or
+        libsndfile cannot decode them. A truncated WAV (fewer samples than its
+        ``data`` chunk declares) is read with a :class:`FormatWarning`.
     """
     import soundfile as sf
 
     target = None if sr is None else _check_rate(sr, "sr")
     p = Path(path)
-    with open(p, "rb") as f:
-        head = f.read(64)
-    source: str | io.BytesIO = str(p)
-    suffix = p.suffix.lower()
-    if head[:2] == GZIP_MAGIC:
-        data = read_bytes(p)
-        head = data[:64]
-        source = io.BytesIO(data)
-        suffix = Path(p.stem).suffix.lower()
-    if not _looks_like_audio(head, suffix):
-        raise FormatError(p, f"not a WAV/audio file: the bytes look like {describe_bytes(head)}")
+    source, head, size = _audio_source(p)
+    info = _checked_info(p, source, head, size)
+    if info.declared_frames is not None and info.declared_frames > info.frames:
+        warnings.warn(
+            f"{p}: truncated audio: the header declares {info.declared_frames} frames "
+            f"({info.declared_frames / info.samplerate:.3f} s) but the file holds {info.frames} "
+            f"({info.duration:.3f} s); using what is there",
+            FormatWarning,
+            stacklevel=2,
+        )
     try:
         y, native = sf.read(source, dtype="float32", always_2d=True)
     except (sf.LibsndfileError, RuntimeError, TypeError) as exc:
-        raise FormatError(p, f"cannot decode audio ({describe_bytes(head)}): {exc}") from None
+        raise FormatError(p, f"cannot decode audio ({describe_bytes(head[:64])}): {exc}") from None
     if mono:
         y = y.mean(axis=1, dtype=np.float32) if y.shape[1] > 1 else y[:, 0]
     if target is not None and target != native:

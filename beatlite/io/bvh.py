@@ -13,11 +13,23 @@ Frame rates: ``Frame Time`` is printed with few digits (BEAT writes
 (``0.008333`` -> 120.0, ``0.0333333`` -> 30.0). Real BEAT files sometimes carry a
 wrong Frame Time (docs/reference_code.md#bvh-header); pass ``fps=`` to override it.
 
+Frame rates that lie: derived BEAT files keep the 120 fps header (``Frames: 7669``,
+``Frame Time: 0.008333``) over rows written at 15 fps (957 rows). When ``Frames``
+and the row count differ by a clean integer factor ``k`` (within 1 %),
+:func:`read_bvh` reads the rows at ``header_fps / k`` (or ``* k``) so that the
+header duration is kept, and says so in one :class:`BVHWarning` naming both
+readings and the override (:func:`infer_row_rate`).
+
+Units: beatlite works in centimetres. ``units="auto"`` warns when the rest pose
+is under :data:`METRE_EXTENT` units tall (a skeleton in metres, e.g. SMPL-X
+exports); ``units="m"`` or ``"mm"`` converts offsets and position channels to cm.
+
 Taught in notebooks/01_beat_formats.ipynb, sections 2 (the BVH file) and 3 (reading the motion); writing in notebooks/08_visualisation_3d.ipynb, section 6 (export to Blender: BVH).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import os
@@ -35,13 +47,29 @@ from beatlite.io.motion import Motion
 from beatlite.io.textfile import describe_bytes, open_binary
 from beatlite.skeleton.core import POSITION_CHANNELS, ROTATION_CHANNELS, Skeleton
 
-__all__ = ["read_bvh", "read_bvh_header", "write_bvh", "parse_frame_time", "format_frame_time"]
+__all__ = [
+    "read_bvh",
+    "read_bvh_header",
+    "write_bvh",
+    "parse_frame_time",
+    "format_frame_time",
+    "infer_row_rate",
+    "UNITS",
+]
 
 CHANNEL_NAMES = POSITION_CHANNELS + ROTATION_CHANNELS
 _CHANNEL_LOOKUP = {c.lower(): c for c in CHANNEL_NAMES}
 _FRAMES_RE = re.compile(r"^\s*Frames\s*:\s*(\S+)\s*$", re.IGNORECASE)
 _FRAME_TIME_RE = re.compile(r"^\s*Frame\s+Time\s*:\s*(\S+)\s*$", re.IGNORECASE)
 _MAX_HEADER_LINES = 200_000
+#: Accepted ``Frame Time`` range in seconds (100 kHz .. 1 fps; resampling to 15 fps stays bounded).
+FRAME_TIME_RANGE = (1e-5, 1.0)
+#: Largest integer factor between ``Frames`` and the row count that :func:`infer_row_rate` accepts.
+MAX_RATE_FACTOR = 16
+#: ``units=`` values of :func:`read_bvh` and their factor to centimetres.
+UNITS = {"auto": 1.0, "cm": 1.0, "m": 100.0, "mm": 0.1}
+#: A rest pose less tall than this (in file units) looks like metres to ``units="auto"``.
+METRE_EXTENT = 5.0
 
 
 # ----------------------------------------------------------------------------- frame time
@@ -78,6 +106,10 @@ def parse_frame_time(text: str) -> float:
     frame_time = float(dec)
     if not math.isfinite(frame_time) or frame_time <= 0:
         raise ValueError(f"frame time must be a positive number of seconds, got {text!r}")
+    if not FRAME_TIME_RANGE[0] <= frame_time <= FRAME_TIME_RANGE[1]:
+        raise ValueError(
+            f"frame time {text!r} s is outside {FRAME_TIME_RANGE[0]:g}..{FRAME_TIME_RANGE[1]:g} s"
+        )
     exponent = dec.as_tuple().exponent
     unit = 10.0 ** int(exponent) if isinstance(exponent, int) else 0.0
     n = round(1.0 / frame_time)
@@ -167,88 +199,108 @@ class _Tokens:
         return out
 
 
+class _Joints:
+    """The joints parsed so far, in file (depth-first) order."""
+
+    def __init__(self, path: Path | None) -> None:
+        self.path = path
+        self.names: list[str] = []
+        self.parents: list[int] = []
+        self.offsets: list[tuple[float, float, float] | None] = []
+        self.channels: list[tuple[str, ...]] = []
+        self.end_sites: dict[int, np.ndarray] = {}
+        self.lines: dict[str, int] = {}
+
+    def add(self, name: str, parent: int, line: int) -> int:
+        if name in self.lines:
+            raise FormatError(
+                self.path, f"joint name {name!r} appears twice (first on line {self.lines[name]})", line=line
+            )
+        self.lines[name] = line
+        self.names.append(name)
+        self.parents.append(parent)
+        self.offsets.append(None)
+        self.channels.append(())
+        return len(self.names) - 1
+
+    def skeleton(self) -> Skeleton:
+        return Skeleton(
+            names=tuple(self.names),
+            parents=np.array(self.parents, dtype=np.int64),
+            offsets=np.array(self.offsets, dtype=np.float64),
+            channels=tuple(self.channels),
+            end_sites=self.end_sites,
+        )
+
+
+def _joint_name(tokens: _Tokens, keyword_line: int, keyword: str) -> str:
+    """The rest of the ``ROOT``/``JOINT`` line (a name may hold spaces), leaving a trailing ``{``."""
+    parts = tokens.rest_of_line(keyword_line)
+    if parts and parts[-1] == "{":
+        parts.pop()
+        tokens.pos -= 1  # give the brace back
+    if not parts:
+        raise FormatError(tokens.path, f"{keyword} without a joint name", line=keyword_line)
+    return " ".join(parts)
+
+
+def _parse_end_site(tokens: _Tokens, joints: _Joints, j: int) -> None:
+    site_tok, site_line, _ = tokens.next("'Site'")
+    if site_tok.upper() != "SITE":
+        raise FormatError(tokens.path, f"expected 'End Site', found 'End {site_tok}'", line=site_line)
+    extra = tokens.rest_of_line(site_line)  # some exporters name End Sites; ignore the name
+    if extra and extra[-1] == "{":
+        tokens.pos -= 1
+    tokens.expect("{")
+    tokens.expect("OFFSET")
+    what = f"End Site OFFSET of {joints.names[j]!r}"
+    joints.end_sites[j] = np.array([tokens.number(what) for _ in range(3)])
+    tokens.expect("}")
+
+
 def _parse_hierarchy(lines: list[tuple[int, str]], path: Path | None) -> Skeleton:
-    """Build a :class:`Skeleton` from the numbered lines before ``MOTION``."""
+    """Build a :class:`Skeleton` from the numbered lines before ``MOTION`` (a loop, no recursion)."""
     tokens = _Tokens(lines, path)
     tokens.expect("HIERARCHY")
-    names: list[str] = []
-    parents: list[int] = []
-    offsets: list[tuple[float, float, float] | None] = []
-    channels: list[tuple[str, ...]] = []
-    end_sites: dict[int, np.ndarray] = {}
-
+    joints = _Joints(path)
     tok, line, col = tokens.next("'ROOT'")
     if tok.upper() != "ROOT":
         raise FormatError(path, f"expected 'ROOT', found {tok!r}", line=line, column=col)
-
-    def joint_name(keyword_line: int, keyword: str) -> str:
-        parts = tokens.rest_of_line(keyword_line)
-        if parts and parts[-1] == "{":
-            parts.pop()
-            tokens.pos -= 1  # give the brace back
-        if not parts:
-            raise FormatError(path, f"{keyword} without a joint name", line=keyword_line)
-        return " ".join(parts)
-
-    stack: list[int] = []
-    names.append(joint_name(line, "ROOT"))
-    parents.append(-1)
-    offsets.append(None)
-    channels.append(())
+    stack = [joints.add(_joint_name(tokens, line, "ROOT"), -1, line)]
     tokens.expect("{")
-    stack.append(0)
     while stack:
         tok, line, col = tokens.next("'}'")
         key = tok.upper()
         j = stack[-1]
         if key == "OFFSET":
-            offsets[j] = (
-                tokens.number(f"OFFSET of {names[j]!r}"),
-                tokens.number(f"OFFSET of {names[j]!r}"),
-                tokens.number(f"OFFSET of {names[j]!r}"),
-            )
+            joints.offsets[j] = tuple(tokens.number(f"OFFSET of {joints.names[j]!r}") for _ in range(3))  # type: ignore[assignment]
         elif key == "CHANNELS":
-            channels[j] = _parse_channels(tokens, names[j], line, col, path)
+            joints.channels[j] = _parse_channels(tokens, joints.names[j], line, col, path)
         elif key == "JOINT":
-            if offsets[j] is None:
-                raise FormatError(path, f"joint {names[j]!r} has no OFFSET before its children", line=line)
-            names.append(joint_name(line, "JOINT"))
-            parents.append(j)
-            offsets.append(None)
-            channels.append(())
+            if joints.offsets[j] is None:
+                raise FormatError(
+                    path, f"joint {joints.names[j]!r} has no OFFSET before its children", line=line
+                )
+            stack.append(joints.add(_joint_name(tokens, line, "JOINT"), j, line))
             tokens.expect("{")
-            stack.append(len(names) - 1)
         elif key == "END":
-            site_tok, site_line, site_col = tokens.next("'Site'")
-            if site_tok.upper() != "SITE":
-                raise FormatError(path, f"expected 'End Site', found 'End {site_tok}'", line=site_line)
-            extra = tokens.rest_of_line(site_line)  # some exporters name End Sites; ignore the name
-            if extra and extra[-1] == "{":
-                tokens.pos -= 1
-            tokens.expect("{")
-            tokens.expect("OFFSET")
-            end_sites[j] = np.array([tokens.number(f"End Site OFFSET of {names[j]!r}") for _ in range(3)])
-            tokens.expect("}")
+            _parse_end_site(tokens, joints, j)
         elif key == "}":
-            if offsets[j] is None:
-                raise FormatError(path, f"joint {names[j]!r} has no OFFSET", line=line)
+            if joints.offsets[j] is None:
+                raise FormatError(path, f"joint {joints.names[j]!r} has no OFFSET", line=line)
             stack.pop()
         elif key == "ROOT":
             raise FormatError(path, "more than one ROOT is not supported", line=line, column=col)
         else:
-            raise FormatError(path, f"unexpected {tok!r} inside joint {names[j]!r}", line=line, column=col)
+            raise FormatError(
+                path, f"unexpected {tok!r} inside joint {joints.names[j]!r}", line=line, column=col
+            )
     extra = tokens.peek()
     if extra is not None:
         raise FormatError(
             path, f"unexpected {extra[0]!r} after the ROOT joint closed", line=extra[1], column=extra[2]
         )
-    return Skeleton(
-        names=tuple(names),
-        parents=np.array(parents, dtype=np.int64),
-        offsets=np.array(offsets, dtype=np.float64),
-        channels=tuple(channels),
-        end_sites=end_sites,
-    )
+    return joints.skeleton()
 
 
 def _parse_channels(tokens: _Tokens, joint: str, line: int, col: int, path: Path | None) -> tuple[str, ...]:
@@ -281,6 +333,14 @@ def _parse_channels(tokens: _Tokens, joint: str, line: int, col: int, path: Path
         names.append(_CHANNEL_LOOKUP[item[0].lower()])
     if len(set(names)) != len(names):
         raise FormatError(path, f"CHANNELS of joint {joint!r} repeats a channel: {names}", line=line)
+    n_rot = sum(c.endswith("rotation") for c in names)
+    if n_rot not in (0, 3) or count - n_rot not in (0, 3):
+        raise FormatError(
+            path,
+            f"CHANNELS of joint {joint!r} lists {n_rot} rotation and {count - n_rot} position channels "
+            f"({' '.join(names)}); a joint needs all three of a kind (X, Y and Z)",
+            line=line,
+        )
     return tuple(names)
 
 
@@ -291,14 +351,26 @@ def _decode(raw: bytes, path: Path, lineno: int) -> str:
         raise FormatError(path, f"not a text BVH file: {describe_bytes(raw[:64])}", line=lineno) from None
 
 
-def _read_header(f: IO[bytes], path: Path) -> tuple[Skeleton, int, str, int, int]:
-    """Read up to and including ``Frame Time``.
+def _open_bvh(path: Path) -> tuple[IO[bytes], bytes]:
+    """The file as a byte stream (gzip by content) and its first bytes.
 
-    Returns
-    -------
-    skeleton, n_frames_declared, frame_time_text, frame_time_line, header_line_count
+    A file with CR-only line endings (classic Mac) is read whole and its CRs turned into LFs.
     """
-    head = f.peek(256)[:256] if hasattr(f, "peek") else b""  # type: ignore[attr-defined]
+    f = open_binary(path)
+    head = f.peek(65536)[:65536]  # type: ignore[attr-defined]
+    if b"\r" in head and b"\n" not in head:
+        try:
+            data = f.read()
+        except (OSError, EOFError) as exc:
+            f.close()
+            raise FormatError(path, f"cannot decompress gzip data: {exc}") from None
+        f.close()
+        return io.BytesIO(data.replace(b"\r", b"\n")), head
+    return f, head
+
+
+def _hierarchy_lines(f: IO[bytes], path: Path, head: bytes) -> tuple[list[tuple[int, str]], int]:
+    """The numbered lines before ``MOTION`` and the line number of ``MOTION``."""
     lines: list[tuple[int, str]] = []
     lineno = 0
     first_seen = False
@@ -318,24 +390,34 @@ def _read_header(f: IO[bytes], path: Path) -> tuple[Skeleton, int, str, int, int
                     path, f"not a BVH file: expected 'HIERARCHY', found {describe_bytes(head)}", line=lineno
                 )
         if stripped.upper() == "MOTION":
-            break
+            return lines, lineno
         lines.append((lineno, text))
         if lineno > _MAX_HEADER_LINES:
             raise FormatError(path, f"no MOTION line in the first {_MAX_HEADER_LINES} lines", line=lineno)
+
+
+def _next_nonblank(f: IO[bytes], path: Path, lineno: int, what: str) -> tuple[int, str]:
+    """The next non-blank line after line ``lineno``: ``(its number, its text)``."""
+    while True:
+        raw = f.readline()
+        if not raw:
+            raise FormatError(path, f"file ends after MOTION: expected {what}", line=lineno)
+        lineno += 1
+        text = _decode(raw, path, lineno)
+        if text.strip():
+            return lineno, text
+
+
+def _read_header(f: IO[bytes], path: Path, head: bytes = b"") -> tuple[Skeleton, int, str, int, int]:
+    """Read up to and including ``Frame Time``.
+
+    Returns
+    -------
+    skeleton, n_frames_declared, frame_time_text, frame_time_line, header_line_count
+    """
+    lines, lineno = _hierarchy_lines(f, path, head)
     skeleton = _parse_hierarchy(lines, path)
-
-    def next_nonblank(what: str) -> tuple[int, str]:
-        nonlocal lineno
-        while True:
-            raw = f.readline()
-            if not raw:
-                raise FormatError(path, f"file ends after MOTION: expected {what}", line=lineno)
-            lineno += 1
-            text = _decode(raw, path, lineno)
-            if text.strip():
-                return lineno, text
-
-    frames_line, text = next_nonblank("'Frames: N'")
+    frames_line, text = _next_nonblank(f, path, lineno, "'Frames: N'")
     m = _FRAMES_RE.match(text)
     if m is None:
         raise FormatError(
@@ -345,13 +427,13 @@ def _read_header(f: IO[bytes], path: Path) -> tuple[Skeleton, int, str, int, int
         frames_value = float(m.group(1))
     except ValueError:
         frames_value = math.nan
-    if not (math.isfinite(frames_value) and frames_value >= 0 and frames_value == int(frames_value)):
+    if not (math.isfinite(frames_value) and 0 <= frames_value <= 2**53 and frames_value == int(frames_value)):
         raise FormatError(path, f"Frames: {m.group(1)!r} is not a whole number", line=frames_line)
-    time_line, text = next_nonblank("'Frame Time: dt'")
+    time_line, text = _next_nonblank(f, path, frames_line, "'Frame Time: dt'")
     m = _FRAME_TIME_RE.match(text)
     if m is None:
         raise FormatError(path, f"expected 'Frame Time: dt', found {text.strip()!r}", line=time_line)
-    return skeleton, int(frames_value), m.group(1), time_line, lineno
+    return skeleton, int(frames_value), m.group(1), time_line, time_line
 
 
 # ----------------------------------------------------------------------------- motion block
@@ -438,7 +520,7 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
     Returns
     -------
     skeleton : Skeleton
-        Joint names, parents, offsets (centimetres), channels, End Sites.
+        Joint names, parents, offsets (file units, normally centimetres), channels, End Sites.
     n_frames_declared : int
         The ``Frames:`` value (the rows are not counted).
     frame_time : float
@@ -450,30 +532,135 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
         If the header is malformed (naming the line).
     """
     p = Path(path)
-    with open_binary(p) as f:
-        skeleton, n_frames, time_text, time_line, _ = _read_header(f, p)
+    f, head = _open_bvh(p)
+    with f:
+        skeleton, n_frames, time_text, time_line, _ = _read_header(f, p, head)
     try:
         frame_time = float(time_text)
     except ValueError:
         raise FormatError(p, f"Frame Time {time_text!r} is not a number", line=time_line) from None
+    if not math.isfinite(frame_time):
+        raise FormatError(p, f"Frame Time {time_text!r} is not finite", line=time_line)
     return skeleton, n_frames, frame_time
 
 
-def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: bool = False) -> Motion:
+def infer_row_rate(n_declared: int, header_fps: float, n_rows: int) -> float | None:
+    """The frame rate of the rows when ``Frames`` and the row count differ by a clean integer factor.
+
+    The header duration ``n_declared / header_fps`` is trusted: with ``k = round(n_declared /
+    n_rows)`` (or its inverse) in ``2..MAX_RATE_FACTOR`` and ``|n_declared - k * n_rows|`` within
+    1 % of the larger count, the rows are at ``header_fps / k`` (``header_fps * k`` when there are
+    more rows than declared). Otherwise ``None`` (e.g. a truncated file).
+
+    Examples
+    --------
+    >>> infer_row_rate(7669, 120.0, 957)  # a 120 fps header over 15 fps rows
+    15.0
+    >>> infer_row_rate(100, 120.0, 99) is None
+    True
+    """
+    if min(n_declared, n_rows) < 2 or n_declared == n_rows:
+        return None
+    big, small = max(n_declared, n_rows), min(n_declared, n_rows)
+    k = round(big / small)
+    if not 2 <= k <= MAX_RATE_FACTOR or abs(big - k * small) > 0.01 * big:
+        return None
+    rate = header_fps / k if n_declared > n_rows else header_fps * k
+    return rate if rate >= 1.0 else None
+
+
+def _settle_rate(
+    p: Path, n_declared: int, file_fps: float | None, n_rows: int, override: float | None
+) -> float:
+    """The rate to read the rows at, with the one warning that names both readings and the override.
+
+    ``file_fps`` is the ``Frame Time`` rate (None when unreadable, then ``override`` is set).
+    An override equal to the inferred rate is silent: the mismatch was already resolved.
+    """
+    inferred = None if file_fps is None else infer_row_rate(n_declared, file_fps, n_rows)
+    if n_rows == n_declared or (override is not None and override == inferred):
+        return float(override if override is not None else file_fps)  # type: ignore[arg-type]
+    message = f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows"
+    if override is not None or inferred is None or file_fps is None:
+        rate = float(override if override is not None else file_fps)  # type: ignore[arg-type]
+        hint = (
+            ""
+            if override is not None
+            else " (pass fps= to read_bvh, bvh_fps= to load_take/index_folder if the rate is wrong)"
+        )
+        warnings.warn(
+            f"{p}: {message}; using the {n_rows} rows at {rate:g} fps{hint}", BVHWarning, stacklevel=3
+        )
+        return rate
+    warnings.warn(
+        f"{p}: {message}: the header says {n_declared / file_fps:.2f} s at {file_fps:g} fps, so the rows "
+        f"are read at {inferred:g} fps ({n_rows / inferred:.2f} s), not at the header's {file_fps:g} fps "
+        f"({n_rows / file_fps:.2f} s); pass fps={file_fps:g} to read_bvh (bvh_fps= to load_take/"
+        "index_folder) to keep the header rate",
+        BVHWarning,
+        stacklevel=3,
+    )
+    return inferred
+
+
+def convert_units(skeleton: Skeleton, channels: np.ndarray, factor: float) -> tuple[Skeleton, np.ndarray]:
+    """Scale offsets, End Sites and position channels by ``factor`` (e.g. 100 for metres -> cm)."""
+    if factor == 1.0:
+        return skeleton, channels
+    cols = [
+        int(start) + k
+        for start, chans in zip(skeleton.channel_starts, skeleton.channels)
+        for k, c in enumerate(chans)
+        if c.endswith("position")
+    ]
+    channels = channels.copy()
+    channels[:, cols] *= factor
+    scaled = dataclasses.replace(
+        skeleton,
+        offsets=skeleton.offsets * factor,
+        end_sites={j: v * factor for j, v in skeleton.end_sites.items()},
+    )
+    return scaled, channels
+
+
+def _check_units(p: Path, skeleton: Skeleton, units: str) -> float:
+    """Factor to centimetres for ``units``; ``"auto"`` warns when the skeleton looks like metres."""
+    if units == "auto":
+        from beatlite.skeleton.kinematics import skeleton_extent
+
+        extent = skeleton_extent(skeleton)
+        if 0 < extent < METRE_EXTENT:
+            warnings.warn(
+                f"{p}: the rest pose is only {extent:.3g} units tall, so the file is probably in metres "
+                "(beatlite works in centimetres); pass units='m' to convert or units='cm' to keep the values",
+                BVHWarning,
+                stacklevel=3,
+            )
+    return UNITS[units]
+
+
+def read_bvh(
+    path: str | os.PathLike[str], *, fps: float | None = None, strict: bool = False, units: str = "auto"
+) -> Motion:
     """Read a BVH file (``.bvh`` or ``.bvh.gz``) into a :class:`Motion`.
 
     Parameters
     ----------
     path : str or PathLike
-        The file. Gzip is detected from the content.
+        The file. Gzip is detected from the content; LF, CRLF or CR-only line endings.
     fps : float, optional
-        Frame rate to use instead of the file's ``Frame Time`` (some real BEAT
+        Frame rate of the rows, instead of the file's ``Frame Time`` (some real BEAT
         files have a wrong one, docs/reference_code.md#bvh-header). By default the rate comes from
-        :func:`parse_frame_time`, which snaps e.g. ``0.008333`` to 120.
+        :func:`parse_frame_time`, which snaps e.g. ``0.008333`` to 120; when
+        ``Frames`` and the row count differ by a clean integer factor the rows are
+        read at the rate that keeps the header duration (:func:`infer_row_rate`).
     strict : bool
         If True, a ``Frames:`` value that differs from the number of rows
         raises :class:`FormatError`; otherwise a :class:`BVHWarning` naming
-        both numbers is issued and the rows are used.
+        both numbers (and both readings of the rate) is issued and the rows are used.
+    units : {"auto", "cm", "m", "mm"}
+        Length unit of the file. ``"m"``/``"mm"`` convert to centimetres; ``"auto"``
+        (default) keeps the values and warns when the skeleton looks like metres.
 
     Returns
     -------
@@ -529,29 +716,33 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None, strict: 
            [  4., 105.,   0.]])
     """
     p = Path(path)
+    if units not in UNITS:
+        raise ValueError(f"read_bvh: units must be one of {sorted(UNITS)}, got {units!r}")
     if fps is not None:
         fps = float(fps)
         if not math.isfinite(fps) or fps <= 0:
             raise ValueError(f"read_bvh: fps must be a positive number, got {fps}")
-    with open_binary(p) as f:
-        skeleton, n_declared, time_text, time_line, n_header = _read_header(f, p)
+    f, head = _open_bvh(p)
+    with f:
+        skeleton, n_declared, time_text, time_line, n_header = _read_header(f, p, head)
         try:
             data = f.read()
         except (OSError, EOFError) as exc:
             raise FormatError(p, f"cannot decompress gzip data: {exc}") from None
-    if fps is None:
-        try:
-            fps = parse_frame_time(time_text)
-        except ValueError as exc:
+    factor = _check_units(p, skeleton, units)
+    try:
+        file_fps: float | None = parse_frame_time(time_text)
+    except ValueError as exc:
+        if fps is None:
             raise FormatError(p, f"{exc} (pass fps= to override)", line=time_line) from None
+        file_fps = None
     channels = _parse_motion(data, skeleton.n_channels, n_header + 1, p)
     n_rows = channels.shape[0]
-    if n_rows != n_declared:
-        message = f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows"
-        if strict:
-            raise FormatError(p, message, field="Frames")
-        warnings.warn(f"{p}: {message}; using the {n_rows} rows", BVHWarning, stacklevel=2)
-    return Motion(skeleton=skeleton, channels=channels, fps=fps)
+    if strict and n_rows != n_declared:
+        raise FormatError(p, f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows", field="Frames")
+    rate = _settle_rate(p, n_declared, file_fps, n_rows, fps)
+    skeleton, channels = convert_units(skeleton, channels, factor)
+    return Motion(skeleton=skeleton, channels=channels, fps=rate)
 
 
 def _fmt_offset(value: float) -> str:
@@ -559,31 +750,60 @@ def _fmt_offset(value: float) -> str:
     return text if float(text) == value else repr(float(value))
 
 
+def _check_names(skeleton: Skeleton) -> None:
+    """Joint names that :func:`read_bvh` could not read back raise ``ValueError``."""
+    seen: set[str] = set()
+    for j, name in enumerate(skeleton.names):
+        if not isinstance(name, str) or not name.strip() or " ".join(name.split()) != name:
+            raise ValueError(
+                f"write_bvh: joint {j} name {name!r} is empty, has leading/trailing or repeated "
+                "whitespace, a tab or a newline, so it cannot be read back"
+            )
+        if "{" in name or "}" in name:
+            raise ValueError(
+                f"write_bvh: joint {j} name {name!r} contains a brace, so it cannot be read back"
+            )
+        if name in seen:
+            raise ValueError(f"write_bvh: joint name {name!r} appears twice")
+        seen.add(name)
+
+
+def _joint_lines(skeleton: Skeleton, j: int, pad: str) -> list[str]:
+    """The opening lines of joint ``j``: keyword and name, brace, OFFSET, CHANNELS."""
+    keyword = "ROOT" if j == 0 else "JOINT"
+    lines = [f"{pad}{keyword} {skeleton.names[j]}", f"{pad}{{"]
+    lines.append(pad + "\tOFFSET " + " ".join(_fmt_offset(float(v)) for v in skeleton.offsets[j]))
+    if skeleton.channels[j]:
+        lines.append(f"{pad}\tCHANNELS {len(skeleton.channels[j])} " + " ".join(skeleton.channels[j]))
+    return lines
+
+
+def _closing_lines(skeleton: Skeleton, j: int, pad: str) -> list[str]:
+    """The End Site of joint ``j`` (if any) and its closing brace."""
+    lines = []
+    if j in skeleton.end_sites:
+        offset = " ".join(_fmt_offset(float(v)) for v in skeleton.end_sites[j])
+        lines += [f"{pad}\tEnd Site", f"{pad}\t{{", f"{pad}\t\tOFFSET {offset}", f"{pad}\t}}"]
+    lines.append(f"{pad}}}")
+    return lines
+
+
 def _header_text(skeleton: Skeleton) -> list[str]:
-    lines = ["HIERARCHY"]
+    """HIERARCHY lines, written with an explicit stack (no recursion limit on deep chains)."""
     children: list[list[int]] = [[] for _ in range(skeleton.n_joints)]
     for j, p in enumerate(skeleton.parents[1:], start=1):
         children[int(p)].append(j)
-
-    def emit(j: int, depth: int) -> None:
+    lines = ["HIERARCHY"]
+    stack: list[tuple[int, int, bool]] = [(0, 0, False)]  # (joint, depth, children done)
+    while stack:
+        j, depth, done = stack.pop()
         pad = "\t" * depth
-        keyword = "ROOT" if j == 0 else "JOINT"
-        lines.append(f"{pad}{keyword} {skeleton.names[j]}")
-        lines.append(f"{pad}{{")
-        lines.append(pad + "\tOFFSET " + " ".join(_fmt_offset(float(v)) for v in skeleton.offsets[j]))
-        if skeleton.channels[j]:
-            lines.append(f"{pad}\tCHANNELS {len(skeleton.channels[j])} " + " ".join(skeleton.channels[j]))
-        for c in children[j]:
-            emit(c, depth + 1)
-        if j in skeleton.end_sites:
-            lines.append(f"{pad}\tEnd Site")
-            lines.append(f"{pad}\t{{")
-            lines.append(pad + "\t\tOFFSET " + " ".join(_fmt_offset(float(v)) for v in skeleton.end_sites[j]))
-            lines.append(f"{pad}\t}}")
-        lines.append(f"{pad}}}")
-
-    # file order must be depth-first: check that recursion reproduces it
-    emit(0, 0)
+        if done:
+            lines += _closing_lines(skeleton, j, pad)
+            continue
+        lines += _joint_lines(skeleton, j, pad)
+        stack.append((j, depth, True))
+        stack.extend((c, depth + 1, False) for c in reversed(children[j]))
     return lines
 
 
@@ -595,7 +815,9 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion, *, precision: int = 
     path : str or PathLike
         Destination.
     motion : Motion
-        Skeleton and ``(T, C)`` channels; non-finite values are rejected.
+        Skeleton and ``(T, C)`` channels; non-finite values are rejected, and so are
+        joint names the reader could not read back (braces, newlines, tabs, repeated or
+        edge whitespace, duplicates). Any depth of hierarchy is written (no recursion).
     precision : int
         Decimals printed for each channel value (0..17). Values already
         rounded to ``precision`` decimals read back bit-identical.
@@ -611,6 +833,7 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion, *, precision: int = 
         row, col = np.argwhere(~np.isfinite(values))[0]
         raise ValueError(f"write_bvh: motion.channels[{row}, {col}] is {values[row, col]} (not finite)")
     skeleton = motion.skeleton
+    _check_names(skeleton)
     order = _depth_first_order(skeleton)
     if not np.array_equal(order, np.arange(skeleton.n_joints)):
         raise ValueError("write_bvh: skeleton joints are not in depth-first (file) order")

@@ -17,7 +17,7 @@ import numpy as np
 
 from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError
-from beatlite.io.semantic import parse_number, segments_to_frames
+from beatlite.io.semantic import check_times, parse_number, segments_to_frames, warn_durations
 from beatlite.io.textfile import read_text
 
 __all__ = ["EmotionSegment", "read_emotion", "write_emotion", "emotion_to_frames", "N_EMOTIONS"]
@@ -46,11 +46,14 @@ def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
     Raises
     ------
     FormatError
-        Not 5 fields, a non-numeric field, ``start > end`` or a class that is
-        not a whole number in 0..7, naming the line and the field.
+        An empty file (no row: not "neutral"), not 5 fields, a non-numeric field, a
+        negative time, ``start > end`` or a class that is not a whole number in 0..7,
+        naming the line and the field. Rows whose ``duration`` is not
+        ``end - start`` give one :class:`FormatWarning`.
     """
     p = Path(path)
     out: list[EmotionSegment] = []
+    notes: list[str] = []
     for lineno, raw in enumerate(read_text(p).split("\n"), start=1):
         if not raw.strip():
             continue
@@ -65,8 +68,8 @@ def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
         end = parse_number(p, parts[2], lineno, "end")
         duration = parse_number(p, parts[3], lineno, "duration")
         value = parse_number(p, parts[4], lineno, "class")
-        if start > end:
-            raise FormatError(p, f"start {start} is after end {end}", line=lineno, field="start")
+        if (note := check_times(p, lineno, start, end, duration)) is not None:
+            notes.append(note)
         if value != int(value) or not 0 <= value < N_EMOTIONS:
             raise FormatError(
                 p,
@@ -75,6 +78,9 @@ def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
                 field="class",
             )
         out.append(EmotionSegment(parts[0], start, end, duration, int(value)))
+    if not out:
+        raise FormatError(p, "no emotion rows (an empty file is not 'neutral'; delete it instead)")
+    warn_durations(p, notes)
     return out
 
 

@@ -53,7 +53,14 @@ class FormatError(ValueError):
         super().__init__(f"{', '.join(where)}: {message}")
 
 
-class BVHWarning(UserWarning):
+class FormatWarning(UserWarning):
+    """A file is readable but inconsistent (truncated audio, annotation times that disagree, ...).
+
+    The message names the file and what was assumed.
+    """
+
+
+class BVHWarning(FormatWarning):
     """A BVH file is readable but inconsistent, e.g. ``Frames: 100`` above 99 motion rows."""
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,10 +20,18 @@ from pathlib import Path
 import numpy as np
 
 from beatlite.io.atomic import atomic_write
-from beatlite.io.errors import FormatError
+from beatlite.io.errors import FormatError, FormatWarning
 from beatlite.io.textfile import read_text
 
-__all__ = ["ARKIT_52", "ARKIT_51", "Facial", "read_facial", "write_facial", "estimate_fps"]
+__all__ = [
+    "ARKIT_52",
+    "ARKIT_51",
+    "Facial",
+    "read_facial",
+    "select_blendshapes",
+    "write_facial",
+    "estimate_fps",
+]
 
 #: The 52 ARKit blendshapes in the standard order (ARKit documentation / Live Link Face CSV).
 ARKIT_52: tuple[str, ...] = (
@@ -42,6 +51,8 @@ ARKIT_52: tuple[str, ...] = (
 ARKIT_51: tuple[str, ...] = tuple(n for n in ARKIT_52 if n != "tongueOut")
 
 DEFAULT_FPS = 60.0
+#: Frame rates the time stamps may imply (Hz).
+FPS_RANGE = (1.0, 1000.0)
 
 
 @dataclass(eq=False)
@@ -90,21 +101,129 @@ def estimate_fps(times: np.ndarray, default: float = DEFAULT_FPS) -> float:
     if t.size < 2:
         return float(default)
     fps = 1.0 / float(np.median(np.diff(t)))
+    if not math.isfinite(fps):
+        return fps
     n = round(fps)
     return float(n) if n >= 1 and abs(fps - n) <= 0.01 * n else fps
 
 
-def _number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+def _parse_json(p: Path) -> dict:
+    """The JSON object of ``p``; numbers become floats (no digit limit, no overflow)."""
+    text = read_text(p)
+    if not text.strip():
+        raise FormatError(p, "empty file: expected facial JSON")
+    try:
+        doc = json.loads(text, parse_int=float)
+    except json.JSONDecodeError as exc:
+        raise FormatError(p, f"invalid JSON: {exc.msg}", line=exc.lineno, column=exc.colno) from None
+    except RecursionError:
+        raise FormatError(p, "invalid JSON: nested too deeply") from None
+    if not isinstance(doc, dict):
+        raise FormatError(p, f"top level must be an object, got {type(doc).__name__}")
+    for key in ("names", "frames"):
+        if key not in doc:
+            raise FormatError(
+                p, f"missing key {key!r} (keys present: {sorted(map(str, doc))[:10]})", field=key
+            )
+    names = doc["names"]
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        raise FormatError(p, "'names' must be a non-empty list of strings", field="names")
+    if len(set(names)) != len(names):
+        twice = sorted({n for n in names if names.count(n) > 1})
+        raise FormatError(p, f"blendshape names appear twice: {twice[:5]}", field="names")
+    if not isinstance(doc["frames"], list):
+        raise FormatError(p, f"'frames' must be a list, got {type(doc['frames']).__name__}", field="frames")
+    return doc
 
 
-def read_facial(path: str | os.PathLike[str]) -> Facial:
+def _frame_values(p: Path, i: int, frame: object, k: int) -> tuple[float, list[float]]:
+    """``(time, weights)`` of frame ``i``, each a finite float (bools and strings refused)."""
+    if not isinstance(frame, dict):
+        raise FormatError(p, f"frame {i} is not an object", field=f"frames[{i}]")
+    for key in ("time", "weights"):
+        if key not in frame:
+            raise FormatError(p, f"frame {i} has no {key!r}", field=f"frames[{i}].{key}")
+    t, w = frame["time"], frame["weights"]
+    if type(t) is not float or not math.isfinite(t):
+        raise FormatError(p, f"frame {i}: time {t!r:.40} is not a finite number", field=f"frames[{i}].time")
+    if not isinstance(w, list) or len(w) != k:
+        got = len(w) if isinstance(w, list) else type(w).__name__
+        raise FormatError(
+            p, f"frame {i} has {got} weights but there are {k} names", field=f"frames[{i}].weights"
+        )
+    bad = next((j for j, v in enumerate(w) if type(v) is not float or not math.isfinite(v)), None)
+    if bad is not None:
+        raise FormatError(
+            p,
+            f"frame {i}: weight {bad} ({w[bad]!r:.40}) is not a finite number",
+            field=f"frames[{i}].weights",
+        )
+    return t, w
+
+
+def select_blendshapes(
+    facial: Facial, names: Sequence[str] = ARKIT_51, *, path: str | os.PathLike[str] | None = None
+) -> Facial:
+    """The weights of ``names``, in that order, picked from ``facial`` by name.
+
+    Parameters
+    ----------
+    facial : Facial
+        As read (any column order, e.g. an ARKit export with 52 names).
+    names : sequence of str
+        The canonical order (default :data:`ARKIT_51`, BEAT's 51 channels).
+    path : str or PathLike, optional
+        File named in errors and warnings.
+
+    Returns
+    -------
+    Facial
+        ``weights`` (T, len(names)) float32 in the order of ``names``.
+
+    Raises
+    ------
+    FormatError
+        If a name of ``names`` is missing (naming it). Extra names (``tongueOut``) are
+        dropped, and a different column order is reordered, each with one
+        :class:`FormatWarning`.
+    """
+    wanted = tuple(names)
+    where = {n: i for i, n in enumerate(facial.names)}
+    missing = [n for n in wanted if n not in where]
+    if missing:
+        raise FormatError(
+            path,
+            f"blendshape {missing[0]!r} is missing ({len(missing)} of {len(wanted)} missing: {missing[:5]})",
+            field="names",
+        )
+    extra = [n for n in facial.names if n not in set(wanted)]
+    kept = [n for n in facial.names if n not in set(extra)]
+    if extra:
+        warnings.warn(
+            f"{path}: dropping {len(extra)} blendshapes not in the canonical {len(wanted)}: {extra[:5]}",
+            FormatWarning,
+            stacklevel=2,
+        )
+    if kept != list(wanted):
+        warnings.warn(
+            f"{path}: blendshape columns are in another order; reordered by name to the canonical order",
+            FormatWarning,
+            stacklevel=2,
+        )
+    cols = np.array([where[n] for n in wanted], dtype=np.int64)
+    return Facial(names=wanted, weights=facial.weights[:, cols], times=facial.times, fps=facial.fps)
+
+
+def read_facial(path: str | os.PathLike[str], *, names: Sequence[str] | None = None) -> Facial:
     """Read a BEAT facial JSON file (``.json`` or ``.json.gz``).
 
     Parameters
     ----------
     path : str or PathLike
         The file.
+    names : sequence of str, optional
+        Canonical blendshape order to map the columns to by name
+        (:func:`select_blendshapes`, e.g. :data:`ARKIT_51`); default: the file's own.
 
     Returns
     -------
@@ -114,58 +233,21 @@ def read_facial(path: str | os.PathLike[str]) -> Facial:
     Raises
     ------
     FormatError
-        Invalid JSON (line/column), a missing key, a frame whose weight count
-        differs from the number of names, a non-numeric or non-finite value, or
-        time stamps that do not increase (each naming the frame index).
+        Invalid or too deeply nested JSON (line/column), a missing key, duplicate
+        names, a frame whose weight count differs from the number of names, a weight
+        or time that is not a finite number (strings and booleans included), or time
+        stamps that do not increase (each naming the frame index).
     """
     p = Path(path)
-    text = read_text(p)
-    if not text.strip():
-        raise FormatError(p, "empty file: expected facial JSON")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FormatError(p, f"invalid JSON: {exc.msg}", line=exc.lineno, column=exc.colno) from None
-    if not isinstance(doc, dict):
-        raise FormatError(p, f"top level must be an object, got {type(doc).__name__}")
-    for key in ("names", "frames"):
-        if key not in doc:
-            raise FormatError(p, f"missing key {key!r} (keys present: {sorted(doc)})", field=key)
-    names = doc["names"]
-    if not isinstance(names, list) or not all(isinstance(n, str) for n in names) or not names:
-        raise FormatError(p, "'names' must be a non-empty list of strings", field="names")
-    frames = doc["frames"]
-    if not isinstance(frames, list):
-        raise FormatError(p, f"'frames' must be a list, got {type(frames).__name__}", field="frames")
-    k = len(names)
+    doc = _parse_json(p)
+    frames, k = doc["frames"], len(doc["names"])
     times = np.empty(len(frames), dtype=np.float64)
     weights = np.empty((len(frames), k), dtype=np.float32)
     for i, frame in enumerate(frames):
-        if not isinstance(frame, dict):
-            raise FormatError(p, f"frame {i} is not an object", field=f"frames[{i}]")
-        for key in ("time", "weights"):
-            if key not in frame:
-                raise FormatError(p, f"frame {i} has no {key!r}", field=f"frames[{i}].{key}")
-        t, w = frame["time"], frame["weights"]
-        if not _number(t) or not math.isfinite(t):
-            raise FormatError(p, f"frame {i}: time {t!r} is not a finite number", field=f"frames[{i}].time")
-        if not isinstance(w, list) or len(w) != k:
-            got = len(w) if isinstance(w, list) else type(w).__name__
-            raise FormatError(
-                p, f"frame {i} has {got} weights but there are {k} names", field=f"frames[{i}].weights"
-            )
-        times[i] = t
-        try:
-            weights[i] = w
-        except (TypeError, ValueError):
-            bad = next(v for v in w if not _number(v))
-            raise FormatError(
-                p, f"frame {i}: weight {bad!r} is not a number", field=f"frames[{i}].weights"
-            ) from None
-    bad_rows = np.flatnonzero(~np.isfinite(weights).all(axis=1))
-    if bad_rows.size:
-        i = int(bad_rows[0])
-        raise FormatError(p, f"frame {i} has a non-finite weight", field=f"frames[{i}].weights")
+        times[i], weights[i] = _frame_values(p, i, frame, k)
+    if not np.isfinite(weights).all():  # finite float64 beyond float32's range
+        i = int(np.flatnonzero(~np.isfinite(weights).all(axis=1))[0])
+        raise FormatError(p, f"frame {i} has a weight beyond float32 range", field=f"frames[{i}].weights")
     steps = np.diff(times)
     if steps.size and not (steps > 0).all():
         i = int(np.flatnonzero(steps <= 0)[0]) + 1
@@ -174,7 +256,13 @@ def read_facial(path: str | os.PathLike[str]) -> Facial:
             f"time stamps must increase: frame {i} has time {times[i]} after {times[i - 1]}",
             field=f"frames[{i}].time",
         )
-    return Facial(names=tuple(names), weights=weights, times=times, fps=estimate_fps(times))
+    fps = estimate_fps(times)
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+        raise FormatError(
+            p, f"frame times imply {fps:g} fps, outside {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}", field="frames"
+        )
+    facial = Facial(names=tuple(doc["names"]), weights=weights, times=times, fps=fps)
+    return facial if names is None else select_blendshapes(facial, names, path=p)
 
 
 def write_facial(

@@ -192,8 +192,12 @@ class TakeName:
 
 
 def _int_field(path: str, text: str, field: str) -> int:
-    if not text.isdigit():
-        raise FormatError(path, f"take name {path!r}: {field} {text!r} is not a whole number", field=field)
+    """``int(text)`` for 1 to 6 ASCII digits (no superscripts, no 4300-digit numbers)."""
+    if not (text.isascii() and text.isdigit() and len(text) <= 6):
+        shown = text if len(text) <= 20 else text[:20] + "..."
+        raise FormatError(
+            path, f"take name {path[:60]!r}: {field} {shown!r} is not a whole number", field=field
+        )
     return int(text)
 
 

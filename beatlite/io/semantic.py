@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -18,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from beatlite.io.atomic import atomic_write
-from beatlite.io.errors import FormatError
+from beatlite.io.errors import FormatError, FormatWarning
 from beatlite.io.textfile import read_text
 
 __all__ = ["SemanticSegment", "read_semantic", "write_semantic", "semantic_to_frames", "segments_to_frames"]
@@ -48,6 +49,32 @@ def parse_number(path: Path, token: str, line: int, field: str) -> float:
     return value
 
 
+#: Largest ``|duration - (end - start)|`` accepted without a warning, seconds (BEAT prints 3 decimals).
+DURATION_TOLERANCE = 0.01
+
+
+def check_times(path: Path, line: int, start: float, end: float, duration: float) -> str | None:
+    """Raise for negative or reversed times; return a note when ``duration != end - start``."""
+    if start < 0 or end < 0:
+        raise FormatError(path, f"negative time: start {start}, end {end}", line=line, field="start")
+    if start > end:
+        raise FormatError(path, f"start {start} is after end {end}", line=line, field="start")
+    if abs(duration - (end - start)) > DURATION_TOLERANCE:
+        return f"line {line}: duration {duration} but end - start = {end - start:.6g}"
+    return None
+
+
+def warn_durations(path: Path, notes: list[str]) -> None:
+    """One :class:`FormatWarning` for the rows whose duration disagrees with their times."""
+    if notes:
+        warnings.warn(
+            f"{path}: {len(notes)} rows have a duration that is not end - start, e.g. {notes[0]}; "
+            "the start and end times are used",
+            FormatWarning,
+            stacklevel=3,
+        )
+
+
 def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
     """Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
 
@@ -65,11 +92,13 @@ def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
     Raises
     ------
     FormatError
-        Fewer than 5 fields, a non-numeric time/score, ``start > end`` or a
-        score outside [0, 1], naming the line and the field.
+        Fewer than 5 fields, a non-numeric time/score, a negative time, ``start > end``
+        or a score outside [0, 1], naming the line and the field. Rows whose
+        ``duration`` is not ``end - start`` give one :class:`FormatWarning`.
     """
     p = Path(path)
     out: list[SemanticSegment] = []
+    notes: list[str] = []
     for lineno, raw in enumerate(read_text(p).split("\n"), start=1):
         if not raw.strip():
             continue
@@ -85,12 +114,13 @@ def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
         score = parse_number(p, parts[4], lineno, "score")
         if not parts[0]:
             raise FormatError(p, "empty gesture type", line=lineno, field="type")
-        if start > end:
-            raise FormatError(p, f"start {start} is after end {end}", line=lineno, field="start")
+        if (note := check_times(p, lineno, start, end, duration)) is not None:
+            notes.append(note)
         if not 0.0 <= score <= 1.0:
             raise FormatError(p, f"score {score} is outside [0, 1]", line=lineno, field="score")
         keywords = " ".join(x for x in parts[5:] if x)
         out.append(SemanticSegment(parts[0], start, end, duration, score, keywords))
+    warn_durations(p, notes)
     return out
 
 

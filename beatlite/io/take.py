@@ -22,6 +22,17 @@ Modalities of different lengths are truncated to the shortest, with an
 :class:`~beatlite.io.errors.AlignmentWarning` (a ``UserWarning``) naming each
 duration when they differ by more than one frame.
 
+Frame rates that lie
+--------------------
+The rate of the BVH rows is settled before anything is cut: :func:`read_bvh`
+trusts the header duration when ``Frames`` and the row count differ by a clean
+integer factor, and :func:`reconcile_rate` then compares the motion with the
+audio (else face, else TextGrid) duration and, when they disagree by more than
+:data:`RATE_GAP_S`, picks the one clean factor of the header rate that makes
+them agree. Each change is one :class:`~beatlite.io.errors.BVHWarning` naming
+both readings; ``bvh_fps=`` overrides it all. The dataset index runs the same
+code (:func:`read_take_motion`), so it reports the duration loading produces.
+
 Taught in notebooks/01_beat_formats.ipynb, section 11 (one timeline: ``load_take`` at 15 fps).
 """
 
@@ -30,26 +41,43 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from beatlite.io.audio import read_audio
-from beatlite.io.bvh import read_bvh
+from beatlite.io.bvh import parse_frame_time, read_bvh, read_bvh_header
 from beatlite.io.emotion import EmotionSegment, emotion_to_frames, read_emotion
-from beatlite.io.errors import AlignmentWarning, FormatError
-from beatlite.io.facial import read_facial
+from beatlite.io.errors import AlignmentWarning, BVHWarning, FormatError
+from beatlite.io.facial import ARKIT_51, Facial, read_facial
 from beatlite.io.motion import Motion
 from beatlite.io.names import TakeName, parse_take_name
 from beatlite.io.semantic import SemanticSegment, read_semantic, semantic_to_frames
 from beatlite.io.textfile import resolve
 from beatlite.io.textgrid import WordIntervals, read_words
 
-__all__ = ["Take", "load_take", "take_stem", "resample_frames", "PHASES", "TAKE_EXTENSIONS"]
+__all__ = [
+    "Take",
+    "load_take",
+    "take_stem",
+    "take_files",
+    "read_take_motion",
+    "read_take_words",
+    "reconcile_rate",
+    "reference_duration",
+    "resample_frames",
+    "PHASES",
+    "TAKE_EXTENSIONS",
+    "RATE_GAP_S",
+]
 
 PHASES = ("start", "beat")
 TAKE_EXTENSIONS = (".bvh", ".wav", ".json", ".TextGrid", ".txt", ".csv")
+#: Seconds by which motion may differ from the other modalities before its frame rate is questioned
+#: (the dataset index's ``MAX_DURATION_GAP``).
+RATE_GAP_S = 1.0
 
 
 @dataclass(eq=False)
@@ -203,6 +231,169 @@ def _optional(stem: Path, ext: str) -> Path | None:
         return None
 
 
+def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Path]]:
+    """The stem of a take and its files by extension (:data:`TAKE_EXTENSIONS`, plain or ``.gz``).
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no ``.bvh`` / ``.bvh.gz`` for the stem.
+    """
+    stem = take_stem(stem_or_path)
+    paths = {".bvh": resolve(stem, ".bvh")}
+    for ext in TAKE_EXTENSIONS[1:]:
+        if (found := _optional(stem, ext)) is not None:
+            paths[ext] = found
+    return stem, paths
+
+
+def read_take_words(path: str | os.PathLike[str]) -> WordIntervals:
+    """The words of a take's TextGrid: tier ``"words"`` (MFA), else tier 0 as BEAT's loader does."""
+    try:
+        return read_words(path, tier="words")
+    except FormatError as exc:
+        if exc.field != "words":
+            raise
+        return read_words(path, tier=0)
+
+
+def reference_duration(durations: dict[str, float], half: str | None = None) -> float | None:
+    """The duration the motion should match: the audio's, else the face's, else the TextGrid's.
+
+    The TextGrid of an ``_a``/``_b`` half spans the whole sequence (docs/reference_code.md#textgrid), so it is not used then.
+    """
+    for modality in ("audio", "face", "text"):
+        if modality in durations and not (modality == "text" and half):
+            return float(durations[modality])
+    return None
+
+
+def reconcile_rate(n_rows: int, fps: float, header_fps: float, reference_s: float | None) -> float | None:
+    """A clean-factor motion rate that matches the other modalities, when ``fps`` does not.
+
+    When ``n_rows / fps`` is more than :data:`RATE_GAP_S` seconds from ``reference_s``, the
+    rates ``header_fps``, ``header_fps * k`` and ``header_fps / k`` (``k = 2..16``) are tried;
+    the one rate whose duration ``n_rows / r`` lies within ``max(0.15 s, 1 %)`` of
+    ``reference_s`` is returned. ``None`` keeps ``fps`` (no reference, close enough, no fit,
+    or an ambiguous fit).
+
+    Examples
+    --------
+    >>> reconcile_rate(240, 24.0, 24.0, 2.0)  # 120 fps rows under 'Frame Time: 0.041667' (docs/reference_code.md#bvh-header)
+    120.0
+    >>> reconcile_rate(957, 15.0, 120.0, 64.0) is None  # already agrees
+    True
+    """
+    if reference_s is None or reference_s <= 0 or n_rows < 2:
+        return None
+    if abs(n_rows / fps - reference_s) <= RATE_GAP_S:
+        return None
+    rates = {header_fps} | {header_fps * k for k in range(2, 17)} | {header_fps / k for k in range(2, 17)}
+    tolerance = max(0.15, 0.01 * reference_s)
+    fits = [r for r in rates if r >= 1.0 and r != fps and abs(n_rows / r - reference_s) <= tolerance]
+    return fits[0] if len(fits) == 1 else None
+
+
+def read_take_motion(
+    path: str | os.PathLike[str], *, bvh_fps: float | None = None, reference_s: float | None = None
+) -> Motion:
+    """Read a take's BVH at the frame rate that agrees with the take's other files.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The ``.bvh`` / ``.bvh.gz``.
+    bvh_fps : float, optional
+        The rate of the rows, an override: nothing is inferred.
+    reference_s : float, optional
+        Duration of the other modalities (:func:`reference_duration`). Without an override,
+        :func:`read_bvh` settles the rate from the header (:func:`~beatlite.io.bvh.infer_row_rate`),
+        then :func:`reconcile_rate` may change it to a clean factor of the header rate that
+        matches ``reference_s``, with one :class:`BVHWarning` naming both readings and the override.
+
+    Returns
+    -------
+    Motion
+    """
+    p = Path(path)
+    if bvh_fps is not None:
+        return read_bvh(p, fps=bvh_fps)
+    motion = read_bvh(p)
+    _, _, frame_time = read_bvh_header(p)
+    header_fps = parse_frame_time(repr(frame_time))
+    rate = reconcile_rate(motion.n_frames, motion.fps, header_fps, reference_s)
+    if rate is None:
+        return motion
+    warnings.warn(
+        f"{p}: {motion.n_frames} rows at {motion.fps:g} fps last {motion.duration:.2f} s but the take's "
+        f"other files last {reference_s:.2f} s; reading the rows at {rate:g} fps ({motion.n_frames / rate:.2f} s), "
+        f"a clean factor of the header's {header_fps:g} fps. Pass bvh_fps= to load_take/index_folder to choose",
+        BVHWarning,
+        stacklevel=2,
+    )
+    return Motion(motion.skeleton, motion.channels, rate)
+
+
+def _check_load_args(fps: float, phase: str) -> float:
+    if phase not in PHASES:
+        raise ValueError(f"load_take: phase must be one of {PHASES}, got {phase!r}")
+    if not np.isfinite(fps) or fps <= 0:
+        raise ValueError(f"load_take: fps must be positive, got {fps!r}")
+    return float(fps)
+
+
+def _align(
+    name: str, source: Motion, audio: np.ndarray | None, sr: int, face: Facial | None, fps: float, phase: str
+) -> tuple[Motion, np.ndarray | None, np.ndarray | None]:
+    """Motion and face resampled to ``fps`` and every modality cut to the shortest (with a warning)."""
+    shift = 1 if phase == "beat" else 0
+    channels = resample_frames(
+        source.channels, source.fps, fps, shift=shift, angle_columns=_rotation_columns(source)
+    )
+    lengths = {"motion": channels.shape[0] / fps}
+    n_frames = channels.shape[0]
+    if audio is not None:
+        lengths["audio"] = audio.shape[0] / sr
+        n_frames = min(n_frames, int(math.floor(audio.shape[0] * fps / sr + 1e-9)))
+    face_frames = None
+    if face is not None:
+        face_frames = resample_frames(face.weights, face.fps, fps, shift=0)
+        lengths["face"] = face_frames.shape[0] / fps
+        n_frames = min(n_frames, face_frames.shape[0])
+    if max(lengths.values()) - min(lengths.values()) > 1.0 / fps + 1e-9:
+        detail = ", ".join(f"{k} {v:.3f} s" for k, v in lengths.items())
+        hint = ""
+        if any(abs(v - lengths["motion"]) > RATE_GAP_S for v in lengths.values()):
+            hint = f" (motion read at {source.fps:g} fps: if that rate is wrong, pass bvh_fps=)"
+        warnings.warn(
+            f"{name}: modalities differ in length ({detail}); truncating to {n_frames / fps:.3f} s{hint}",
+            AlignmentWarning,
+            stacklevel=3,
+        )
+    if audio is not None:
+        audio = audio[: int(math.floor(n_frames * sr / fps + 1e-9))]
+    return (
+        Motion(source.skeleton, channels[:n_frames], fps),
+        audio,
+        None if face_frames is None else face_frames[:n_frames],
+    )
+
+
+def _annotations(
+    paths: dict[str, Path], info: TakeName | None, n_frames: int, fps: float
+) -> dict[str, object]:
+    """Semantic and emotion segments and their per-frame arrays (emotion from the name without a ``.csv``)."""
+    semantic_segments = read_semantic(paths[".txt"]) if ".txt" in paths else []
+    emotion_segments = read_emotion(paths[".csv"]) if ".csv" in paths else []
+    default_emotion = info.emotion if info is not None and ".csv" not in paths else 0
+    return {
+        "semantic": semantic_to_frames(semantic_segments, n_frames, fps),
+        "semantic_segments": semantic_segments,
+        "emotion": emotion_to_frames(emotion_segments, n_frames, fps, default=default_emotion),
+        "emotion_segments": emotion_segments,
+    }
+
+
 def load_take(
     stem_or_path: str | os.PathLike[str],
     *,
@@ -210,6 +401,7 @@ def load_take(
     phase: str = "start",
     audio_sr: int = 16000,
     bvh_fps: float | None = None,
+    blendshapes: Sequence[str] | None = ARKIT_51,
 ) -> Take:
     """Read every file of a take and align them on one timeline.
 
@@ -224,7 +416,13 @@ def load_take(
     audio_sr : int
         Audio rate in Hz.
     bvh_fps : float, optional
-        Override of the BVH's ``Frame Time`` (some real BEAT files are wrong, docs/reference_code.md#bvh-header).
+        Rate of the BVH rows, an override of everything the files say. By default the
+        rate is reconciled with the audio (else face, else TextGrid) duration
+        (:func:`read_take_motion`), warning when it differs from the header's.
+    blendshapes : sequence of str or None
+        Canonical face columns, picked by name (default :data:`ARKIT_51`; a missing name
+        is a :class:`FormatError`, extra names such as ``tongueOut`` are dropped with a
+        warning). ``None`` keeps the file's columns.
 
     Returns
     -------
@@ -237,82 +435,26 @@ def load_take(
     FormatError
         From the reader of a malformed file.
     """
-    if phase not in PHASES:
-        raise ValueError(f"load_take: phase must be one of {PHASES}, got {phase!r}")
-    if not np.isfinite(fps) or fps <= 0:
-        raise ValueError(f"load_take: fps must be positive, got {fps!r}")
-    fps = float(fps)
-    stem = take_stem(stem_or_path)
-    paths: dict[str, Path] = {}
-    bvh_path = resolve(stem, ".bvh")
-    paths[".bvh"] = bvh_path
-    source = read_bvh(bvh_path, fps=bvh_fps)
-    channels = resample_frames(
-        source.channels,
-        source.fps,
-        fps,
-        shift=1 if phase == "beat" else 0,
-        angle_columns=_rotation_columns(source),
-    )
-    lengths = {"motion": channels.shape[0] / fps}
-    n_frames = channels.shape[0]
-
-    audio = None
-    if (wav := _optional(stem, ".wav")) is not None:
-        paths[".wav"] = wav
-        audio, audio_sr = read_audio(wav, sr=audio_sr)
-        lengths["audio"] = audio.shape[0] / audio_sr
-        n_frames = min(n_frames, int(math.floor(audio.shape[0] * fps / audio_sr + 1e-9)))
-
-    face = None
-    face_names: tuple[str, ...] = ()
-    if (face_path := _optional(stem, ".json")) is not None:
-        paths[".json"] = face_path
-        facial = read_facial(face_path)
-        face = resample_frames(facial.weights, facial.fps, fps, shift=0)
-        face_names = facial.names
-        lengths["face"] = face.shape[0] / fps
-        n_frames = min(n_frames, face.shape[0])
-
-    if max(lengths.values()) - min(lengths.values()) > 1.0 / fps + 1e-9:
-        detail = ", ".join(f"{k} {v:.3f} s" for k, v in lengths.items())
-        warnings.warn(
-            f"{stem.name}: modalities differ in length ({detail}); truncating to {n_frames / fps:.3f} s",
-            AlignmentWarning,
-            stacklevel=2,
-        )
-    motion = Motion(source.skeleton, channels[:n_frames], fps)
-    if audio is not None:
-        audio = audio[: int(math.floor(n_frames * audio_sr / fps + 1e-9))]
-    if face is not None:
-        face = face[:n_frames]
-
-    words = None
-    if (tg := _optional(stem, ".TextGrid")) is not None:
-        paths[".TextGrid"] = tg
-        try:
-            words = read_words(tg, tier="words")
-        except FormatError as exc:
-            if exc.field != "words":
-                raise
-            words = read_words(tg, tier=0)  # no "words" tier: BEAT's loader uses tier 0
-
+    fps = _check_load_args(fps, phase)
+    stem, paths = take_files(stem_or_path)
+    durations: dict[str, float] = {}
+    audio = facial = words = None
+    if ".wav" in paths:
+        audio, audio_sr = read_audio(paths[".wav"], sr=audio_sr)
+        durations["audio"] = audio.shape[0] / audio_sr
+    if ".json" in paths:
+        facial = read_facial(paths[".json"], names=blendshapes)
+        durations["face"] = facial.n_frames / facial.fps
+    if ".TextGrid" in paths:
+        words = read_take_words(paths[".TextGrid"])
+        durations["text"] = float(words.xmax or 0.0)
     try:
-        info = parse_take_name(stem.name)
+        info: TakeName | None = parse_take_name(stem.name)
     except FormatError:
         info = None
-
-    semantic_segments: list[SemanticSegment] = []
-    if (txt := _optional(stem, ".txt")) is not None:
-        paths[".txt"] = txt
-        semantic_segments = read_semantic(txt)
-    emotion_segments: list[EmotionSegment] = []
-    default_emotion = info.emotion if info is not None else 0
-    if (csv := _optional(stem, ".csv")) is not None:
-        paths[".csv"] = csv
-        emotion_segments = read_emotion(csv)
-        default_emotion = 0
-
+    reference = reference_duration(durations, info.half if info is not None else None)
+    source = read_take_motion(paths[".bvh"], bvh_fps=bvh_fps, reference_s=reference)
+    motion, audio, face = _align(stem.name, source, audio, int(audio_sr), facial, fps, phase)
     return Take(
         name=stem.name,
         fps=fps,
@@ -320,12 +462,9 @@ def load_take(
         audio=audio,
         sr=int(audio_sr),
         face=face,
-        face_names=face_names,
+        face_names=() if facial is None else facial.names,
         words=words,
-        semantic=semantic_to_frames(semantic_segments, n_frames, fps),
-        semantic_segments=semantic_segments,
-        emotion=emotion_to_frames(emotion_segments, n_frames, fps, default=default_emotion),
-        emotion_segments=emotion_segments,
         info=info,
         paths=paths,
+        **_annotations(paths, info, motion.n_frames, fps),  # type: ignore[arg-type]
     )

@@ -11,6 +11,7 @@ from __future__ import annotations
 import gzip
 import io
 import os
+import zlib
 from pathlib import Path
 from typing import IO
 
@@ -26,15 +27,45 @@ def is_gzip(path: str | os.PathLike[str]) -> bool:
         return f.read(2) == GZIP_MAGIC
 
 
+#: What a corrupt or truncated gzip stream raises while it is read.
+GZIP_ERRORS = (gzip.BadGzipFile, EOFError, zlib.error)
+
+
+class _CheckedGzip(gzip.GzipFile):
+    """A gzip stream whose corrupt or truncated data raises :class:`FormatError` naming the file."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(filename=path, mode="rb")
+        self.path = path
+
+    def _checked(self, method: str, *args: int) -> bytes:
+        try:
+            return getattr(super(), method)(*args)
+        except GZIP_ERRORS as exc:
+            raise FormatError(self.path, f"cannot decompress gzip data: {exc}") from None
+
+    def read(self, size: int = -1) -> bytes:
+        return self._checked("read", size)
+
+    def read1(self, size: int = -1) -> bytes:
+        return self._checked("read1", size)
+
+    def readline(self, size: int = -1) -> bytes:
+        return self._checked("readline", size)
+
+    def peek(self, n: int) -> bytes:
+        return self._checked("peek", n)
+
+
 def open_binary(path: str | os.PathLike[str]) -> IO[bytes]:
     """Open ``path`` for binary reading, decompressing gzip transparently.
 
     Gzip is recognised by its magic bytes, so a ``.gz`` file and a gzipped
-    file without the suffix both work.
+    file without the suffix both work. Corrupt gzip data raises :class:`FormatError`.
     """
     p = Path(path)
     if is_gzip(p):
-        return gzip.open(p, "rb")
+        return _CheckedGzip(p)
     return open(p, "rb")
 
 
@@ -44,23 +75,34 @@ def read_bytes(path: str | os.PathLike[str]) -> bytes:
     with open_binary(p) as f:
         try:
             return f.read()
-        except (OSError, EOFError) as exc:  # corrupt or truncated gzip stream
+        except (OSError, *GZIP_ERRORS) as exc:  # corrupt or truncated gzip stream
             raise FormatError(p, f"cannot decompress gzip data: {exc}") from None
+
+
+#: Byte-order marks, longest first (UTF-32 LE starts with the UTF-16 LE mark).
+BOMS: tuple[tuple[bytes, str], ...] = (
+    (b"\xff\xfe\x00\x00", "utf-32"),
+    (b"\x00\x00\xfe\xff", "utf-32"),
+    (b"\xef\xbb\xbf", "utf-8-sig"),
+    (b"\xff\xfe", "utf-16"),
+    (b"\xfe\xff", "utf-16"),
+)
+
+
+def bom_encoding(head: bytes) -> str | None:
+    """The encoding a byte-order mark at the start of ``head`` announces (``None`` without one)."""
+    return next((enc for bom, enc in BOMS if head.startswith(bom)), None)
 
 
 def decode_text(data: bytes, path: str | os.PathLike[str] | None, encoding: str = "utf-8") -> str:
     """Decode ``data``; a byte that is not valid ``encoding`` raises :class:`FormatError` naming its line.
 
-    A UTF-8 byte-order mark is dropped. ``encoding="auto"`` also accepts
-    UTF-16 files that start with a BOM (as Praat writes them).
+    For ``encoding="utf-8"`` (the default) or ``"auto"`` a byte-order mark decides:
+    UTF-8, UTF-16 (as Praat writes them) or UTF-32 files with a BOM are all read,
+    and the BOM is dropped.
     """
-    if encoding == "auto":
-        if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-            encoding = "utf-16"
-        else:
-            encoding = "utf-8-sig"
-    elif encoding.lower().replace("_", "-") == "utf-8":
-        encoding = "utf-8-sig"
+    if encoding == "auto" or encoding.lower().replace("_", "-") == "utf-8":
+        encoding = bom_encoding(data[:4]) or "utf-8-sig"
     try:
         return data.decode(encoding)
     except UnicodeDecodeError as exc:
@@ -80,7 +122,7 @@ def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
     path : str or PathLike
         File to read.
     encoding : str
-        Text encoding; ``"auto"`` accepts UTF-8 and UTF-16 with BOM.
+        Text encoding; ``"utf-8"`` and ``"auto"`` also accept UTF-16/32 files with a BOM.
 
     Returns
     -------
@@ -158,6 +200,8 @@ def describe_bytes(head: bytes) -> str:
     stripped = head.lstrip(b"\xef\xbb\xbf").lstrip()
     if head.startswith(LFS_POINTER_PREFIX):
         return "a Git-LFS pointer text, not the file content (run `git lfs pull`)"
+    if (bom := bom_encoding(head)) in ("utf-16", "utf-32"):  # before MP3: FF FE looks like a sync word
+        return f"{bom.upper()} text"
     if head.startswith(b"ID3") or (len(head) > 1 and head[0] == 0xFF and head[1] & 0xE0 == 0xE0):
         return "MP3 audio"
     if head.startswith(b"RIFF") and head[8:12] == b"WAVE":
@@ -189,8 +233,6 @@ def describe_bytes(head: bytes) -> str:
         return "an XML document"
     if stripped[:1] in (b"{", b"["):
         return "JSON text"
-    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
-        return "UTF-16 text"
     if b"\x00" in head:
         return "binary data"
     try:

@@ -26,8 +26,10 @@ Taught in notebooks/01_beat_formats.ipynb, section 9 (the words: a Praat TextGri
 
 from __future__ import annotations
 
+import math
 import os
 import re
+import warnings
 from bisect import bisect_right
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -37,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 
 from beatlite.io.atomic import atomic_write
-from beatlite.io.errors import FormatError
+from beatlite.io.errors import FormatError, FormatWarning
 from beatlite.io.textfile import read_text
 
 __all__ = [
@@ -158,6 +160,8 @@ class _Values:
 
     def number(self, what: str) -> tuple[float, int]:
         value, line = self.take("num", what)
+        if not math.isfinite(float(value)):
+            raise FormatError(self.path, f"{what} is not a finite number", line=line, field=what)
         return float(value), line
 
     def string(self, what: str) -> tuple[str, int]:
@@ -168,7 +172,56 @@ class _Values:
         value, line = self.number(what)
         if value < 0 or value != int(value):
             raise FormatError(self.path, f"{what} must be a whole number, got {value}", line=line)
+        if value > len(self.items) - self.pos:  # each counted item needs at least one more value
+            raise FormatError(self.path, f"{what} is {value:g}, more than the file holds", line=line)
         return int(value), line
+
+
+def _extent(values: _Values, what: str) -> tuple[float, float]:
+    """``xmin, xmax`` of the TextGrid or of a tier; ``xmin > xmax`` raises."""
+    xmin, _ = values.number(f"xmin of {what}")
+    xmax, line = values.number(f"xmax of {what}")
+    if xmin > xmax:
+        raise FormatError(values.path, f"{what}: xmin {xmin} is after xmax {xmax}", line=line, field="xmax")
+    return xmin, xmax
+
+
+def _read_tier(values: _Values, k: int) -> tuple[str, str, list[Interval], list[int]]:
+    """Tier ``k`` (0-based): ``(name, class, intervals, line of each interval)``."""
+    tier_class, class_line = values.string(f"class of tier {k + 1}")
+    name, _ = values.string(f"name of tier {k + 1}")
+    _extent(values, f"tier {name!r}")
+    n, _ = values.count(f"size of tier {name!r}")
+    intervals: list[Interval] = []
+    lines: list[int] = []
+    if tier_class not in ("IntervalTier", "TextTier"):
+        raise FormatError(values.path, f"unknown tier class {tier_class!r}", line=class_line)
+    for i in range(n):
+        if tier_class == "IntervalTier":
+            start, line = values.number(f"xmin of interval {i + 1} of tier {name!r}")
+            end, _ = values.number(f"xmax of interval {i + 1} of tier {name!r}")
+            mark, _ = values.string(f"text of interval {i + 1} of tier {name!r}")
+        else:
+            start, line = values.number(f"time of point {i + 1} of tier {name!r}")
+            end = start
+            mark, _ = values.string(f"mark of point {i + 1} of tier {name!r}")
+        intervals.append(Interval(start, end, mark))
+        lines.append(line)
+    return name, tier_class, intervals, lines
+
+
+def _warn_outside(path: Path, xmin: float, xmax: float, tiers: list) -> None:
+    """One :class:`FormatWarning` for the first interval outside ``[xmin, xmax]``."""
+    for name, _, intervals in tiers:
+        for i, iv in enumerate(intervals):
+            if iv.start < xmin - _EPS or iv.end > xmax + _EPS:
+                warnings.warn(
+                    f"{path}: tier {name!r}, interval {i + 1} [{iv.start}, {iv.end}] lies outside the "
+                    f"TextGrid's [{xmin}, {xmax}]",
+                    FormatWarning,
+                    stacklevel=3,
+                )
+                return
 
 
 def read_textgrid_tiers(
@@ -183,6 +236,12 @@ def read_textgrid_tiers(
     tiers : list of (name, class, intervals)
         ``class`` is ``"IntervalTier"`` or ``"TextTier"``, in file order
         (duplicate names are kept).
+
+    Raises
+    ------
+    FormatError
+        Malformed file, infinite times, ``xmin > xmax``, unsorted or overlapping
+        intervals. An interval outside ``[xmin, xmax]`` gives a :class:`FormatWarning`.
     """
     p = Path(path)
     text = read_text(p, encoding="auto")
@@ -197,42 +256,21 @@ def read_textgrid_tiers(
     object_class, line = values.string("Object class")
     if object_class != "TextGrid":
         raise FormatError(p, f"Object class is {object_class!r}, expected 'TextGrid'", line=line)
-    xmin, _ = values.number("xmin")
-    xmax, _ = values.number("xmax")
+    xmin, xmax = _extent(values, "the TextGrid")
     flag, line = values.take("flag", "tiers? <exists>")
     if flag == "<absent>":
         return xmin, xmax, []
     n_tiers, _ = values.count("size (number of tiers)")
     tiers: list[tuple[str, str, list[Interval]]] = []
     for k in range(n_tiers):
-        tier_class, class_line = values.string(f"class of tier {k + 1}")
-        name, _ = values.string(f"name of tier {k + 1}")
-        values.number(f"xmin of tier {name!r}")
-        values.number(f"xmax of tier {name!r}")
-        n, _ = values.count(f"size of tier {name!r}")
-        intervals: list[Interval] = []
-        lines: list[int] = []
-        if tier_class == "IntervalTier":
-            for i in range(n):
-                start, line = values.number(f"xmin of interval {i + 1} of tier {name!r}")
-                end, _ = values.number(f"xmax of interval {i + 1} of tier {name!r}")
-                mark, _ = values.string(f"text of interval {i + 1} of tier {name!r}")
-                intervals.append(Interval(start, end, mark))
-                lines.append(line)
-        elif tier_class == "TextTier":
-            for i in range(n):
-                t, line = values.number(f"time of point {i + 1} of tier {name!r}")
-                mark, _ = values.string(f"mark of point {i + 1} of tier {name!r}")
-                intervals.append(Interval(t, t, mark))
-                lines.append(line)
-        else:
-            raise FormatError(p, f"unknown tier class {tier_class!r}", line=class_line)
+        name, tier_class, intervals, lines = _read_tier(values, k)
         _validate_tier(p, name, intervals, lines)
         tiers.append((name, tier_class, intervals))
     if values.pos < len(values.items):
         raise FormatError(
             p, f"unexpected content after the {n_tiers} declared tiers", line=values.current_line()
         )
+    _warn_outside(p, xmin, xmax, tiers)
     return xmin, xmax, tiers
 
 

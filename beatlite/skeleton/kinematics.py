@@ -9,6 +9,12 @@ where ``R_local[j]`` is built from the joint's rotation channels in the Euler or
 line gives (intrinsic, degrees) and ``t[j]`` is its ``X/Y/Zposition`` channels (0 if it has none).
 For the root ``R_world[p] = I`` and ``x_world[p] = 0``.
 
+Position channels (``position_mode``): by default (``"replace"``) a joint with position channels
+is placed at those channels alone, ignoring its OFFSET (as Blender and MotionBuilder read BVH).
+``"add"`` places a non-root joint at ``OFFSET + channels``; the root is always placed at its
+channels alone, because exporters (ZEGGS, LAFAN1, PyMO) write the root OFFSET as the start
+position that the root channels already contain -- adding it would count it twice.
+
 Implementation: the loop runs over joints only. Frames are processed in blocks of
 ``_BLOCK`` with the frame axis last, so every NumPy call works on contiguous rows that stay
 in cache, and the local rotations of all joints of one Euler order are built at once.
@@ -25,7 +31,7 @@ import numpy as np
 from beatlite.skeleton.core import Skeleton
 from beatlite.skeleton.rotations import _AXIS, _euler_fill
 
-__all__ = ["forward_kinematics", "global_transforms", "local_rotations", "rest_pose"]
+__all__ = ["forward_kinematics", "global_transforms", "local_rotations", "rest_pose", "skeleton_extent"]
 
 _POSITION_MODES = ("add", "replace")
 _BLOCK = 384  # frames per block (small enough for the working set to stay in cache)
@@ -150,7 +156,8 @@ def _blocks(
             # translation from the parent: the offset (3,) and/or the position channels (3, n)
             tj: np.ndarray = offsets[j]
             if pos_cols[j].size:
-                tj = offsets[j][:, None] + ch_t[pos_cols[j]] if position_mode == "add" else ch_t[pos_cols[j]]
+                add = position_mode == "add" and p >= 0  # the root's channels are absolute
+                tj = offsets[j][:, None] + ch_t[pos_cols[j]] if add else ch_t[pos_cols[j]]
             if p < 0:
                 rot[j] = local[j]
                 pos[j] = tj if tj.ndim == 2 else tj[:, None]
@@ -204,8 +211,8 @@ def global_transforms(
         How a joint's ``X/Y/Zposition`` channels combine with its OFFSET: ``"replace"`` (default:
         ``t`` alone, as Blender and MotionBuilder read BVH; right for files such as the
         Bandai-Namco set whose non-root position channels repeat the offsets) or ``"add"``
-        (``offset + t``).
-        BEAT's root OFFSET is zero, so both give the same answer for BEAT.
+        (``offset + t`` for non-root joints; the root always uses its channels alone, so a
+        non-zero root OFFSET is not counted twice). Both give the same answer for BEAT.
 
     Returns
     -------
@@ -313,3 +320,18 @@ def rest_pose(skeleton: Skeleton, *, end_sites: bool = False) -> np.ndarray:
         tips = np.stack([pos[j] + skeleton.end_sites[j] for j in owners])
         pos = np.concatenate([pos, tips], axis=0)
     return pos
+
+
+def skeleton_extent(skeleton: Skeleton) -> float:
+    """Size of the rest pose: the largest extent along x, y or z of its joints and End Sites.
+
+    In the file's length unit: about 100-200 for a person in centimetres, 1-2 in metres.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> 100 < skeleton_extent(beat_skeleton()) < 250
+    True
+    """
+    pos = rest_pose(skeleton, end_sites=True)
+    return float(np.max(np.ptp(pos, axis=0))) if len(pos) else 0.0

@@ -115,11 +115,11 @@ def frame_rms(audio: np.ndarray, n_frames: int, fps: float, sr: int) -> np.ndarr
 
 
 def corpus_take(record: TakeRecord, *, fps: float = 15, sr: int = 16000) -> CorpusTake:
-    """Load one take (:func:`beatlite.io.load_take`) and compute its :class:`CorpusTake` streams."""
+    """Load one take (:func:`beatlite.io.load_take`, at the index's ``record.bvh_fps``) and compute its streams."""
     from beatlite.io import load_take
     from beatlite.skeleton import forward_kinematics, subset_columns
 
-    take = load_take(record.path("motion"), fps=fps, audio_sr=sr)
+    take = load_take(record.path("motion"), fps=fps, audio_sr=sr, bvh_fps=record.bvh_fps)
     motion = take.motion
     audio = np.asarray(take.audio)
     n = take.n_frames  # load_take already cut every modality to the shortest one
