@@ -374,7 +374,7 @@ def test_bc_legacy_with_ha2g_constants_equals_ha2g_formula():
     theta = 0.3 + 0.1 * np.cos(np.pi * (t + 0.5 / FPS) / PERIOD)
     dirs = ear_swinging_skeleton(theta)
     audio = AUDIO[: int(5.0 * SR)]
-    got = beat_consistency(audio, SR, dirs, FPS, change_angle=HA2G_CHANGE_ANGLE, legacy=True)
+    got = beat_consistency(audio, SR, dirs, FPS, change_angle=HA2G_CHANGE_ANGLE, variant="ha2g")
     assert got == pytest.approx(_ha2g_bc_formula(audio, dirs, HA2G_CHANGE_ANGLE), rel=1e-12)
     assert 0.5 < got <= 1.0
 
@@ -400,16 +400,15 @@ def test_bc_is_stable_when_a_rigid_pair_is_perturbed():
     v = rigid_pair_skeleton()
     ca = mean_angle_change(v, pairs)
     assert ca[1] < 1e-12 * ca[0]  # the second pair is rigid
-    kw = {"pairs": pairs, "palm_normals": False, "change_angle": ca}
+    kw = {"variant": BCVariant(pairs=((0, 1), (0, 2)), palm_normals=False), "change_angle": ca}
     clean = beat_consistency(AUDIO, SR, v, FPS, **kw)
     rng = np.random.default_rng(0)
     for _ in range(3):
         noisy = beat_consistency(AUDIO, SR, v + 1e-9 * rng.standard_normal(v.shape), FPS, **kw)
         assert abs(noisy - clean) < 0.005
     # the rigid pair is left out: the score is the moving pair's alone
-    assert clean == beat_consistency(
-        AUDIO, SR, v, FPS, pairs=pairs[:1], palm_normals=False, change_angle=ca[:1]
-    )
+    alone = BCVariant(pairs=((0, 1),), palm_normals=False)
+    assert clean == beat_consistency(AUDIO, SR, v, FPS, variant=alone, change_angle=ca[:1])
 
 
 def test_drop_rigid_pairs_threshold_is_relative():
