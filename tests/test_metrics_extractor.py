@@ -15,10 +15,10 @@ from beatlite.metrics.extractor import (  # noqa: E402
     ExtractorConfig,
     MotionAutoencoder,
     autoencoder_loss,
-    data_fingerprint,
     load_extractor,
     save_extractor,
     train_autoencoder,
+    windows_hash,
 )
 from beatlite.paths import checkpoints_dir  # noqa: E402
 
@@ -89,10 +89,10 @@ def test_load_errors(tmp_path):
 
 def test_fingerprint_changes_with_the_data():
     w = smooth_windows()
-    assert data_fingerprint(w) == data_fingerprint(w.copy())
+    assert windows_hash(w) == windows_hash(w.copy())
     w2 = w.copy()
     w2[0, 0, 0] += 1
-    assert data_fingerprint(w2) != data_fingerprint(w)
+    assert windows_hash(w2) != windows_hash(w)
 
 
 def test_command_line_help():

@@ -181,16 +181,9 @@ class FeatureExtractor:
                 out.append(self.model.encode(torch.from_numpy(x[i : i + batch_size])).numpy())
         return np.concatenate(out).astype(np.float64) if out else np.zeros((0, self.latent_dim))
 
-    def reconstruct(self, windows: np.ndarray) -> np.ndarray:
-        """Autoencoder reconstruction of (N, 34, D) windows, same shape, float32, input units."""
-        x = self._check(windows)
-        with torch.no_grad():
-            r = self.model(torch.from_numpy(x)).numpy()
-        return r * self.std + self.mean
-
 
 # ----------------------------------------------------------------------------- training
-def data_fingerprint(windows: np.ndarray) -> str:
+def windows_hash(windows: np.ndarray) -> str:
     """sha256 (first 16 hex digits) of the float32 training windows and their shape."""
     w = np.ascontiguousarray(windows, dtype=np.float32)
     h = hashlib.sha256(str(w.shape).encode())
@@ -389,7 +382,7 @@ def _train_command(args: argparse.Namespace) -> int:
     model, info = train_autoencoder(w, config, val_windows=val)
     takes = sorted({str(t) for t in np.asarray(train["take"]).tolist()})
     meta = {
-        "data_fingerprint": data_fingerprint(w),
+        "data_fingerprint": windows_hash(w),
         "n_windows": int(len(w)),
         "n_val_windows": 0 if val is None else int(len(val)),
         "takes": takes,

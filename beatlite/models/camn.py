@@ -148,18 +148,15 @@ to show it). The shipped training schedule is in
 def _assembly_index() -> torch.Tensor:
     """(141,) index into ``cat[body27, hands114]`` giving the reference's 141-d layout.
 
-    Computed by :func:`beatlite.skeleton.beat.camn_assemble` on index arrays when that
-    module is available, else from docs/reference_code.md#camn-decoders: out[0:18] = body[0:18], out[18:75] =
-    hands[0:57], out[75:84] = body[18:27], out[84:141] = hands[57:114].
+    Computed by :func:`beatlite.skeleton.beat.camn_assemble` on index arrays
+    (docs/reference_code.md#camn-decoders: out[0:18] = body[0:18], out[18:75] = hands[0:57],
+    out[75:84] = body[18:27], out[84:141] = hands[57:114]).
     """
+    from beatlite.skeleton.beat import camn_assemble
+
     body = np.arange(BODY_DIM, dtype=np.float64)
     hands = np.arange(BODY_DIM, BODY_DIM + HANDS_DIM, dtype=np.float64)
-    try:
-        from beatlite.skeleton.beat import camn_assemble
-    except ImportError:  # pragma: no cover - the skeleton module is always present in a release
-        index = np.concatenate([body[:18], hands[:57], body[18:], hands[57:]])
-    else:
-        index = np.asarray(camn_assemble(body[None], hands[None]))[0]
+    index = np.asarray(camn_assemble(body[None], hands[None]))[0]
     return torch.as_tensor(np.rint(index).astype(np.int64))
 
 

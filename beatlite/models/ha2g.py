@@ -63,6 +63,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.metrics.consistency import default_angle_pairs
 from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
 from beatlite.models.ha2g_ablations import ABLATIONS
 from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
@@ -70,7 +71,6 @@ from beatlite.models.ha2g_losses import (
     N_BONES,
     angle_statistics,
     bone_angles,
-    default_angle_pairs,
     hierarchical_huber,
     kl_divergence,
     multilevel_contrastive_loss,

@@ -26,13 +26,6 @@ PALM_BONES: tuple[tuple[int, int], ...] = ((11, 17), (28, 34))
 """TED-43 direction-vector pairs whose cross products are the left / right palm normals (docs/reference_code.md#palm-normals)."""
 
 
-def default_angle_pairs() -> np.ndarray:
-    """``beatlite.skeleton.ted.ANGLE_PAIRS`` as a (P, 2) int64 array (into 42 bones + 2 palm normals)."""
-    from beatlite.skeleton import ted
-
-    return np.asarray(ted.ANGLE_PAIRS, dtype=np.int64).reshape(-1, 2)
-
-
 # ----------------------------------------------------------------------------- contrastive
 def contrastive_ce(query: torch.Tensor, key: torch.Tensor, *, min_distance: float = 1e-2) -> torch.Tensor:
     """HA2G's ``SoftmaxContrastiveLoss``: cross-entropy of inverse-distance logits against the diagonal.
@@ -332,6 +325,8 @@ def angle_statistics(
         raise ValueError(f"mean_dirvec must be (126,), got shape {m.shape}")
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(m))):
         raise ValueError("dirvec_windows and mean_dirvec must be finite")
+    from beatlite.metrics.consistency import default_angle_pairs
+
     pr = default_angle_pairs() if pairs is None else np.asarray(pairs, dtype=np.int64)
     n, t, _ = d.shape
     v = (d + m).reshape(n * t, N_BONES, 3)
