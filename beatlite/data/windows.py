@@ -616,9 +616,9 @@ def build_windows(
                 pass  # broken cache: rebuild
     items = records
     if progress:
-        from tqdm import tqdm
+        from beatlite.notebook import progress as progress_bar
 
-        items = tqdm(records, desc=f"windows {split}")
+        items = progress_bar(records, desc=f"windows {split}")
     parts: dict[str, list[np.ndarray]] = {k: [] for k in WINDOW_KEYS}
     lens: dict[str, list[int]] = {"frames": [], "audio": [], "mel": []}
     for record in items:

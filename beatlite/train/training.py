@@ -217,7 +217,7 @@ def fit(
         raise TypeError(f"fit: model must be a GestureModel, got {type(model).__name__}")
     if not isinstance(config, TrainConfig):
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
-    from tqdm.auto import tqdm
+    from beatlite.notebook import progress
 
     arrays = as_arrays(train_windows)
     keys = _needed_keys(model, arrays, "fit")
@@ -291,7 +291,9 @@ def fit(
         save(config.epochs)
         return result()
 
-    bar = tqdm(range(start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch")
+    bar = progress(
+        range(start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch"
+    )
     for epoch in bar:
         model.train()
         factor = config.lr_factor(epoch)
@@ -335,6 +337,11 @@ def fit(
                 state = {k: v.detach().clone() for k, v in model.state_dict().items()}
                 best = {"epoch": epoch, "score": score, "state": state}
         history.append(entry)
-        bar.set_postfix(loss=f"{entry['train'].get('total', float('nan')):.4g}")
+        # the bar shows the model's first unweighted term (as the history and summaries do), not the weighted total
+        main = next((k for k in entry["train"] if k != "total" and not k.startswith("D_")), "total")
+        shown = {main: entry["train"].get(main, float("nan"))} | (
+            {f"val_{main}": entry["val"][main]} if main in entry["val"] else {}
+        )
+        bar.set_postfix({k: f"{v:.4g}" for k, v in shown.items()})
         save(epoch + 1)
     return result()
