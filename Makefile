@@ -47,7 +47,8 @@ LAB_FROM ?= notebooks
 lab: $(INTERACTIVE) system-deps
 	@mkdir -p $(LAB)
 	@for nb in $(LAB_FROM)/[0-9][0-9]_*.ipynb; do test -e $(LAB)/$$(basename $$nb) || cp $$nb $(LAB)/; done
-	BEATLITE_BUILD=$(abspath $(LAB)) BEATLITE_INTERACTIVE=on $(VPY) -m jupyter lab --notebook-dir=$(LAB) $(LAB_ARGS)
+	BEATLITE_BUILD=$(abspath $(LAB)) BEATLITE_INTERACTIVE=on $(VPY) -m jupyter lab --notebook-dir=$(LAB) \
+		$(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
 ## The test suite: lint, unit tests and nbval over every notebook.
 test: $(STAMP) system-deps lint
