@@ -265,12 +265,12 @@ def predict(
     unit = f" {unit}" if unit else ""
     tolerance = atol + rtol * abs(actual)
     if abs(guess - actual) <= tolerance:
-        print(f"[exercise] {name}: predicted {guess:.4g}{unit}, measured {actual:.4g}{unit} ✓")
+        print(f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit} ✓")
         return True
     side = "high" if guess > actual else "low"
     ratio = f", {abs(guess / actual):.2g}x the measured value" if actual != 0 and guess != 0 else ""
     print(
-        f"[exercise] {name}: predicted {guess:.4g}{unit}, measured {actual:.4g}{unit}: too {side}{ratio} "
+        f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit}: too {side}{ratio} "
         f"(within ±{tolerance:.3g}{unit} counts as right)"
     )
     return False
