@@ -149,7 +149,11 @@ def open_offline(browser: Browser, page: Path) -> None:
     browser.page("Page.enable")
     browser.page("Page.navigate", url=page.resolve().as_uri())
     browser.wait_for("Page.loadEventFired")
-    browser.evaluate("new Promise(r => setTimeout(r, 300))")  # let the player's inline script run
+    # the player's inline script sets its first frame after loading: wait (at most 20 s) until every image is decoded
+    browser.evaluate(
+        "Promise.race([new Promise(r => setTimeout(r, 20000)), (async () => { while ([...document.images].some("
+        "i => !(i.complete && i.naturalWidth > 0))) await new Promise(r => setTimeout(r, 50)); })()])"
+    )
 
 
 # Measured in the browser: every <math> laid out with a size, fractions stacked (numerator above the
