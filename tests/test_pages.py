@@ -13,6 +13,7 @@ import importlib.util
 import json
 import os
 import re
+import select
 import shutil
 import subprocess
 import sys
@@ -76,8 +77,10 @@ class Browser:
         target = self.send("Target.createTarget", url="about:blank")["targetId"]
         self.session = self.send("Target.attachToTarget", targetId=target, flatten=True)["sessionId"]
 
-    def _read(self) -> dict:
+    def _read(self, timeout: float = 60.0) -> dict:
         while b"\0" not in self._buffer:
+            if not select.select([self._out_r], [], [], timeout)[0]:
+                raise TimeoutError(f"Chromium sent nothing for {timeout} s")
             chunk = os.read(self._out_r, 1 << 20)
             if not chunk:
                 raise RuntimeError("Chromium closed the DevTools pipe")
@@ -139,13 +142,16 @@ class Browser:
 def open_offline(browser: Browser, page: Path) -> None:
     """Load ``page`` with the network emulated offline and requests recorded; wait for its scripts."""
     browser.page("Network.enable")
-    browser.page(
-        "Network.emulateNetworkConditions",
-        offline=True,
-        latency=0,
-        downloadThroughput=-1,
-        uploadThroughput=-1,
-    )
+    try:  # on top of --host-resolver-rules; the command may leave the protocol one day
+        browser.page(
+            "Network.emulateNetworkConditions",
+            offline=True,
+            latency=0,
+            downloadThroughput=-1,
+            uploadThroughput=-1,
+        )
+    except RuntimeError:
+        pass
     browser.page("Page.enable")
     browser.page("Page.navigate", url=page.resolve().as_uri())
     browser.wait_for("Page.loadEventFired")
