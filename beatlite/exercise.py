@@ -215,6 +215,13 @@ def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint
     -------
     bool or None
         True (right), False (wrong or not an option), None (not answered yet).
+
+    Examples
+    --------
+    >>> options = {"a": "it trains faster", "b": "a seed pose can be all zeros"}
+    >>> choice("seed bit", "a", options, answer_key("seed bit", "b"), hint="What does a 0 input mean?")
+    [exercise] seed bit: a is not the best answer. What does a 0 input mean?
+    False
     """
     valid = {str(k).strip().lower(): k for k in options}
     if not any(answer_key(name, k) == key for k in valid):
@@ -257,6 +264,12 @@ def predict(
     bool or None
         True (within tolerance), False (outside; the message says how far and in which direction),
         None (no prediction made: the measured value is not shown, so the student can still predict).
+
+    Examples
+    --------
+    >>> predict("mel frames per 34-pose window", 68, 70, rtol=0.05)  # 70: notebook 03
+    [exercise] mel frames per 34-pose window: predicted 68, measured 70 ✓
+    True
     """
     if guess is None:
         print(f"[exercise] {name}: write your prediction first (the measured value is printed afterwards)")

@@ -41,6 +41,11 @@ def interactive() -> bool:
     not ``off`` (also ``0``, ``false``, ``no``). ``scripts/run_notebooks.py`` (``make run``) and
     ``make test`` set it to ``off``: a notebook executed in batch saves a widget's stale first state,
     and its exported page would need the widget scripts from the web. Read at call time.
+
+    Examples
+    --------
+    >>> interactive()  # a plain Python process is not a Jupyter kernel
+    False
     """
     if os.environ.get(ENV_INTERACTIVE, "").strip().lower() in ("off", "0", "false", "no"):
         return False
@@ -64,6 +69,11 @@ def progress(iterable: Any = None, **kwargs: Any) -> Any:
         What to iterate over.
     **kwargs
         Passed to ``tqdm`` (``desc``, ``total``, ``unit``, ``disable``, ...).
+
+    Examples
+    --------
+    >>> sum(progress(range(4), desc="demo", disable=True))
+    6
     """
     if interactive():
         from tqdm.auto import tqdm
