@@ -5,6 +5,7 @@ PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 VPY    := $(VENV)/bin/python
 STAMP  := $(VENV)/.beatlite-installed
+INTERACTIVE := $(VENV)/.beatlite-interactive
 
 # Headless, deterministic defaults for the notebooks and tests (override on the command line).
 export MPLBACKEND ?= Agg
@@ -14,7 +15,7 @@ export PYTHONHASHSEED ?= 0
 # Training processes at once for `make checkpoints` / `make seeds` (1 torch thread each; 2 on an idle 2-core machine).
 JOBS ?= 1
 
-.PHONY: run test lint venv system-deps data checkpoints results seeds bench clean
+.PHONY: run test lint lab venv system-deps data checkpoints results seeds bench clean
 
 venv: $(STAMP)
 
@@ -24,19 +25,35 @@ $(STAMP): pyproject.toml
 	$(VPY) -m pip install --quiet -e ".[notebooks,dev]"
 	@touch $(STAMP)
 
+# The `interactive` extra (pyvista's trame backend, ipywidgets) for JupyterLab; `make run` and `make lab` add it.
+$(INTERACTIVE): $(STAMP)
+	$(VPY) -m pip install --quiet -e ".[notebooks,dev,interactive]"
+	@touch $(INTERACTIVE)
+
 # Debian packages needed at run/test time (offscreen OpenGL for pyvista, espeak-ng for the corpus
 # generator). Installs them when running as root with apt-get, otherwise says what is missing.
 system-deps:
 	@bash scripts/system_deps.sh
 
 ## The main job: execute every notebook in order on data_samples/ and write build/.
-run: $(STAMP) system-deps
+run: $(STAMP) $(INTERACTIVE) system-deps
 	$(VPY) scripts/run_notebooks.py --out build
+
+## JupyterLab on working copies of the notebooks in build/lab/ (copied from LAB_FROM once; delete a copy to get a
+## fresh one). notebooks/ keeps the solutions and stays clean, and BEATLITE_BUILD=build/lab keeps the figures,
+## tables and caches of interactive work away from `make run`'s build/. Students: `make lab LAB_FROM=build/student`.
+LAB      ?= build/lab
+LAB_FROM ?= notebooks
+lab: $(INTERACTIVE) system-deps
+	@mkdir -p $(LAB)
+	@for nb in $(LAB_FROM)/[0-9][0-9]_*.ipynb; do test -e $(LAB)/$$(basename $$nb) || cp $$nb $(LAB)/; done
+	BEATLITE_BUILD=$(abspath $(LAB)) BEATLITE_INTERACTIVE=on $(VPY) -m jupyter lab --notebook-dir=$(LAB) \
+		$(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
 ## The test suite: lint, unit tests, nbval over every notebook, then the doctests (Examples) of beatlite.
 test: $(STAMP) system-deps lint
-	$(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
-	$(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
+	BEATLITE_INTERACTIVE=off $(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
+	BEATLITE_INTERACTIVE=off $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
 
 lint: $(STAMP)
 	$(VPY) -m ruff check beatlite tests bench scripts

@@ -7,15 +7,38 @@ copy made by ``make run`` in ``build/student/`` drops it). :func:`resolve`
 lets later cells keep working while the exercise is not done yet, so every
 notebook still runs end to end.
 
+The feedback of :func:`check` names the failing case (numbered from 1) with its
+inputs, then the first thing that differs: a missing ``return``, the type, the
+shape, the kind of dtype (integer, float, bool), or the first differing element
+(index, both values, how many elements differ). It never prints whole arrays.
+
+"Why?" questions get feedback too: :func:`choice` checks a multiple-choice answer
+against a key that does not show the answer (:func:`answer_key` makes it), and
+:func:`predict` compares a number the student predicted with the value the next
+lines measure.
+
+Examples
+--------
+>>> def double(x):
+...     return x + x
+>>> check("square", double, lambda x: x * x, [(2,), (3,)])
+[exercise] square: case 2 of 2 differs: square(3)
+    got 6, expected 9
+False
+
 Used by the Exercises section at the end of every notebook (first in notebooks/00_setup_and_tour.ipynb, Exercises).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import hashlib
+import numbers
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
+
+_KINDS = {"b": "bool", "i": "integer", "u": "integer", "f": "float", "c": "complex"}
 
 
 def resolve(student_fn: Callable[..., Any], reference_fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -34,6 +57,83 @@ def resolve(student_fn: Callable[..., Any], reference_fn: Callable[..., Any]) ->
             return reference_fn(*args, **kwargs)
 
     return call
+
+
+def describe(value: Any, width: int = 60) -> str:
+    """A short description of an input or a result: small values in full, big arrays by shape and dtype.
+
+    Examples
+    --------
+    >>> describe(np.zeros((20, 5, 3)))
+    'array(shape=(20, 5, 3), dtype=float64)'
+    >>> describe(np.array([1.5, 2.0]))
+    'array([1.5, 2. ])'
+    >>> describe(0.1 + 0.2)
+    '0.3'
+    """
+    if isinstance(value, np.ndarray) and value.size <= 6:
+        return "array(" + np.array2string(value, precision=4, separator=", ") + ")"
+    if hasattr(value, "shape") and hasattr(value, "dtype") and np.ndim(value) > 0:
+        dtype = str(value.dtype).removeprefix("torch.")
+        return (
+            f"{type(value).__name__.replace('ndarray', 'array')}(shape={tuple(value.shape)}, dtype={dtype})"
+        )
+    if isinstance(value, numbers.Real) and not isinstance(value, numbers.Integral | bool):
+        text = f"{float(value):.6g}"
+        return text if any(c in text for c in ".en") else text + ".0"  # 15.0 stays a float
+    if isinstance(value, list | tuple) and len(value) > 6:
+        return f"{type(value).__name__} of {len(value)} items: {describe(value[0], width // 2)}, ..."
+    text = repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _call_text(name: str, args: tuple, kwargs: dict) -> str:
+    parts = [describe(a) for a in args] + [f"{k}={describe(v)}" for k, v in kwargs.items()]
+    return f"{name}({', '.join(parts)})"
+
+
+def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -> str | None:
+    """Why ``got`` is not ``want`` in one line, or ``None`` when they match (``numpy.isclose``, NaN == NaN).
+
+    Examples
+    --------
+    >>> difference(None, 4.5)
+    'got None: does the function end with `return ...`?'
+    >>> difference(np.zeros(3), np.zeros(4))
+    'shape: got (3,), expected (4,)'
+    >>> difference(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 3.5]))
+    'first difference at index (1,): got 2.0, expected 2.5 (2 of 3 elements differ)'
+    """
+    if got is None and want is not None:
+        return "got None: does the function end with `return ...`?"
+    try:
+        g, w = np.asarray(got), np.asarray(want)
+    except (TypeError, ValueError):  # ragged containers
+        return None if _equal(got, want) else f"got {describe(got)}, expected {describe(want)}"
+    if g.dtype == object or w.dtype == object or g.dtype.kind in "USV" or w.dtype.kind in "USV":
+        return None if _equal(got, want) else f"got {describe(got)}, expected {describe(want)}"
+    if g.shape != w.shape:
+        return f"shape: got {g.shape}, expected {w.shape}"
+    if g.ndim and _KINDS.get(g.dtype.kind) != _KINDS.get(w.dtype.kind):
+        return f"dtype: got {_KINDS.get(g.dtype.kind, g.dtype)} ({g.dtype}), expected {_KINDS.get(w.dtype.kind, w.dtype)} ({w.dtype})"
+    close = np.isclose(g.astype(float), w.astype(float), rtol=rtol, atol=atol, equal_nan=True)
+    if close.all():
+        return None
+    if g.ndim == 0:
+        return f"got {describe(got)}, expected {describe(want)}"
+    first = np.unravel_index(int(np.argmin(close)), close.shape)
+    index = tuple(int(i) for i in first)
+    return (
+        f"first difference at index {index}: got {describe(g[index].item())}, expected {describe(w[index].item())} "
+        f"({int((~close).sum())} of {close.size} elements differ)"
+    )
+
+
+def _equal(got: Any, want: Any) -> bool:
+    try:
+        return bool(got == want)
+    except ValueError:  # arrays inside a container
+        return False
 
 
 def check(
@@ -56,30 +156,136 @@ def check(
     cases : list
         Inputs, each ``(args, kwargs)`` or a plain ``args`` tuple.
     rtol, atol : float
-        Tolerances of ``numpy.allclose`` for numeric results.
+        Tolerances of ``numpy.isclose`` for numeric results.
 
     Returns
     -------
     bool or None
         True when every case matches, False when one does not, None when the
-        exercise is not done yet. Never raises for a wrong answer: it prints a hint.
+        exercise is not done yet. A wrong answer prints the case (numbered from 1)
+        with its inputs and :func:`difference`'s line; an exception raised by the
+        student's function is re-raised after the same case line.
     """
-    for i, case in enumerate(cases):
+    for i, case in enumerate(cases, start=1):
         args, kwargs = case if (len(case) == 2 and isinstance(case[1], dict)) else (case, {})
+        where = f"case {i} of {len(cases)}"
         try:
             got = student_fn(*args, **kwargs)
         except NotImplementedError:
             print(f"[exercise] {name}: not done yet (the stub raises NotImplementedError)")
             return None
-        want = reference_fn(*args, **kwargs)
-        try:
-            ok = bool(
-                np.allclose(np.asarray(got, dtype=float), np.asarray(want, dtype=float), rtol=rtol, atol=atol)
-            )
-        except (TypeError, ValueError):
-            ok = got == want
-        if not ok:
-            print(f"[exercise] {name}: case {i} differs: got {got!r}, expected {want!r}")
+        except Exception as exc:
+            print(f"[exercise] {name}: {where} raised {type(exc).__name__}: {_call_text(name, args, kwargs)}")
+            raise
+        why = difference(got, reference_fn(*args, **kwargs), rtol=rtol, atol=atol)
+        if why is not None:
+            print(f"[exercise] {name}: {where} differs: {_call_text(name, args, kwargs)}\n    {why}")
             return False
     print(f"[exercise] {name}: correct on {len(cases)} cases ✓")
     return True
+
+
+def answer_key(name: str, answer: Any) -> str:
+    """The 12-hex-digit key of ``answer`` to question ``name``, for :func:`choice` (hides the answer).
+
+    Examples
+    --------
+    >>> answer_key("05 indicator bit", "B")
+    '8a650c6856e1'
+    """
+    text = f"beatlite-exercise|{name}|{str(answer).strip().lower()}"
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint: str = "") -> bool | None:
+    """Check a multiple-choice answer to a "why?" question.
+
+    Parameters
+    ----------
+    name : str
+        The question's name (part of the key).
+    answer : str or None
+        The student's choice, one of ``options`` (case-insensitive); ``None`` while unanswered.
+    options : mapping
+        Choice -> statement, printed while unanswered.
+    key : str
+        ``answer_key(name, correct_choice)``: the check never shows the right choice.
+    hint : str
+        Printed after a wrong choice; it should point at the evidence, not at the answer.
+
+    Returns
+    -------
+    bool or None
+        True (right), False (wrong or not an option), None (not answered yet).
+
+    Examples
+    --------
+    >>> options = {"a": "it trains faster", "b": "a seed pose can be all zeros"}
+    >>> choice("seed bit", "a", options, answer_key("seed bit", "b"), hint="What does a 0 input mean?")
+    [exercise] seed bit: a is not the best answer. What does a 0 input mean?
+    False
+    """
+    valid = {str(k).strip().lower(): k for k in options}
+    if not any(answer_key(name, k) == key for k in valid):
+        raise ValueError(f"choice {name!r}: the key {key!r} matches none of the options {list(options)}")
+    if answer is None:
+        lines = [f"[exercise] {name}: not answered yet; set the answer to one of:"]
+        lines += [f"    {k}: {text}" for k, text in options.items()]
+        print("\n".join(lines))
+        return None
+    if str(answer).strip().lower() not in valid:
+        print(f"[exercise] {name}: {answer!r} is not one of the options {list(options)}")
+        return False
+    if answer_key(name, answer) == key:
+        print(f"[exercise] {name}: {answer} is right ✓")
+        return True
+    print(f"[exercise] {name}: {answer} is not the best answer. {hint}".rstrip())
+    return False
+
+
+def predict(
+    name: str, guess: float | None, actual: float, *, rtol: float = 0.1, atol: float = 0.0, unit: str = ""
+) -> bool | None:
+    """Compare a numeric prediction, written down before running the code, with the measured value.
+
+    Parameters
+    ----------
+    name : str
+        What was predicted.
+    guess : float or None
+        The student's prediction; ``None`` while not made.
+    actual : float
+        The value the notebook measured.
+    rtol, atol : float
+        The prediction counts as right when ``|guess - actual| <= atol + rtol * |actual|``.
+    unit : str
+        Unit printed after the numbers.
+
+    Returns
+    -------
+    bool or None
+        True (within tolerance), False (outside; the message says how far and in which direction),
+        None (no prediction made: the measured value is not shown, so the student can still predict).
+
+    Examples
+    --------
+    >>> predict("mel frames per 34-pose window", 68, 70, rtol=0.05)  # 70: notebook 03
+    [exercise] mel frames per 34-pose window: predicted 68, measured 70 ✓
+    True
+    """
+    if guess is None:
+        print(f"[exercise] {name}: write your prediction first (the measured value is printed afterwards)")
+        return None
+    guess, actual = float(guess), float(actual)
+    unit = f" {unit}" if unit else ""
+    tolerance = atol + rtol * abs(actual)
+    if abs(guess - actual) <= tolerance:
+        print(f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit} ✓")
+        return True
+    side = "high" if guess > actual else "low"
+    ratio = f", {abs(guess / actual):.2g}x the measured value" if actual != 0 and guess != 0 else ""
+    print(
+        f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit}: too {side}{ratio} "
+        f"(within ±{tolerance:.3g}{unit} counts as right)"
+    )
+    return False

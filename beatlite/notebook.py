@@ -1,5 +1,10 @@
 """One call at the top of every notebook: versions, mode, seeds, threads, figure style.
 
+Also where beatlite decides between widgets and plain output: :func:`interactive` is True in a live
+Jupyter kernel unless ``BEATLITE_INTERACTIVE=off`` (set by ``make run`` and ``make test``, whose saved
+pages cannot hold live widgets); :func:`progress` gives a widget bar there and a text bar elsewhere, and
+:func:`beatlite.viz.render.show_skeleton` an interactive 3D view.
+
 Used by the setup cell at the top of every notebook (the first code cell of notebooks/00_setup_and_tour.ipynb).
 """
 
@@ -9,10 +14,13 @@ import os
 import platform
 import random
 import warnings
+from typing import Any
 
 import numpy as np
 
 from beatlite import __version__, paths
+
+ENV_INTERACTIVE = "BEATLITE_INTERACTIVE"
 
 
 def require(version: str) -> None:
@@ -26,6 +34,54 @@ def require(version: str) -> None:
             f"these notebooks need beatlite >= {version}, installed is {__version__}: run `make run` or "
             "`pip install -e .` in the repository"
         )
+
+
+def interactive() -> bool:
+    """True in a live Jupyter kernel that may show widgets.
+
+    That is: IPython's ZMQ shell (JupyterLab, Notebook, VS Code) and ``$BEATLITE_INTERACTIVE``
+    not ``off`` (also ``0``, ``false``, ``no``). ``scripts/run_notebooks.py`` (``make run``) and
+    ``make test`` set it to ``off``: a notebook executed in batch saves a widget's stale first state,
+    and its exported page would need the widget scripts from the web. Read at call time.
+
+    Examples
+    --------
+    >>> interactive()  # a plain Python process is not a Jupyter kernel
+    False
+    """
+    if os.environ.get(ENV_INTERACTIVE, "").strip().lower() in ("off", "0", "false", "no"):
+        return False
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return shell is not None and type(shell).__name__ == "ZMQInteractiveShell"
+
+
+def progress(iterable: Any = None, **kwargs: Any) -> Any:
+    """A tqdm progress bar: a widget in a live kernel with ipywidgets, a text bar elsewhere.
+
+    ``tqdm.auto`` when :func:`interactive` (it falls back to text without ipywidgets), else
+    ``tqdm.std``. The text bar redraws one line with carriage returns, which
+    ``scripts/run_notebooks.py`` collapses to its final state in the saved notebook.
+
+    Parameters
+    ----------
+    iterable : iterable, optional
+        What to iterate over.
+    **kwargs
+        Passed to ``tqdm`` (``desc``, ``total``, ``unit``, ``disable``, ...).
+
+    Examples
+    --------
+    >>> sum(progress(range(4), desc="demo", disable=True))
+    6
+    """
+    if interactive():
+        from tqdm.auto import tqdm
+    else:
+        from tqdm.std import tqdm
+    return tqdm(iterable, **kwargs)
 
 
 def _inline_figures() -> None:

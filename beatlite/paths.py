@@ -9,6 +9,8 @@ Every function reads the environment at call time (no global state):
 - ``BEATLITE_THREADS``: torch CPU threads (default 1; see :func:`n_threads`).
 - ``BEATLITE_BUILD``: output folder of the main job (default ``build/``).
 - ``BEATLITE_PYVISTA``: ``off`` forces matplotlib instead of pyvista (see :mod:`beatlite.viz.probe`).
+- ``BEATLITE_INTERACTIVE``: ``off`` means no widgets (text progress bars, static 3D images) even in a
+  Jupyter kernel (see :func:`beatlite.notebook.interactive`).
 
 Taught in notebooks/00_setup_and_tour.ipynb, sections 1 (the environment) and 4 (running everything on the real BEAT dataset).
 """

@@ -2,33 +2,174 @@
 
 Writes, for each ``notebooks/NN_name.ipynb``:
 
-- ``build/notebooks/NN_name.ipynb`` (executed, with outputs) and ``.html``;
+- ``build/notebooks/NN_name.ipynb`` (executed, with outputs) and ``.html``: a page that works offline
+  (formulas rendered to MathML at export time, no script, font or style sheet from the web; see
+  :func:`export_html`);
 - the tables the notebook saved with :func:`beatlite.report.save_table` (``build/tables/``);
 - ``build/student/NN_name.ipynb``: the student copy, without the cells tagged ``solution``;
 - ``build/results.md``: per-notebook status and wall time, then every table.
 
-Exit status is non-zero when any notebook fails (the others still run).
+Exit status is non-zero when any notebook fails (the others still run). The notebooks run with
+``BEATLITE_INTERACTIVE=off`` (text progress bars, static 3D images: see :func:`beatlite.notebook.interactive`)
+and each cell's stream output is merged into one block with carriage returns applied.
 """
 
 from __future__ import annotations
 
 import argparse
+import copy
 import os
+import re
 import sys
 import time
 from pathlib import Path
+from urllib.parse import quote
 
 REPO = Path(__file__).resolve().parents[1]
+
+# The exported page extends nbconvert's "lab" template without its web scripts: require.js and the widget
+# manager (no widget state is stored), MathJax (formulas are MathML already) and mermaid (no diagrams).
+_OFFLINE_TEMPLATE = """{%- extends 'index.html.j2' -%}
+{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
+{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mathjax -%}{%- endblock html_head_js_mathjax -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+{%- block extra_css -%}<style type="text/css">{{ resources.offline_css }}</style>{%- endblock extra_css -%}
+"""
+
+# matplotlib's animation player (``to_jshtml``) links Font Awesome 4 from a CDN for its nine button icons;
+# the page drops that link and draws the icons as inline SVG (16 x 16 paths) instead.
+_ICONS = {
+    "play": "M4 2l10 6-10 6z",
+    "pause": "M3 2h4v12H3zM9 2h4v12H9z",
+    "step-forward": "M2 2l9 6-9 6zM11 2h3v12h-3z",
+    "step-backward": "M14 2L5 8l9 6zM2 2h3v12H2z",
+    "fast-forward": "M1 2l6 6-6 6zM7 2l6 6-6 6zM13 2h2v12h-2z",
+    "fast-backward": "M15 2L9 8l6 6zM9 2L3 8l6 6zM1 2h2v12H1z",
+    "minus": "M2 7h12v2H2z",
+    "plus": "M7 2h2v5h5v2H9v5H7V9H2V7h5z",
+}
+_FONT_AWESOME_LINK = re.compile(r"<link[^>]*font-awesome[^>]*>", re.IGNORECASE)
+
+
+def _offline_css() -> str:
+    """Style sheet of the offline page: MathML fonts and the animation player's icons."""
+    rules = [
+        'math { font-family: "Latin Modern Math", "STIX Two Math", "Cambria Math", "DejaVu Math TeX Gyre", math; font-size: 1.1em; }',
+        'math[display="block"] { margin: 0.5em 0; }',
+        ".anim-buttons .fa { display: inline-block; width: 1em; height: 1em; vertical-align: -0.125em; "
+        "background: no-repeat center / contain; }",
+        ".anim-buttons .fa-flip-horizontal { transform: scaleX(-1); }",
+    ]
+    for name, path in _ICONS.items():
+        svg = f"<svg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 16 16' fill='#333'><path d='{path}'/></svg>"
+        rules.append(
+            f'.anim-buttons .fa-{name} {{ background-image: url("data:image/svg+xml,{quote(svg)}"); }}'
+        )
+    return "\n".join(rules)
+
+
+# Formulas are taken out of the Markdown before it is parsed, as JupyterLab does, so that Markdown syntax inside
+# them (a line starting with "+ ", "_" pairs) cannot break them; code spans and fenced blocks keep their "$".
+_CODE = re.compile(r"^ {0,3}(```|~~~).*?^ {0,3}\1[ \t]*$|(`+)(?!`).+?(?<!`)\2(?!`)", re.M | re.S)
+_MATH = re.compile(
+    r"(?<!\\)\$\$(?P<display>.+?)(?<!\\)\$\$"
+    r"|(?P<env>\\begin\{(?P<name>[a-z]+\*?)\}.*?\\end\{(?P=name)\})"
+    r"|(?<![\\$])\$(?P<inline>[^$]+?)(?<![\\$])\$",
+    re.S,
+)
+_PLAIN_BARS = re.compile(r"<mo>(&#x0007C;|&#x02016;)</mo>")
+
+
+def markdown_to_html(source: str, **renderer_options) -> str:
+    """Markdown to HTML with every formula written as MathML (browsers render it natively, no script).
+
+    ``$$...$$`` and ``\\begin{env}...\\end{env}`` become display formulas, ``$...$`` inline ones; a
+    formula never spans a blank line, and ``$`` inside code stays as it is. Raises ``ValueError`` naming
+    a formula that ``latex2mathml`` cannot convert or that uses a command it does not know.
+    """
+    from latex2mathml.converter import convert
+    from nbconvert.filters.markdown_mistune import IPythonRenderer, MarkdownWithMath
+
+    codes: list[str] = []
+    maths: list[str] = []
+
+    def keep_code(m: re.Match) -> str:
+        codes.append(m[0])
+        return f"@@code{len(codes) - 1}@@"
+
+    def take_math(m: re.Match) -> str:
+        if re.search(r"\n[ \t]*\n", m[0]):  # a paragraph break: not a formula
+            return m[0]
+        tex, display = (
+            (m["inline"], "inline") if m["inline"] is not None else (m["display"] or m["env"], "block")
+        )
+        try:
+            mathml = convert(tex, display=display)
+        except Exception as exc:
+            raise ValueError(f"cannot convert the formula {m[0]!r} to MathML: {exc!r}") from exc
+        if unknown := re.findall(r">(\\[A-Za-z]+)<", mathml):  # latex2mathml prints commands it does not know
+            raise ValueError(f"cannot convert the formula {m[0]!r} to MathML: unknown {', '.join(unknown)}")
+        # latex2mathml leaves \lvert, \rvert, \lVert, \rVert stretchy; in TeX only \left/\right stretch
+        maths.append(_PLAIN_BARS.sub(r'<mo stretchy="false">\1</mo>', mathml))
+        return f"@@math{len(maths) - 1}@@"
+
+    text = _MATH.sub(take_math, _CODE.sub(keep_code, source))
+    text = re.sub(r"@@code(\d+)@@", lambda m: codes[int(m[1])], text)
+    html = MarkdownWithMath(renderer=IPythonRenderer(escape=False, **renderer_options)).render(text)
+    return re.sub(r"@@math(\d+)@@", lambda m: maths[int(m[1])], html)
+
+
+def _offline_exporter():
+    """nbconvert's ``HTMLExporter`` with :func:`markdown_to_html` and the offline template."""
+    from jinja2 import DictLoader, pass_context
+    from nbconvert import HTMLExporter
+
+    class OfflineHTMLExporter(HTMLExporter):
+        @pass_context
+        def markdown2html(self, context, source):
+            return markdown_to_html(
+                source,
+                attachments=context.get("cell", {}).get("attachments", {}),
+                anchor_link_text=self.anchor_link_text,
+                path=context.get("resources", {}).get("metadata", {}).get("path", ""),
+            )
+
+    return OfflineHTMLExporter(
+        extra_loaders=[DictLoader({"beatlite_offline.html.j2": _OFFLINE_TEMPLATE})],
+        template_file="beatlite_offline.html.j2",
+    )
+
+
+def export_html(nb) -> str:
+    """The HTML page of an executed notebook, complete offline.
+
+    Formulas in Markdown cells and Markdown outputs become MathML at export time (:func:`markdown_to_html`),
+    so no MathJax is loaded; the page has no ``<script src>``, web font or remote style sheet: the animation
+    player's Font Awesome link is dropped and its icons are inline SVG. Widget state is not embedded (the
+    notebooks run with ``BEATLITE_INTERACTIVE=off``, without widgets).
+    """
+    nb = copy.deepcopy(nb)
+    for cell in nb.cells:
+        for output in cell.get("outputs", []):
+            html = output.get("data", {}).get("text/html")
+            if isinstance(html, str | list):
+                text = "".join(html) if isinstance(html, list) else html
+                output["data"]["text/html"] = _FONT_AWESOME_LINK.sub("", text)
+    nb.metadata.pop("widgets", None)
+    body, _ = _offline_exporter().from_notebook_node(nb, resources={"offline_css": _offline_css()})
+    return body
 
 
 def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     """Execute one notebook in its own folder; save the executed copy and its HTML."""
     import nbformat
-    from nbconvert import HTMLExporter
     from nbconvert.preprocessors import CellExecutionError, ExecutePreprocessor
 
     nb = nbformat.read(path, as_version=4)
-    ep = ExecutePreprocessor(timeout=timeout, kernel_name="python3")
+    ep = ExecutePreprocessor(
+        timeout=timeout, kernel_name="python3", coalesce_streams=True, store_widget_state=False
+    )
     start = time.perf_counter()
     ok, message = True, ""
     try:
@@ -38,8 +179,7 @@ def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     seconds = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, out_dir / path.name)
-    body, _ = HTMLExporter().from_notebook_node(nb)
-    (out_dir / path.with_suffix(".html").name).write_text(body, encoding="utf-8")
+    (out_dir / path.with_suffix(".html").name).write_text(export_html(nb), encoding="utf-8")
     return ok, seconds, message
 
 
@@ -64,6 +204,7 @@ def main(argv: list[str] | None = None) -> int:
 
     out = args.out.resolve()
     os.environ["BEATLITE_BUILD"] = str(out)
+    os.environ["BEATLITE_INTERACTIVE"] = "off"  # text bars and static 3D images in the saved pages
     paths = args.notebooks or sorted((REPO / "notebooks").glob("[0-9][0-9]_*.ipynb"))
     if not paths:
         print("run_notebooks: no notebooks found in notebooks/", file=sys.stderr)

@@ -5,16 +5,19 @@
 #   libegl1 libgl1-mesa-dri         headless OpenGL (EGL + Mesa llvmpipe) for pyvista off-screen rendering;
 #                                   beatlite.viz.probe tries VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow first
 #   libosmesa6                      second choice for pyvista off-screen rendering (vtkOSOpenGLRenderWindow)
+#   chromium                        headless browser of tests/test_pages.py: opens the exported notebook pages
+#                                   offline and checks that formulas and the animation player render
 #   ffmpeg            (optional)    MP4 export of animations (GIF export needs nothing)
 #
 # Idempotent: installs only what `dpkg -s` reports missing. Installs only when run as root with apt-get
 # available; otherwise prints the command to run and exits 0 (nothing here is fatal: without the
-# rendering libraries beatlite.viz warns once and draws with matplotlib; without ffmpeg, save as .gif).
+# rendering libraries beatlite.viz warns once and draws with matplotlib; without ffmpeg, save as .gif;
+# without chromium the browser test of the exported pages is skipped with that reason).
 #
 # Usage: scripts/system_deps.sh [--no-optional]      (or: sudo scripts/system_deps.sh)
 set -u
 
-REQUIRED="espeak-ng libegl1 libgl1-mesa-dri libosmesa6"
+REQUIRED="espeak-ng libegl1 libgl1-mesa-dri libosmesa6 chromium"
 OPTIONAL="ffmpeg"
 [ "${1:-}" = "--no-optional" ] && OPTIONAL=""
 
@@ -28,6 +31,8 @@ for pkg in $REQUIRED $OPTIONAL; do
     elif [ "$pkg" = espeak-ng ] && command -v espeak-ng >/dev/null 2>&1; then
         continue
     elif [ "$pkg" = ffmpeg ] && command -v ffmpeg >/dev/null 2>&1; then
+        continue
+    elif [ "$pkg" = chromium ] && command -v chromium >/dev/null 2>&1; then
         continue
     fi
     missing="$missing $pkg"

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sys
+
+import numpy as np
 import pytest
 
 from beatlite import exercise, notebook, paths, report
@@ -57,8 +60,110 @@ def test_exercise_resolve_and_check(capsys):
     assert exercise.resolve(_square, lambda x: -1)(3) == 9
     assert exercise.check("square", stub, _square, [(2,)]) is None
     assert exercise.check("square", wrong, _square, [(2,), (3,)]) is False  # 2+2 == 2*2 but 3+3 != 9
-    assert "case 1 differs" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert (
+        "case 2 of 2 differs: square(3)" in out and "got 6, expected 9" in out
+    )  # numbered from 1, with inputs
     assert exercise.check("square", _square, _square, [((4,), {})]) is True
+
+
+def _first_line_of_feedback(capsys, student, reference, cases):
+    assert exercise.check("ex", student, reference, cases) is False
+    return capsys.readouterr().out.splitlines()[-1].strip()
+
+
+def test_exercise_feedback_names_what_differs(capsys):
+    big = np.arange(222.0)
+    off = big.copy()
+    off[[7, 9]] += 1.0
+    line = _first_line_of_feedback(capsys, lambda x: off, lambda x: x, [(big,)])
+    assert line == "first difference at index (7,): got 8.0, expected 7.0 (2 of 222 elements differ)"
+    line = _first_line_of_feedback(capsys, lambda x: None, lambda x: x, [(big,)])
+    assert line == "got None: does the function end with `return ...`?"
+    line = _first_line_of_feedback(capsys, lambda x: x[:-1], lambda x: x, [(big,)])
+    assert line == "shape: got (221,), expected (222,)"
+    line = _first_line_of_feedback(capsys, lambda x: x.astype(float), lambda x: x, [(np.arange(3),)])
+    assert line == "dtype: got float (float64), expected integer (int64)"
+    line = _first_line_of_feedback(capsys, lambda s: "val", lambda s: "train", [(1,)])
+    assert line == "got 'val', expected 'train'"
+
+
+def test_exercise_inputs_are_described_not_dumped(capsys):
+    cases = [((np.zeros((20, 5, 3)), 15.0), {"k": [1, 2]})]
+    assert exercise.check("f", lambda a, fps, k: 1.0, lambda a, fps, k: 2.0, cases) is False
+    out = capsys.readouterr().out
+    assert "f(array(shape=(20, 5, 3), dtype=float64), 15.0, k=[1, 2])" in out
+    assert exercise.describe(np.array([1.5, 2.0])) == "array([1.5, 2. ])"
+    assert exercise.describe(list(range(100))) == "list of 100 items: 0, ..."
+    assert exercise.describe("x" * 200).endswith("...") and len(exercise.describe("x" * 200)) == 60
+
+
+def test_exercise_tolerance_and_nan_and_errors(capsys):
+    assert exercise.difference(np.array([1.0, np.nan]), np.array([1.0 + 1e-9, np.nan])) is None
+    assert exercise.difference((3, 4), [3, 4]) is None  # a tuple answers an array question
+    assert exercise.difference(1, 1.0) is None  # scalars: the value counts, not int vs float
+
+    def broken(x):
+        return x[5]
+
+    with pytest.raises(IndexError):
+        exercise.check("broken", broken, _square, [(np.zeros(2),)])
+    assert "case 1 of 1 raised IndexError: broken(array([0., 0.]))" in capsys.readouterr().out
+
+
+def test_exercise_choice_hides_the_answer_and_checks_it(capsys):
+    options = {"a": "it is faster", "b": "a z-scored pose can be all zeros", "c": "the paper says so"}
+    key = exercise.answer_key("bit", "B")
+    assert key == exercise.answer_key("bit", " b ") and key != exercise.answer_key("bit", "a")
+    assert exercise.choice("bit", None, options, key) is None
+    assert "c: the paper says so" in capsys.readouterr().out
+    assert exercise.choice("bit", "a", options, key, hint="What does a 0 input mean?") is False
+    assert "not the best answer. What does a 0 input mean?" in capsys.readouterr().out
+    assert exercise.choice("bit", "d", options, key) is False
+    assert exercise.choice("bit", "B", options, key) is True
+    with pytest.raises(ValueError, match="matches none"):
+        exercise.choice("bit", "a", options, exercise.answer_key("other question", "b"))
+
+
+def test_exercise_predict(capsys):
+    assert exercise.predict("frames", None, 35) is None
+    assert "35" not in capsys.readouterr().out  # the measured value stays hidden until a prediction is made
+    assert exercise.predict("frames", 36, 35, rtol=0.05) is True
+    assert exercise.predict("FGD", 10, 25.0, unit="") is False
+    assert "too low, 0.4x the measured value" in capsys.readouterr().out
+    assert exercise.predict("lag", 0.2, 0.0, atol=0.05, unit="s") is False
+    assert "too high" in capsys.readouterr().out
+
+
+class ZMQInteractiveShell:  # what IPython's get_ipython() returns in a Jupyter kernel (by class name)
+    pass
+
+
+def _fake_kernel(monkeypatch):
+    import types
+
+    monkeypatch.setitem(sys.modules, "IPython", types.SimpleNamespace(get_ipython=ZMQInteractiveShell))
+
+
+def test_interactive_only_in_a_live_kernel_unless_switched_off(monkeypatch):
+    from tqdm.std import tqdm as text_bar
+
+    from beatlite.viz import render
+
+    monkeypatch.delenv("BEATLITE_INTERACTIVE", raising=False)
+    assert not notebook.interactive()  # pytest is not a Jupyter kernel
+    assert type(notebook.progress(range(2), disable=True)) is text_bar
+    assert render.notebook_backend() == "static"
+    _fake_kernel(monkeypatch)
+    assert notebook.interactive()
+    monkeypatch.setattr(render.importlib.util, "find_spec", lambda name: object())  # trame + ipywidgets
+    assert render.notebook_backend() == "trame"
+    monkeypatch.setattr(render.importlib.util, "find_spec", lambda name: None)
+    assert render.notebook_backend() == "static"  # live kernel without the interactive extra
+    for value in ("off", "OFF", "0", "false"):
+        monkeypatch.setenv("BEATLITE_INTERACTIVE", value)  # make run / make test
+        assert not notebook.interactive()
+        assert type(notebook.progress(range(2), disable=True)) is text_bar
 
 
 def test_require_and_setup(capsys):

@@ -43,6 +43,15 @@ def test_two_runs_with_one_seed_give_identical_losses(windows):
     assert c.history != a.history
 
 
+def test_progress_bar_shows_the_unweighted_losses_of_the_history(windows, capsys, monkeypatch):
+    monkeypatch.setenv("BEATLITE_INTERACTIVE", "off")  # a text bar on stderr
+    train, val = windows
+    last = fit(camn(), train, cfg(progress=True), val).history[-1]
+    bar = capsys.readouterr().err.replace("\r", "\n").splitlines()[-1]
+    assert f"rec={last['train']['rec']:.4g}, val_rec={last['val']['rec']:.4g}" in bar, bar
+    assert f"{last['train']['total']:.4g}" not in bar  # not the 500x weighted total (nor the D_ terms)
+
+
 def test_resume_reproduces_an_uninterrupted_run(windows, tmp_path):
     train, val = windows
     full = fit(camn(), train, cfg(epochs=3, checkpoint=tmp_path / "full.pt"), val)

@@ -593,9 +593,9 @@ def build_windows(
         except ValueError:
             pass  # broken cache: rebuild
     if progress:
-        from tqdm.auto import tqdm
+        from beatlite.notebook import progress as progress_bar
 
-        records = tqdm(records, desc=f"windows {split}")
+        records = progress_bar(records, desc=f"windows {split}")
     features = (loaded.pop(r.stem, None) or take_features(r, **feature_args) for r in records)
     windows = Windows(_cut(features, stats, params), normalizers=stats, params=params)
     if path is not None:

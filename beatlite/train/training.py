@@ -227,7 +227,7 @@ def fit(
         raise TypeError(f"fit: model must be a GestureModel, got {type(model).__name__}")
     if not isinstance(config, TrainConfig):
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
-    from tqdm.auto import tqdm
+    from beatlite.notebook import progress
 
     data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads)
@@ -240,7 +240,7 @@ def fit(
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
         return run.result()
-    bar = tqdm(
+    bar = progress(
         range(run.start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch"
     )
     for epoch in bar:
@@ -250,9 +250,19 @@ def fit(
         if val_score is not None:
             run.score(epoch, val_score, entry)
         run.history.append(entry)
-        bar.set_postfix(loss=f"{entry['train'].get('total', float('nan')):.4g}")
+        bar.set_postfix(_shown_losses(entry))
         run.save(epoch + 1)
     return run.result()
+
+
+def _shown_losses(entry: dict[str, Any]) -> dict[str, str]:
+    """The progress bar's losses: the model's first unweighted term (train, and val when there is one),
+    as the history and the notebooks' summaries print it, not the weighted total."""
+    main = next((k for k in entry["train"] if k != "total" and not k.startswith("D_")), "total")
+    shown = {main: entry["train"].get(main, float("nan"))}
+    if main in entry["val"]:
+        shown[f"val_{main}"] = entry["val"][main]
+    return {k: f"{v:.4g}" for k, v in shown.items()}
 
 
 @dataclasses.dataclass(eq=False)

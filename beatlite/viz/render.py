@@ -320,10 +320,19 @@ def render_animation(
 
 
 def notebook_backend() -> str:
-    """The pyvista Jupyter backend to use: ``"trame"`` (interactive) when trame is installed, else ``"static"``."""
-    if importlib.util.find_spec("trame") is not None and importlib.util.find_spec("trame_vtk") is not None:
-        return "trame"
-    return "static"
+    """pyvista's Jupyter backend for :func:`show_skeleton`: ``"trame"`` (interactive) or ``"static"``.
+
+    ``"trame"`` in a live kernel (:func:`beatlite.notebook.interactive`: not under ``make run`` /
+    ``make test``, which set ``BEATLITE_INTERACTIVE=off``) with the ``interactive`` extra installed
+    (``trame-pyvista`` and ``ipywidgets``: ``pip install -e ".[interactive]"``, done by ``make lab``);
+    ``"static"`` (a PNG) otherwise.
+    """
+    from beatlite.notebook import interactive
+
+    if not interactive():
+        return "static"
+    needed = ("trame_pyvista", "ipywidgets")
+    return "trame" if all(importlib.util.find_spec(m) is not None for m in needed) else "static"
 
 
 def show_skeleton(
@@ -336,7 +345,7 @@ def show_skeleton(
     jupyter_backend: str | None = None,
     backend: str = "auto",
 ) -> Any:
-    """Show one frame in a notebook: interactive (trame) when installed, a static image otherwise.
+    """Show one frame in a notebook: an interactive view in a live kernel that has trame, else an image.
 
     Parameters
     ----------
@@ -351,7 +360,8 @@ def show_skeleton(
     view : {"default", "front", "side", "top"}
         Initial camera.
     jupyter_backend : str, optional
-        pyvista's Jupyter backend (default :func:`notebook_backend`: ``"trame"`` or ``"static"``).
+        pyvista's Jupyter backend (default :func:`notebook_backend`: ``"trame"`` in a live JupyterLab
+        kernel with the ``interactive`` extra, ``"static"`` under ``make run`` / ``make test``).
     backend : {"auto", "pyvista", "matplotlib"}
         ``"matplotlib"`` (or a failed probe, with one warning) returns a matplotlib figure.
 
