@@ -179,7 +179,10 @@ class GestureModel(nn.Module):
         Override it when switches in the config change the inputs (CaMN's ablations); the recipes
         ask it whether a model reads words (to give it the vocabulary and word vectors).
         """
-        return tuple(cls.input_keys)
+        keys = cls.input_keys
+        if isinstance(keys, property):
+            raise TypeError(f"{cls.__name__}: input_keys depends on the config: define keys_for(config) too")
+        return tuple(keys)
 
     # ---------------------------------------------------------------- representation
     @property

@@ -372,10 +372,15 @@ class HA2G(GestureModel):
     representation = "dirvec126"
     config_class = HA2GConfig
 
+    @classmethod
+    def keys_for(cls, config: HA2GConfig) -> tuple[str, ...]:
+        """Batch keys read with ``config`` (no ``"word"`` without text)."""
+        return ("mel", "word", "speaker", "dirvec") if config.use_text else ("mel", "speaker", "dirvec")
+
     @property
     def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
-        """Batch keys the forward pass reads (no ``"word"`` without text)."""
-        return ("mel", "word", "speaker", "dirvec") if self.config.use_text else ("mel", "speaker", "dirvec")
+        """Batch keys the forward pass reads (:meth:`keys_for` of its config)."""
+        return self.keys_for(self.config)
 
     def __init__(self, config: HA2GConfig) -> None:
         super().__init__(config)

@@ -288,6 +288,9 @@ class _Run:
         self, model: GestureModel, config: TrainConfig, fingerprint: str, meta: dict[str, Any]
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
+        self.device = config.torch_device()
+        model.to(self.device)
+        self.amp = config.amp and self.device.type == "cuda"
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
         self.g_opt = (
