@@ -125,7 +125,7 @@ def test_joint_group_by_name(name, group):
 
 
 def test_skeleton_bones_partition_joints_and_bones():
-    bones = _inputs.skeleton_bones(tiny_skeleton())
+    bones = _inputs.bone_groups(tiny_skeleton())
     # joints: hands = {RightHand, LeftHand}; head = {Neck, Head}; body = the other 6
     assert bones.joints["hands"].tolist() == [5, 7]
     assert bones.joints["head"].tolist() == [2, 3]
@@ -135,15 +135,15 @@ def test_skeleton_bones_partition_joints_and_bones():
     assert sorted(all_pairs[:, 1].tolist()) == list(range(1, 10))
     assert all(PARENTS[c] == p for p, c in all_pairs)
     # a parents array gives the same bones, all in the body group
-    plain = _inputs.skeleton_bones(np.array(PARENTS))
+    plain = _inputs.bone_groups(np.array(PARENTS))
     assert len(plain.pairs["body"]) == 9 and len(plain.pairs["hands"]) == 0
 
 
 def test_skeleton_bones_rejects_bad_parents():
     with pytest.raises(ValueError, match="parents"):
-        _inputs.skeleton_bones(np.array([-1, 5, 0]))
+        _inputs.bone_groups(np.array([-1, 5, 0]))
     with pytest.raises(TypeError, match="parents array"):
-        _inputs.skeleton_bones(np.zeros((2, 2), dtype=int))
+        _inputs.bone_groups(np.zeros((2, 2), dtype=int))
 
 
 def test_check_positions_errors_name_the_shape():
@@ -237,7 +237,7 @@ def test_filmstrip_views_and_trajectories_layouts():
 
 def test_beat_skeleton_joint_groups():
     beat = pytest.importorskip("beatlite.skeleton.beat")
-    bones = _inputs.skeleton_bones(beat.beat_skeleton())
+    bones = _inputs.bone_groups(beat.beat_skeleton())
     # reference table: per side RightHand + 23 finger joints (M1-4, R..R4, P..P4, I..I4, T1-4) = 24;
     # head = Neck, Neck1, Head, HeadEnd; body = the other 75 - 48 - 4 = 23
     assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
@@ -367,7 +367,7 @@ def test_real_beat_skeleton_file_plots_with_expected_groups(real_samples):
     from beatlite.io import read_bvh
 
     motion = read_bvh(real_samples / "beat_skeleton_2_scott_0_1_1_frame0.bvh")
-    bones = _inputs.skeleton_bones(motion.skeleton)
+    bones = _inputs.bone_groups(motion.skeleton)
     assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
     img = fig_image(plot3d.plot_frame(motion.positions(), motion.skeleton, figsize=(2, 3), dpi=60))
     assert img.shape == (180, 120, 3) and img.std() > 5

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from beatlite.viz._files import atomic_target
-from beatlite.viz._inputs import GROUPS, Bones, check_fps, check_positions, frame_indices, skeleton_bones
+from beatlite.viz._inputs import GROUPS, Bones, bone_groups, check_fps, check_positions, frame_indices
 from beatlite.viz.animation import ffmpeg_available
 from beatlite.viz.plot3d import SkeletonLike
 from beatlite.viz.probe import use_pyvista
@@ -138,7 +138,7 @@ def _mpl_frame_image(
         canvas = FigureCanvasAgg(fig)
         ax = fig.add_axes((0, 0, 1, 1), projection="3d")
         setup_axes(ax, positions, view=view)
-        SkeletonArtist(ax, skeleton_bones(skeleton)).update(positions[frame])
+        SkeletonArtist(ax, bone_groups(skeleton)).update(positions[frame])
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[..., :3].copy()
     return img
@@ -184,7 +184,7 @@ def render_frame(
     (height, width, 3) uint8 ndarray
         The RGB image.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     if (
         isinstance(frame, bool)
@@ -273,7 +273,7 @@ def render_animation(
     Path
         ``path``.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     fps = check_fps(fps)
     w, h = _check_size(size)
@@ -360,7 +360,7 @@ def show_skeleton(
         static image); outside a notebook the ``(H, W, 3) uint8`` image; a matplotlib
         Figure when pyvista cannot render.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     w, h = _check_size(size)
     if not -len(pos) <= int(frame) < len(pos):
