@@ -234,7 +234,7 @@ def plot_frame(
     floor: bool | None = None,
     title: str | None = None,
     names: Sequence[str] | None = None,
-    figsize: tuple[float, float] = (4.0, 4.0),
+    figsize: tuple[float, float] = (6.4, 6.4),
     dpi: float | None = None,
 ) -> Any:
     """Draw one frame of a skeleton in 3D: body, hands and head in different colours, over a floor grid.
@@ -420,7 +420,7 @@ def plot_trajectories(
     frame: int | None = None,
     view: str | tuple[float, float] = "default",
     names: Sequence[str] | None = None,
-    figsize: tuple[float, float] = (5.0, 5.0),
+    figsize: tuple[float, float] = (6.4, 6.4),
     dpi: float | None = None,
 ) -> Any:
     """3D paths of chosen joints over the whole clip, over a faint skeleton at one frame.

@@ -160,7 +160,7 @@ def render_frame(
     skeleton: SkeletonLike,
     frame: int = 0,
     *,
-    size: Sequence[int] = (640, 480),
+    size: Sequence[int] = (SLIDE_WIDTH_PX, 720),
     view: str = "default",
     floor: bool | None = None,
     radius: float | None = None,
@@ -178,7 +178,7 @@ def render_frame(
     frame : int
         Frame to render.
     size : (width, height)
-        Image size in pixels.
+        Image size in pixels (default 960 x 720, slide size).
     view : {"default", "front", "side", "top"}
         Camera.
     floor : bool, optional
