@@ -174,6 +174,42 @@ def check_positions(positions: Any, n_joints: int | None = None, name: str = "po
     return arr
 
 
+def per_sequence(values: Any, n: int, name: str) -> list[Any]:
+    """One skeleton per sequence: a list/tuple of skeletons is used as is, anything else is repeated."""
+    is_per_sequence = (
+        isinstance(values, list | tuple) and len(values) > 0 and not isinstance(values[0], int | np.integer)
+    )
+    if is_per_sequence:
+        if len(values) != n:
+            raise ValueError(f"{name}: {len(values)} given for {n} sequences")
+        return list(values)
+    return [values] * n
+
+
+def checked_sequences(seqs: Sequence[Any], skeletons: Any, name: str) -> tuple[list[np.ndarray], list[Bones]]:
+    """Several position sequences checked against their skeletons (one skeleton for all, or one each).
+
+    Parameters
+    ----------
+    seqs : sequence of (T_i, J_i, 3) array-like, centimetres
+        At least one sequence.
+    skeletons : Skeleton or parents array, or a list/tuple of them (one per sequence)
+        Hierarchies.
+    name : str
+        Argument name for error messages.
+
+    Returns
+    -------
+    (list of (T_i, J_i, 3) float64, list of Bones)
+    """
+    if not len(seqs):
+        raise ValueError(f"{name}: no sequence to draw")
+    bones = [bone_groups(s) for s in per_sequence(skeletons, len(seqs), "skeleton")]
+    return [
+        check_positions(p, b.n_joints, f"{name}[{i}]") for i, (p, b) in enumerate(zip(seqs, bones))
+    ], bones
+
+
 def check_fps(fps: Any, name: str = "fps") -> float:
     """A positive finite frame rate as float (frames per second)."""
     try:

@@ -33,10 +33,9 @@ from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 from beatlite.viz._files import atomic_target
 from beatlite.viz._inputs import (
     Bones,
-    bone_groups,
     check_fps,
-    check_positions,
     check_words,
+    checked_sequences,
     frame_indices,
     word_at,
 )
@@ -227,13 +226,7 @@ class FacePanel:
 
     def checked(self, fps: float) -> FacePanel:
         """A copy with the rows to show selected, names filled and ``fps`` set; ValueError on bad input."""
-        w = np.asarray(self.weights, dtype=np.float64)
-        if w.ndim != 2 or w.shape[0] == 0:
-            raise ValueError(f"face must be (T, 51) blendshape weights, got shape {w.shape}")
-        if self.names is not None and len(self.names) != w.shape[1]:
-            raise ValueError(f"face_names: {len(self.names)} names for {w.shape[1]} blendshapes")
-        if self.kind not in FACE_PANELS:
-            raise ValueError(f"face_panel must be one of {FACE_PANELS}, got {self.kind!r}")
+        w = _check_face(self.weights, self.names, self.kind)
         names = list(self.names) if self.names is not None else [f"blendshape {k}" for k in range(w.shape[1])]
         rows = np.arange(w.shape[1])
         if self.top is not None and int(self.top) < w.shape[1]:
@@ -242,18 +235,16 @@ class FacePanel:
         return FacePanel(w[:, rows], [names[k] for k in rows], f_fps, self.kind, None)
 
 
-def per_sequence(values: Any, n: int, name: str) -> list[Any]:
-    """One skeleton per sequence: a list/tuple of skeletons is used as is, anything else is repeated."""
-    is_per_sequence = isinstance(values, list | tuple) and len(values) > 0 and not _is_int(values[0])
-    if is_per_sequence:
-        if len(values) != n:
-            raise ValueError(f"{name}: {len(values)} given for {n} sequences")
-        return list(values)
-    return [values] * n
-
-
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int | np.integer)
+def _check_face(weights: Any, names: Sequence[str] | None, kind: str) -> np.ndarray:
+    """Blendshape weights as ``(T, K) float64``, or a ValueError naming the bad argument."""
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim != 2 or w.shape[0] == 0:
+        raise ValueError(f"face must be (T, 51) blendshape weights, got shape {w.shape}")
+    if names is not None and len(names) != w.shape[1]:
+        raise ValueError(f"face_names: {len(names)} names for {w.shape[1]} blendshapes")
+    if kind not in FACE_PANELS:
+        raise ValueError(f"face_panel must be one of {FACE_PANELS}, got {kind!r}")
+    return w
 
 
 def _envelope(y: np.ndarray, sr: float, n_bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -273,16 +264,12 @@ def _sequences(
 ) -> tuple[list[str] | None, list[np.ndarray], list[Bones]]:
     """Step 1: the sequences to animate, their labels and drawable bones, checked."""
     if isinstance(positions, Mapping):
-        labels = list(positions) if labels is None else labels
-        seqs = list(positions.values())
+        labels, seqs = (list(positions) if labels is None else labels), list(positions.values())
     else:
         seqs = list(positions) if isinstance(positions, list | tuple) else [positions]
-    if not seqs:
-        raise ValueError("positions: no sequence to animate")
     if labels is not None and len(labels) != len(seqs):
         raise ValueError(f"labels: {len(labels)} labels for {len(seqs)} sequences")
-    bones = [bone_groups(s) for s in per_sequence(skeleton, len(seqs), "skeleton")]
-    seqs = [check_positions(p, b.n_joints, f"positions[{i}]") for i, (p, b) in enumerate(zip(seqs, bones))]
+    seqs, bones = checked_sequences(seqs, skeleton, "positions")
     return (None if labels is None else [str(x) for x in labels]), seqs, bones
 
 
@@ -339,6 +326,13 @@ def _face_heights(face: FacePanel | None) -> tuple[float, float]:
     return 1.3, 1.5  # bars, names written vertically below
 
 
+def _skeleton_row(n: int, width: float, panel_size: float | None, below: bool) -> tuple[float, float]:
+    """Height of the skeleton row and figure width, inches: square panels up to 3.6 in (5.4 alone)."""
+    if panel_size is None:
+        return min(width / n, 3.6 if below else 5.4), width
+    return panel_size, max(panel_size * n, 6.0 if below else 0.0)  # beatlite 0.1's panel_size layout
+
+
 def _layout(
     n: int,
     width: float,
@@ -351,15 +345,10 @@ def _layout(
 ) -> _Layout:
     """Stack from the top: skeleton row, caption band, timeline, face; side margins for names and legends."""
     below = timeline or face is not None
-    if panel_size is None:
-        sk_h = min(width / n, 3.6 if below else 5.4)
-    else:
-        sk_h, width = panel_size, max(panel_size * n, 6.0 if below else 0.0)
-    title_h = 0.4 if titles else 0.0
-    cap_h = 0.55 if caption else 0.0
-    tl_h = 1.0 + 0.55 if timeline else 0.0
+    sk_h, width = _skeleton_row(n, width, panel_size, below)
+    title_h, cap_h, tl_h = 0.4 * titles, 0.55 * caption, 1.55 * timeline
     face_h, face_below = _face_heights(face)
-    height = title_h + sk_h + cap_h + tl_h + face_h + face_below + (0.1 if below else 0.0)
+    height = title_h + sk_h + cap_h + tl_h + face_h + face_below + 0.1 * below
     left, right = min(1.6, 0.22 * width), min(1.8, 0.22 * width)
     w_frac = (width - left - right) / width
 

@@ -166,9 +166,7 @@ def plot_scores(
     matplotlib.figure.Figure
     """
     labels = list(scores)
-    values = np.asarray([float(scores[k]) for k in labels])
-    if not len(values) or not np.all(np.isfinite(values)) or np.any(values < 0):
-        raise ValueError(f"scores must be finite and >= 0, got {dict(scores)}")
+    values = _check_scores(scores)
     limit = _axis_limit(values)
     with figure_style():
         ax = _new_axes(ax, figsize)
@@ -188,6 +186,14 @@ def plot_scores(
     return ax.figure
 
 
+def _check_scores(scores: Mapping[str, float]) -> np.ndarray:
+    """``(S,) float64`` scores, or a ValueError when one is missing, not finite or negative."""
+    values = np.asarray([float(v) for v in scores.values()])
+    if not len(values) or not np.all(np.isfinite(values)) or np.any(values < 0):
+        raise ValueError(f"scores must be finite and >= 0, got {dict(scores)}")
+    return values
+
+
 def _axis_limit(values: np.ndarray) -> float:
     """x-axis end: the largest value, or 1.3 x the largest non-outlier when one bar dwarfs the rest."""
     top = float(values.max())
@@ -195,6 +201,10 @@ def _axis_limit(values: np.ndarray) -> float:
     if len(rest) and rest.max() > 0 and top > OUTLIER_FACTOR * rest.max():
         return float(1.3 * rest.max())
     return top if top > 0 else 1.0
+
+
+def _finite_pair(a: float | None, b: float | None) -> bool:
+    return a is not None and b is not None and bool(np.isfinite(a) and np.isfinite(b))
 
 
 def plot_score_scatter(
@@ -227,7 +237,7 @@ def plot_score_scatter(
     -------
     matplotlib.figure.Figure
     """
-    keep = [k for k in x if k in y and np.isfinite(x[k]) and np.isfinite(y[k])]
+    keep = [k for k in x if _finite_pair(x.get(k), y.get(k))]
     if not keep:
         raise ValueError("plot_score_scatter: no system has both scores")
     xs = np.array([float(x[k]) for k in keep])

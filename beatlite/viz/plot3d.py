@@ -17,7 +17,15 @@ from typing import Any
 import numpy as np
 
 from beatlite.skeleton.core import Skeleton
-from beatlite.viz._inputs import GROUPS, Bones, bone_groups, check_fps, check_positions, to_plot_coords
+from beatlite.viz._inputs import (
+    GROUPS,
+    Bones,
+    bone_groups,
+    check_fps,
+    check_positions,
+    checked_sequences,
+    to_plot_coords,
+)
 from beatlite.viz.style import GROUP_COLOURS, figure_style, legend_outside, system_colour
 
 #: Camera angles ``(elev, azim)`` in degrees of the named views (plot axes, see the module docstring).
@@ -465,6 +473,15 @@ def plot_trajectories(
     return fig
 
 
+def _keyframe_row(
+    axes: list[Any], pos: np.ndarray, bones: Bones, frames: list[int], view: Any, half: Any
+) -> None:
+    """One system's key frames, one per axes, in the shared box ``half``."""
+    for ax, k in zip(axes, frames):
+        setup_axes(ax, pos[frames], view=view, floor=bones.has_feet, half=half)
+        SkeletonArtist(ax, bones, linewidth=1.5, joint_size=1.5).update(pos[k])
+
+
 def plot_keyframes(
     systems: Mapping[str, Any],
     skeletons: SkeletonLike | Sequence[SkeletonLike],
@@ -505,14 +522,11 @@ def plot_keyframes(
     --------
     >>> fig = plot_keyframes({"ground truth": gt, "CaMN": camn}, skeleton, [0, 15, 30], fps=15)  # doctest: +SKIP
     """
-    from beatlite.viz.animation import per_sequence
-
-    labels, seqs = list(systems), list(systems.values())
-    bones = [bone_groups(s) for s in per_sequence(skeletons, len(seqs), "skeletons")]
-    seqs = [check_positions(p, b.n_joints, f"systems[{lab!r}]") for lab, p, b in zip(labels, seqs, bones)]
+    labels = list(systems)
+    seqs, bones = checked_sequences(list(systems.values()), skeletons, "systems")
     frames = [_check_frame(f, min(len(p) for p in seqs), "frames") for f in frames]
-    if not frames or not seqs:
-        raise ValueError("plot_keyframes needs at least one system and one frame")
+    if not frames:
+        raise ValueError("frames must list at least one frame, got an empty sequence")
     fps = check_fps(fps)
     half = half_extents([p[frames] for p in seqs])
     with figure_style():
@@ -521,15 +535,12 @@ def plot_keyframes(
             left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=1 - 0.3 / fig.get_figheight()
         )
         for row, (label, pos, b) in enumerate(zip(labels, seqs, bones)):
-            for col, k in enumerate(frames):
-                ax = fig.add_subplot(len(seqs), len(frames), row * len(frames) + col + 1, projection="3d")
-                setup_axes(ax, pos[frames], view=view, floor=b.has_feet, half=half)
-                SkeletonArtist(ax, b, linewidth=1.5, joint_size=1.5).update(pos[k])
-                if row == 0:
-                    ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
-                if col == 0:
-                    colour = system_colour(label, row)
-                    ax.text2D(-0.06, 0.5, label, transform=ax.transAxes, rotation=90, va="center", ha="right",
-                              color=colour, fontsize=11, fontweight="bold")  # fmt: skip
+            axes = [fig.add_subplot(len(seqs), len(frames), row * len(frames) + col + 1, projection="3d")
+                    for col in range(len(frames))]  # fmt: skip
+            _keyframe_row(axes, pos, b, frames, view, half)
+            axes[0].text2D(-0.06, 0.5, label, transform=axes[0].transAxes, rotation=90, va="center", ha="right",
+                           color=system_colour(label, row), fontsize=11, fontweight="bold")  # fmt: skip
+        for ax, k in zip(fig.axes, frames):
+            ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
         fig.subplots_adjust(wspace=0, hspace=0)
     return fig
