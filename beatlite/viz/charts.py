@@ -101,7 +101,7 @@ def plot_training_curves(
         raise ValueError("panels must name at least one quantity to plot")
     with figure_style():
         fig, axes = plt.subplots(1, len(panels), figsize=(panel_size[0] * len(panels), panel_size[1]),
-                                 layout="constrained", squeeze=False)  # fmt: skip
+                                 layout="constrained", squeeze=False, sharex=True)  # fmt: skip
         for ax, (ylabel, curves) in zip(axes[0], panels.items()):
             _draw_curves(ax, history, curves, selected)
             ax.set_ylabel(ylabel)
@@ -128,6 +128,8 @@ def _draw_curves(
     if drawn:
         legend_outside(ax, "top", fontsize=8)
     else:
+        epochs = [float(h.get("epoch", k)) for k, h in enumerate(history)]
+        ax.set_xlim(min(epochs, default=0.0), max(epochs, default=0.0) + 1)
         ax.text(
             0.5, 0.5, "not logged in this run", ha="center", va="center", transform=ax.transAxes, color="0.4"
         )
