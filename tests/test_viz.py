@@ -588,3 +588,50 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
     assert len(labels) == 3 and all(_inside(t.get_window_extent(renderer), ax.get_window_extent(renderer))
                                     for t in labels)  # fmt: skip
     plt.close("all")
+
+
+def test_signals_label_the_axes_keep_the_legend_outside_and_cut_one_large_swing():
+    from beatlite.viz import charts
+
+    t = np.arange(150) / 15
+    swing = np.where(np.abs(t - 1.0) < 0.2, 100.0, 0.0)  # one 100 cm/s swing before speech
+    speed = 5.0 + 5.0 * np.sin(2 * np.pi * t) + swing
+    fig = charts.plot_signals(t, {"wrist": speed}, "wrist speed (cm/s)", events={"onsets": [2.0, 3.0]},
+                              markers={"wrist": [2.75]}, clip_quantile=0.9)  # fmt: skip
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("time (s)", "wrist speed (cm/s)")
+    cut = 1.2 * np.quantile(speed, 0.9)  # the y axis ends near the sine's range, not at 105
+    assert ax.get_ylim()[1] == pytest.approx(cut + 0.05 * (cut - speed.min()))
+    assert any("cut" in txt.get_text() for txt in ax.texts)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert ax.get_legend().get_window_extent(renderer).x0 >= ax.get_window_extent(renderer).x1 - 1
+    assert [txt.get_text() for txt in ax.get_legend().get_texts()] == ["wrist", "onsets"]
+    with pytest.raises(ValueError, match="curves"):
+        charts.plot_signals(t, {"short": speed[:10]}, "x")
+    plt.close("all")
+
+
+def test_waveform_has_an_amplitude_axis_and_the_words_of_the_window():
+    from beatlite.viz import charts
+
+    sr = 1000
+    y = 0.5 * np.sin(2 * np.pi * 50 * np.arange(3 * sr) / sr)
+    words = ([0.2, 1.0, 2.5], [0.6, 1.4, 2.9], ["one", "two", "three"])
+    ax = charts.plot_waveform(y, sr, words=words, onsets={"onsets": [0.2]}, xlim=(0, 2)).axes[0]
+    assert ax.get_ylabel() == "amplitude (full scale)" and ax.get_xlabel() == "time (s)"
+    assert [t.get_text() for t in ax.texts] == ["one", "two"]  # "three" starts after the 2 s shown
+    assert ax.get_xlim() == (0.0, 2.0)
+    plt.close("all")
+
+
+def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
+    w = np.zeros((120, 4))
+    w[:, 2] = 0.5 + 0.5 * np.sin(np.arange(120) / 10)
+    w[:, 0] = np.linspace(0, 0.2, 120)
+    fig = face.plot_blendshape_curves(w, ["a", "b", "c", "d"], fps=60, top=2)
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["a", "c"]
+    assert ax.get_ylabel() == "weight (0-1)"
+    assert ax.lines[0].get_xdata()[-1] == pytest.approx(119 / 60)  # seconds
+    plt.close("all")

@@ -11,9 +11,11 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ``animation``                :func:`animate_skeletons` (GT | CaMN | HA2G side by side, one scale;
                              :class:`Timeline`, words, :class:`FacePanel`) -> :class:`SkeletonAnimation`
                              (inline JS/HTML, ``.save_as`` GIF/MP4/HTML, 960 px wide)
-``face``                     :func:`plot_blendshapes` (ARKit heat map / bars, by name)
+``face``                     :func:`plot_blendshapes` (ARKit heat map / bars, by name),
+                             :func:`plot_blendshape_curves` (the most active ones over time)
 ``charts``                   :func:`plot_training_curves`, :func:`plot_scores` (bars, outliers cut),
-                             :func:`plot_score_scatter` (labelled points)
+                             :func:`plot_score_scatter` (labelled points), :func:`plot_signals`
+                             (curves + event lines), :func:`plot_waveform` (amplitude, words, onsets)
 ``render``                   pyvista: :func:`render_frame`, :func:`render_animation`, :func:`show_skeleton`
 ``probe``                    :func:`probe_offscreen`, :func:`use_pyvista` (subprocess probe, cached)
 ``bvh_export``               :func:`motion_from_subset`, :func:`export_bvh` (Blender import steps)
@@ -52,6 +54,9 @@ _EXPORTS: dict[str, str] = {
     "plot_training_curves": "charts",
     "plot_scores": "charts",
     "plot_score_scatter": "charts",
+    "plot_signals": "charts",
+    "plot_waveform": "charts",
+    "plot_blendshape_curves": "face",
     "plot_blendshapes": "face",
     "render_frame": "render",
     "render_animation": "render",

@@ -257,3 +257,159 @@ def plot_score_scatter(
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
     return ax.figure
+
+
+def plot_signals(
+    times: Any,
+    signals: Mapping[str, Any],
+    ylabel: str,
+    *,
+    events: Mapping[str, Any] | None = None,
+    markers: Mapping[str, Any] | None = None,
+    xlim: tuple[float, float] | None = None,
+    clip_quantile: float | None = None,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.8),
+) -> Any:
+    """Curves over time (joint angles, wrist speeds, onset strength) with event lines, legend right of the data.
+
+    Parameters
+    ----------
+    times : (T,) float, seconds
+        Common time axis of the signals.
+    signals : mapping label -> (T,) float
+        The curves, in the colours C0, C1, ...
+    ylabel : str
+        y-axis label with its unit, e.g. ``"wrist speed (cm/s)"``.
+    events : mapping label -> (E,) float seconds, optional
+        Times drawn as vertical lines over the whole height (e.g. ``{"audio onsets": onsets}``).
+    markers : mapping curve label -> (M,) float seconds, optional
+        Times marked on that curve with a triangle (e.g. speed minima), in the curve's colour.
+    xlim : (float, float), optional
+        Time range shown, seconds; the y range follows the data inside it.
+    clip_quantile : float in (0, 1], optional
+        Upper y limit = 1.2 x this quantile of the shown values, so that one large
+        swing does not flatten the rest (the cut is written in the corner); ``None``: all data.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> t = np.arange(100) / 15
+    >>> fig = plot_signals(t, {"right wrist": np.abs(np.sin(t))}, "speed (cm/s)", events={"onsets": [1.0, 2.5]})
+    >>> fig.axes[0].get_ylabel()
+    'speed (cm/s)'
+    """
+    t = np.asarray(times, dtype=np.float64).reshape(-1)
+    curves = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in signals.items()}
+    bad = [k for k, v in curves.items() if v.shape != t.shape]
+    if not curves or bad:
+        raise ValueError(
+            f"signals must be (T,) = {t.shape} curves, got {[(k, curves[k].shape) for k in bad]}"
+        )
+    shown = (t >= xlim[0]) & (t <= xlim[1]) if xlim is not None else np.ones(t.shape, bool)
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        for i, (label, y) in enumerate(curves.items()):
+            ax.plot(t, y, lw=1.1, color=f"C{i}", label=label)
+            when = np.asarray((markers or {}).get(label, []), dtype=np.float64)
+            ax.plot(when, np.interp(when, t, y), "v", ms=5, color=f"C{i}", ls="none")
+        _draw_events(ax, events)
+        _set_signal_limits(ax, t, np.stack(list(curves.values()))[:, shown], xlim, clip_quantile)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel(ylabel)
+        legend_outside(ax, "right")
+    return ax.figure
+
+
+def _draw_events(ax: Any, events: Mapping[str, Any] | None) -> None:
+    """Vertical lines at event times, one colour per kind, from the red end of the palette."""
+    for k, (label, when) in enumerate((events or {}).items()):
+        ax.axvline(np.nan, color=f"C{3 + k}", lw=0.9, label=label)  # one legend entry per kind
+        for x in np.asarray(when, dtype=np.float64).reshape(-1):
+            ax.axvline(x, color=f"C{3 + k}", lw=0.9, alpha=0.6)
+
+
+def _set_signal_limits(
+    ax: Any, t: np.ndarray, shown: np.ndarray, xlim: Any, clip_quantile: float | None
+) -> None:
+    """x range as asked; y range from the shown values, optionally cut at a quantile."""
+    ax.set_xlim(*(xlim if xlim is not None else (t.min(), t.max())))
+    if shown.size == 0:
+        return
+    lo, hi = float(shown.min()), float(shown.max())
+    if clip_quantile is not None:
+        if not 0.0 < clip_quantile <= 1.0:
+            raise ValueError(f"clip_quantile must be in (0, 1], got {clip_quantile!r}")
+        cut = 1.2 * float(np.quantile(shown, clip_quantile))
+        if cut < hi:
+            hi = cut
+            ax.text(1.01, 0.0, f"y axis cut at {cut:.3g}:\nhigher peaks run off", transform=ax.transAxes,
+                    ha="left", va="bottom", fontsize=8, color="0.35")  # fmt: skip
+    pad = 0.05 * (hi - lo) if hi > lo else 1.0
+    ax.set_ylim(lo - pad, hi + pad)
+
+
+def plot_waveform(
+    audio: Any,
+    sr: float,
+    *,
+    words: Any = None,
+    onsets: Mapping[str, Any] | None = None,
+    xlim: tuple[float, float] | None = None,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.6),
+) -> Any:
+    """A waveform with its amplitude axis, optional words (shaded, written above) and onset lines.
+
+    Parameters
+    ----------
+    audio : (N,) float, in [-1, 1]
+        Mono waveform.
+    sr : float
+        Sample rate, Hz.
+    words : (starts, ends, words) or WordIntervals, optional
+        Word timings in seconds, shaded and written over the waveform's top margin.
+    onsets : mapping label -> (E,) float seconds, optional
+        Event times drawn as vertical lines (e.g. ``{"audio onsets": onsets}``); legend right of the data.
+    xlim : (float, float), optional
+        Time range shown, seconds (default the whole waveform).
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from beatlite.viz._inputs import check_fps, check_words
+
+    y = np.asarray(audio, dtype=np.float64).reshape(-1)
+    if y.size == 0:
+        raise ValueError("audio must be a non-empty (N,) waveform")
+    sr = check_fps(sr, "sr")
+    t = np.arange(len(y)) / sr
+    xlim = xlim if xlim is not None else (0.0, len(y) / sr)
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        ax.plot(t, y, lw=0.4, color="0.4")
+        _draw_events(ax, onsets)
+        peak = max(float(np.abs(y).max()), 1e-6)
+        ax.set_ylim(-1.05 * peak, 1.45 * peak)  # the top margin holds the words
+        if words is not None:
+            for start, end, word in zip(*check_words(words)):
+                if end > xlim[0] and start < xlim[1]:
+                    ax.axvspan(start, end, color="#4c72b0", alpha=0.12, lw=0)
+                    ax.text((start + end) / 2, 1.2 * peak, word, ha="center", va="center", fontsize=8)
+        ax.set_xlim(*xlim)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("amplitude (full scale)")
+        legend_outside(ax, "right")
+    return ax.figure

@@ -139,3 +139,41 @@ def plot_blendshapes(
             fig, ax = plt.subplots(figsize=figsize, layout="constrained")
         (_heatmap if kind == "heatmap" else _bars)(ax, w, labels, fps, frame)
     return ax.figure
+
+
+def plot_blendshape_curves(
+    weights: Any,
+    names: Sequence[str],
+    fps: float = 60.0,
+    *,
+    top: int = 4,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.8),
+) -> Any:
+    """The ``top`` most active blendshapes as curves over time (none that sits at 0), legend right of the data.
+
+    Parameters
+    ----------
+    weights : (T, K) float, values in [0, 1]
+        Blendshape weights.
+    names : sequence of str
+        The K names (legend).
+    fps : float
+        Frame rate of ``weights``, frames per second.
+    top : int
+        How many curves: the blendshapes with the largest standard deviation (:func:`most_active`).
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from beatlite.viz.charts import plot_signals
+
+    w = _check_weights(weights, names, "heatmap", None)
+    rows = most_active(w, top)
+    times = np.arange(len(w)) / check_fps(fps)
+    return plot_signals(times, {names[j]: w[:, j] for j in rows}, "weight (0-1)", ax=ax, figsize=figsize)
