@@ -635,3 +635,22 @@ def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
     assert ax.get_ylabel() == "weight (0-1)"
     assert ax.lines[0].get_xdata()[-1] == pytest.approx(119 / 60)  # seconds
     plt.close("all")
+
+
+def test_bone_levels_mark_the_new_bones_of_each_level_on_shared_limits():
+    from beatlite.skeleton import ted
+
+    pose = upper_body(1)[0]
+    levels = ted.HA2G_LEVELS
+    fig = plot3d.plot_bone_levels(pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist")
+    body, hands = fig.axes[0::2], fig.axes[1::2]
+    assert len(body) == len(hands) == len(levels) == 6
+    red = style.GROUP_COLOURS["hands"]
+    for k, ax in enumerate(body):  # thick red lines = the bones this level adds (levels are cumulative)
+        added = len(levels[k]) - (len(levels[k - 1]) if k else 0)
+        assert sum(line.get_color() == red for line in ax.lines) == added
+    assert len({(ax.get_xlim(), ax.get_ylim()) for ax in body}) == 1  # one scale for every level
+    # the right hand's 15 finger bones arrive in levels 4-6; before that its panel says so
+    assert [bool(ax.texts) for ax in hands] == [True, True, True, False, False, False]
+    assert sum(len(ax.lines) for ax in hands[-1:]) == 15
+    plt.close("all")

@@ -7,7 +7,8 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ``style``                    one figure style (:func:`figure_style`, :data:`STYLE`), :func:`save_figure`,
                              :func:`system_colour`, :func:`legend_outside`
 ``plot3d``                   :func:`plot_frame`, :func:`plot_filmstrip`, :func:`plot_views`,
-                             :func:`plot_trajectories`, :func:`plot_keyframes` (matplotlib 3D)
+                             :func:`plot_trajectories`, :func:`plot_keyframes` (matplotlib 3D),
+                             :func:`plot_bone_levels` (what each hierarchy level adds, 2D)
 ``animation``                :func:`animate_skeletons` (GT | CaMN | HA2G side by side, one scale;
                              :class:`Timeline`, words, :class:`FacePanel`) -> :class:`SkeletonAnimation`
                              (inline JS/HTML, ``.save_as`` GIF/MP4/HTML, 960 px wide)
@@ -46,6 +47,7 @@ _EXPORTS: dict[str, str] = {
     "plot_views": "plot3d",
     "plot_trajectories": "plot3d",
     "plot_keyframes": "plot3d",
+    "plot_bone_levels": "plot3d",
     "animate_skeletons": "animation",
     "save_animation": "animation",
     "SkeletonAnimation": "animation",

@@ -544,3 +544,106 @@ def plot_keyframes(
             ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
         fig.subplots_adjust(wspace=0, hspace=0)
     return fig
+
+
+def _level_panel(
+    ax: Any, pts: np.ndarray, bones: np.ndarray, shown: Sequence[int], new: set[int], box: np.ndarray
+) -> None:
+    """2D bones (``pts`` already projected) inside ``box`` ((2, 2): min, max): new ones thick red, earlier grey."""
+    for b in shown:
+        xy = pts[bones[b]]
+        ax.plot(xy[:, 0], xy[:, 1], "-o", ms=2.5, lw=2.2 if b in new else 1.0,
+                color=GROUP_COLOURS["hands"] if b in new else "0.6")  # fmt: skip
+    if not len(shown):
+        ax.text(0.5, 0.5, "no bones here yet", transform=ax.transAxes, ha="center", va="center", color="0.5")
+    ax.set_xlim(box[0, 0], box[1, 0])
+    ax.set_ylim(box[0, 1], box[1, 1])
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+
+
+def _box(pts: np.ndarray, margin: float = 0.06) -> np.ndarray:
+    """(2, 2) min/max corners of 2D points, with a margin (fraction of the larger side)."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = margin * float(max(hi - lo)) + 1e-6
+    return np.stack([lo - pad, hi + pad])
+
+
+def _subtree(bones: np.ndarray, root: int) -> set[int]:
+    """Indices of the bones below joint ``root`` (its descendants' bones)."""
+    below, found = {root}, set()
+    for _ in range(len(bones)):
+        for b, (p, c) in enumerate(bones):
+            if p in below and b not in found:
+                found.add(b)
+                below.add(int(c))
+    return found
+
+
+def plot_bone_levels(
+    positions: Any,
+    bones: Any,
+    levels: Sequence[Sequence[int]],
+    *,
+    names: Sequence[str] | None = None,
+    zoom: str | int | None = None,
+    ncols: int = 3,
+) -> Any:
+    """What each level of a bone hierarchy adds (HA2G's 6 levels, Sec. 3.2): new bones red, earlier ones grey.
+
+    One panel per level: the body from the front; with ``zoom``, a second panel per
+    level shows the bones below that joint (e.g. the right hand) from above,
+    enlarged. Panels are tight around the bones (equal aspect, no empty axes).
+
+    Parameters
+    ----------
+    positions : (J, 3) float, centimetres, Y up
+        One pose (e.g. the rest pose on TED-43).
+    bones : (B, 2) int
+        (parent, child) joint index of each bone.
+    levels : sequence of sequence of int
+        Bone indices of each level (cumulative, like ``beatlite.skeleton.ted.HA2G_LEVELS``).
+    names : sequence of str, optional
+        Joint names (needed when ``zoom`` is a name).
+    zoom : str or int, optional
+        Joint whose subtree gets an enlarged top view (e.g. ``"right_wrist"``).
+    ncols : int
+        Levels per row of the figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    pos = check_positions(positions)[0]
+    bones = np.asarray(bones, dtype=np.int64).reshape(-1, 2)
+    if bones.size == 0 or bones.min() < 0 or bones.max() >= len(pos):
+        raise ValueError(f"bones must be (B, 2) joint indices below {len(pos)}, got shape {bones.shape}")
+    root = None if zoom is None else _joint_indices([zoom], names, len(pos))[0]
+    views = [(pos[:, [0, 1]], set(range(len(bones))))]  # the body from the front: x right, y up
+    if root is not None:  # the subtree from above, around the zoom joint: x right, +z (forward) down
+        views.append(((pos - pos[root])[:, [0, 2]] * [1, -1], _subtree(bones, root)))
+    boxes = [_box(pts[np.unique(bones[sorted(keep)])]) for pts, keep in views]
+    col_w = 9.6 / ncols
+    heights = [min(col_w * float(np.ptp(b[:, 1]) / np.ptp(b[:, 0])), 1.5) for b in boxes]
+    n_blocks = -(-len(levels) // ncols)
+    with figure_style():
+        fig = _new_figure((9.6, n_blocks * (sum(heights) + 0.35 * len(views)) + 0.5), None)
+        grid = fig.add_gridspec(
+            n_blocks * len(views), ncols, height_ratios=heights * n_blocks, hspace=0.2, wspace=0.05
+        )
+        previous: set[int] = set()
+        for k, level in enumerate(levels):
+            block, col = divmod(k, ncols)
+            for v, ((pts, keep), box) in enumerate(zip(views, boxes)):
+                ax = fig.add_subplot(grid[block * len(views) + v, col])
+                _level_panel(ax, pts, bones, sorted(set(level) & keep), (set(level) - previous) & keep, box)
+                if v == 0:
+                    ax.set_title(f"level {k + 1}: {len(level)} bones, {3 * len(level)} dims", fontsize=10)
+            previous = set(level)
+        where = (
+            ""
+            if root is None
+            else f"; under each: the bones below {names[root] if names else root}, from above"
+        )
+        fig.suptitle(f"bones each level adds (red) to the earlier ones (grey){where}", fontsize=11)
+    return fig
