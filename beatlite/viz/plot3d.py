@@ -580,6 +580,14 @@ def _subtree(bones: np.ndarray, root: int) -> set[int]:
     return found
 
 
+def _level_views(pos: np.ndarray, bones: np.ndarray, root: int | None) -> list[tuple[np.ndarray, set[int]]]:
+    """(2D points, bones shown) of each panel row: the body from the front, then the subtree of ``root`` from above."""
+    views = [(pos[:, [0, 1]], set(range(len(bones))))]  # front: x right, y up
+    if root is not None:  # above, around the root joint: x right, +z (forward) down
+        views.append(((pos - pos[root])[:, [0, 2]] * [1, -1], _subtree(bones, root)))
+    return views
+
+
 def plot_bone_levels(
     positions: Any,
     bones: Any,
@@ -619,9 +627,7 @@ def plot_bone_levels(
     if bones.size == 0 or bones.min() < 0 or bones.max() >= len(pos):
         raise ValueError(f"bones must be (B, 2) joint indices below {len(pos)}, got shape {bones.shape}")
     root = None if zoom is None else _joint_indices([zoom], names, len(pos))[0]
-    views = [(pos[:, [0, 1]], set(range(len(bones))))]  # the body from the front: x right, y up
-    if root is not None:  # the subtree from above, around the zoom joint: x right, +z (forward) down
-        views.append(((pos - pos[root])[:, [0, 2]] * [1, -1], _subtree(bones, root)))
+    views = _level_views(pos, bones, root)
     boxes = [_box(pts[np.unique(bones[sorted(keep)])]) for pts, keep in views]
     col_w = 9.6 / ncols
     heights = [min(col_w * float(np.ptp(b[:, 1]) / np.ptp(b[:, 0])), 1.5) for b in boxes]
