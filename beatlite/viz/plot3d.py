@@ -588,6 +588,20 @@ def _level_views(pos: np.ndarray, bones: np.ndarray, root: int | None) -> list[t
     return views
 
 
+def _check_bones(bones: Any, n_joints: int) -> np.ndarray:
+    bones = np.asarray(bones, dtype=np.int64).reshape(-1, 2)
+    if bones.size == 0 or bones.min() < 0 or bones.max() >= n_joints:
+        raise ValueError(f"bones must be (B, 2) joint indices below {n_joints}, got shape {bones.shape}")
+    return bones
+
+
+def _levels_title(root: int | None, names: Sequence[str] | None) -> str:
+    title = "bones each level adds (red) to the earlier ones (grey)"
+    if root is None:
+        return title
+    return f"{title}; under each: the bones below {names[root] if names else root}, from above"
+
+
 def plot_bone_levels(
     positions: Any,
     bones: Any,
@@ -623,9 +637,7 @@ def plot_bone_levels(
     matplotlib.figure.Figure
     """
     pos = check_positions(positions)[0]
-    bones = np.asarray(bones, dtype=np.int64).reshape(-1, 2)
-    if bones.size == 0 or bones.min() < 0 or bones.max() >= len(pos):
-        raise ValueError(f"bones must be (B, 2) joint indices below {len(pos)}, got shape {bones.shape}")
+    bones = _check_bones(bones, len(pos))
     root = None if zoom is None else _joint_indices([zoom], names, len(pos))[0]
     views = _level_views(pos, bones, root)
     boxes = [_box(pts[np.unique(bones[sorted(keep)])]) for pts, keep in views]
@@ -646,10 +658,5 @@ def plot_bone_levels(
                 if v == 0:
                     ax.set_title(f"level {k + 1}: {len(level)} bones, {3 * len(level)} dims", fontsize=10)
             previous = set(level)
-        where = (
-            ""
-            if root is None
-            else f"; under each: the bones below {names[root] if names else root}, from above"
-        )
-        fig.suptitle(f"bones each level adds (red) to the earlier ones (grey){where}", fontsize=11)
+        fig.suptitle(_levels_title(root, names), fontsize=11)
     return fig
