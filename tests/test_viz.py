@@ -654,3 +654,11 @@ def test_bone_levels_mark_the_new_bones_of_each_level_on_shared_limits():
     assert [bool(ax.texts) for ax in hands] == [True, True, True, False, False, False]
     assert sum(len(ax.lines) for ax in hands[-1:]) == 15
     plt.close("all")
+
+
+def test_inline_player_resolution_and_format_are_chosen_per_call():
+    anim = animation.animate_skeletons(wave_motion(4), tiny_skeleton(), 15, max_frames=2)
+    small, large = anim.to_html(dpi=20), anim.to_html(dpi=80)  # a second call is not the cached first one
+    assert len(small) < len(large)
+    assert "data:image/jpeg" in anim.to_html(dpi=20, frame_format="jpeg")
+    assert "data:image/png" in small
