@@ -306,7 +306,11 @@ def test_animation_mp4_and_html(tmp_path):
         data = anim.save_as(tmp_path / "clip.mp4").read_bytes()
         assert data[4:8] == b"ftyp"  # an ISO media file
     html = anim.to_html()
-    assert "<script" in html and html == anim._repr_html_()
+    import re
+
+    shown = anim._repr_html_()  # what JupyterLab displays: the same player, 3 frames
+    frames = [sorted(set(re.findall(r"frames\[(\d+)\] = ", h))) for h in (html, shown)]
+    assert "<script" in html and "<script" in shown and frames[0] == frames[1] == ["0", "1", "2"]
     assert anim.save_as(tmp_path / "clip.html").read_text().count("<script") >= 1
 
 
@@ -329,7 +333,7 @@ def test_animation_face_panels_follow_the_clock():
     ax_face = anim.figure.axes[-1]
     anim.frame_image(10)  # t = 10 / 15 s -> face frame round(40.0) = 40
     heights = [r.get_height() for r in ax_face.patches]
-    assert np.allclose(heights, weights[40])
+    assert np.allclose(heights, weights[40, face.most_active(weights, 12)])  # the 12 most active blendshapes
     heat = animation.animate_skeletons(
         wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, face_panel="heatmap", dpi=40
     )

@@ -39,6 +39,7 @@ from beatlite.viz._inputs import (
     frame_indices,
     word_at,
 )
+from beatlite.viz.face import most_active
 from beatlite.viz.plot3d import SkeletonArtist, SkeletonLike, half_extents, setup_axes
 from beatlite.viz.style import SLIDE_WIDTH_PX, STYLE, legend_outside, system_colour
 
@@ -249,8 +250,8 @@ class FacePanel:
         w = _check_face(self.weights, self.names, self.kind)
         names = list(self.names) if self.names is not None else [f"blendshape {k}" for k in range(w.shape[1])]
         rows = np.arange(w.shape[1])
-        if self.top is not None and int(self.top) < w.shape[1]:
-            rows = np.sort(np.argsort(-w.std(axis=0), kind="stable")[: max(int(self.top), 1)])
+        if self.top is not None:
+            rows = most_active(w, self.top)
         f_fps = fps if self.fps is None else check_fps(self.fps, "face_fps")
         return FacePanel(w[:, rows], [names[k] for k in rows], f_fps, self.kind, None)
 
@@ -321,8 +322,9 @@ def _legacy_options(timeline: Any, face: Any, legacy: dict[str, Any]) -> tuple[A
         timeline = Timeline(*(legacy.get(k) for k in ("audio", "sr", "audio_beats", "motion_beats")))
         timeline = replace(timeline, sr=16000 if timeline.sr is None else timeline.sr)
     if face is not None and not isinstance(face, FacePanel):
-        face = FacePanel(face, legacy.get("face_names"), legacy.get("face_fps"),
-                         legacy.get("face_panel", "bars"), top=None)  # fmt: skip
+        face = FacePanel(
+            face, legacy.get("face_names"), legacy.get("face_fps"), legacy.get("face_panel", "bars")
+        )
     return timeline, face, legacy.get("panel_size")
 
 
@@ -518,8 +520,8 @@ def animate_skeletons(
     **legacy
         The keywords of beatlite 0.1, still accepted: ``audio``, ``sr``,
         ``audio_beats``, ``motion_beats`` (-> ``timeline``), ``face`` as an array with
-        ``face_names``, ``face_fps``, ``face_panel`` (-> ``FacePanel``, all rows,
-        bars by default), and ``panel_size`` (inches per skeleton panel; the figure is
+        ``face_names``, ``face_fps``, ``face_panel`` (-> ``FacePanel``, its 12 most
+        active rows, bars by default), and ``panel_size`` (inches per skeleton panel; the figure is
         then ``max(panel_size * n, 6)`` inches wide when panels are shown below).
 
     Returns
