@@ -59,6 +59,9 @@ NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
     }
 )
 
+#: Colours of systems without a named colour (baselines, new models): never grey, blue or orange.
+OTHER_SYSTEM_COLOURS: tuple[str, ...] = ("#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+
 #: Smallest width in pixels of a saved figure, an animation or a GIF ("slide size").
 SLIDE_WIDTH_PX = 960
 
@@ -176,8 +179,9 @@ def system_colour(label: str, index: int = 0) -> str:
         System name, e.g. ``"CaMN"``, ``"HA2G (ours)"``, ``"ground truth"``; the
         first word that names a known system decides (case-insensitive).
     index : int
-        Position of the system in the figure, used for unknown names
-        (``SYSTEM_COLOURS[index % 6]``).
+        Position of the system in the figure, used for other names:
+        ``OTHER_SYSTEM_COLOURS[index % 6]``, so a baseline never takes the colour of
+        ground truth, CaMN or HA2G.
 
     Returns
     -------
@@ -186,14 +190,14 @@ def system_colour(label: str, index: int = 0) -> str:
 
     Examples
     --------
-    >>> system_colour("CaMN (tiny)"), system_colour("ground truth"), system_colour("mine", 3)
-    ('#1f77b4', '#333333', '#2ca02c')
+    >>> system_colour("CaMN (tiny)"), system_colour("ground truth"), system_colour("mean pose", 1)
+    ('#1f77b4', '#333333', '#9467bd')
     """
     low = str(label).lower()
     for name in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True):
         if low.startswith(name):
             return NAMED_SYSTEM_COLOURS[name]
-    return SYSTEM_COLOURS[int(index) % len(SYSTEM_COLOURS)]
+    return OTHER_SYSTEM_COLOURS[int(index) % len(OTHER_SYSTEM_COLOURS)]
 
 
 def slide_figsize(
