@@ -314,7 +314,8 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
     ]
     fig, sep = plot_emotion_tsne(takes, out=tmp_path / "fig3a")
     assert sep.n == 18 and sep.n_classes == 3
-    plot_figure4(takes, out=tmp_path / "fig4")
+    fig4 = plot_figure4(takes, out=tmp_path / "fig4")
+    assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)", "(c)"]  # the paper's panel order
     plot_correlations(takes, out=tmp_path / "corr")
     plot_table6({"neutral": 0.5, "avg": 0.5}, out=tmp_path / "table6")
     plt.close("all")
@@ -383,3 +384,22 @@ def test_load_corpus_streams_and_skips_broken_takes(tmp_path: Path) -> None:
     assert t.face_activity is not None and np.allclose(t.face_activity, 0.0)  # constant weights
     assert np.all(t.emotion_frames == 2)  # from the .csv
     assert t.semantic_scores.tolist() == [0.5] and t.words == ("Hello", "world,", "zebra")
+
+
+def test_figures_label_every_axis_and_keep_legends_off_the_data() -> None:
+    import matplotlib.pyplot as plt
+
+    fig2 = plot_figure2(hand_index())
+    table6 = plot_table6({"neutral": 0.5, "avg": 0.5}, {"neutral": 0.25, "avg": 0.25}, generated_by="CaMN")
+    for fig in (fig2, table6):
+        assert all(ax.get_ylabel() and ax.get_xlabel() for ax in fig.axes)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        legends = [leg for ax in fig.axes if (leg := ax.get_legend())] + list(fig.legends)
+        assert legends
+        for leg in legends:
+            box = leg.get_window_extent(renderer)
+            assert not any(box.overlaps(ax.get_window_extent(renderer)) for ax in fig.axes)
+    labels = [t.get_text() for t in table6.axes[0].get_legend().get_texts()]
+    assert labels[-1] == "beatlite, generated (CaMN)"  # the generated row names its model
+    plt.close("all")

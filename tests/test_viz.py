@@ -125,7 +125,7 @@ def test_joint_group_by_name(name, group):
 
 
 def test_skeleton_bones_partition_joints_and_bones():
-    bones = _inputs.skeleton_bones(tiny_skeleton())
+    bones = _inputs.bone_groups(tiny_skeleton())
     # joints: hands = {RightHand, LeftHand}; head = {Neck, Head}; body = the other 6
     assert bones.joints["hands"].tolist() == [5, 7]
     assert bones.joints["head"].tolist() == [2, 3]
@@ -135,15 +135,15 @@ def test_skeleton_bones_partition_joints_and_bones():
     assert sorted(all_pairs[:, 1].tolist()) == list(range(1, 10))
     assert all(PARENTS[c] == p for p, c in all_pairs)
     # a parents array gives the same bones, all in the body group
-    plain = _inputs.skeleton_bones(np.array(PARENTS))
+    plain = _inputs.bone_groups(np.array(PARENTS))
     assert len(plain.pairs["body"]) == 9 and len(plain.pairs["hands"]) == 0
 
 
 def test_skeleton_bones_rejects_bad_parents():
     with pytest.raises(ValueError, match="parents"):
-        _inputs.skeleton_bones(np.array([-1, 5, 0]))
+        _inputs.bone_groups(np.array([-1, 5, 0]))
     with pytest.raises(TypeError, match="parents array"):
-        _inputs.skeleton_bones(np.zeros((2, 2), dtype=int))
+        _inputs.bone_groups(np.zeros((2, 2), dtype=int))
 
 
 def test_check_positions_errors_name_the_shape():
@@ -237,7 +237,7 @@ def test_filmstrip_views_and_trajectories_layouts():
 
 def test_beat_skeleton_joint_groups():
     beat = pytest.importorskip("beatlite.skeleton.beat")
-    bones = _inputs.skeleton_bones(beat.beat_skeleton())
+    bones = _inputs.bone_groups(beat.beat_skeleton())
     # reference table: per side RightHand + 23 finger joints (M1-4, R..R4, P..P4, I..I4, T1-4) = 24;
     # head = Neck, Neck1, Head, HeadEnd; body = the other 75 - 48 - 4 = 23
     assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
@@ -306,7 +306,11 @@ def test_animation_mp4_and_html(tmp_path):
         data = anim.save_as(tmp_path / "clip.mp4").read_bytes()
         assert data[4:8] == b"ftyp"  # an ISO media file
     html = anim.to_html()
-    assert "<script" in html and html == anim._repr_html_()
+    import re
+
+    shown = anim._repr_html_()  # what JupyterLab displays: the same player, 3 frames
+    frames = [sorted(set(re.findall(r"frames\[(\d+)\] = ", h))) for h in (html, shown)]
+    assert "<script" in html and "<script" in shown and frames[0] == frames[1] == ["0", "1", "2"]
     assert anim.save_as(tmp_path / "clip.html").read_text().count("<script") >= 1
 
 
@@ -329,7 +333,7 @@ def test_animation_face_panels_follow_the_clock():
     ax_face = anim.figure.axes[-1]
     anim.frame_image(10)  # t = 10 / 15 s -> face frame round(40.0) = 40
     heights = [r.get_height() for r in ax_face.patches]
-    assert np.allclose(heights, weights[40])
+    assert np.allclose(heights, weights[40, face.most_active(weights, 12)])  # the 12 most active blendshapes
     heat = animation.animate_skeletons(
         wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, face_panel="heatmap", dpi=40
     )
@@ -353,7 +357,7 @@ def test_plot_blendshapes_heatmap_and_bars():
     names = [f"shape{i}" for i in range(51)]
     heat = face.plot_blendshapes(w, names, fps=60, frame=30)
     ax = heat.axes[0]
-    assert ax.images[0].get_extent() == [0.0, 1.0, -0.5, 50.5]  # 60 frames / 60 fps = 1 s
+    assert ax.images[0].get_extent() == [0.0, 1.0, 50.5, -0.5]  # 60 frames / 60 fps = 1 s; row 0 at the top
     assert ax.get_yticklabels()[3].get_text() == "shape3"
     bars = face.plot_blendshapes(w, names, fps=60, kind="bars", frame=2)
     assert np.allclose([r.get_height() for r in bars.axes[0].patches], w[2])
@@ -367,7 +371,7 @@ def test_real_beat_skeleton_file_plots_with_expected_groups(real_samples):
     from beatlite.io import read_bvh
 
     motion = read_bvh(real_samples / "beat_skeleton_2_scott_0_1_1_frame0.bvh")
-    bones = _inputs.skeleton_bones(motion.skeleton)
+    bones = _inputs.bone_groups(motion.skeleton)
     assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [23, 48, 4]
     img = fig_image(plot3d.plot_frame(motion.positions(), motion.skeleton, figsize=(2, 3), dpi=60))
     assert img.shape == (180, 120, 3) and img.std() > 5
@@ -383,3 +387,283 @@ def test_animation_takes_one_skeleton_per_sequence_or_a_parents_list():
     assert parents_list.frame_image(0).std() > 0
     with pytest.raises(ValueError, match="skeleton: 3 given for 2"):
         animation.animate_skeletons([wave_motion(2)] * 2, [tiny_skeleton()] * 3, 15)
+
+
+# ------------------------------------------------------------------ slide-size figures (issue 16)
+def ted_parents() -> np.ndarray:
+    from beatlite.skeleton.ted import TED43_JOINTS, TED_BONES
+
+    parents = np.full(len(TED43_JOINTS), -1)
+    for parent, child in TED_BONES:
+        parents[child] = parent
+    return parents
+
+
+def upper_body(n_frames: int = 6) -> np.ndarray:
+    """(T, 43, 3) cm: a TED-43 pose built by chaining 10 cm bones straight up from the spine at y = 100."""
+    parents = ted_parents()
+    pos = np.zeros((43, 3))
+    for j in range(43):  # TED_BONES lists parents before children
+        if parents[j] >= 0:
+            pos[j] = pos[parents[j]] + [0.0, 10.0, 0.0]
+    pos[:, 1] += 100.0
+    pos[:, 0] = np.arange(43) - 21.0  # spread sideways so the box is not degenerate
+    return np.repeat(pos[None], n_frames, axis=0)
+
+
+def _inside(inner, outer, tol=1.0):
+    return (
+        inner.x0 >= outer.x0 - tol
+        and inner.x1 <= outer.x1 + tol
+        and inner.y0 >= outer.y0 - tol
+        and (inner.y1 <= outer.y1 + tol)
+    )
+
+
+def test_system_colour_by_name_then_by_position():
+    assert style.system_colour("CaMN") == style.system_colour("camn (tiny)") == style.SYSTEM_COLOURS[1]
+    assert style.system_colour("HA2G") == style.SYSTEM_COLOURS[2]
+    assert style.system_colour("ground truth", 5) == style.SYSTEM_COLOURS[0]
+    others = {style.system_colour("baseline", i) for i in range(6)}  # never a named system's colour
+    assert len(others) == 6 and not others & set(style.NAMED_SYSTEM_COLOURS.values())
+
+
+def test_legend_outside_does_not_cover_the_data():
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1], label="a")
+    fig.canvas.draw()
+    for where in ("right", "top"):
+        leg = style.legend_outside(ax, where)
+        fig.canvas.draw()
+        box, axes_box = leg.get_window_extent(), ax.get_window_extent()
+        assert box.x0 >= axes_box.x1 - 1 if where == "right" else box.y0 >= axes_box.y1 - 1
+    with pytest.raises(ValueError, match="where"):
+        style.legend_outside(ax, "inside")
+    assert style.legend_outside(plt.subplots()[1]) is None  # nothing labelled: no legend
+    plt.close("all")
+
+
+def test_ted43_parents_get_named_groups_and_no_feet():
+    bones = _inputs.bone_groups(ted_parents())
+    # TED-43: 2 wrists + 30 finger joints are hands; neck, nose, 2 eyes, 2 ears are head; spine,
+    # 2 shoulders, 2 elbows are body (module docstring of beatlite.skeleton.ted)
+    assert [len(bones.joints[g]) for g in ("body", "hands", "head")] == [5, 32, 6]
+    assert not bones.has_feet
+    assert _inputs.bone_groups(tiny_skeleton()).has_feet  # RightFoot, LeftFoot
+    assert not _inputs.bone_groups(np.array(PARENTS)).has_feet  # unnamed: do not guess a floor
+    assert _inputs.joint_group("right_wrist") == "hands" and _inputs.joint_group("left_ear") == "head"
+
+
+def _floor_lines(ax):
+    return [ln for ln in ax.lines if ln.get_color() == "0.75"]
+
+
+def test_no_floor_under_an_upper_body():
+    standing = plot3d.plot_frame(wave_motion(2), tiny_skeleton())
+    assert len(_floor_lines(standing.axes[0])) == 1
+    upper = plot3d.plot_frame(upper_body(2), ted_parents())
+    assert _floor_lines(upper.axes[0]) == []
+    forced = plot3d.plot_frame(upper_body(2), ted_parents(), floor=True)
+    assert len(_floor_lines(forced.axes[0])) == 1
+    plt.close("all")
+
+
+def test_keyframes_share_one_scale_and_colour_rows_by_system():
+    fig = plot3d.plot_keyframes(
+        {"ground truth": wave_motion(10), "HA2G": upper_body(10)},
+        [tiny_skeleton(), ted_parents()],
+        [0, 5],
+        15,
+    )
+    assert len(fig.axes) == 4
+    spans = {tuple(np.round([np.diff(ax.get_xlim())[0], np.diff(ax.get_zlim())[0]], 6)) for ax in fig.axes}
+    assert len(spans) == 1  # the same box in cm in every panel
+    assert [ax.get_title() for ax in fig.axes[:2]] == ["t = 0.0 s", "t = 0.3 s"]
+    row_labels = {t.get_text(): t.get_color() for ax in fig.axes for t in ax.texts}
+    assert row_labels == {"ground truth": style.SYSTEM_COLOURS[0], "HA2G": style.SYSTEM_COLOURS[2]}
+    assert _floor_lines(fig.axes[0]) and not _floor_lines(fig.axes[2])  # floor only under the standing body
+    plt.close("all")
+
+
+def _slide_animation(**kwargs):
+    sr = 1000
+    audio = np.sin(2 * np.pi * 5 * np.arange(2 * sr) / sr)
+    face = np.zeros((30, 5))
+    face[:, 3] = np.linspace(0, 1, 30)  # the only blendshape that moves
+    face[:, 1] = 0.5  # constant
+    return animation.animate_skeletons(
+        {"CaMN": wave_motion(30), "HA2G": upper_body(30)},
+        [tiny_skeleton(), ted_parents()],
+        fps=15,
+        timeline=animation.Timeline(audio, sr, audio_beats=[0.2, 0.9], motion_beats=[0.5]),
+        words=([0.0, 1.0], [0.5, 1.5], ["hello", "world"]),
+        face=animation.FacePanel(face, ["a", "b", "c", "d", "e"], top=2),
+        **kwargs,
+    )
+
+
+def test_animation_is_slide_size_with_one_scale_and_readable_panels():
+    anim = _slide_animation(dpi=100)
+    img = anim.frame_image(0)
+    assert img.shape[1] == 960  # default width, pixels
+    fig = anim.figure
+    sk = [ax for ax in fig.axes if ax.name == "3d"]
+    assert np.diff(sk[0].get_zlim()) == pytest.approx(np.diff(sk[1].get_zlim()))  # one scale
+    assert [ax.get_title() for ax in sk] == ["CaMN", "HA2G"]
+    assert [ax.title.get_color() for ax in sk] == [style.SYSTEM_COLOURS[1], style.SYSTEM_COLOURS[2]]
+    assert _floor_lines(sk[0]) and not _floor_lines(sk[1])
+    timeline, face_ax = fig.axes[2], fig.axes[3]
+    # the face rows are the 2 most variable blendshapes, by name, in their order: b (constant) and d
+    # have std 0 and > 0; a, c, e are all zero, so the stable sort keeps the first of them: a
+    assert [t.get_text() for t in face_ax.get_yticklabels()] == ["a", "d"]
+    anim.frame_image(18)  # 15 fps played at 15 fps: t = 1.2 s, the caption reads "world"
+    renderer = fig.canvas.get_renderer()
+    caption = fig.texts[-1]
+    assert caption.get_text() == "world"
+    assert caption.get_window_extent(renderer).y0 > timeline.get_tightbbox(renderer).y1  # above the timeline
+    legend = timeline.get_legend().get_window_extent(renderer)
+    assert legend.x0 >= timeline.get_window_extent(renderer).x1 - 1  # legend right of the data
+    assert timeline.get_xlabel() == "time (s)" and timeline.get_ylabel() == "amplitude"
+
+
+def test_face_panel_and_timeline_check_their_inputs():
+    with pytest.raises(ValueError, match="timeline"):
+        animation.Timeline().checked()
+    with pytest.raises(ValueError, match="face_panel"):
+        animation.FacePanel(np.zeros((3, 2)), kind="pie").checked(15)
+    checked = animation.FacePanel(np.zeros((3, 2)), top=None).checked(15)
+    assert checked.names == ["blendshape 0", "blendshape 1"] and checked.fps == 15
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        animation.animate_skeletons(wave_motion(3), tiny_skeleton(), 15, colour="red")
+
+
+def test_blendshape_heatmap_labels_every_row_by_name_at_a_readable_height():
+    w = np.zeros((20, 51))
+    w[:, 7] = np.linspace(0, 1, 20)
+    names = [f"shape{k}" for k in range(51)]
+    fig = face.plot_blendshapes(w, names, fps=60)
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_yticklabels()] == names  # first name at the top row
+    assert ax.get_ylim()[0] > ax.get_ylim()[1]  # origin upper
+    assert fig.get_figheight() >= 51 * face.ROW_INCHES
+    top = face.plot_blendshapes(w, names, fps=60, top=3)
+    assert "shape7" in [t.get_text() for t in top.axes[0].get_yticklabels()]
+    assert face.most_active(w, 1).tolist() == [7]
+    plt.close("all")
+
+
+def test_history_values_and_training_curves_label_every_panel():
+    from beatlite.viz import charts
+
+    history = [{"epoch": e, "train": {"rec": 1.0 / (e + 1)}, **({"val_score": 10.0 - e} if e % 2 else {})}
+               for e in range(4)]  # fmt: skip
+    epochs, values = charts.history_values(history, "val_score")
+    assert epochs.tolist() == [1.0, 3.0] and values.tolist() == [9.0, 7.0]
+    fig = charts.plot_training_curves(
+        history,
+        {"loss (Huber)": {"train": "train.rec"}, "FGD": {"val": "val_score"}, "adv": {"g": "train.adv"}},
+    )
+    assert [ax.get_ylabel() for ax in fig.axes] == ["loss (Huber)", "FGD", "adv"]
+    assert [len(ax.lines) for ax in fig.axes] == [1, 1, 0]
+    assert fig.axes[2].texts[0].get_text() == "not logged in this run"  # no empty box without a word
+    plt.close("all")
+
+
+def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
+    from beatlite.viz import charts
+
+    fgd = {"CaMN": 1.0, "HA2G": 2.0, "mean pose": 25.0}
+    ax = charts.plot_scores(fgd, "FGD").axes[0]
+    # 25 > 3 x 2: the axis ends at 1.3 x 2 x 1.35, the bar is cut and its value written
+    assert ax.get_xlim()[1] == pytest.approx(2.0 * 1.3 * 1.35)
+    assert max(p.get_width() for p in ax.patches) == pytest.approx(2.6)
+    assert any("25 (bar cut)" in t.get_text() for t in ax.texts)
+    plain = charts.plot_scores({"a": 1.0, "b": 2.0}, "FGD").axes[0]
+    assert plain.get_xlim()[1] == pytest.approx(2.0 * 1.12)
+    with pytest.raises(ValueError, match="finite"):
+        charts.plot_scores({"a": np.nan}, "FGD")
+    fig = charts.plot_score_scatter(
+        {"CaMN": 1.0, "HA2G": 2.0, "a long model name": 9.0}, {"CaMN": 0.4, "HA2G": 0.5, "a long model name": 0.3},
+        "FGD", "BC"
+    )  # fmt: skip
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    renderer = fig.canvas.get_renderer()
+    labels = [t for t in ax.texts if t.get_text()]
+    assert len(labels) == 3 and all(_inside(t.get_window_extent(renderer), ax.get_window_extent(renderer))
+                                    for t in labels)  # fmt: skip
+    plt.close("all")
+
+
+def test_signals_label_the_axes_keep_the_legend_outside_and_cut_one_large_swing():
+    from beatlite.viz import charts
+
+    t = np.arange(150) / 15
+    swing = np.where(np.abs(t - 1.0) < 0.2, 100.0, 0.0)  # one 100 cm/s swing before speech
+    speed = 5.0 + 5.0 * np.sin(2 * np.pi * t) + swing
+    fig = charts.plot_signals(t, {"wrist": speed}, "wrist speed (cm/s)", events={"onsets": [2.0, 3.0]},
+                              markers={"wrist": [2.75]}, clip_quantile=0.9)  # fmt: skip
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("time (s)", "wrist speed (cm/s)")
+    cut = 1.2 * np.quantile(speed, 0.9)  # the y axis ends near the sine's range, not at 105
+    assert ax.get_ylim()[1] == pytest.approx(cut + 0.05 * (cut - speed.min()))
+    assert any("cut" in txt.get_text() for txt in ax.texts)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert ax.get_legend().get_window_extent(renderer).x0 >= ax.get_window_extent(renderer).x1 - 1
+    assert [txt.get_text() for txt in ax.get_legend().get_texts()] == ["wrist", "onsets"]
+    with pytest.raises(ValueError, match="curves"):
+        charts.plot_signals(t, {"short": speed[:10]}, "x")
+    plt.close("all")
+
+
+def test_waveform_has_an_amplitude_axis_and_the_words_of_the_window():
+    from beatlite.viz import charts
+
+    sr = 1000
+    y = 0.5 * np.sin(2 * np.pi * 50 * np.arange(3 * sr) / sr)
+    words = ([0.2, 1.0, 2.5], [0.6, 1.4, 2.9], ["one", "two", "three"])
+    ax = charts.plot_waveform(y, sr, words=words, onsets={"onsets": [0.2]}, xlim=(0, 2)).axes[0]
+    assert ax.get_ylabel() == "amplitude (full scale)" and ax.get_xlabel() == "time (s)"
+    assert [t.get_text() for t in ax.texts] == ["one", "two"]  # "three" starts after the 2 s shown
+    assert ax.get_xlim() == (0.0, 2.0)
+    plt.close("all")
+
+
+def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
+    w = np.zeros((120, 4))
+    w[:, 2] = 0.5 + 0.5 * np.sin(np.arange(120) / 10)
+    w[:, 0] = np.linspace(0, 0.2, 120)
+    fig = face.plot_blendshape_curves(w, ["a", "b", "c", "d"], fps=60, top=2)
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["a", "c"]
+    assert ax.get_ylabel() == "weight (0-1)"
+    assert ax.lines[0].get_xdata()[-1] == pytest.approx(119 / 60)  # seconds
+    plt.close("all")
+
+
+def test_bone_levels_mark_the_new_bones_of_each_level_on_shared_limits():
+    from beatlite.skeleton import ted
+
+    pose = upper_body(1)[0]
+    levels = ted.HA2G_LEVELS
+    fig = plot3d.plot_bone_levels(pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist")
+    body, hands = fig.axes[0::2], fig.axes[1::2]
+    assert len(body) == len(hands) == len(levels) == 6
+    red = style.GROUP_COLOURS["hands"]
+    for k, ax in enumerate(body):  # thick red lines = the bones this level adds (levels are cumulative)
+        added = len(levels[k]) - (len(levels[k - 1]) if k else 0)
+        assert sum(line.get_color() == red for line in ax.lines) == added
+    assert len({(ax.get_xlim(), ax.get_ylim()) for ax in body}) == 1  # one scale for every level
+    # the right hand's 15 finger bones arrive in levels 4-6; before that its panel says so
+    assert [bool(ax.texts) for ax in hands] == [True, True, True, False, False, False]
+    assert sum(len(ax.lines) for ax in hands[-1:]) == 15
+    plt.close("all")
+
+
+def test_inline_player_resolution_and_format_are_chosen_per_call():
+    anim = animation.animate_skeletons(wave_motion(4), tiny_skeleton(), 15, max_frames=2)
+    small, large = anim.to_html(dpi=20), anim.to_html(dpi=80)  # a second call is not the cached first one
+    assert len(small) < len(large)
+    assert "data:image/jpeg" in anim.to_html(dpi=20, frame_format="jpeg")
+    assert "data:image/png" in small

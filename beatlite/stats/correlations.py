@@ -296,25 +296,26 @@ def plot_correlations(
     """
     import matplotlib.pyplot as plt
 
-    from beatlite.viz.style import figure_style, save_figure
+    from beatlite.viz.style import SYSTEM_COLOURS, figure_style, save_figure
 
     wm = window_means(takes, seconds=seconds)
     speeds = speed_by_emotion(takes)
     with figure_style():
-        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-        axes[0].scatter(wm["audio"], wm["speed"], s=5, alpha=0.5)
-        axes[0].set_xlabel(f"audio RMS ({seconds:g}-s window mean)")
-        axes[0].set_ylabel("gesture speed, cm/s")
+        fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")
+        axes[0].scatter(wm["audio"], wm["speed"], s=6, alpha=0.5, color=SYSTEM_COLOURS[0])
+        axes[0].set_xlabel(f"audio RMS (full scale, {seconds:g}-s window mean)")
+        axes[0].set_ylabel("gesture speed (cm/s)")
         axes[0].set_title("gesture vs audio energy")
         if not np.any(np.isnan(wm["face"])):
-            axes[1].scatter(wm["face"], wm["speed"], s=5, alpha=0.5)
-        axes[1].set_xlabel("facial activity, 1/s")
+            axes[1].scatter(wm["face"], wm["speed"], s=6, alpha=0.5, color=SYSTEM_COLOURS[0])
+        axes[1].set_xlabel(f"facial activity (1/s, {seconds:g}-s window mean)")
+        axes[1].set_ylabel("gesture speed (cm/s)")
         axes[1].set_title("gesture vs facial activity")
-        axes[2].bar(list(speeds), list(speeds.values()))
-        axes[2].set_ylabel("mean gesture speed, cm/s")
+        axes[2].bar(list(speeds), list(speeds.values()), color=SYSTEM_COLOURS[0])
+        axes[2].set_xlabel("emotion")
+        axes[2].set_ylabel("mean gesture speed (cm/s)")
         axes[2].set_title("gesture energy per emotion")
         axes[2].tick_params(axis="x", rotation=45)
-        fig.tight_layout()
         if out is not None:
             save_figure(fig, out, formats)
     return fig

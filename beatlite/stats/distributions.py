@@ -66,10 +66,23 @@ def speaker_durations(index: TakeIndex) -> dict[str, float]:
     return {f"{sid}_{name}": v for (sid, name), v in sorted(totals.items())}
 
 
+def _paired_bars(ax, names: list[str], ours: list[float], paper: dict[str, float]) -> None:
+    """Bars of this corpus's shares beside the paper's (both in %), names on the x axis."""
+    import numpy as np
+
+    x = np.arange(len(names))
+    ax.bar(x - 0.2, [100 * v for v in ours], 0.4, label="this corpus", color="#333333")
+    ax.bar(x + 0.2, [100 * paper[n] for n in names], 0.4, label="BEAT (paper)", color="#9ecae1")
+    ax.set_xticks(x, names, rotation=45, ha="right")
+
+
 def plot_figure2(
     index: TakeIndex, *, out: str | Path | None = None, formats: tuple[str, ...] = ("png", "svg")
 ):
     """Three panels: emotion shares (corpus vs the paper's design), language share, minutes per speaker.
+
+    BEAT (ECCV 2022) Fig. 2 (c)-(e). One legend above the panels, units on every
+    axis, the style of :mod:`beatlite.viz.style`.
 
     Parameters
     ----------
@@ -85,36 +98,30 @@ def plot_figure2(
     matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
-    import numpy as np
 
-    from beatlite.viz.style import figure_style, save_figure
+    from beatlite.viz.style import SYSTEM_COLOURS, figure_style, save_figure
 
     emo = emotion_shares(index)
     lang = language_shares(index)
     spk = speaker_durations(index)
+    paper_total = sum(PAPER_LANGUAGE_HOURS.values())
     with figure_style():
-        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-        x = np.arange(len(EMOTION_NAMES))
-        axes[0].bar(x - 0.2, [emo[n] * 100 for n in EMOTION_NAMES], 0.4, label="this corpus")
-        axes[0].bar(x + 0.2, [PAPER_EMOTION_SHARES[n] * 100 for n in EMOTION_NAMES], 0.4, label="BEAT design")
-        axes[0].set_xticks(x, EMOTION_NAMES, rotation=45, ha="right")
-        axes[0].set_ylabel("% of self-talk duration")
+        fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")
+        _paired_bars(axes[0], EMOTION_NAMES, [emo[n] for n in EMOTION_NAMES], PAPER_EMOTION_SHARES)
+        axes[0].set_ylabel("share of self-talk duration (%)")
+        axes[0].set_xlabel("emotion")
         axes[0].set_title("(c) emotions")
-        axes[0].legend()
-        paper_total = sum(PAPER_LANGUAGE_HOURS.values())
-        names = list(PAPER_LANGUAGE_HOURS)
-        xl = np.arange(len(names))
-        axes[1].bar(xl - 0.2, [lang.get(n, 0.0) * 100 for n in names], 0.4, label="this corpus")
-        axes[1].bar(xl + 0.2, [PAPER_LANGUAGE_HOURS[n] / paper_total * 100 for n in names], 0.4, label="BEAT")
-        axes[1].set_xticks(xl, names)
-        axes[1].set_ylabel("% of duration")
+        paper_lang = {n: h / paper_total for n, h in PAPER_LANGUAGE_HOURS.items()}
+        _paired_bars(axes[1], list(paper_lang), [lang.get(n, 0.0) for n in paper_lang], paper_lang)
+        axes[1].set_ylabel("share of duration (%)")
+        axes[1].set_xlabel("language")
         axes[1].set_title("(d) languages")
-        axes[1].legend()
-        axes[2].bar(list(spk), [v / 60 for v in spk.values()])
-        axes[2].set_ylabel("minutes")
+        axes[2].bar(list(spk), [v / 60 for v in spk.values()], color=SYSTEM_COLOURS[0])
+        axes[2].set_ylabel("duration (min)")
+        axes[2].set_xlabel("speaker")
         axes[2].set_title("(e) duration per speaker")
         axes[2].tick_params(axis="x", rotation=45)
-        fig.tight_layout()
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside upper center", ncols=2)
         if out is not None:
             save_figure(fig, out, formats)
     return fig

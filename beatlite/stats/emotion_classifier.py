@@ -218,10 +218,27 @@ def plot_table6(
     real: dict[str, float],
     generated: dict[str, float] | None = None,
     *,
+    generated_by: str = "CaMN",
     out: str | Path | None = None,
     formats: tuple[str, ...] = ("png", "svg"),
 ):
     """Per-class accuracy (%) of this corpus (real, optionally generated) beside the paper's Table 6 rows.
+
+    BEAT (ECCV 2022) Table 6 as bars: the paper's rows in light colours, this
+    corpus's in the systems' colours (:func:`beatlite.viz.style.system_colour`),
+    the legend right of the bars.
+
+    Parameters
+    ----------
+    real, generated : dict str -> float
+        Per-class accuracy in [0, 1] (keys: emotion names and ``"avg"``) on real
+        motion and, optionally, on generated motion.
+    generated_by : str
+        The model that generated the motion, named in the legend.
+    out : str or Path, optional
+        Path stem to save to with :func:`beatlite.viz.style.save_figure`.
+    formats : tuple of str
+        Formats to save.
 
     Returns
     -------
@@ -229,27 +246,29 @@ def plot_table6(
     """
     import matplotlib.pyplot as plt
 
-    from beatlite.viz.style import figure_style, save_figure
+    from beatlite.viz.style import figure_style, legend_outside, save_figure, system_colour
 
     names = [*EMOTION_NAMES, "avg"]
-    rows: list[tuple[str, list[float]]] = [
-        (f"paper {k}", [PAPER_TABLE6[k][n] for n in names]) for k in ("real", "generated")
+    rows: list[tuple[str, list[float], str]] = [
+        ("paper, real", [PAPER_TABLE6["real"][n] for n in names], "#bdbdbd"),
+        ("paper, generated", [PAPER_TABLE6["generated"][n] for n in names], "#9ecae1"),
+        ("beatlite, real", [100 * real.get(n, np.nan) for n in names], system_colour("real")),
     ]
-    rows.append(("beatlite real", [100 * real.get(n, np.nan) for n in names]))
     if generated is not None:
-        rows.append(("beatlite generated", [100 * generated.get(n, np.nan) for n in names]))
+        rows.append((f"beatlite, generated ({generated_by})", [100 * generated.get(n, np.nan) for n in names],
+                     system_colour(generated_by, 3)))  # fmt: skip
     with figure_style():
-        fig, ax = plt.subplots(figsize=(10, 3.8))
+        fig, ax = plt.subplots(figsize=(11, 4.2), layout="constrained")
         x = np.arange(len(names))
         width = 0.8 / len(rows)
-        for k, (label, values) in enumerate(rows):
-            ax.bar(x + (k - (len(rows) - 1) / 2) * width, values, width, label=label)
+        for k, (label, values, colour) in enumerate(rows):
+            ax.bar(x + (k - (len(rows) - 1) / 2) * width, values, width, label=label, color=colour)
         ax.set_xticks(x, names, rotation=30, ha="right")
-        ax.set_ylabel("accuracy, %")
-        ax.set_ylim(0, 105)
+        ax.set_xlabel("emotion class")
+        ax.set_ylabel("accuracy (%)")
+        ax.set_ylim(0, 100)
         ax.set_title("Emotion classification of motion windows (Table 6 analog)")
-        ax.legend(ncols=2)
-        fig.tight_layout()
+        legend_outside(ax, "right")
         if out is not None:
             save_figure(fig, out, formats)
     return fig

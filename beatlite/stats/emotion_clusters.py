@@ -389,7 +389,7 @@ def plot_emotion_tsne(
     """
     import matplotlib.pyplot as plt
 
-    from beatlite.viz.style import figure_style, save_figure
+    from beatlite.viz.style import figure_style, legend_outside, save_figure
 
     rw = rotation_windows(takes, seconds=seconds)
     feats = window_features(rw.windows[:, :, subset_dims(joints)], kind=kind)
@@ -398,19 +398,20 @@ def plot_emotion_tsne(
     sep = separability(feats, rw.emotion, groups=rw.take, seed=seed)
     emb = tsne_embedding(feats, seed=seed)
     with figure_style():
-        fig, ax = plt.subplots(figsize=(6.4, 5.2))
+        fig, ax = plt.subplots(figsize=(8.0, 5.6), layout="constrained")
         cmap = plt.get_cmap("tab10")
         for e in np.unique(rw.emotion):
             m = rw.emotion == e
-            ax.scatter(emb[m, 0], emb[m, 1], s=8, color=cmap(int(e)), label=EMOTION_NAMES[int(e)], alpha=0.8)
+            ax.scatter(emb[m, 0], emb[m, 1], s=10, color=cmap(int(e)), label=EMOTION_NAMES[int(e)], alpha=0.8)
         ax.set_xticks([])
         ax.set_yticks([])
+        ax.set_xlabel("t-SNE dimension 1 (no unit)")
+        ax.set_ylabel("t-SNE dimension 2 (no unit)")
         ax.set_title(
             f"t-SNE of {seconds:g}-s rotation windows\n{sep.k}-NN balanced acc {sep.balanced_accuracy:.2f} "
             f"(chance {sep.uniform_chance:.2f}), silhouette {sep.silhouette:.2f}"
         )
-        ax.legend(markerscale=2, loc="best", fontsize=8)
-        fig.tight_layout()
+        legend_outside(ax, "right", title="emotion", markerscale=2)
         if out is not None:
             save_figure(fig, out, formats)
     return fig, sep

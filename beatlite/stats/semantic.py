@@ -99,7 +99,10 @@ def plot_figure4(
     out: str | Path | None = None,
     formats: tuple[str, ...] = ("png", "svg"),
 ):
-    """Three panels: score histogram with the share <= 0.2, mean score of frequent words, per speaker.
+    """BEAT Fig. 4 analog in the paper's order: (a) mean score per speaker, (b) score histogram, (c) words.
+
+    The histogram marks the paper's low-score threshold (0.2) and states the
+    share of gestures at or below it; every axis has its unit.
 
     Returns
     -------
@@ -107,30 +110,39 @@ def plot_figure4(
     """
     import matplotlib.pyplot as plt
 
-    from beatlite.viz.style import figure_style, save_figure
+    from beatlite.viz.style import SYSTEM_COLOURS, figure_style, save_figure
 
     hist = score_histogram(takes)
     words = word_scores(takes, top=top)
     spk = speaker_scores(takes)
     with figure_style():
-        fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+        fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")
+        axes[0].bar([str(s) for s in spk], [v["mean"] for v in spk.values()], color=SYSTEM_COLOURS[0])
+        axes[0].set_xlabel("speaker id")
+        axes[0].set_ylabel("mean semantic score (0-1)")
+        axes[0].set_title("(a) per speaker")
         centers = (hist.edges[:-1] + hist.edges[1:]) / 2
-        axes[0].bar(centers, hist.counts / max(hist.n, 1) * 100, width=np.diff(hist.edges) * 0.9)
-        axes[0].axvline(LOW_SCORE, color="k", ls="--", lw=1)
-        axes[0].set_xlabel("semantic score")
-        axes[0].set_ylabel("% of gestures")
-        axes[0].set_title(
+        axes[1].bar(centers, hist.counts / max(hist.n, 1) * 100, width=np.diff(hist.edges) * 0.9,
+                    color=SYSTEM_COLOURS[0])  # fmt: skip
+        axes[1].axvline(LOW_SCORE, color="#d62728", ls="--", lw=1.2)
+        axes[1].text(
+            LOW_SCORE,
+            0.97,
+            f" {LOW_SCORE}",
+            color="#d62728",
+            va="top",
+            transform=axes[1].get_xaxis_transform(),
+        )
+        axes[1].set_xlabel("semantic score (0-1)")
+        axes[1].set_ylabel("share of gestures (%)")
+        axes[1].set_title(
             f"(b) {hist.share_low * 100:.0f}% <= {LOW_SCORE} (paper {PAPER_LOW_SCORE_SHARE * 100:.0f}%)"
         )
-        axes[1].bar([w for w, _, _ in words], [s for _, _, s in words])
-        axes[1].set_ylabel("mean score")
-        axes[1].set_title(f"(c) {len(words)} most frequent words")
-        axes[1].tick_params(axis="x", rotation=45)
-        axes[2].bar([str(s) for s in spk], [v["mean"] for v in spk.values()])
-        axes[2].set_xlabel("speaker id")
-        axes[2].set_ylabel("mean score")
-        axes[2].set_title("(a) per speaker")
-        fig.tight_layout()
+        axes[2].bar([w for w, _, _ in words], [s for _, _, s in words], color=SYSTEM_COLOURS[0])
+        axes[2].set_xlabel("word")
+        axes[2].set_ylabel("mean semantic score (0-1)")
+        axes[2].set_title(f"(c) {len(words)} most frequent words")
+        axes[2].tick_params(axis="x", rotation=45)
         if out is not None:
             save_figure(fig, out, formats)
     return fig

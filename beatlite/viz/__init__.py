@@ -4,13 +4,19 @@ Submodules are imported lazily (``import beatlite.viz`` imports neither pyplot,
 pyvista nor torch); the names below are importable from ``beatlite.viz``.
 
 ==========================  ==================================================================
-``style``                    one figure style (:func:`figure_style`, :data:`STYLE`), :func:`save_figure`
+``style``                    one figure style (:func:`figure_style`, :data:`STYLE`), :func:`save_figure`,
+                             :func:`system_colour`, :func:`legend_outside`
 ``plot3d``                   :func:`plot_frame`, :func:`plot_filmstrip`, :func:`plot_views`,
-                             :func:`plot_trajectories` (matplotlib 3D)
-``animation``                :func:`animate_skeletons` (GT | CaMN | HA2G side by side, audio/beats,
-                             words, face panels) -> :class:`SkeletonAnimation` (inline JS/HTML,
-                             ``.save_as`` GIF/MP4/HTML)
-``face``                     :func:`plot_blendshapes` (ARKit heat map / bars)
+                             :func:`plot_trajectories`, :func:`plot_keyframes` (matplotlib 3D),
+                             :func:`plot_bone_levels` (what each hierarchy level adds, 2D)
+``animation``                :func:`animate_skeletons` (GT | CaMN | HA2G side by side, one scale;
+                             :class:`Timeline`, words, :class:`FacePanel`) -> :class:`SkeletonAnimation`
+                             (inline JS/HTML, ``.save_as`` GIF/MP4/HTML, 960 px wide)
+``face``                     :func:`plot_blendshapes` (ARKit heat map / bars, by name),
+                             :func:`plot_blendshape_curves` (the most active ones over time)
+``charts``                   :func:`plot_training_curves`, :func:`plot_scores` (bars, outliers cut),
+                             :func:`plot_score_scatter` (labelled points), :func:`plot_signals`
+                             (curves + event lines), :func:`plot_waveform` (amplitude, words, onsets)
 ``render``                   pyvista: :func:`render_frame`, :func:`render_animation`, :func:`show_skeleton`
 ``probe``                    :func:`probe_offscreen`, :func:`use_pyvista` (subprocess probe, cached)
 ``bvh_export``               :func:`motion_from_subset`, :func:`export_bvh` (Blender import steps)
@@ -29,20 +35,32 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-_SUBMODULES = ("style", "plot3d", "animation", "face", "render", "probe", "bvh_export")
+_SUBMODULES = ("style", "plot3d", "animation", "face", "charts", "render", "probe", "bvh_export")
 _EXPORTS: dict[str, str] = {
     "STYLE": "style",
     "GROUP_COLOURS": "style",
     "SYSTEM_COLOURS": "style",
     "figure_style": "style",
     "save_figure": "style",
+    "system_colour": "style",
+    "legend_outside": "style",
     "plot_frame": "plot3d",
     "plot_filmstrip": "plot3d",
     "plot_views": "plot3d",
     "plot_trajectories": "plot3d",
+    "plot_keyframes": "plot3d",
+    "plot_bone_levels": "plot3d",
     "animate_skeletons": "animation",
     "save_animation": "animation",
     "SkeletonAnimation": "animation",
+    "Timeline": "animation",
+    "FacePanel": "animation",
+    "plot_training_curves": "charts",
+    "plot_scores": "charts",
+    "plot_score_scatter": "charts",
+    "plot_signals": "charts",
+    "plot_waveform": "charts",
+    "plot_blendshape_curves": "face",
     "plot_blendshapes": "face",
     "render_frame": "render",
     "render_animation": "render",

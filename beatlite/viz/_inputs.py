@@ -26,15 +26,30 @@ class Bones:
         bones; a bone belongs to its child's group.
     joints : dict str -> (J_g,) int64
         The joint indices of each group.
+    has_feet : bool
+        True when a joint is named like a foot, toe or ankle: the skeleton stands,
+        so plots draw a floor under it. An upper body (HA2G's TED-43) or an
+        unnamed parents array gets no floor.
     """
 
     n_joints: int
     pairs: dict[str, np.ndarray]
     joints: dict[str, np.ndarray]
+    has_feet: bool = False
+
+
+_TED_HANDS = ("wrist", "thumb", "index", "middle", "ring", "pinky")
+_TED_HEAD = ("nose", "eye", "ear")
+_FEET = ("foot", "toe", "ankle")
 
 
 def joint_group(name: str) -> str:
-    """The plot group of a joint from its name: ``"hands"`` if it contains "Hand", ``"head"`` for Head/Neck.
+    """The plot group of a joint from its name: hands, head (and neck) or body.
+
+    BEAT names (``"RightHandIndex2"``, ``"Neck1"``) are matched by the words
+    "Hand", "Head" and "Neck"; TED-43 names (``"right_wrist"``, ``"left_thumb2"``,
+    ``"nose"``), split at underscores, by wrist and finger words (hands) and
+    nose, eye and ear (head), so a TED-43 skeleton has the colours of a BEAT one.
 
     Parameters
     ----------
@@ -47,61 +62,82 @@ def joint_group(name: str) -> str:
         One of ``"body"``, ``"hands"``, ``"head"``.
     """
     low = name.lower()
-    if "hand" in low:
+    words = low.rstrip("0123456789").split("_")
+    if "hand" in low or any(w in _TED_HANDS for w in words):
         return "hands"
-    if "head" in low or "neck" in low:
+    if "head" in low or "neck" in low or any(w in _TED_HEAD for w in words):
         return "head"
     return "body"
 
 
-def skeleton_bones(
-    skeleton: Skeleton | Sequence[int] | np.ndarray, names: Sequence[str] | None = None
-) -> Bones:
-    """Bones and joint groups of a :class:`Skeleton` or of a parents array.
+def _ted43_names(parents: np.ndarray) -> tuple[str, ...] | None:
+    """TED-43 joint names when ``parents`` is HA2G's TED-43 hierarchy (so its plots get named colours)."""
+    from beatlite.skeleton.ted import TED43_JOINTS, TED_BONES
+
+    if parents.size != len(TED43_JOINTS):
+        return None
+    ted = np.full(len(TED43_JOINTS), -1)
+    for parent, child in TED_BONES:
+        ted[child] = parent
+    return TED43_JOINTS if np.array_equal(ted, parents) else None
+
+
+def _check_parents(skeleton: Any) -> np.ndarray:
+    """A ``(J,) int64`` parents array (-1 at roots, else another joint's index), or a TypeError/ValueError."""
+    parents = np.asarray(skeleton)
+    if parents.ndim != 1 or parents.size == 0 or not np.issubdtype(parents.dtype, np.integer):
+        raise TypeError(
+            "skeleton must be a beatlite Skeleton or a (J,) integer parents array, "
+            f"got {type(skeleton).__name__} with shape {getattr(parents, 'shape', None)} "
+            f"and dtype {getattr(parents, 'dtype', None)}"
+        )
+    parents = parents.astype(np.int64)
+    bad = np.flatnonzero((parents < -1) | (parents >= parents.size) | (parents == np.arange(parents.size)))
+    if bad.size:
+        raise ValueError(f"skeleton: parents[{bad[0]}] = {parents[bad[0]]} is not -1 or another joint index")
+    return parents
+
+
+def _joint_groups(names: Sequence[str] | None, n: int) -> np.ndarray:
+    """``(J,)`` group name of each joint (all ``"body"`` without names)."""
+    if names is None:
+        return np.array(["body"] * n)
+    if len(names) != n:
+        raise ValueError(f"names: {len(names)} names for {n} joints")
+    return np.array([joint_group(str(nm)) for nm in names])
+
+
+def bone_groups(skeleton: Skeleton | Sequence[int] | np.ndarray, names: Sequence[str] | None = None) -> Bones:
+    """Drawable bones and joint groups of a :class:`Skeleton` or of a parents array.
+
+    (Not :func:`beatlite.skeleton.skeleton_bones`, which lists the bone vectors of a Skeleton.)
 
     Parameters
     ----------
     skeleton : Skeleton or (J,) int array
         The hierarchy; a parents array has ``-1`` at roots and ``0 <= parents[j] < J`` elsewhere.
     names : sequence of str, optional
-        Joint names used to colour groups when ``skeleton`` is a parents array (else all joints are body).
+        Joint names used to colour groups when ``skeleton`` is a parents array. Without
+        them HA2G's TED-43 hierarchy is recognised and named; any other array is all body.
 
     Returns
     -------
     Bones
     """
     if isinstance(skeleton, Skeleton):
-        parents = skeleton.parents
-        names = skeleton.names
+        parents, names = skeleton.parents, skeleton.names
     else:
-        parents = np.asarray(skeleton)
-        if parents.ndim != 1 or parents.size == 0 or not np.issubdtype(parents.dtype, np.integer):
-            raise TypeError(
-                "skeleton must be a beatlite Skeleton or a (J,) integer parents array, "
-                f"got {type(skeleton).__name__} with shape {getattr(parents, 'shape', None)} "
-                f"and dtype {getattr(parents, 'dtype', None)}"
-            )
-        parents = parents.astype(np.int64)
-        bad = np.flatnonzero(
-            (parents < -1) | (parents >= parents.size) | (parents == np.arange(parents.size))
-        )
-        if bad.size:
-            raise ValueError(
-                f"skeleton: parents[{bad[0]}] = {parents[bad[0]]} is not -1 or another joint index"
-            )
+        parents = _check_parents(skeleton)
     n = int(parents.size)
-    if names is None:
-        groups = np.array(["body"] * n)
-    else:
-        if len(names) != n:
-            raise ValueError(f"names: {len(names)} names for {n} joints")
-        groups = np.array([joint_group(str(nm)) for nm in names])
+    names = _ted43_names(parents) if names is None else names
+    groups = _joint_groups(names, n)
     child = np.flatnonzero(parents >= 0)
     pairs = np.stack([parents[child], child], axis=1) if child.size else np.zeros((0, 2), np.int64)
     return Bones(
         n_joints=n,
         pairs={g: pairs[groups[pairs[:, 1]] == g] for g in GROUPS},
         joints={g: np.flatnonzero(groups == g) for g in GROUPS},
+        has_feet=names is not None and any(f in str(nm).lower() for nm in names for f in _FEET),
     )
 
 
@@ -136,6 +172,42 @@ def check_positions(positions: Any, n_joints: int | None = None, name: str = "po
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} contains NaN or infinite values (shape {arr.shape})")
     return arr
+
+
+def per_sequence(values: Any, n: int, name: str) -> list[Any]:
+    """One skeleton per sequence: a list/tuple of skeletons is used as is, anything else is repeated."""
+    is_per_sequence = (
+        isinstance(values, list | tuple) and len(values) > 0 and not isinstance(values[0], int | np.integer)
+    )
+    if is_per_sequence:
+        if len(values) != n:
+            raise ValueError(f"{name}: {len(values)} given for {n} sequences")
+        return list(values)
+    return [values] * n
+
+
+def checked_sequences(seqs: Sequence[Any], skeletons: Any, name: str) -> tuple[list[np.ndarray], list[Bones]]:
+    """Several position sequences checked against their skeletons (one skeleton for all, or one each).
+
+    Parameters
+    ----------
+    seqs : sequence of (T_i, J_i, 3) array-like, centimetres
+        At least one sequence.
+    skeletons : Skeleton or parents array, or a list/tuple of them (one per sequence)
+        Hierarchies.
+    name : str
+        Argument name for error messages.
+
+    Returns
+    -------
+    (list of (T_i, J_i, 3) float64, list of Bones)
+    """
+    if not len(seqs):
+        raise ValueError(f"{name}: no sequence to draw")
+    bones = [bone_groups(s) for s in per_sequence(skeletons, len(seqs), "skeleton")]
+    return [
+        check_positions(p, b.n_joints, f"{name}[{i}]") for i, (p, b) in enumerate(zip(seqs, bones))
+    ], bones
 
 
 def check_fps(fps: Any, name: str = "fps") -> float:

@@ -1,15 +1,22 @@
 """Synchronised matplotlib animations of one or several skeletons (ground truth | CaMN | HA2G ...).
 
-Optional panels under the skeletons: the audio waveform with audio beats and
-motion beats under a moving cursor, the ARKit blendshapes of the face (bars or
-a heat map), and the current word as a caption. Lines are updated in place
-(``set_data_3d``); axes are never rebuilt, and frames are subsampled to the
-playback rate asked (``out_fps``).
+Optional panels under the skeletons, each described by one small object: the
+:class:`Timeline` (audio waveform, audio beats and motion beats under a moving
+cursor), the :class:`FacePanel` (ARKit blendshapes by name, as a heat map or
+bars), and the current word as a caption between the skeletons and the
+timeline. Every skeleton panel has the same scale and the same joint-group
+colours; a floor is drawn only under skeletons with feet. Lines are updated in
+place (``set_data_3d``); axes are never rebuilt, and frames are subsampled to
+the playback rate asked (``out_fps``). The figure is 960 pixels wide by default
+(slide size, :data:`beatlite.viz.style.SLIDE_WIDTH_PX`).
+
+Taught in notebook 08, section 3 ("One clock for everything").
 
 Usage (skipped by the doctests: ``gt``, ``camn``, ``y`` and ``take`` stand for your own data; it writes a file):
 
 >>> anim = animate_skeletons({"ground truth": gt, "CaMN": camn}, skeleton, fps=15,
-...                          audio=y, sr=16000, words=take.words)        # doctest: +SKIP
+...                          timeline=Timeline(audio=y, sr=16000, audio_beats=onsets),
+...                          words=take.words, face=FacePanel(take.face, take.face_names))  # doctest: +SKIP
 >>> anim                        # in JupyterLab: shown inline as JS/HTML (to_jshtml)  # doctest: +SKIP
 >>> anim.save_as("build/clip.gif")     # or .mp4 (needs ffmpeg) or .html             # doctest: +SKIP
 
@@ -19,7 +26,8 @@ Taught in notebooks/08_visualisation_3d.ipynb, section 3 (one clock for everythi
 from __future__ import annotations
 
 import shutil
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -28,15 +36,16 @@ from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
 from beatlite.viz._files import atomic_target
 from beatlite.viz._inputs import (
+    Bones,
     check_fps,
-    check_positions,
     check_words,
+    checked_sequences,
     frame_indices,
-    skeleton_bones,
     word_at,
 )
-from beatlite.viz.plot3d import SkeletonArtist, SkeletonLike, setup_axes
-from beatlite.viz.style import STYLE, SYSTEM_COLOURS
+from beatlite.viz.face import most_active
+from beatlite.viz.plot3d import SkeletonArtist, SkeletonLike, half_extents, setup_axes
+from beatlite.viz.style import SLIDE_WIDTH_PX, STYLE, legend_outside, system_colour
 
 FACE_PANELS = ("bars", "heatmap")
 
@@ -76,11 +85,31 @@ class SkeletonAnimation(FuncAnimation):
         self._draw_update(k)  # the first draw event resets the artists to frame 0 (FuncAnimation._start)
         return image
 
-    def to_html(self) -> str:
-        """The animation as a self-contained JS/HTML player (``to_jshtml``)."""
+    def to_html(self, *, dpi: float | None = None, frame_format: str = "png") -> str:
+        """The animation as a self-contained JS/HTML player (``to_jshtml``).
+
+        Parameters
+        ----------
+        dpi : float, optional
+            Resolution of the embedded frames (default: the figure's, 960 px wide);
+            e.g. ``dpi=60`` embeds 576-px frames to keep a saved notebook small.
+        frame_format : {"png", "jpeg"}
+            Format of the embedded frames; JPEG frames are several times smaller.
+
+        Returns
+        -------
+        str
+            HTML with the frames base64-embedded.
+        """
         import matplotlib.pyplot as plt
 
-        with plt.rc_context({"animation.embed_limit": STYLE["animation.embed_limit"]}):
+        params = {
+            "animation.embed_limit": STYLE["animation.embed_limit"],
+            "animation.frame_format": frame_format,
+        }
+        params["savefig.dpi"] = "figure" if dpi is None else float(dpi)
+        self.__dict__.pop("_html_representation", None)  # to_jshtml caches its first answer
+        with plt.rc_context(params):
             return self.to_jshtml(fps=self.fps)
 
     def _repr_html_(self) -> str:  # JupyterLab shows the player when the object ends a cell
@@ -154,18 +183,93 @@ def save_animation(anim: Any, path: str | Path, *, fps: float, dpi: float | None
     return path
 
 
-def _as_list(values: Any, n: int, name: str) -> list[Any]:
-    """One skeleton per sequence: a list/tuple of skeletons is used as is, anything else is repeated."""
-    is_per_sequence = isinstance(values, list | tuple) and len(values) > 0 and not _is_int(values[0])
-    if is_per_sequence:
-        if len(values) != n:
-            raise ValueError(f"{name}: {len(values)} given for {n} sequences")
-        return list(values)
-    return [values] * n
+@dataclass(frozen=True)
+class Timeline:
+    """The timeline panel of :func:`animate_skeletons`: waveform, audio beats and motion beats.
+
+    Attributes
+    ----------
+    audio : (N,) float array, optional
+        Mono waveform in [-1, 1] (drawn as its min/max envelope).
+    sr : float
+        Sample rate of ``audio``, Hz.
+    audio_beats : (A,) float array, optional
+        Audio beat / onset times, seconds (full-height lines).
+    motion_beats : (M,) float array, optional
+        Motion beat times, seconds (short ticks at the bottom).
+    """
+
+    audio: Any = None
+    sr: float = 16000
+    audio_beats: Any = None
+    motion_beats: Any = None
+
+    def checked(self) -> Timeline:
+        """A copy with float64 arrays, or a ValueError naming the bad field."""
+        wave = None
+        if self.audio is not None:
+            wave = np.asarray(self.audio, dtype=np.float64)
+            if wave.ndim != 1 or wave.size == 0:
+                raise ValueError(f"audio must be a non-empty (N,) mono waveform, got shape {wave.shape}")
+        beats = [None if b is None else np.asarray(b, dtype=np.float64).reshape(-1) for b in
+                 (self.audio_beats, self.motion_beats)]  # fmt: skip
+        if wave is None and beats[0] is None and beats[1] is None:
+            raise ValueError("timeline: give audio, audio_beats or motion_beats")
+        return Timeline(wave, check_fps(self.sr, "sr"), *beats)
+
+    @property
+    def duration(self) -> float:
+        """Length of the waveform in seconds (0 without one)."""
+        return 0.0 if self.audio is None else len(self.audio) / self.sr
 
 
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int | np.integer)
+@dataclass(frozen=True)
+class FacePanel:
+    """The face panel of :func:`animate_skeletons`: ARKit blendshape weights, labelled by name.
+
+    Attributes
+    ----------
+    weights : (T_f, K) float array, values in [0, 1]
+        Blendshape weights (BEAT: K = 51).
+    names : sequence of str, optional
+        The K blendshape names (row / bar labels; ``"blendshape k"`` otherwise).
+    fps : float, optional
+        Frame rate of ``weights`` (default: the skeletons' ``fps``; BEAT's JSON is 60).
+    kind : {"heatmap", "bars"}
+        Heat map over time with a cursor, or bars of the current frame.
+    top : int, optional
+        Show only the ``top`` blendshapes that vary most over the clip (largest
+        standard deviation), in their original order, so that every label is
+        readable; ``None`` shows all K.
+    """
+
+    weights: Any
+    names: Sequence[str] | None = None
+    fps: float | None = None
+    kind: str = "heatmap"
+    top: int | None = 12
+
+    def checked(self, fps: float) -> FacePanel:
+        """A copy with the rows to show selected, names filled and ``fps`` set; ValueError on bad input."""
+        w = _check_face(self.weights, self.names, self.kind)
+        names = list(self.names) if self.names is not None else [f"blendshape {k}" for k in range(w.shape[1])]
+        rows = np.arange(w.shape[1])
+        if self.top is not None:
+            rows = most_active(w, self.top)
+        f_fps = fps if self.fps is None else check_fps(self.fps, "face_fps")
+        return FacePanel(w[:, rows], [names[k] for k in rows], f_fps, self.kind, None)
+
+
+def _check_face(weights: Any, names: Sequence[str] | None, kind: str) -> np.ndarray:
+    """Blendshape weights as ``(T, K) float64``, or a ValueError naming the bad argument."""
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim != 2 or w.shape[0] == 0:
+        raise ValueError(f"face must be (T, 51) blendshape weights, got shape {w.shape}")
+    if names is not None and len(names) != w.shape[1]:
+        raise ValueError(f"face_names: {len(names)} names for {w.shape[1]} blendshapes")
+    if kind not in FACE_PANELS:
+        raise ValueError(f"face_panel must be one of {FACE_PANELS}, got {kind!r}")
+    return w
 
 
 def _envelope(y: np.ndarray, sr: float, n_bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -179,201 +283,173 @@ def _envelope(y: np.ndarray, sr: float, n_bins: int) -> tuple[np.ndarray, np.nda
     return t, lo, hi
 
 
-def animate_skeletons(
-    positions: Any,
-    skeleton: SkeletonLike | Sequence[SkeletonLike],
-    fps: float,
-    *,
-    out_fps: float | None = 15.0,
-    labels: Sequence[str] | None = None,
-    audio: Any = None,
-    sr: float = 16000,
-    audio_beats: Any = None,
-    motion_beats: Any = None,
-    words: Any = None,
-    face: Any = None,
-    face_names: Sequence[str] | None = None,
-    face_fps: float | None = None,
-    face_panel: str = "bars",
-    view: str | tuple[float, float] = "default",
-    panel_size: float = 3.0,
-    dpi: float = 80,
-    max_frames: int | None = None,
-) -> SkeletonAnimation:
-    """Animate one or several skeletons side by side, in sync, with optional audio, face and word panels.
-
-    Parameters
-    ----------
-    positions : (T, J, 3) array, or mapping label -> (T_i, J_i, 3), or sequence of arrays
-        Joint positions, centimetres, Y up, all at ``fps``. Several sequences are
-        shown left to right (e.g. ``{"ground truth": gt, "CaMN": a, "HA2G": b}``)
-        on the same clock; a shorter one holds its last frame.
-    skeleton : Skeleton or (J,) parents array, or a sequence of them (one per sequence)
-        Hierarchy of each sequence.
-    fps : float
-        Frame rate of ``positions`` (frames per second).
-    out_fps : float or None
-        Playback rate; frames are subsampled to it (``None``: every frame).
-    labels : sequence of str, optional
-        Panel titles (default: mapping keys, or none for one sequence).
-    audio : (N,) float array, optional
-        Waveform in [-1, 1] for the timeline panel.
-    sr : float
-        Audio sample rate, Hz.
-    audio_beats : (A,) float array, optional
-        Audio beat / onset times, seconds (drawn as full-height lines).
-    motion_beats : (M,) float array, optional
-        Motion beat times, seconds (drawn as short ticks at the bottom).
-    words : (starts, ends, words) or WordIntervals, optional
-        Word timings in seconds; the current word is shown as a caption.
-    face : (T_f, 51) float array, optional
-        ARKit blendshape weights in [0, 1] at ``face_fps``.
-    face_names : sequence of str, optional
-        Blendshape names (bar labels / heat-map rows).
-    face_fps : float, optional
-        Frame rate of ``face`` (default ``fps``; BEAT's JSON is 60 fps).
-    face_panel : {"bars", "heatmap"}
-        Bars of the current frame, or the heat map over time with a cursor.
-    view : str or (elev, azim)
-        Camera of every skeleton panel.
-    panel_size : float
-        Width and height of a skeleton panel, inches.
-    dpi : float
-        Figure resolution (pixels = inches x dpi).
-    max_frames : int, optional
-        Stop after this many animation frames.
-
-    Returns
-    -------
-    SkeletonAnimation
-        A ``FuncAnimation``; ends a notebook cell -> inline player; ``.save_as("x.gif")``.
-    """
-    import matplotlib.pyplot as plt
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fps = check_fps(fps)
-    rate = None if out_fps is None else check_fps(out_fps, "out_fps")
+# ----------------------------------------------------------------------------------- the steps
+def _sequences(
+    positions: Any, skeleton: Any, labels: Sequence[str] | None
+) -> tuple[list[str] | None, list[np.ndarray], list[Bones]]:
+    """Step 1: the sequences to animate, their labels and drawable bones, checked."""
     if isinstance(positions, Mapping):
-        labels = list(positions) if labels is None else labels
-        seqs = list(positions.values())
-    elif isinstance(positions, list | tuple):
-        seqs = list(positions)
+        labels, seqs = (list(positions) if labels is None else labels), list(positions.values())
     else:
-        seqs = [positions]
-    if not seqs:
-        raise ValueError("positions: no sequence to animate")
-    n = len(seqs)
-    if labels is not None and len(labels) != n:
-        raise ValueError(f"labels: {len(labels)} labels for {n} sequences")
-    skels = _as_list(skeleton, n, "skeleton")
-    bones = [skeleton_bones(s) for s in skels]
-    seqs = [check_positions(p, b.n_joints, f"positions[{i}]") for i, (p, b) in enumerate(zip(seqs, bones))]
-    n_frames = max(len(p) for p in seqs)
+        seqs = list(positions) if isinstance(positions, list | tuple) else [positions]
+    if labels is not None and len(labels) != len(seqs):
+        raise ValueError(f"labels: {len(labels)} labels for {len(seqs)} sequences")
+    seqs, bones = checked_sequences(seqs, skeleton, "positions")
+    return (None if labels is None else [str(x) for x in labels]), seqs, bones
+
+
+def _clock(
+    n_frames: int, fps: float, out_fps: float | None, max_frames: int | None
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Step 2: data frame of each animation frame, its time (s) and the playback rate (frames/s)."""
+    rate = None if out_fps is None else check_fps(out_fps, "out_fps")
     idx = frame_indices(n_frames, fps, rate)
     if max_frames is not None:
         idx = idx[: int(max_frames)]
-    times = idx / fps
-    play_fps = (
-        fps if rate is None or rate >= fps else fps / max(np.mean(np.diff(idx)) if len(idx) > 1 else 1, 1)
-    )
+    step = float(np.mean(np.diff(idx))) if len(idx) > 1 else 1.0
+    play_fps = fps if rate is None or rate >= fps else fps / max(step, 1.0)
+    return idx, idx / fps, play_fps
 
-    wave = None
-    if audio is not None:
-        wave = np.asarray(audio, dtype=np.float64)
-        if wave.ndim != 1 or wave.size == 0:
-            raise ValueError(f"audio must be a non-empty (N,) mono waveform, got shape {wave.shape}")
-        sr = check_fps(sr, "sr")
-    beats_a = None if audio_beats is None else np.asarray(audio_beats, dtype=np.float64).reshape(-1)
-    beats_m = None if motion_beats is None else np.asarray(motion_beats, dtype=np.float64).reshape(-1)
-    timeline = wave is not None or beats_a is not None or beats_m is not None
-    word_table = None if words is None else check_words(words)
 
-    weights = None
-    if face is not None:
-        weights = np.asarray(face, dtype=np.float64)
-        if weights.ndim != 2 or weights.shape[0] == 0:
-            raise ValueError(f"face must be (T, 51) blendshape weights, got shape {weights.shape}")
-        if face_names is not None and len(face_names) != weights.shape[1]:
-            raise ValueError(f"face_names: {len(face_names)} names for {weights.shape[1]} blendshapes")
-        if face_panel not in FACE_PANELS:
-            raise ValueError(f"face_panel must be one of {FACE_PANELS}, got {face_panel!r}")
-        f_fps = fps if face_fps is None else check_fps(face_fps, "face_fps")
+_LEGACY = ("audio", "sr", "audio_beats", "motion_beats", "face_names", "face_fps", "face_panel", "panel_size")
 
-    heights = [panel_size] + ([1.1] if timeline else []) + ([1.4] if weights is not None else [])
-    caption_h = 0.3 if word_table is not None else 0.0
-    width = max(panel_size * n, 6.0 if (timeline or weights is not None) else 0.0)
-    with plt.rc_context(dict(STYLE)):
-        fig = Figure(figsize=(width, sum(heights) + caption_h), dpi=dpi)
-        FigureCanvasAgg(fig)
-        grid = fig.add_gridspec(
-            len(heights),
-            n,
-            height_ratios=heights,
-            hspace=0.35,
-            wspace=0.0,
-            left=0.08,
-            right=0.98,
-            bottom=(caption_h + 0.3) / (sum(heights) + caption_h)
-            if len(heights) > 1
-            else caption_h / (sum(heights) + caption_h),
-            top=0.93,
+
+def _legacy_options(timeline: Any, face: Any, legacy: dict[str, Any]) -> tuple[Any, Any, float | None]:
+    """The keyword arguments of beatlite <= 0.1 (``audio=``, ``face_names=``, ...) as Timeline / FacePanel.
+
+    Returns ``(timeline, face, panel_size)``; ``panel_size`` (inches) is ``None`` unless given.
+    """
+    unknown = sorted(set(legacy) - set(_LEGACY))
+    if unknown:
+        raise TypeError(f"animate_skeletons() got unexpected keyword arguments {unknown}")
+    if timeline is None and any(legacy.get(k) is not None for k in ("audio", "audio_beats", "motion_beats")):
+        timeline = Timeline(*(legacy.get(k) for k in ("audio", "sr", "audio_beats", "motion_beats")))
+        timeline = replace(timeline, sr=16000 if timeline.sr is None else timeline.sr)
+    if face is not None and not isinstance(face, FacePanel):
+        face = FacePanel(
+            face, legacy.get("face_names"), legacy.get("face_fps"), legacy.get("face_panel", "bars")
         )
-        artists = []
-        for i in range(n):
-            ax = fig.add_subplot(grid[0, i], projection="3d")
-            setup_axes(ax, seqs[i], view=view)
-            artists.append(SkeletonArtist(ax, bones[i]))
-            if labels is not None:
-                ax.set_title(str(labels[i]), color=SYSTEM_COLOURS[i % len(SYSTEM_COLOURS)])
-        row = 1
-        cursors = []
-        if timeline:
-            ax_t = fig.add_subplot(grid[row, :])
-            row += 1
-            end = max(n_frames / fps, len(wave) / sr if wave is not None else 0.0)
-            if wave is not None:
-                tw, lo, hi = _envelope(wave, sr, 2000)
-                ax_t.fill_between(tw, lo, hi, color="0.6", lw=0, label="audio")
-            if beats_a is not None:
-                ax_t.vlines(beats_a, -1, 1, color="#1f77b4", lw=0.8, alpha=0.8, label="audio beats")
-            if beats_m is not None:
-                ax_t.vlines(beats_m, -1, -0.4, color="#d62728", lw=1.6, label="motion beats")
-            ax_t.set_xlim(0, end)
-            ax_t.set_ylim(-1, 1)
-            ax_t.set_yticks([])
-            ax_t.set_xlabel("time (s)")
-            ax_t.legend(loc="upper right", ncol=3, fontsize=7)
-            cursors.append(ax_t.axvline(0.0, color="k", lw=1.2))
-        bars = None
-        if weights is not None:
-            ax_f = fig.add_subplot(grid[row, :])
-            k_face = weights.shape[1]
-            if face_panel == "bars":
-                bars = ax_f.bar(np.arange(k_face), weights[0], color="#2e8b57", width=0.8)
-                ax_f.set_ylim(0, max(1.0, float(weights.max())))
-                ax_f.set_xlim(-0.6, k_face - 0.4)
-                ax_f.set_ylabel("weight")
-                if face_names is not None:
-                    ax_f.set_xticks(np.arange(k_face), face_names, rotation=90, fontsize=5)
-                else:
-                    ax_f.set_xlabel("blendshape")
-            else:
-                t_face = len(weights) / f_fps
-                ax_f.imshow(
-                    weights.T,
-                    aspect="auto",
-                    origin="lower",
-                    extent=(0, t_face, -0.5, k_face - 0.5),
-                    vmin=0,
-                    vmax=1,
-                    cmap="magma",
-                    interpolation="nearest",
-                )
-                ax_f.set_ylabel("blendshape")
-                ax_f.set_xlabel("time (s)")
-                cursors.append(ax_f.axvline(0.0, color="w", lw=1.2))
-        caption = fig.text(0.5, 0.02, "", ha="center", va="bottom", fontsize=13) if word_table else None
+    return timeline, face, legacy.get("panel_size")
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """Step 3: the figure size and the rectangle (figure fractions) of every panel."""
+
+    size: tuple[float, float]  # inches
+    skeletons: list[tuple[float, float, float, float]]
+    caption: tuple[float, float] | None  # centre (x, y)
+    timeline: tuple[float, float, float, float] | None
+    face: tuple[float, float, float, float] | None
+
+
+def _face_heights(face: FacePanel | None) -> tuple[float, float]:
+    """Inches of the face panel's axes and of its labels below (blendshape names for bars), (0, 0) without one."""
+    if face is None:
+        return 0.0, 0.0
+    if face.kind == "heatmap":
+        return max(1.0, 0.16 * face.weights.shape[1]), 0.55
+    return 1.3, 1.5  # bars, names written vertically below
+
+
+def _skeleton_row(n: int, width: float, panel_size: float | None, below: bool) -> tuple[float, float]:
+    """Height of the skeleton row and figure width, inches: square panels up to 3.6 in (5.4 alone)."""
+    if panel_size is None:
+        return min(width / n, 3.6 if below else 5.4), width
+    return panel_size, max(panel_size * n, 6.0 if below else 0.0)  # beatlite 0.1's panel_size layout
+
+
+def _layout(
+    n: int,
+    width: float,
+    panel_size: float | None,
+    *,
+    titles: bool,
+    timeline: bool,
+    caption: bool,
+    face: FacePanel | None,
+) -> _Layout:
+    """Stack from the top: skeleton row, caption band, timeline, face; side margins for names and legends."""
+    below = timeline or face is not None
+    sk_h, width = _skeleton_row(n, width, panel_size, below)
+    title_h, cap_h, tl_h = 0.4 * titles, 0.55 * caption, 1.55 * timeline
+    face_h, face_below = _face_heights(face)
+    height = title_h + sk_h + cap_h + tl_h + face_h + face_below + 0.1 * below
+    left, right = min(1.6, 0.22 * width), min(1.8, 0.22 * width)
+    w_frac = (width - left - right) / width
+
+    def rect(top_in: float, h_in: float) -> tuple[float, float, float, float]:
+        return (left / width, 1 - (top_in + h_in) / height, w_frac, h_in / height)
+
+    skeletons = [(i / n, 1 - (title_h + sk_h) / height, 1 / n, sk_h / height) for i in range(n)]
+    sk_h += title_h
+    cap = (0.5, 1 - (sk_h + cap_h / 2) / height) if caption else None
+    tl = rect(sk_h + cap_h + 0.05, 1.0) if timeline else None
+    fc = rect(sk_h + cap_h + tl_h + 0.05, face_h) if face is not None else None
+    return _Layout((width, height), skeletons, cap, tl, fc)
+
+
+def _draw_skeletons(fig: Any, layout: _Layout, seqs: list[np.ndarray], bones: list[Bones],
+                    labels: list[str] | None, view: Any) -> list[SkeletonArtist]:  # fmt: skip
+    """Step 4: one 3D panel per sequence, one scale for all, titled in the system's colour."""
+    half = half_extents(seqs)
+    artists = []
+    for i, (rect, seq, b) in enumerate(zip(layout.skeletons, seqs, bones)):
+        ax = fig.add_axes(rect, projection="3d")
+        setup_axes(ax, seq, view=view, floor=b.has_feet, half=half)
+        artists.append(SkeletonArtist(ax, b))
+        if labels is not None:
+            ax.set_title(labels[i], color=system_colour(labels[i], i), fontsize=13, fontweight="bold")
+    return artists
+
+
+def _draw_timeline(fig: Any, rect: Any, tl: Timeline, end: float) -> Any:
+    """Step 5: waveform envelope, audio beats, motion beats, legend outside; returns the cursor line."""
+    ax = fig.add_axes(rect)
+    if tl.audio is not None:
+        tw, lo, hi = _envelope(tl.audio, tl.sr, 2000)
+        ax.fill_between(tw, lo, hi, color="0.65", lw=0, label="audio")
+    if tl.audio_beats is not None:
+        ax.vlines(tl.audio_beats, -1, 1, color="#1f77b4", lw=1.0, alpha=0.8, label="audio beats")
+    if tl.motion_beats is not None:
+        ax.vlines(tl.motion_beats, -1, -0.4, color="#d62728", lw=2.0, label="motion beats")
+    ax.set_xlim(0, end)
+    ax.set_ylim(-1, 1)
+    ax.set_yticks([-1, 0, 1] if tl.audio is not None else [])
+    ax.set_ylabel("amplitude" if tl.audio is not None else "beats")
+    ax.set_xlabel("time (s)")
+    ax.grid(False)
+    legend_outside(ax, "right")
+    return ax.axvline(0.0, color="k", lw=1.4)
+
+
+def _draw_face(fig: Any, rect: Any, face: FacePanel) -> tuple[Any, Any]:
+    """Step 6: blendshapes by name, heat map (returns its cursor) or bars (returns the bars)."""
+    ax = fig.add_axes(rect)
+    w, k = face.weights, face.weights.shape[1]
+    top = max(1.0, float(w.max()))
+    ax.grid(False)
+    if face.kind == "bars":
+        bars = ax.bar(np.arange(k), w[0], color="#2e8b57", width=0.8)
+        ax.set_ylim(0, top)
+        ax.set_xlim(-0.6, k - 0.4)
+        ax.set_ylabel("weight (0-1)")
+        ax.set_xticks(np.arange(k), face.names, rotation=90, fontsize=8)
+        return None, bars
+    im = ax.imshow(w.T, aspect="auto", origin="upper", extent=(0, len(w) / face.fps, k - 0.5, -0.5),
+                   vmin=0, vmax=top, cmap="magma", interpolation="nearest")  # fmt: skip
+    ax.set_yticks(np.arange(k), face.names, fontsize=8)
+    ax.set_xlabel("time (s)")
+    x0, y0, wd, ht = rect
+    bar_ax = fig.add_axes((x0 + wd + 0.01, y0, 0.012, ht))
+    fig.colorbar(im, cax=bar_ax).set_label("weight (0-1)", fontsize=9)
+    return ax.axvline(0.0, color="w", lw=1.4), None
+
+
+def _updater(idx: np.ndarray, times: np.ndarray, seqs: list[np.ndarray], artists: list[SkeletonArtist],
+             cursors: list[Any], bars: Any, face: FacePanel | None, caption: Any,
+             words: Any) -> Callable[[int], list[Any]]:  # fmt: skip
+    """Step 7: the function that moves every artist to animation frame k."""
 
     def update(k: int) -> list[Any]:
         t = float(times[k])
@@ -385,14 +461,114 @@ def animate_skeletons(
             c.set_xdata([t, t])
             changed.append(c)
         if bars is not None:
-            row_w = weights[min(int(round(t * f_fps)), len(weights) - 1)]
-            for rect, h in zip(bars, row_w):
+            row = face.weights[min(int(round(t * face.fps)), len(face.weights) - 1)]
+            for rect, h in zip(bars, row):
                 rect.set_height(h)
             changed += list(bars)
         if caption is not None:
-            caption.set_text(word_at(t, *word_table))
+            caption.set_text(word_at(t, *words))
             changed.append(caption)
         return changed
 
+    return update
+
+
+def animate_skeletons(
+    positions: Any,
+    skeleton: SkeletonLike | Sequence[SkeletonLike],
+    fps: float,
+    *,
+    out_fps: float | None = 15.0,
+    labels: Sequence[str] | None = None,
+    timeline: Timeline | None = None,
+    words: Any = None,
+    face: FacePanel | None = None,
+    view: str | tuple[float, float] = "default",
+    width: float = SLIDE_WIDTH_PX,
+    dpi: float = 100,
+    max_frames: int | None = None,
+    **legacy: Any,
+) -> SkeletonAnimation:
+    """Animate one or several skeletons side by side, in sync, with optional timeline, face and word panels.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) array, or mapping label -> (T_i, J_i, 3), or sequence of arrays
+        Joint positions, centimetres, Y up, all at ``fps``. Several sequences are
+        shown left to right (e.g. ``{"ground truth": gt, "CaMN": a, "HA2G": b}``)
+        on the same clock and the same scale; a shorter one holds its last frame.
+    skeleton : Skeleton or (J,) parents array, or a sequence of them (one per sequence)
+        Hierarchy of each sequence (HA2G's TED-43 parents array is recognised).
+    fps : float
+        Frame rate of ``positions`` (frames per second).
+    out_fps : float or None
+        Playback rate; frames are subsampled to it (``None``: every frame).
+    labels : sequence of str, optional
+        Panel titles (default: mapping keys, or none for one sequence), in the
+        systems' colours (:func:`beatlite.viz.style.system_colour`).
+    timeline : Timeline, optional
+        Waveform, audio beats and motion beats under the skeletons, with a cursor.
+    words : (starts, ends, words) or WordIntervals, optional
+        Word timings in seconds; the current word is the caption under the skeletons.
+    face : FacePanel, optional
+        Blendshape weights by name, as a heat map with a cursor or as bars.
+    view : str or (elev, azim)
+        Camera of every skeleton panel.
+    width : float
+        Figure width in pixels (default 960, slide size).
+    dpi : float
+        Pixels per inch; fonts are in points, so a larger ``dpi`` at the same
+        ``width`` makes the text larger.
+    max_frames : int, optional
+        Stop after this many animation frames.
+    **legacy
+        The keywords of beatlite 0.1, still accepted: ``audio``, ``sr``,
+        ``audio_beats``, ``motion_beats`` (-> ``timeline``), ``face`` as an array with
+        ``face_names``, ``face_fps``, ``face_panel`` (-> ``FacePanel``, its 12 most
+        active rows, bars by default), and ``panel_size`` (inches per skeleton panel; the figure is
+        then ``max(panel_size * n, 6)`` inches wide when panels are shown below).
+
+    Returns
+    -------
+    SkeletonAnimation
+        A ``FuncAnimation``; ends a notebook cell -> inline player; ``.save_as("x.gif")``.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fps, dpi = check_fps(fps), check_fps(dpi, "dpi")
+    timeline, face, panel_size = _legacy_options(timeline, face, legacy)
+    labels, seqs, bones = _sequences(positions, skeleton, labels)
+    n_frames = max(len(p) for p in seqs)
+    idx, times, play_fps = _clock(n_frames, fps, out_fps, max_frames)
+    timeline = None if timeline is None else timeline.checked()
+    face = None if face is None else face.checked(fps)
+    word_table = None if words is None else check_words(words)
+    layout = _layout(
+        len(seqs),
+        check_fps(width, "width") / dpi,
+        panel_size,
+        titles=labels is not None,
+        timeline=timeline is not None,
+        caption=word_table is not None,
+        face=face,
+    )
+    with plt.rc_context(dict(STYLE)):
+        fig = Figure(figsize=layout.size, dpi=dpi)
+        FigureCanvasAgg(fig)
+        artists = _draw_skeletons(fig, layout, seqs, bones, labels, view)
+        cursors, bars = [], None
+        if timeline is not None:
+            cursors.append(
+                _draw_timeline(fig, layout.timeline, timeline, max(n_frames / fps, timeline.duration))
+            )
+        if face is not None:
+            cursor, bars = _draw_face(fig, layout.face, face)
+            cursors += [] if cursor is None else [cursor]
+        caption = None
+        if layout.caption is not None:
+            caption = fig.text(*layout.caption, "", ha="center", va="center", fontsize=16, fontweight="bold")
+    update = _updater(idx, times, seqs, artists, cursors, bars, face, caption, word_table)
     update(0)
     return SkeletonAnimation(fig, update, times, play_fps)

@@ -18,6 +18,73 @@ from beatlite.viz._inputs import check_fps
 from beatlite.viz.style import figure_style
 
 KINDS = ("heatmap", "bars")
+#: Inches per heat-map row: 51 rows at 8-pt labels need 0.17 in each to stay readable.
+ROW_INCHES = 0.17
+
+
+def most_active(weights: np.ndarray, top: int) -> np.ndarray:
+    """Indices of the ``top`` blendshapes with the largest standard deviation over time, in ascending order.
+
+    Parameters
+    ----------
+    weights : (T, K) float
+        Blendshape weights.
+    top : int
+        How many to keep (all K when ``top >= K``).
+
+    Returns
+    -------
+    (min(top, K),) int64
+
+    Examples
+    --------
+    >>> w = np.array([[0.0, 0.5, 0.0], [0.0, 0.5, 1.0], [0.0, 0.5, 0.0]])
+    >>> most_active(w, 1).tolist()          # only the third one moves
+    [2]
+    """
+    if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 1:
+        raise ValueError(f"top must be a positive integer, got {top!r}")
+    order = np.argsort(-np.asarray(weights).std(axis=0), kind="stable")
+    return np.sort(order[: int(top)]).astype(np.int64)
+
+
+def _check_weights(weights: Any, names: Sequence[str] | None, kind: str, frame: int | None) -> np.ndarray:
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim != 2 or w.shape[0] == 0 or w.shape[1] == 0:
+        raise ValueError(f"weights must be a (T, K) array with T, K >= 1, got shape {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise ValueError(f"weights contains NaN or infinite values (shape {w.shape})")
+    if names is not None and len(names) != w.shape[1]:
+        raise ValueError(f"names: {len(names)} names for {w.shape[1]} blendshapes (weights shape {w.shape})")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    if frame is not None and not -w.shape[0] <= int(frame) < w.shape[0]:
+        raise ValueError(f"frame={frame} is out of range for {w.shape[0]} frames")
+    return w
+
+
+def _heatmap(ax: Any, w: np.ndarray, labels: list[str], fps: float, frame: int | None) -> None:
+    """Rows = blendshapes (first name at the top), columns = time in seconds, colour bar in weight units."""
+    n_frames, k = w.shape
+    im = ax.imshow(w.T, aspect="auto", origin="upper", extent=(0.0, n_frames / fps, k - 0.5, -0.5),
+                   vmin=0.0, vmax=max(1.0, float(w.max())), cmap="magma", interpolation="nearest")  # fmt: skip
+    ax.set_yticks(np.arange(k), labels, fontsize=8)
+    ax.set_ylabel("blendshape")
+    ax.set_xlabel("time (s)")
+    ax.grid(False)
+    ax.figure.colorbar(im, ax=ax, label="weight (0-1)", fraction=0.03, pad=0.02)
+    if frame is not None:
+        ax.axvline((int(frame) % n_frames) / fps, color="w", lw=1.2)
+
+
+def _bars(ax: Any, w: np.ndarray, labels: list[str], fps: float, frame: int | None) -> None:
+    """Bars of one frame, blendshape names written vertically under them."""
+    f = 0 if frame is None else int(frame) % len(w)
+    ax.bar(np.arange(w.shape[1]), w[f], color="#2e8b57")
+    ax.set_xticks(np.arange(w.shape[1]), labels, rotation=90, fontsize=8)
+    ax.set_ylim(0, max(1.0, float(w.max())))
+    ax.set_ylabel("weight (0-1)")
+    ax.set_title(f"blendshapes at t = {f / fps:.2f} s")
 
 
 def plot_blendshapes(
@@ -27,17 +94,18 @@ def plot_blendshapes(
     *,
     kind: str = "heatmap",
     frame: int | None = None,
+    top: int | None = None,
     ax: Any = None,
-    figsize: tuple[float, float] = (9.0, 5.0),
+    figsize: tuple[float, float] | None = None,
 ) -> Any:
-    """Plot blendshape weights as a heat map (blendshape x time) or as bars of one frame.
+    """Plot blendshape weights as a heat map (blendshape x time) or as bars of one frame, labelled by name.
 
     Parameters
     ----------
     weights : (T, K) float, usually K = 51, values in [0, 1]
         Blendshape weights per frame.
     names : sequence of str, optional
-        K blendshape names (row / bar labels); indices otherwise.
+        K blendshape names (row / bar labels); ``"blendshape k"`` otherwise.
     fps : float
         Frame rate of ``weights`` (BEAT facial JSON: 60), frames per second.
     kind : {"heatmap", "bars"}
@@ -45,6 +113,57 @@ def plot_blendshapes(
     frame : int, optional
         For ``"heatmap"``, draw a cursor at this frame; for ``"bars"``, the frame
         to show (default 0).
+    top : int, optional
+        Keep only the ``top`` blendshapes that vary most (:func:`most_active`), in
+        their original order; default all K.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float), optional
+        Size of a new figure, inches; default 9.6 wide and tall enough for 8-pt
+        labels on every row (51 rows: 9.7 inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    w = _check_weights(weights, names, kind, frame)
+    fps = check_fps(fps)
+    labels = list(names) if names is not None else [f"blendshape {j}" for j in range(w.shape[1])]
+    if top is not None:
+        rows = most_active(w, top)
+        w, labels = w[:, rows], [labels[j] for j in rows]
+    if figsize is None:
+        figsize = (9.6, 1.0 + ROW_INCHES * w.shape[1]) if kind == "heatmap" else (9.6, 4.0)
+    with figure_style():
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            fig, ax = plt.subplots(figsize=figsize, layout="constrained")
+        (_heatmap if kind == "heatmap" else _bars)(ax, w, labels, fps, frame)
+    return ax.figure
+
+
+def plot_blendshape_curves(
+    weights: Any,
+    names: Sequence[str],
+    fps: float = 60.0,
+    *,
+    top: int = 4,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.8),
+) -> Any:
+    """The ``top`` most active blendshapes as curves over time (none that sits at 0), legend right of the data.
+
+    Parameters
+    ----------
+    weights : (T, K) float, values in [0, 1]
+        Blendshape weights.
+    names : sequence of str
+        The K names (legend).
+    fps : float
+        Frame rate of ``weights``, frames per second.
+    top : int
+        How many curves: the blendshapes with the largest standard deviation (:func:`most_active`).
     ax : matplotlib Axes, optional
         Draw into it; a new figure otherwise.
     figsize : (float, float)
@@ -54,49 +173,9 @@ def plot_blendshapes(
     -------
     matplotlib.figure.Figure
     """
-    w = np.asarray(weights, dtype=np.float64)
-    if w.ndim != 2 or w.shape[0] == 0 or w.shape[1] == 0:
-        raise ValueError(f"weights must be a (T, K) array with T, K >= 1, got shape {w.shape}")
-    if not np.all(np.isfinite(w)):
-        raise ValueError(f"weights contains NaN or infinite values (shape {w.shape})")
-    n_frames, k = w.shape
-    if names is not None and len(names) != k:
-        raise ValueError(f"names: {len(names)} names for {k} blendshapes (weights shape {w.shape})")
-    fps = check_fps(fps)
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    if frame is not None and not -n_frames <= int(frame) < n_frames:
-        raise ValueError(f"frame={frame} is out of range for {n_frames} frames")
-    labels = list(names) if names is not None else [str(i) for i in range(k)]
-    with figure_style():
-        if ax is None:
-            import matplotlib.pyplot as plt
+    from beatlite.viz.charts import plot_signals
 
-            fig, ax = plt.subplots(figsize=figsize)
-        else:
-            fig = ax.figure
-        if kind == "heatmap":
-            im = ax.imshow(
-                w.T,
-                aspect="auto",
-                origin="lower",
-                extent=(0.0, n_frames / fps, -0.5, k - 0.5),
-                vmin=0.0,
-                vmax=max(1.0, float(w.max())),
-                cmap="magma",
-                interpolation="nearest",
-            )
-            ax.set_yticks(np.arange(k), labels, fontsize=5 if k > 20 else 8)
-            ax.set_xlabel("time (s)")
-            ax.grid(False)
-            fig.colorbar(im, ax=ax, label="weight", fraction=0.03)
-            if frame is not None:
-                ax.axvline((int(frame) % n_frames) / fps, color="w", lw=1.2)
-        else:
-            f = 0 if frame is None else int(frame) % n_frames
-            ax.bar(np.arange(k), w[f], color="#2e8b57")
-            ax.set_xticks(np.arange(k), labels, rotation=90, fontsize=5 if k > 20 else 8)
-            ax.set_ylim(0, max(1.0, float(w.max())))
-            ax.set_ylabel("weight")
-            ax.set_title(f"blendshapes at t = {f / fps:.2f} s")
-    return fig
+    w = _check_weights(weights, names, "heatmap", None)
+    rows = most_active(w, top)
+    times = np.arange(len(w)) / check_fps(fps)
+    return plot_signals(times, {names[j]: w[:, j] for j in rows}, "weight (0-1)", ax=ax, figsize=figsize)

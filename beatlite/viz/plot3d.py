@@ -19,8 +19,16 @@ from typing import Any
 import numpy as np
 
 from beatlite.skeleton.core import Skeleton
-from beatlite.viz._inputs import GROUPS, Bones, check_fps, check_positions, skeleton_bones, to_plot_coords
-from beatlite.viz.style import GROUP_COLOURS, figure_style
+from beatlite.viz._inputs import (
+    GROUPS,
+    Bones,
+    bone_groups,
+    check_fps,
+    check_positions,
+    checked_sequences,
+    to_plot_coords,
+)
+from beatlite.viz.style import GROUP_COLOURS, figure_style, legend_outside, system_colour
 
 #: Camera angles ``(elev, azim)`` in degrees of the named views (plot axes, see the module docstring).
 VIEWS: Mapping[str, tuple[float, float]] = {"front": (0.0, -90.0), "side": (0.0, 0.0), "top": (90.0, -90.0)}
@@ -56,7 +64,7 @@ class SkeletonArtist:
     ax : mpl_toolkits.mplot3d.Axes3D
         Target axes.
     bones : Bones
-        From :func:`beatlite.viz._inputs.skeleton_bones`.
+        From :func:`beatlite.viz._inputs.bone_groups`.
     colours : mapping group -> colour, optional
         Defaults to :data:`beatlite.viz.style.GROUP_COLOURS`.
     linewidth : float
@@ -108,6 +116,46 @@ class SkeletonArtist:
             self._joint_lines[g].set_data_3d(jp[:, 0], jp[:, 1], jp[:, 2])
 
 
+def half_extents(positions: np.ndarray | Sequence[np.ndarray], margin: float = 5.0) -> np.ndarray:
+    """Half-widths in plot axes that hold every frame: one scale for panels drawn side by side.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) float or a sequence of such arrays, centimetres, Y up
+        Every frame of every panel that must share the scale.
+    margin : float
+        Extra space around the bounding boxes, centimetres.
+
+    Returns
+    -------
+    (3,) float64, centimetres
+        Half-widths along plot x, y (both the larger ground-plane half-width) and
+        z (height). Pass them to :func:`setup_axes` as ``half=`` for every panel: a
+        100 cm arm is then equally long in every panel.
+    """
+    arrays = [positions] if isinstance(positions, np.ndarray) else list(positions)
+    half = np.zeros(3)
+    for a in arrays:
+        pts = to_plot_coords(np.asarray(a, dtype=np.float64).reshape(-1, 3))
+        half = np.maximum(half, (pts.max(axis=0) - pts.min(axis=0)) / 2 + margin)
+    half = np.maximum(half, 1.0)
+    half[:2] = half[:2].max()  # equal scale on the ground plane so turning the camera keeps proportions
+    return half
+
+
+def _draw_floor(ax: Any, centre: np.ndarray, half: np.ndarray, z0: float, n: int = 6) -> None:
+    """A grey n x n grid on the plane plot-z = ``z0`` (the floor), as one line."""
+    xs = np.linspace(centre[0] - half[0], centre[0] + half[0], n)
+    ys = np.linspace(centre[1] - half[1], centre[1] + half[1], n)
+    segs = []
+    for x in xs:
+        segs += [[x, ys[0], z0], [x, ys[-1], z0], [np.nan] * 3]
+    for y in ys:
+        segs += [[xs[0], y, z0], [xs[-1], y, z0], [np.nan] * 3]
+    grid = np.array(segs)
+    ax.plot(grid[:, 0], grid[:, 1], grid[:, 2], "-", color="0.75", lw=0.6, zorder=0)
+
+
 def setup_axes(
     ax: Any,
     positions: np.ndarray | Sequence[np.ndarray],
@@ -116,6 +164,7 @@ def setup_axes(
     floor: bool = True,
     axis_off: bool = True,
     margin: float = 5.0,
+    half: np.ndarray | None = None,
 ) -> None:
     """Fix equal-aspect limits that hold every frame, set the camera and draw a floor grid.
 
@@ -129,17 +178,25 @@ def setup_axes(
         ``"front"``, ``"side"``, ``"top"``, ``"default"`` (three-quarter) or angles in degrees.
     floor : bool
         Draw a grid on the plane ``y = min(y)`` (the lowest joint over all frames).
+        Pass ``bones.has_feet``: a floor under an upper body (no legs) makes its
+        lowest hand look like it rests on the ground.
     axis_off : bool
         Hide panes, ticks and labels.
     margin : float
         Extra space around the bounding box, centimetres.
+    half : (3,) float, optional
+        Half-widths of the box in plot axes, centimetres (:func:`half_extents` of
+        every panel, for one scale across panels; the box is then aligned on the
+        highest joint, so heads line up); default: this axes' own data, centred.
     """
     arrays = [positions] if isinstance(positions, np.ndarray) else list(positions)
     pts = to_plot_coords(np.concatenate([np.asarray(a, dtype=np.float64).reshape(-1, 3) for a in arrays]))
-    lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
-    centre, half = (lo + hi) / 2, np.maximum((hi - lo) / 2, 1.0)
-    # equal scale on the ground plane so turning the camera keeps proportions
-    half[:2] = half[:2].max()
+    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+    if half is None:
+        half = half_extents(arrays, margin)
+    else:  # a shared box: align the tops (heads) of the panels, so an upper body sits where a full body's does
+        half = np.asarray(half, dtype=np.float64)
+        centre[2] = pts[:, 2].max() + margin - half[2]
     ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
     ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
     ax.set_zlim(centre[2] - half[2], centre[2] + half[2])
@@ -149,17 +206,7 @@ def setup_axes(
     if isinstance(view, str) and view in VIEWS:
         ax.set_proj_type("ortho")
     if floor:
-        z0 = lo[2] + margin
-        n = 6
-        xs = np.linspace(centre[0] - half[0], centre[0] + half[0], n)
-        ys = np.linspace(centre[1] - half[1], centre[1] + half[1], n)
-        segs = []
-        for x in xs:
-            segs += [[x, ys[0], z0], [x, ys[-1], z0], [np.nan] * 3]
-        for y in ys:
-            segs += [[xs[0], y, z0], [xs[-1], y, z0], [np.nan] * 3]
-        grid = np.array(segs)
-        ax.plot(grid[:, 0], grid[:, 1], grid[:, 2], "-", color="0.75", lw=0.6, zorder=0)
+        _draw_floor(ax, centre, half, pts[:, 2].min())
     if axis_off:
         ax.set_axis_off()
     else:
@@ -175,7 +222,7 @@ def _new_figure(figsize: tuple[float, float], dpi: float | None) -> Any:
 
 
 def _prepare(positions: Any, skeleton: SkeletonLike, names: Sequence[str] | None) -> tuple[np.ndarray, Bones]:
-    bones = skeleton_bones(skeleton, names)
+    bones = bone_groups(skeleton, names)
     return check_positions(positions, bones.n_joints), bones
 
 
@@ -194,10 +241,10 @@ def plot_frame(
     *,
     ax: Any = None,
     view: str | tuple[float, float] = "default",
-    floor: bool = True,
+    floor: bool | None = None,
     title: str | None = None,
     names: Sequence[str] | None = None,
-    figsize: tuple[float, float] = (4.0, 4.0),
+    figsize: tuple[float, float] = (6.4, 6.4),
     dpi: float | None = None,
 ) -> Any:
     """Draw one frame of a skeleton in 3D: body, hands and head in different colours, over a floor grid.
@@ -214,8 +261,9 @@ def plot_frame(
         Draw into this axes (made with ``projection="3d"``); a new figure otherwise.
     view : str or (elev, azim)
         ``"front"``, ``"side"``, ``"top"``, ``"default"`` or camera angles in degrees.
-    floor : bool
-        Draw the floor grid.
+    floor : bool, optional
+        Draw the floor grid; default only under a skeleton with feet (no floor under
+        an upper body such as HA2G's TED-43).
     title : str, optional
         Axes title.
     names : sequence of str, optional
@@ -234,7 +282,7 @@ def plot_frame(
         if ax is None:
             fig = _new_figure(figsize, dpi)
             ax = fig.add_subplot(projection="3d")
-        setup_axes(ax, pos[k : k + 1], view=view, floor=floor)
+        setup_axes(ax, pos[k : k + 1], view=view, floor=bones.has_feet if floor is None else floor)
         SkeletonArtist(ax, bones).update(pos[k])
         if title:
             ax.set_title(title)
@@ -294,7 +342,7 @@ def plot_filmstrip(
         shown = pos[frames]
         for i, k in enumerate(frames):
             ax = fig.add_subplot(1, len(frames), i + 1, projection="3d")
-            setup_axes(ax, shown, view=view)
+            setup_axes(ax, shown, view=view, floor=bones.has_feet)
             SkeletonArtist(ax, bones, linewidth=1.5, joint_size=1.5).update(pos[k])
             ax.set_title(f"t = {k / rate:.2f} s" if rate else f"frame {k}", fontsize=9)
         fig.subplots_adjust(left=0, right=1, bottom=0, top=0.9, wspace=0)
@@ -340,7 +388,7 @@ def plot_views(
         fig = _new_figure((panel_size * len(views), panel_size), dpi)
         for i, v in enumerate(views):
             ax = fig.add_subplot(1, len(views), i + 1, projection="3d")
-            setup_axes(ax, pos[k : k + 1], view=v, floor=v != "top")
+            setup_axes(ax, pos[k : k + 1], view=v, floor=v != "top" and bones.has_feet)
             SkeletonArtist(ax, bones).update(pos[k])
             ax.set_title(str(v))
         fig.subplots_adjust(left=0, right=1, bottom=0, top=0.9, wspace=0)
@@ -359,6 +407,21 @@ def _default_joints(bones: Bones, names: Sequence[str] | None) -> list[int]:
     return leaves[:5].tolist()
 
 
+def _joint_indices(joints: Sequence[str | int], names: Sequence[str] | None, n_joints: int) -> list[int]:
+    """Joint indices of names (needs ``names``) or of in-range integers."""
+    idx = []
+    for j in joints:
+        if isinstance(j, str):
+            if names is None or j not in names:
+                raise KeyError(f"joints: no joint named {j!r} (pass a Skeleton or names=)")
+            idx.append(list(names).index(j))
+        elif 0 <= int(j) < n_joints:
+            idx.append(int(j))
+        else:
+            raise ValueError(f"joints: index {j} is out of range for {n_joints} joints")
+    return idx
+
+
 def plot_trajectories(
     positions: Any,
     skeleton: SkeletonLike,
@@ -367,7 +430,7 @@ def plot_trajectories(
     frame: int | None = None,
     view: str | tuple[float, float] = "default",
     names: Sequence[str] | None = None,
-    figsize: tuple[float, float] = (5.0, 5.0),
+    figsize: tuple[float, float] = (6.4, 6.4),
     dpi: float | None = None,
 ) -> Any:
     """3D paths of chosen joints over the whole clip, over a faint skeleton at one frame.
@@ -397,28 +460,205 @@ def plot_trajectories(
     pos, bones = _prepare(positions, skeleton, names)
     if isinstance(skeleton, Skeleton):
         names = skeleton.names
-    if joints is None:
-        idx = _default_joints(bones, names)
-    else:
-        idx = []
-        for j in joints:
-            if isinstance(j, str):
-                if names is None or j not in names:
-                    raise KeyError(f"joints: no joint named {j!r} (pass a Skeleton or names=)")
-                idx.append(list(names).index(j))
-            else:
-                if not 0 <= int(j) < bones.n_joints:
-                    raise ValueError(f"joints: index {j} is out of range for {bones.n_joints} joints")
-                idx.append(int(j))
+    idx = _default_joints(bones, names) if joints is None else _joint_indices(joints, names, bones.n_joints)
     k = len(pos) // 2 if frame is None else _check_frame(frame, len(pos))
     with figure_style():
         fig = _new_figure(figsize, dpi)
         ax = fig.add_subplot(projection="3d")
-        setup_axes(ax, pos, view=view)
+        setup_axes(ax, pos, view=view, floor=bones.has_feet)
         SkeletonArtist(ax, bones, alpha=0.35).update(pos[k])
         for j in idx:
             path = to_plot_coords(pos[:, j])
             label = names[j] if names is not None else f"joint {j}"
             ax.plot(path[:, 0], path[:, 1], path[:, 2], lw=1.2, label=label)
-        ax.legend(loc="upper left", fontsize=8)
+        legend_outside(ax, "right")
+    return fig
+
+
+def _keyframe_row(
+    axes: list[Any], pos: np.ndarray, bones: Bones, frames: list[int], view: Any, half: Any
+) -> None:
+    """One system's key frames, one per axes, in the shared box ``half``."""
+    for ax, k in zip(axes, frames):
+        setup_axes(ax, pos[frames], view=view, floor=bones.has_feet, half=half)
+        SkeletonArtist(ax, bones, linewidth=1.5, joint_size=1.5).update(pos[k])
+
+
+def plot_keyframes(
+    systems: Mapping[str, Any],
+    skeletons: SkeletonLike | Sequence[SkeletonLike],
+    frames: Sequence[int],
+    fps: float,
+    *,
+    view: str | tuple[float, float] = "front",
+    panel_size: float = 1.6,
+) -> Any:
+    """Key frames of several systems, one row each, on one scale (HA2G Fig. 2, BEAT Fig. 3b).
+
+    Every panel has the same box size in centimetres (:func:`half_extents` of
+    all rows), so a shorter skeleton (HA2G's TED-43 upper body) looks shorter
+    rather than zoomed in; joint groups have the same colours in every row,
+    the row label the system's colour (:func:`beatlite.viz.style.system_colour`),
+    and a floor is drawn only under skeletons that have feet.
+
+    Parameters
+    ----------
+    systems : mapping label -> (T_i, J_i, 3) float, centimetres, Y up
+        Joint positions of each system at ``fps``, e.g. ``{"ground truth": gt, "CaMN": a, "HA2G": b}``.
+    skeletons : Skeleton or (J,) parents array, or a sequence of them (one per system)
+        Hierarchy of each row (HA2G's TED-43 parents array is recognised by name).
+    frames : sequence of int
+        Frame indices (columns), the same for every row.
+    fps : float
+        Frame rate; columns are titled with the time in seconds.
+    view : str or (elev, azim)
+        Camera of every panel (``"front"``: the character faces us).
+    panel_size : float
+        Width and height of a panel, inches (6 columns x 1.6 in = 9.6 in: 1440 px saved at 150 dpi).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> fig = plot_keyframes({"ground truth": gt, "CaMN": camn}, skeleton, [0, 15, 30], fps=15)  # doctest: +SKIP
+    """
+    labels = list(systems)
+    seqs, bones = checked_sequences(list(systems.values()), skeletons, "systems")
+    frames = [_check_frame(f, min(len(p) for p in seqs), "frames") for f in frames]
+    if not frames:
+        raise ValueError("frames must list at least one frame, got an empty sequence")
+    fps = check_fps(fps)
+    half = half_extents([p[frames] for p in seqs])
+    with figure_style():
+        fig = _new_figure((panel_size * len(frames) + 0.4, panel_size * len(seqs) + 0.3), None)
+        fig.subplots_adjust(
+            left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=1 - 0.3 / fig.get_figheight()
+        )
+        for row, (label, pos, b) in enumerate(zip(labels, seqs, bones)):
+            axes = [fig.add_subplot(len(seqs), len(frames), row * len(frames) + col + 1, projection="3d")
+                    for col in range(len(frames))]  # fmt: skip
+            _keyframe_row(axes, pos, b, frames, view, half)
+            axes[0].text2D(-0.06, 0.5, label, transform=axes[0].transAxes, rotation=90, va="center", ha="right",
+                           color=system_colour(label, row), fontsize=11, fontweight="bold")  # fmt: skip
+        for ax, k in zip(fig.axes, frames):
+            ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
+        fig.subplots_adjust(wspace=0, hspace=0)
+    return fig
+
+
+def _level_panel(
+    ax: Any, pts: np.ndarray, bones: np.ndarray, shown: Sequence[int], new: set[int], box: np.ndarray
+) -> None:
+    """2D bones (``pts`` already projected) inside ``box`` ((2, 2): min, max): new ones thick red, earlier grey."""
+    for b in shown:
+        xy = pts[bones[b]]
+        ax.plot(xy[:, 0], xy[:, 1], "-o", ms=2.5, lw=2.2 if b in new else 1.0,
+                color=GROUP_COLOURS["hands"] if b in new else "0.6")  # fmt: skip
+    if not len(shown):
+        ax.text(0.5, 0.5, "no bones here yet", transform=ax.transAxes, ha="center", va="center", color="0.5")
+    ax.set_xlim(box[0, 0], box[1, 0])
+    ax.set_ylim(box[0, 1], box[1, 1])
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+
+
+def _box(pts: np.ndarray, margin: float = 0.06) -> np.ndarray:
+    """(2, 2) min/max corners of 2D points, with a margin (fraction of the larger side)."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = margin * float(max(hi - lo)) + 1e-6
+    return np.stack([lo - pad, hi + pad])
+
+
+def _subtree(bones: np.ndarray, root: int) -> set[int]:
+    """Indices of the bones below joint ``root`` (its descendants' bones)."""
+    below, found = {root}, set()
+    for _ in range(len(bones)):
+        for b, (p, c) in enumerate(bones):
+            if p in below and b not in found:
+                found.add(b)
+                below.add(int(c))
+    return found
+
+
+def _level_views(pos: np.ndarray, bones: np.ndarray, root: int | None) -> list[tuple[np.ndarray, set[int]]]:
+    """(2D points, bones shown) of each panel row: the body from the front, then the subtree of ``root`` from above."""
+    views = [(pos[:, [0, 1]], set(range(len(bones))))]  # front: x right, y up
+    if root is not None:  # above, around the root joint: x right, +z (forward) down
+        views.append(((pos - pos[root])[:, [0, 2]] * [1, -1], _subtree(bones, root)))
+    return views
+
+
+def _check_bones(bones: Any, n_joints: int) -> np.ndarray:
+    bones = np.asarray(bones, dtype=np.int64).reshape(-1, 2)
+    if bones.size == 0 or bones.min() < 0 or bones.max() >= n_joints:
+        raise ValueError(f"bones must be (B, 2) joint indices below {n_joints}, got shape {bones.shape}")
+    return bones
+
+
+def _levels_title(root: int | None, names: Sequence[str] | None) -> str:
+    title = "bones each level adds (red) to the earlier ones (grey)"
+    if root is None:
+        return title
+    return f"{title}; under each: the bones below {names[root] if names else root}, from above"
+
+
+def plot_bone_levels(
+    positions: Any,
+    bones: Any,
+    levels: Sequence[Sequence[int]],
+    *,
+    names: Sequence[str] | None = None,
+    zoom: str | int | None = None,
+    ncols: int = 3,
+) -> Any:
+    """What each level of a bone hierarchy adds (HA2G's 6 levels, Sec. 3.2): new bones red, earlier ones grey.
+
+    One panel per level: the body from the front; with ``zoom``, a second panel per
+    level shows the bones below that joint (e.g. the right hand) from above,
+    enlarged. Panels are tight around the bones (equal aspect, no empty axes).
+
+    Parameters
+    ----------
+    positions : (J, 3) float, centimetres, Y up
+        One pose (e.g. the rest pose on TED-43).
+    bones : (B, 2) int
+        (parent, child) joint index of each bone.
+    levels : sequence of sequence of int
+        Bone indices of each level (cumulative, like ``beatlite.skeleton.ted.HA2G_LEVELS``).
+    names : sequence of str, optional
+        Joint names (needed when ``zoom`` is a name).
+    zoom : str or int, optional
+        Joint whose subtree gets an enlarged top view (e.g. ``"right_wrist"``).
+    ncols : int
+        Levels per row of the figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    pos = check_positions(positions)[0]
+    bones = _check_bones(bones, len(pos))
+    root = None if zoom is None else _joint_indices([zoom], names, len(pos))[0]
+    views = _level_views(pos, bones, root)
+    boxes = [_box(pts[np.unique(bones[sorted(keep)])]) for pts, keep in views]
+    col_w = 9.6 / ncols
+    heights = [min(col_w * float(np.ptp(b[:, 1]) / np.ptp(b[:, 0])), 1.5) for b in boxes]
+    n_blocks = -(-len(levels) // ncols)
+    with figure_style():
+        fig = _new_figure((9.6, n_blocks * (sum(heights) + 0.35 * len(views)) + 0.5), None)
+        grid = fig.add_gridspec(
+            n_blocks * len(views), ncols, height_ratios=heights * n_blocks, hspace=0.2, wspace=0.05
+        )
+        previous: set[int] = set()
+        for k, level in enumerate(levels):
+            block, col = divmod(k, ncols)
+            for v, ((pts, keep), box) in enumerate(zip(views, boxes)):
+                ax = fig.add_subplot(grid[block * len(views) + v, col])
+                _level_panel(ax, pts, bones, sorted(set(level) & keep), (set(level) - previous) & keep, box)
+                if v == 0:
+                    ax.set_title(f"level {k + 1}: {len(level)} bones, {3 * len(level)} dims", fontsize=10)
+            previous = set(level)
+        fig.suptitle(_levels_title(root, names), fontsize=11)
     return fig

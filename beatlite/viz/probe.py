@@ -116,14 +116,22 @@ def _try_window(window: str | None, timeout: float) -> tuple[bool, str]:
     except OSError as exc:
         return False, f"{name}: could not start the probe ({exc})"
     if proc.returncode != 0:
-        if proc.returncode < 0:
-            what = f"crashed with signal {-proc.returncode} (no usable OpenGL library?)"
-        else:
-            last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
-            what = f"failed with exit code {proc.returncode}: {last[:200]}"
-        return False, f"{name}: {what}"
+        return False, f"{name}: {_exit_reason(proc)}"
+    return _read_answer(proc.stdout, window, name)
+
+
+def _exit_reason(proc: subprocess.CompletedProcess) -> str:
+    """Why the probe child failed: a signal (VTK without OpenGL kills the process) or its last stderr line."""
+    if proc.returncode < 0:
+        return f"crashed with signal {-proc.returncode} (no usable OpenGL library?)"
+    last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
+    return f"failed with exit code {proc.returncode}: {last[:200]}"
+
+
+def _read_answer(stdout: str, window: str | None, name: str) -> tuple[bool, str]:
+    """The probe child's JSON line: a non-blank image from the asked render window, or why not."""
     try:
-        answer = json.loads(proc.stdout.strip().splitlines()[-1])
+        answer = json.loads(stdout.strip().splitlines()[-1])
     except (ValueError, IndexError):
         return False, f"{name}: the probe printed no result"
     if answer.get("std", 0.0) <= 0.0:

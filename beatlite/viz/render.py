@@ -23,11 +23,11 @@ from typing import Any
 import numpy as np
 
 from beatlite.viz._files import atomic_target
-from beatlite.viz._inputs import GROUPS, Bones, check_fps, check_positions, frame_indices, skeleton_bones
+from beatlite.viz._inputs import GROUPS, Bones, bone_groups, check_fps, check_positions, frame_indices
 from beatlite.viz.animation import ffmpeg_available
 from beatlite.viz.plot3d import SkeletonLike
 from beatlite.viz.probe import use_pyvista
-from beatlite.viz.style import GROUP_COLOURS
+from beatlite.viz.style import GROUP_COLOURS, SLIDE_WIDTH_PX
 
 #: Unit vectors from the scene centre to the camera, and the camera's up vector, of the named views.
 CAMERAS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
@@ -90,7 +90,12 @@ class _PyvistaSkeleton:
 
 
 def _scene(
-    positions: np.ndarray, bones: Bones, size: tuple[int, int], view: str, floor: bool, radius: float | None
+    positions: np.ndarray,
+    bones: Bones,
+    size: tuple[int, int],
+    view: str,
+    floor: bool | None,
+    radius: float | None,
 ) -> tuple[Any, _PyvistaSkeleton]:
     import pyvista as pv
 
@@ -100,7 +105,7 @@ def _scene(
     r = radius if radius is not None else max(extent / 120.0, 0.2)
     plotter = pv.Plotter(off_screen=True, window_size=size)
     plotter.set_background("white")
-    if floor:
+    if bones.has_feet if floor is None else floor:
         centre = (lo + hi) / 2
         plane = pv.Plane(
             center=(centre[0], lo[1] - r, centre[2]),
@@ -125,7 +130,12 @@ def _scene(
 
 
 def _mpl_frame_image(
-    positions: np.ndarray, skeleton: SkeletonLike, frame: int, size: tuple[int, int], view: str
+    positions: np.ndarray,
+    skeleton: SkeletonLike,
+    frame: int,
+    size: tuple[int, int],
+    view: str,
+    floor: bool | None,
 ) -> np.ndarray:
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -139,8 +149,9 @@ def _mpl_frame_image(
         fig = Figure(figsize=(w / 100, h / 100), dpi=100)
         canvas = FigureCanvasAgg(fig)
         ax = fig.add_axes((0, 0, 1, 1), projection="3d")
-        setup_axes(ax, positions, view=view)
-        SkeletonArtist(ax, skeleton_bones(skeleton)).update(positions[frame])
+        bones = bone_groups(skeleton)
+        setup_axes(ax, positions, view=view, floor=bones.has_feet if floor is None else floor)
+        SkeletonArtist(ax, bones).update(positions[frame])
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[..., :3].copy()
     return img
@@ -151,9 +162,9 @@ def render_frame(
     skeleton: SkeletonLike,
     frame: int = 0,
     *,
-    size: Sequence[int] = (640, 480),
+    size: Sequence[int] = (SLIDE_WIDTH_PX, 720),
     view: str = "default",
-    floor: bool = True,
+    floor: bool | None = None,
     radius: float | None = None,
     path: str | Path | None = None,
     backend: str = "auto",
@@ -169,11 +180,13 @@ def render_frame(
     frame : int
         Frame to render.
     size : (width, height)
-        Image size in pixels.
+        Image size in pixels (default 960 x 720, slide size).
     view : {"default", "front", "side", "top"}
         Camera.
-    floor : bool
-        Draw a floor plane under the lowest joint.
+    floor : bool, optional
+        Draw a floor plane under the lowest joint; default only for a skeleton with
+        feet (under an upper body the floor would meet the lowest hand, and the
+        side view would look like a figure crawling on the ground).
     radius : float, optional
         Bone tube radius, centimetres (default: 1/120 of the scene size).
     path : str or Path, optional
@@ -186,7 +199,7 @@ def render_frame(
     (height, width, 3) uint8 ndarray
         The RGB image.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     if (
         isinstance(frame, bool)
@@ -203,7 +216,7 @@ def render_frame(
         finally:
             plotter.close()
     else:
-        img = _mpl_frame_image(pos, skeleton, frame, (w, h), view)
+        img = _mpl_frame_image(pos, skeleton, frame, (w, h), view, floor)
     if path is not None:
         from matplotlib.image import imsave
 
@@ -239,9 +252,9 @@ def render_animation(
     *,
     fps: float,
     out_fps: float | None = 15.0,
-    size: Sequence[int] = (480, 480),
+    size: Sequence[int] = (SLIDE_WIDTH_PX, 720),
     view: str = "default",
-    floor: bool = True,
+    floor: bool | None = None,
     radius: float | None = None,
     backend: str = "auto",
 ) -> Path:
@@ -260,11 +273,11 @@ def render_animation(
     out_fps : float or None
         Playback rate; frames are subsampled to it (``None``: all frames).
     size : (width, height)
-        Frame size in pixels.
+        Frame size in pixels (default 960 x 720, slide size).
     view : {"default", "front", "side", "top"}
         Camera (fixed for the whole clip).
-    floor : bool
-        Draw a floor plane.
+    floor : bool, optional
+        Draw a floor plane; default only for a skeleton with feet.
     radius : float, optional
         Bone radius, centimetres.
     backend : {"auto", "pyvista", "matplotlib"}
@@ -275,7 +288,7 @@ def render_animation(
     Path
         ``path``.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     fps = check_fps(fps)
     w, h = _check_size(size)
@@ -293,7 +306,7 @@ def render_animation(
     if not use_pyvista(backend):
         from beatlite.viz.animation import animate_skeletons
 
-        anim = animate_skeletons(pos, skeleton, fps, out_fps=out_fps, view=view, panel_size=w / 100, dpi=100)
+        anim = animate_skeletons(pos, skeleton, fps, out_fps=out_fps, view=view, width=w, dpi=100)
         anim.figure.set_size_inches(w / 100, h / 100)
         return anim.save_as(path)
     plotter, skel = _scene(pos, bones, (w, h), view, floor, radius)
@@ -372,7 +385,7 @@ def show_skeleton(
         static image); outside a notebook the ``(H, W, 3) uint8`` image; a matplotlib
         Figure when pyvista cannot render.
     """
-    bones = skeleton_bones(skeleton)
+    bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     w, h = _check_size(size)
     if not -len(pos) <= int(frame) < len(pos):
@@ -382,7 +395,7 @@ def show_skeleton(
 
         return plot_frame(pos, skeleton, int(frame), view=view, figsize=(w / 100, h / 100))
     k = int(frame) % len(pos)
-    plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, True, None)
+    plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, None, None)
     if not _in_notebook():
         try:
             return np.asarray(plotter.screenshot(return_img=True))[..., :3].copy()

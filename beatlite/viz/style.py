@@ -4,6 +4,21 @@ Nothing here changes matplotlib's global state at import time: apply the style
 for a block of code with :func:`figure_style` (a ``plt.rc_context``), or pass
 :data:`STYLE` to ``plt.rc_context`` yourself.
 
+The style's rules, which every figure function of :mod:`beatlite.viz` and
+:mod:`beatlite.stats` follows:
+
+- **Slide size.** A saved figure is at least :data:`SLIDE_WIDTH_PX` (960) pixels
+  wide: the default figure is 6.4 inches at ``savefig.dpi`` 150; animations are
+  drawn at :data:`SLIDE_WIDTH_PX` wide (:func:`slide_figsize`).
+- **Fonts** readable on a projector: 10-12 pt text, 9 pt ticks and legends.
+- **Legends outside the data**: :func:`legend_outside` puts them right of or
+  above the axes, never over bars or curves.
+- **Units on every axis**: labels read ``"quantity (unit)"``; a count or a
+  score without unit says so (``"score (0-1)"``).
+- **One colour per system** in every figure: :func:`system_colour` (ground truth
+  dark grey, CaMN blue, HA2G orange), and one colour per joint group
+  (:data:`GROUP_COLOURS`) on every skeleton.
+
 Usage (the doctests skip the ``with`` block: it writes files under ``build/``):
 
 >>> import matplotlib.pyplot as plt
@@ -37,6 +52,23 @@ GROUP_COLOURS: Mapping[str, str] = MappingProxyType(
 #: Colours of the compared systems, in the order ground truth, CaMN, HA2G, then extras.
 SYSTEM_COLOURS: tuple[str, ...] = ("#333333", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b")
 
+#: The colour of a system by name (lower case), so that a model keeps its colour in every figure.
+NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
+    {
+        "ground truth": SYSTEM_COLOURS[0],
+        "real": SYSTEM_COLOURS[0],
+        "gt": SYSTEM_COLOURS[0],
+        "camn": SYSTEM_COLOURS[1],
+        "ha2g": SYSTEM_COLOURS[2],
+    }
+)
+
+#: Colours of systems without a named colour (baselines, new models): never grey, blue or orange.
+OTHER_SYSTEM_COLOURS: tuple[str, ...] = ("#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+
+#: Smallest width in pixels of a saved figure, an animation or a GIF ("slide size").
+SLIDE_WIDTH_PX = 960
+
 #: The beatlite rcParams (read-only). Use with ``plt.rc_context(dict(STYLE))`` or :func:`figure_style`.
 STYLE: Mapping[str, Any] = MappingProxyType(
     {
@@ -51,12 +83,13 @@ STYLE: Mapping[str, Any] = MappingProxyType(
         "grid.linewidth": 0.6,
         "axes.spines.top": False,
         "axes.spines.right": False,
-        "axes.titlesize": 11,
-        "axes.labelsize": 10,
+        "axes.titlesize": 12,
+        "axes.labelsize": 11,
         "axes.prop_cycle": cycler(color=list(SYSTEM_COLOURS)),
         "font.size": 10,
         "legend.fontsize": 9,
         "legend.frameon": False,
+        "legend.borderaxespad": 0.3,
         "xtick.labelsize": 9,
         "ytick.labelsize": 9,
         "lines.linewidth": 1.5,
@@ -139,3 +172,76 @@ def save_figure(
             fig.savefig(tmp, format=fmt, **savefig_kwargs)
         written.append(target)
     return written
+
+
+def system_colour(label: str, index: int = 0) -> str:
+    """The colour of a compared system: by name when known (ground truth, CaMN, HA2G), else by position.
+
+    Parameters
+    ----------
+    label : str
+        System name, e.g. ``"CaMN"``, ``"HA2G (ours)"``, ``"ground truth"``; the
+        first word that names a known system decides (case-insensitive).
+    index : int
+        Position of the system in the figure, used for other names:
+        ``OTHER_SYSTEM_COLOURS[index % 6]``, so a baseline never takes the colour of
+        ground truth, CaMN or HA2G.
+
+    Returns
+    -------
+    str
+        A hex colour.
+
+    Examples
+    --------
+    >>> system_colour("CaMN (tiny)"), system_colour("ground truth"), system_colour("mean pose", 1)
+    ('#1f77b4', '#333333', '#9467bd')
+    """
+    low = str(label).lower()
+    for name in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True):
+        if low.startswith(name):
+            return NAMED_SYSTEM_COLOURS[name]
+    return OTHER_SYSTEM_COLOURS[int(index) % len(OTHER_SYSTEM_COLOURS)]
+
+
+def slide_figsize(
+    height_px: float, width_px: float = SLIDE_WIDTH_PX, dpi: float = 100
+) -> tuple[float, float]:
+    """Figure size in inches of a ``width_px`` x ``height_px`` picture at ``dpi`` (animations, GIFs).
+
+    >>> slide_figsize(540)
+    (9.6, 5.4)
+    """
+    return (float(width_px) / dpi, float(height_px) / dpi)
+
+
+def legend_outside(ax: Any, where: str = "right", **kwargs: Any) -> Any:
+    """Draw ``ax``'s legend outside the data area: right of the axes or in a row above it.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        Axes whose labelled artists make the legend.
+    where : {"right", "top"}
+        ``"right"``: one column beside the axes, top aligned; ``"top"``: one row
+        above the axes (below its title), left aligned.
+    **kwargs
+        Passed to ``ax.legend`` (``ncols``, ``title``, ``handles``, ...).
+
+    Returns
+    -------
+    matplotlib.legend.Legend
+        The legend (``None`` when the axes has no labelled artist).
+    """
+    handles, labels = ax.get_legend_handles_labels()
+    if "handles" not in kwargs and not handles:
+        return None
+    if where == "right":
+        place = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0)}
+    elif where == "top":
+        n = len(kwargs.get("handles", handles))
+        place = {"loc": "lower left", "bbox_to_anchor": (0.0, 1.01), "ncols": n}
+    else:
+        raise ValueError(f"where must be 'right' or 'top', got {where!r}")
+    place.update(kwargs)
+    return ax.legend(**place)

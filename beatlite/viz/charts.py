@@ -1,0 +1,415 @@
+"""2D charts for the notebooks' results: training curves, model scores (bars), one score against another.
+
+Each function follows :mod:`beatlite.viz.style`: a y label on every panel, legends
+outside the data, one colour per system (:func:`beatlite.viz.style.system_colour`).
+Taught in notebooks 05 and 06 (training curves) and 07 (benchmark).
+
+>>> fig = plot_training_curves(history, {"reconstruction loss (Huber)": {"train": "train.rec",
+...                                                                        "validation": "val.rec"}})  # doctest: +SKIP
+>>> fig = plot_scores({"CaMN": 1.2, "HA2G": 2.0, "mean pose": 25.0}, "FGD")                  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from beatlite.viz.style import figure_style, legend_outside, system_colour
+
+#: A bar longer than this many times the longest other bar is drawn cut, with its value written.
+OUTLIER_FACTOR = 3.0
+
+
+def _new_axes(ax: Any, figsize: tuple[float, float]) -> Any:
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=figsize, layout="constrained")[1]
+
+
+def history_values(history: Sequence[Mapping[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
+    """Epochs and values of one logged quantity: ``key`` is a dotted path such as ``"val.rec"`` or ``"val_score"``.
+
+    Parameters
+    ----------
+    history : sequence of dict
+        One dict per epoch, with an ``"epoch"`` entry (the training history of
+        :mod:`beatlite.train`).
+    key : str
+        Dotted path into each dict.
+
+    Returns
+    -------
+    (epochs (E,) float64, values (E,) float64)
+        Only the epochs where the quantity was logged (possibly none).
+
+    Examples
+    --------
+    >>> h = [{"epoch": 0, "val": {"rec": 2.0}}, {"epoch": 1, "val": {"rec": 1.5}, "val_score": 9.0}]
+    >>> history_values(h, "val_score")
+    (array([1.]), array([9.]))
+    """
+    epochs, values = [], []
+    for k, entry in enumerate(history):
+        value: Any = entry
+        for part in key.split("."):
+            value = value.get(part) if isinstance(value, Mapping) else None
+        if value is not None:
+            epochs.append(float(entry.get("epoch", k)))
+            values.append(float(value))
+    return np.asarray(epochs), np.asarray(values)
+
+
+def plot_training_curves(
+    history: Sequence[Mapping[str, Any]],
+    panels: Mapping[str, Mapping[str, str]],
+    *,
+    mark_epoch: float | None = None,
+    selected: tuple[float, float] | None = None,
+    title: str | None = None,
+    panel_size: tuple[float, float] = (3.8, 2.9),
+) -> Any:
+    """One panel per quantity over epochs; every panel has its y label, and says so when nothing was logged.
+
+    Parameters
+    ----------
+    history : sequence of dict
+        One dict per epoch (``{"epoch": 3, "train": {"rec": ...}, "val": {...}, "val_score": ...}``).
+    panels : mapping y label -> mapping curve label -> dotted key
+        E.g. ``{"reconstruction loss (Huber)": {"train": "train.rec", "validation": "val.rec"},
+        "validation FGD": {"validation takes": "val_score"}}``. The y label
+        should carry the unit or say what the loss is.
+    mark_epoch : float, optional
+        Draw a dotted vertical line there on every panel (e.g. where the adversarial loss starts).
+    selected : (epoch, value), optional
+        A star on the panel whose curve contains ``val_score`` (the exported epoch).
+    title : str, optional
+        Figure title.
+    panel_size : (float, float)
+        Inches per panel.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    if not panels:
+        raise ValueError("panels must name at least one quantity to plot")
+    with figure_style():
+        fig, axes = plt.subplots(1, len(panels), figsize=(panel_size[0] * len(panels), panel_size[1]),
+                                 layout="constrained", squeeze=False, sharex=True)  # fmt: skip
+        for ax, (ylabel, curves) in zip(axes[0], panels.items()):
+            _draw_curves(ax, history, curves, selected)
+            ax.set_ylabel(ylabel)
+            ax.set_xlabel("epoch")
+            if mark_epoch is not None:
+                ax.axvline(mark_epoch, color="0.6", ls=":", lw=1)
+        if title:
+            fig.suptitle(title)
+    return fig
+
+
+def _draw_curves(
+    ax: Any, history: Sequence[Mapping[str, Any]], curves: Mapping[str, str], selected: Any
+) -> None:
+    """The curves of one panel; a note instead of an empty box when none was logged."""
+    drawn = 0
+    for i, (label, key) in enumerate(curves.items()):
+        epochs, values = history_values(history, key)
+        if len(values):
+            ax.plot(epochs, values, "o-", ms=3, label=label, color=f"C{i}")
+            drawn += 1
+        if key == "val_score" and selected is not None:
+            ax.plot(*selected, "k*", ms=11, label="exported epoch")
+    if drawn:
+        legend_outside(ax, "top", fontsize=8)
+    else:
+        epochs = [float(h.get("epoch", k)) for k, h in enumerate(history)]
+        ax.set_xlim(min(epochs, default=0.0), max(epochs, default=0.0) + 1)
+        ax.text(
+            0.5, 0.5, "not logged in this run", ha="center", va="center", transform=ax.transAxes, color="0.4"
+        )
+
+
+def plot_scores(
+    scores: Mapping[str, float],
+    metric: str,
+    *,
+    lower_is_better: bool = True,
+    ax: Any = None,
+    figsize: tuple[float, float] = (6.4, 3.4),
+) -> Any:
+    """Horizontal bars of one metric per system; an outlier bar is cut so it does not flatten the others.
+
+    A bar longer than :data:`OUTLIER_FACTOR` times the longest other bar (e.g. the
+    mean-pose baseline, FGD 25, beside models near 1) is drawn up to the axis
+    end with a break mark and its value written on it; every bar carries its
+    value. Bars are in the systems' colours, in the order given, first at the top.
+
+    Parameters
+    ----------
+    scores : mapping label -> float
+        The metric of each system (finite, >= 0).
+    metric : str
+        x-axis label, e.g. ``"FGD"``; "(lower is better)" or "(higher is better)" is added.
+    lower_is_better : bool
+        Which direction is better.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    labels = list(scores)
+    values = _check_scores(scores)
+    limit = _axis_limit(values)
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        y = np.arange(len(labels))[::-1]
+        colours = [system_colour(k, i) for i, k in enumerate(labels)]
+        ax.barh(y, np.minimum(values, limit), color=colours)
+        for yi, v in zip(y, values):
+            ax.text(
+                min(v, limit), yi, f" {v:.3g}" + (" (bar cut)" if v > limit else ""), va="center", fontsize=9
+            )
+            if v > limit:  # a white break across the bar
+                ax.plot([limit * 0.88, limit * 0.9], [yi - 0.45, yi + 0.45], color="white", lw=4)
+        ax.set_yticks(y, labels)
+        ax.set_xlim(0, limit * (1.35 if values.max() > limit else 1.12))
+        ax.set_xlabel(f"{metric} ({'lower' if lower_is_better else 'higher'} is better)")
+        ax.grid(axis="y", visible=False)
+    return ax.figure
+
+
+def _check_scores(scores: Mapping[str, float]) -> np.ndarray:
+    """``(S,) float64`` scores, or a ValueError when one is missing, not finite or negative."""
+    values = np.asarray([float(v) for v in scores.values()])
+    if not len(values) or not np.all(np.isfinite(values)) or np.any(values < 0):
+        raise ValueError(f"scores must be finite and >= 0, got {dict(scores)}")
+    return values
+
+
+def _axis_limit(values: np.ndarray) -> float:
+    """x-axis end: the largest value, or 1.3 x the largest non-outlier when one bar dwarfs the rest."""
+    top = float(values.max())
+    rest = np.sort(values)[:-1]
+    if len(rest) and rest.max() > 0 and top > OUTLIER_FACTOR * rest.max():
+        return float(1.3 * rest.max())
+    return top if top > 0 else 1.0
+
+
+def _finite_pair(a: float | None, b: float | None) -> bool:
+    return a is not None and b is not None and bool(np.isfinite(a) and np.isfinite(b))
+
+
+def plot_score_scatter(
+    x: Mapping[str, float],
+    y: Mapping[str, float],
+    xlabel: str,
+    ylabel: str,
+    *,
+    ax: Any = None,
+    figsize: tuple[float, float] = (6.4, 4.0),
+) -> Any:
+    """One point per system (e.g. FGD against BC), labelled in its colour; no label is clipped.
+
+    Labels right of the middle are written to the left of their point, and the
+    axes have a margin, so a label never leaves the axes. Systems missing from
+    ``y`` or with a non-finite value are left out.
+
+    Parameters
+    ----------
+    x, y : mapping label -> float
+        The two scores of each system.
+    xlabel, ylabel : str
+        Axis labels with direction or unit, e.g. ``"FGD (lower is better)"``.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    keep = [k for k in x if _finite_pair(x.get(k), y.get(k))]
+    if not keep:
+        raise ValueError("plot_score_scatter: no system has both scores")
+    xs = np.array([float(x[k]) for k in keep])
+    ys = np.array([float(y[k]) for k in keep])
+    middle = (xs.min() + xs.max()) / 2
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        for label, xi, yi in zip(keep, xs, ys):
+            colour = system_colour(label, list(x).index(label))
+            ax.scatter(xi, yi, color=colour, s=40, zorder=3)
+            left = xi > middle and len(keep) > 1
+            ax.annotate(label, (xi, yi), xytext=(-6 if left else 6, 4), textcoords="offset points",
+                        ha="right" if left else "left", fontsize=9, color=colour)  # fmt: skip
+        ax.margins(x=0.15, y=0.2)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+    return ax.figure
+
+
+def plot_signals(
+    times: Any,
+    signals: Mapping[str, Any],
+    ylabel: str,
+    *,
+    events: Mapping[str, Any] | None = None,
+    markers: Mapping[str, Any] | None = None,
+    xlim: tuple[float, float] | None = None,
+    clip_quantile: float | None = None,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.8),
+) -> Any:
+    """Curves over time (joint angles, wrist speeds, onset strength) with event lines, legend right of the data.
+
+    Parameters
+    ----------
+    times : (T,) float, seconds
+        Common time axis of the signals.
+    signals : mapping label -> (T,) float
+        The curves, in the colours C0, C1, ...
+    ylabel : str
+        y-axis label with its unit, e.g. ``"wrist speed (cm/s)"``.
+    events : mapping label -> (E,) float seconds, optional
+        Times drawn as vertical lines over the whole height (e.g. ``{"audio onsets": onsets}``).
+    markers : mapping curve label -> (M,) float seconds, optional
+        Times marked on that curve with a triangle (e.g. speed minima), in the curve's colour.
+    xlim : (float, float), optional
+        Time range shown, seconds; the y range follows the data inside it.
+    clip_quantile : float in (0, 1], optional
+        Upper y limit = 1.2 x this quantile of the shown values, so that one large
+        swing does not flatten the rest (the cut is written in the corner); ``None``: all data.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> t = np.arange(100) / 15
+    >>> fig = plot_signals(t, {"right wrist": np.abs(np.sin(t))}, "speed (cm/s)", events={"onsets": [1.0, 2.5]})
+    >>> fig.axes[0].get_ylabel()
+    'speed (cm/s)'
+    """
+    t = np.asarray(times, dtype=np.float64).reshape(-1)
+    curves = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in signals.items()}
+    bad = [k for k, v in curves.items() if v.shape != t.shape]
+    if not curves or bad:
+        raise ValueError(
+            f"signals must be (T,) = {t.shape} curves, got {[(k, curves[k].shape) for k in bad]}"
+        )
+    shown = (t >= xlim[0]) & (t <= xlim[1]) if xlim is not None else np.ones(t.shape, bool)
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        for i, (label, y) in enumerate(curves.items()):
+            ax.plot(t, y, lw=1.1, color=f"C{i}", label=label)
+            when = np.asarray((markers or {}).get(label, []), dtype=np.float64)
+            ax.plot(when, np.interp(when, t, y), "v", ms=5, color=f"C{i}", ls="none")
+        _draw_events(ax, events)
+        _set_signal_limits(ax, t, np.stack(list(curves.values()))[:, shown], xlim, clip_quantile)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel(ylabel)
+        legend_outside(ax, "right")
+    return ax.figure
+
+
+def _draw_events(ax: Any, events: Mapping[str, Any] | None) -> None:
+    """Vertical lines at event times, one colour per kind, from the red end of the palette."""
+    for k, (label, when) in enumerate((events or {}).items()):
+        ax.axvline(np.nan, color=f"C{3 + k}", lw=0.9, label=label)  # one legend entry per kind
+        for x in np.asarray(when, dtype=np.float64).reshape(-1):
+            ax.axvline(x, color=f"C{3 + k}", lw=0.9, alpha=0.6)
+
+
+def _set_signal_limits(
+    ax: Any, t: np.ndarray, shown: np.ndarray, xlim: Any, clip_quantile: float | None
+) -> None:
+    """x range as asked; y range from the shown values, optionally cut at a quantile."""
+    ax.set_xlim(*(xlim if xlim is not None else (t.min(), t.max())))
+    if shown.size == 0:
+        return
+    lo, hi = float(shown.min()), float(shown.max())
+    if clip_quantile is not None:
+        if not 0.0 < clip_quantile <= 1.0:
+            raise ValueError(f"clip_quantile must be in (0, 1], got {clip_quantile!r}")
+        cut = 1.2 * float(np.quantile(shown, clip_quantile))
+        if cut < hi:
+            hi = cut
+            ax.text(1.01, 0.0, f"y axis cut at {cut:.3g}:\nhigher peaks run off", transform=ax.transAxes,
+                    ha="left", va="bottom", fontsize=8, color="0.35")  # fmt: skip
+    pad = 0.05 * (hi - lo) if hi > lo else 1.0
+    ax.set_ylim(lo - pad, hi + pad)
+
+
+def plot_waveform(
+    audio: Any,
+    sr: float,
+    *,
+    words: Any = None,
+    onsets: Mapping[str, Any] | None = None,
+    xlim: tuple[float, float] | None = None,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 2.6),
+) -> Any:
+    """A waveform with its amplitude axis, optional words (shaded, written above) and onset lines.
+
+    Parameters
+    ----------
+    audio : (N,) float, in [-1, 1]
+        Mono waveform.
+    sr : float
+        Sample rate, Hz.
+    words : (starts, ends, words) or WordIntervals, optional
+        Word timings in seconds, shaded and written over the waveform's top margin.
+    onsets : mapping label -> (E,) float seconds, optional
+        Event times drawn as vertical lines (e.g. ``{"audio onsets": onsets}``); legend right of the data.
+    xlim : (float, float), optional
+        Time range shown, seconds (default the whole waveform).
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from beatlite.viz._inputs import check_fps, check_words
+
+    y = np.asarray(audio, dtype=np.float64).reshape(-1)
+    if y.size == 0:
+        raise ValueError("audio must be a non-empty (N,) waveform")
+    sr = check_fps(sr, "sr")
+    t = np.arange(len(y)) / sr
+    xlim = xlim if xlim is not None else (0.0, len(y) / sr)
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        ax.plot(t, y, lw=0.4, color="0.4")
+        _draw_events(ax, onsets)
+        peak = max(float(np.abs(y).max()), 1e-6)
+        ax.set_ylim(-1.05 * peak, 1.45 * peak)  # the top margin holds the words
+        if words is not None:
+            for start, end, word in zip(*check_words(words)):
+                if end > xlim[0] and start < xlim[1]:
+                    ax.axvspan(start, end, color="#4c72b0", alpha=0.12, lw=0)
+                    ax.text((start + end) / 2, 1.2 * peak, word, ha="center", va="center", fontsize=8)
+        ax.set_xlim(*xlim)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("amplitude (full scale)")
+        legend_outside(ax, "right")
+    return ax.figure
