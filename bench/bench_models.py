@@ -39,7 +39,7 @@ MODELS = (
 """(recipe name, label) of the timed models."""
 
 
-def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str]:
+def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str, dict]:
     try:
         from beatlite.data.index import index_folder
         from beatlite.data.vocab import build_vocab
@@ -49,16 +49,18 @@ def _train_windows(limit: int | None) -> tuple[dict[str, np.ndarray], int, str]:
         vocab = build_vocab(index)
         w = build_windows(index, split="train", vocab=vocab)
         arrays = {k: w[k] for k in w.keys()}
+        meta = w.normalizers.to_meta()
         source = f"{data_dir().name} train windows"
         n_vocab = len(vocab)
     except (OSError, ValueError) as exc:
         print(f"(no data: {exc}; using fake windows)")
         n_vocab = 200
         arrays = fake_windows(limit or 658, vocab_size=n_vocab)
+        meta = {"pose_mean": np.zeros(141), "pose_std": np.ones(141), "dirvec_mean": np.zeros(126)}
         source = "fake windows"
     if limit is not None:
         arrays = {k: v[:limit] for k, v in arrays.items()}
-    return arrays, n_vocab, source
+    return arrays, n_vocab, source, meta
 
 
 def main() -> None:
@@ -70,7 +72,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     torch.set_num_threads(n_threads())
-    train, vocab, source = _train_windows(args.windows)
+    train, vocab, source, meta = _train_windows(args.windows)
     n = len(train["pose"])
     t = int(args.seconds * 15)
     take = {k: v[0] for k, v in fake_windows(1, n_frames=t, vocab_size=vocab).items()}
@@ -97,7 +99,7 @@ def main() -> None:
             for _ in range(args.repeats):  # the fastest of a few: the least disturbed by the machine
                 config = TrainConfig(epochs=1, batch_size=recipe.batch_size, lr=recipe.lr, progress=False)
                 start = time.perf_counter()
-                fit(model, train, config)
+                fit(model, train, config, meta=meta)
                 times.append(time.perf_counter() - start)
             per_kind[adversarial] = min(times)
         n_adv = max(0, epochs - int(build_model(name, preset="tiny", **kw).config.no_adv_epochs))

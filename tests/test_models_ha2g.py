@@ -10,6 +10,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+from beatlite.data.normalize import Normalizer, Normalizers  # noqa: E402
 from beatlite.models import build_model  # noqa: E402
 from beatlite.models.ha2g import (  # noqa: E402
     ABLATIONS,
@@ -17,7 +18,6 @@ from beatlite.models.ha2g import (  # noqa: E402
     PRESETS,
     HA2GDiscriminator,
     build_ha2g,
-    recover_dirvec_mean,
 )
 from beatlite.models.ha2g_audio import HierarchicalAudioEncoder, StyleCoordinator, blend_audio  # noqa: E402
 from beatlite.models.ha2g_losses import aligned_against_level_ce, style_diverging_loss  # noqa: E402
@@ -48,8 +48,13 @@ def _model(seed: int = 0, **overrides: object) -> HA2G:
     torch.manual_seed(seed)
     model = build_model("ha2g", preset="tiny", **overrides)
     w, mean = _unit_windows(8)
-    model.prepare({**w, "dirvec_mean": mean})
+    model.prepare(w, _norms(mean))
     return model
+
+
+def _norms(mean: np.ndarray) -> Normalizers:
+    """Train-split normalisers whose direction mean is ``mean`` (the pose part is unused by HA2G)."""
+    return Normalizers(Normalizer(np.zeros(141), np.ones(141)), Normalizer(mean, np.ones(126)))
 
 
 # ----------------------------------------------------------------------------- audio learner
@@ -395,23 +400,22 @@ def test_physical_statistics_come_from_prepare() -> None:
     with pytest.raises(RuntimeError, match="prepare"):
         model.losses(batch, model(batch), epoch=0)
     w, mean = _unit_windows(6)
-    model.prepare(w)  # no mean given: recovered from the unit-norm constraint
-    np.testing.assert_allclose(model.mean_dirvec.numpy(), mean, atol=1e-5)
+    with pytest.raises(ValueError, match="Normalizers"):
+        model.prepare(w)  # no guessing the mean: the normalisers travel with the data
+    model.prepare(w, _norms(mean))
+    np.testing.assert_allclose(model.mean_dirvec.numpy(), mean, atol=1e-7)
     assert bool(model.statistics_ready)
     assert model.angle_mean.shape == model.angle_var.shape == (len(model.angle_pairs),)
     assert float(model.angle_var.min()) >= model.config.angle_var_floor
 
 
-def test_prepare_reads_the_mean_from_a_windows_object_and_sets_word_vectors() -> None:
-    class FakeWindows(dict):
-        pass
+def test_fit_passes_the_normalizers_of_its_meta_and_word_vectors_load() -> None:
+    from beatlite.train import TrainConfig, fit
 
     w, mean = _unit_windows(4)
-    obj = FakeWindows(w)
-    obj.dir_norm = type("Norm", (), {"mean": mean})()
     torch.manual_seed(0)
     model = build_model("ha2g", preset="tiny")
-    model.prepare(obj)
+    fit(model, w, TrainConfig(epochs=0, progress=False), meta=_norms(mean).to_meta())
     np.testing.assert_allclose(model.mean_dirvec.numpy(), mean, rtol=0, atol=1e-7)
     vectors = np.random.default_rng(0).standard_normal((1000, 16)).astype(np.float32)
     model.set_word_vectors(vectors)
@@ -419,14 +423,6 @@ def test_prepare_reads_the_mean_from_a_windows_object_and_sets_word_vectors() ->
         np.testing.assert_array_equal(enc.embedding.weight.detach().numpy(), vectors)
     with pytest.raises(ValueError, match="vocab_size, word_dim"):
         model.set_word_vectors(vectors[:, :8])
-
-
-def test_recover_dirvec_mean_round_trip_and_failure() -> None:
-    _, mean = _unit_windows(3, seed=7)
-    w, _ = _unit_windows(3, seed=7)
-    np.testing.assert_allclose(recover_dirvec_mean(w["dirvec"]), mean, atol=1e-5)
-    with pytest.raises(ValueError, match="not mean-subtracted unit vectors"):
-        recover_dirvec_mean(fake_windows(3)["dirvec"])
 
 
 # ----------------------------------------------------------------------------- registry, config, errors
@@ -471,13 +467,12 @@ def test_two_short_runs_with_one_seed_give_identical_losses() -> None:
     from beatlite.train import TrainConfig, fit
 
     w, mean = _unit_windows(12)
-    w["dirvec_mean"] = mean
     histories = []
     for _ in range(2):
         torch.manual_seed(123)
         model = build_model("ha2g", preset="tiny", no_adv_epochs=1)
         cfg = TrainConfig(epochs=2, batch_size=6, seed=3, progress=False, threads=1)
-        histories.append(fit(model, w, cfg).history)
+        histories.append(fit(model, w, cfg, meta=_norms(mean).to_meta()).history)
     assert histories[0] == histories[1]
     assert "adv" in histories[0][1]["train"] and "adv" not in histories[0][0]["train"]
     assert all(np.isfinite(v) for e in histories[0] for v in e["train"].values())

@@ -31,8 +31,9 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
 - ``generate(batch) -> (B, T, D)``: inference seeded only by the first ``n_pre`` frames
   of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
 - ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
-- optional ``prepare(train_windows)``: called once by ``fit`` before training with the
-  numpy window dict (used by the untrained baselines to store a mean pose / clip bank);
+- optional ``prepare(train_windows, normalizers=None)``: called once by ``fit`` before training with the
+  numpy window dict and the train split's ``Normalizers`` (used by the untrained baselines to store a
+  mean pose / clip bank, and by HA2G for its angle statistics);
 - optional classmethod ``keys_for(config)`` when config switches change ``input_keys``.
 
 Adding a model: write the class in its own module, then ``beatlite.models.register_model(name,
@@ -221,8 +222,9 @@ class GestureModel(nn.Module):
         d_ids = set() if self.discriminator is None else {id(p) for p in self.discriminator.parameters()}
         return [p for p in self.parameters() if p.requires_grad and id(p) not in d_ids]
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
-        """Hook called once by ``fit`` with the numpy training windows (default: nothing)."""
+    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
+        """Hook called once by ``fit`` with the numpy training windows and the train split's
+        :class:`~beatlite.data.normalize.Normalizers` (None when unknown) (default: nothing)."""
 
     @property
     def trainable(self) -> bool:

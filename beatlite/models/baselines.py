@@ -101,7 +101,7 @@ class MeanPose(_Untrained):
         super().__init__(config)
         self.register_buffer("mean", torch.zeros(POSE_DIM))
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
         pose = _train_poses(train_windows, "MeanPose")
         self.mean.copy_(
             torch.from_numpy(pose.reshape(-1, POSE_DIM).mean(axis=0, dtype=np.float64).astype(np.float32))
@@ -138,7 +138,7 @@ class RandomClip(_Untrained):
         """Restart the sequence of draws."""
         self._calls = 0
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
         pose = _train_poses(train_windows, "RandomClip")
         cfg = self.config
         if pose.shape[1] < cfg.n_frames:

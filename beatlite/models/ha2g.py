@@ -55,7 +55,6 @@ Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy
 from __future__ import annotations
 
 import dataclasses
-import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -63,6 +62,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.data.normalize import Normalizers
 from beatlite.metrics.consistency import default_angle_pairs
 from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
 from beatlite.models.ha2g_ablations import ABLATIONS
@@ -501,17 +501,22 @@ class HA2G(GestureModel):
                 self.angle_change.copy_(torch.as_tensor(stats.change))
             self.statistics_ready.fill_(True)
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray]) -> None:
+    def prepare(
+        self, train_windows: Mapping[str, np.ndarray], normalizers: Normalizers | None = None
+    ) -> None:
         """Compute the data statistics from the numpy training windows (called by ``fit``).
 
-        The mean direction vector is ``train_windows["dirvec_mean"]`` (126,), a ``dirvec_mean``
-        attribute or ``train_windows.dir_norm.mean``; without any of them it is recovered from
-        the unit-norm constraint (:func:`recover_dirvec_mean`).
+        The mean direction vector the windows were centred with is ``normalizers.dirvec.mean``
+        (the train split's :class:`~beatlite.data.normalize.Normalizers`, which ``fit`` passes).
         """
         if "dirvec" not in train_windows:
             raise KeyError(f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows)})")
-        mean = _find_dirvec_mean(train_windows)
-        self.set_statistics(mean, np.asarray(train_windows["dirvec"]))
+        if normalizers is None:
+            raise ValueError(
+                "HA2G.prepare needs the train split's Normalizers (fit passes Windows.normalizers, or "
+                "meta=normalizers.to_meta()): it adds the mean direction back for its angle statistics"
+            )
+        self.set_statistics(normalizers.dirvec.mean, np.asarray(train_windows["dirvec"]))
 
     def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
         """Copy pretrained word vectors ``(vocab_size, word_dim)`` into every text encoder's embedding."""
@@ -837,71 +842,6 @@ class HA2G(GestureModel):
             "real": -nn.functional.logsigmoid(real).mean().detach(),
             "fake": -nn.functional.logsigmoid(-fake).mean().detach(),
         }
-
-
-def _find_dirvec_mean(windows: Mapping[str, Any]) -> np.ndarray:
-    """The (126,) mean direction vector of ``windows``.
-
-    Looked up as the key ``"dirvec_mean"``, an attribute ``dirvec_mean`` or ``dir_norm.mean``
-    (:class:`beatlite.data.windows.Windows`); otherwise recovered from the windows themselves
-    with :func:`recover_dirvec_mean`. If that fails too (e.g. random test windows that are not
-    shifted unit vectors) a warning is issued and zeros are used.
-    """
-    if "dirvec_mean" in windows:
-        return np.asarray(windows["dirvec_mean"], dtype=np.float64).reshape(-1)
-    for value in (
-        getattr(windows, "dirvec_mean", None),
-        getattr(getattr(windows, "dir_norm", None), "mean", None),
-    ):
-        if value is not None and np.size(value) == 3 * N_BONES:
-            return np.asarray(value, dtype=np.float64).reshape(-1)
-    try:
-        return recover_dirvec_mean(np.asarray(windows["dirvec"]))
-    except ValueError as exc:
-        warnings.warn(f"HA2G.prepare: no dirvec mean given and {exc}; using zeros", stacklevel=3)
-        return np.zeros(3 * N_BONES)
-
-
-def recover_dirvec_mean(dirvec: np.ndarray, *, tol: float = 1e-3, max_frames: int = 20000) -> np.ndarray:
-    """Recover the subtracted mean ``m`` from mean-subtracted unit vectors ``d = u - m``.
-
-    Every frame satisfies ``|d + m|^2 = 1``, i.e. ``2 d.m + |m|^2 = 1 - |d|^2``: linear in
-    ``(m, s = |m|^2)``, solved per bone by least squares over the frames.
-
-    Parameters
-    ----------
-    dirvec : (..., 126) float
-        Mean-subtracted unit direction vectors (e.g. ``windows["dirvec"]``).
-    tol : float
-        Largest accepted ``| |d + m| - 1 |`` over the frames used.
-    max_frames : int
-        Use at most this many frames (evenly spaced).
-
-    Returns
-    -------
-    (126,) float64
-
-    Raises
-    ------
-    ValueError
-        A bone's directions do not span 3-D (ill-posed) or are not shifted unit vectors.
-    """
-    d = np.asarray(dirvec, dtype=np.float64).reshape(-1, N_BONES, 3)
-    if d.shape[0] < 4:
-        raise ValueError(f"need at least 4 frames to recover the dirvec mean, got {d.shape[0]}")
-    d = d[:: max(1, d.shape[0] // max_frames)]
-    mean = np.zeros((N_BONES, 3))
-    for j in range(N_BONES):
-        a = np.concatenate([2.0 * d[:, j], np.ones((d.shape[0], 1))], axis=1)
-        y = 1.0 - (d[:, j] ** 2).sum(axis=1)
-        x, _, rank, _ = np.linalg.lstsq(a, y, rcond=1e-9)
-        if rank < 4:
-            raise ValueError(f"bone {j}'s directions do not vary enough to recover the dirvec mean")
-        err = np.abs(np.linalg.norm(d[:, j] + x[:3], axis=1) - 1.0).max()
-        if err > tol:
-            raise ValueError(f"bone {j}: the windows are not mean-subtracted unit vectors (error {err:.3g})")
-        mean[j] = x[:3]
-    return mean.reshape(-1)
 
 
 def build_ha2g(preset: str = "tiny", ablation: str = "full", **overrides: Any) -> HA2G:

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from beatlite.data.normalize import Normalizers
 from beatlite.models.base import GestureModel
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
 from beatlite.train.config import TrainConfig
@@ -233,7 +234,7 @@ def fit(
     configure_torch(config.seed, config.threads)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
-    model.prepare(data.arrays)
+    model.prepare(data.arrays, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
     if config.resume and run.path is not None and run.path.is_file():
         run.resume()
@@ -253,6 +254,16 @@ def fit(
         bar.set_postfix(_shown_losses(entry))
         run.save(epoch + 1)
     return run.result()
+
+
+def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers | None:
+    """The train split's normalisers: the windows' own (a ``Windows``), else the ones in ``meta``."""
+    norms = getattr(windows, "normalizers", None)
+    if isinstance(norms, Normalizers):
+        return norms
+    if meta and all(k in meta for k in ("pose_mean", "pose_std", "dirvec_mean")):
+        return Normalizers.from_meta(meta)
+    return None
 
 
 def _shown_losses(entry: dict[str, Any]) -> dict[str, str]:
