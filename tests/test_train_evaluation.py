@@ -312,3 +312,30 @@ def test_fgd_scorer_equals_the_fgd_column(test_set, results):
     mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
     score = fgd_scorer(takes=test_set, extractor=_features)
     assert score(mean_pose) == pytest.approx(results.value("Mean pose", "FGD"), rel=1e-9)
+
+
+@pytest.mark.slow
+def test_ha2g_code_protocol_is_seeded_and_differs_from_the_deterministic_one():
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train.evaluation import SampledProtocol, load_test_set
+
+    if not (checkpoints_dir() / "ha2g_tiny.pt").is_file():
+        pytest.skip("no shipped ha2g_tiny checkpoint")
+    from beatlite.data.normalize import Normalizers
+    from beatlite.train.checkpoint import load_model
+
+    test = load_test_set()
+    model, data = load_model("ha2g_tiny")
+    norms = Normalizers.from_meta(data["meta"])
+    columns = ("FGD", "BC (ha2g)", "Diversity")
+    entries = [
+        ("sampled", SampledProtocol(model, test.train_speakers, seed=0), norms),
+        ("sampled again", SampledProtocol(model, test.train_speakers, seed=0), norms),
+        ("deterministic", model, norms),
+    ]
+    res = evaluate_models(entries, test=test, ground_truth=False, columns=columns)
+    assert res.columns == columns and "BC (ha2g)" in res.to_markdown()
+    assert res.get("sampled").metrics == res.get("sampled again").metrics  # one seed, one table
+    assert res.get("sampled").metrics["FGD"] != res.get("deterministic").metrics["FGD"]
+    with pytest.raises(ValueError, match="training speakers"):
+        SampledProtocol(model, ())

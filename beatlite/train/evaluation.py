@@ -123,7 +123,7 @@ class ModelResults:
         return self.get(row).metrics[metric]
 
     def to_markdown(self, *, caption: bool = True) -> str:
-        """A Markdown table: one row per model, the metrics of :data:`COLUMNS`, generation seconds.
+        """A Markdown table: one row per model, the metrics of :attr:`columns`, generation seconds.
 
         With ``caption`` the variant and parameters of every column follow the table.
         """
@@ -132,18 +132,25 @@ class ModelResults:
         rows = []
         for row in self.rows:
             cells = [row.label + (" †" if row.stale else "")]
-            cells += [fmt_metric(row.metrics.get(key, math.nan), key) for key in COLUMNS]
+            cells += [fmt_metric(row.metrics.get(key, math.nan), key) for key in self.columns]
             cells.append(f"{row.seconds:.2f}" if row.representation != "ground_truth" else "")
             rows.append(cells)
-        text = markdown_table(["method", *column_headers(COLUMNS), "gen. s"], rows)
+        text = markdown_table(["method", *column_headers(self.columns), "gen. s"], rows)
         if any(row.stale for row in self.rows):
             text += "\n\n† trained on another version of the data than the one evaluated: retrain it."
-        return text + ("\n\n" + describe(COLUMNS) if caption else "")
+        return text + ("\n\n" + describe(self.columns) if caption else "")
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The metric keys of the table, in order (:data:`COLUMNS` unless chosen otherwise)."""
+        return tuple(self.info.get("columns", COLUMNS))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly dict: ``{"columns", "rows": [...], "info"}`` (NaN written as None)."""
         return {
-            "columns": [{"name": key, "higher_is_better": METRICS[key].higher_is_better} for key in COLUMNS],
+            "columns": [
+                {"name": key, "higher_is_better": METRICS[key].higher_is_better} for key in self.columns
+            ],
             "rows": [
                 {
                     **dataclasses.asdict(r),
@@ -202,6 +209,8 @@ class EvaluationSet:
     fingerprint : str
         :func:`beatlite.train.data_fingerprint` of the train windows ("" = unknown): checkpoints
         trained on other data are flagged as stale.
+    train_speakers : tuple of int
+        Speaker indices of the train windows (HA2G's sampled protocol draws from them).
     """
 
     takes: list[str]
@@ -217,6 +226,7 @@ class EvaluationSet:
     split: str = "test"
     audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
     fingerprint: str = ""
+    train_speakers: tuple[int, ...] = ()
 
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
@@ -335,6 +345,7 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=data_fingerprint(train),
+        train_speakers=tuple(int(s) for s in np.unique(train["speaker"])),
     )
     test.beats()
     return test
@@ -396,6 +407,37 @@ def _generate(
         euler = [norms.inverse_transform(p, "euler141") for p in poses]
         return [euler_to_directions(e) for e in euler], euler
     return [norms.inverse_transform(p, "dirvec126") for p in poses], None
+
+
+class SampledProtocol:
+    """HA2G's evaluation-code protocol, as a model the tables can score.
+
+    HA2G's code scores generated clips with a style code *sampled* for a *random training speaker*
+    (``HA2G.generate(..., protocol="sampled")``); beatlite's tables use z = mu and the take's own speaker.
+    Pass ``(label, SampledProtocol(model, test.train_speakers, seed), normalizers)`` to
+    :func:`evaluate_models`, with ``columns=("FGD", "BC (ha2g)", "Diversity")`` for HA2G's columns
+    (BC on 34-frame clips). Every evaluation restarts the draws from ``seed`` (same numbers each time).
+    """
+
+    def __init__(self, model: Any, speakers: Sequence[int], seed: int = 0) -> None:
+        import torch
+
+        if not speakers:
+            raise ValueError("SampledProtocol needs the training speakers (EvaluationSet.train_speakers)")
+        self.model, self.speakers, self.seed = model, tuple(int(s) for s in speakers), int(seed)
+        self.generator = torch.Generator().manual_seed(self.seed)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.model, name)
+
+    def reset(self) -> None:
+        """Restart the draws (called before every evaluation)."""
+        self.generator.manual_seed(self.seed)
+
+    def generate(self, batch: Any) -> Any:
+        return self.model.generate(
+            batch, protocol="sampled", speakers=self.speakers, generator=self.generator
+        )
 
 
 def _in_units(stream: dict[str, Any], have: Normalizers, want: Normalizers) -> dict[str, Any]:
@@ -538,8 +580,8 @@ def evaluate_models(
     extractor: Any = None,
     ground_truth: bool = True,
     seed: int = 0,
-    threads: int | None = None,
     progress: bool = False,
+    columns: Sequence[str] = COLUMNS,
 ) -> ModelResults:
     """Generate every test take with each model and score all of them in the TED-43 space.
 
@@ -559,10 +601,11 @@ def evaluate_models(
         Add the two ground-truth rows first.
     seed : int
         Seed of the Diversity pairing.
-    threads : int, optional
-        Torch threads (default :func:`beatlite.paths.n_threads`).
     progress : bool
         Print one line per row.
+    columns : sequence of str
+        Metric keys of :data:`beatlite.metrics.scoring.METRICS` to score (default :data:`COLUMNS`; e.g.
+        the reference variants ``"SRGR (reference)"``, ``"BC (ha2g)"`` for a like-for-like table).
 
     Returns
     -------
@@ -574,7 +617,7 @@ def evaluate_models(
     from beatlite.paths import n_threads
 
     start = time.perf_counter()
-    torch.set_num_threads(threads if threads is not None else n_threads())
+    torch.set_num_threads(n_threads())
     entries = _as_entries(models)
     test = load_test_set() if test is None else test
     extractor = load_extractor("dirvec") if extractor is None else extractor
@@ -582,10 +625,12 @@ def evaluate_models(
     rows: list[ResultRow] = []
     if ground_truth:
         for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):
-            metrics = score_directions(dirs, test, extractor, truth, euler=test.gt_euler, seed=seed)
+            metrics = score_directions(
+                dirs, test, extractor, truth, euler=test.gt_euler, columns=columns, seed=seed
+            )
             rows.append(ResultRow(label, "ground_truth", "ground_truth", metrics))
     for label, source, model, norms in entries:
-        rows.append(_model_row(label, source, model, norms, test, extractor, truth, seed))
+        rows.append(_model_row(label, source, model, norms, test, extractor, truth, (columns, seed)))
         if progress:
             values = ", ".join(f"{k} {v:.4g}" for k, v in rows[-1].metrics.items())
             print(f"{label}: {values} ({rows[-1].seconds:.1f} s)", flush=True)
@@ -597,7 +642,7 @@ def evaluate_models(
         "fps": FPS,
         "extractor": str(getattr(extractor, "meta", {}).get("path", type(extractor).__name__)),
         "common_space": "TED-43 unit bone directions; positions from BEAT rest-pose bone lengths, root at origin",
-        "columns": {key: METRICS[key].describe for key in COLUMNS},
+        "columns": {key: METRICS[key].describe for key in columns},
         "data_fingerprint": test.fingerprint,
         "seconds": round(time.perf_counter() - start, 2),
     }
@@ -612,9 +657,9 @@ def _model_row(
     test: EvaluationSet,
     extractor: Any,
     truth: GroundTruth,
-    seed: int,
+    scoring: tuple[Sequence[str], int],
 ) -> ResultRow:
-    """Load (when ``model`` is None), generate and score one model's row."""
+    """Load (when ``model`` is None), generate and score one model's row (``scoring``: columns, seed)."""
     import torch
 
     fingerprint, stale = "", False
@@ -624,7 +669,8 @@ def _model_row(
     with torch.no_grad():
         dirs, euler = _generate(model, test, norms)
     seconds = time.perf_counter() - t0
-    metrics = score_directions(dirs, test, extractor, truth, euler=euler, seed=seed)
+    columns, seed = scoring
+    metrics = score_directions(dirs, test, extractor, truth, euler=euler, columns=columns, seed=seed)
     return ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale)
 
 
