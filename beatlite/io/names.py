@@ -101,40 +101,46 @@ def split_of(speaker_id: int, conversation: bool, sequence: int, half: str | Non
         ``"none"`` for a sequence no split table lists.
     """
     if speaker_id in FOUR_HOUR_SPEAKERS:
-        if conversation:
-            return (
-                "test"
-                if sequence == 1
-                else "val"
-                if sequence == 12
-                else "train"
-                if 2 <= sequence <= 11
-                else "none"
-            )
-        if 1 <= sequence <= 8:
-            return "test"
-        if 9 <= sequence <= 56:
-            return "train"
-        if 57 <= sequence <= 64:
-            return "val"
-        for first, last, _ in _EMOTION_BLOCKS:
-            if sequence == first:
-                return "test"
-            if sequence == last:
-                return "val"
-            if first < sequence < last:
-                return "train"
-        return "none"
-    # 1-hour speakers
-    split_sequences = {first for first, _, _ in _EMOTION_BLOCKS}
+        return _four_hour_conversation(sequence) if conversation else _four_hour_speech(sequence)
+    halves = {"a": "test", "b": "val"}.get(half or "", "test+val")  # a 1-hour speaker's cut sequence
     if conversation:
-        if sequence == 1:
-            return {"a": "test", "b": "val"}.get(half or "", "test+val")
-        if 2 <= sequence <= 3 or (speaker_id == 29 and sequence in (0, 4)):
+        return _one_hour_conversation(speaker_id, sequence, halves)
+    return _one_hour_speech(sequence, halves)
+
+
+def _four_hour_conversation(sequence: int) -> str:
+    if sequence == 1:
+        return "test"
+    if sequence == 12:
+        return "val"
+    return "train" if 2 <= sequence <= 11 else "none"
+
+
+def _four_hour_speech(sequence: int) -> str:
+    for first, last, split in ((1, 8, "test"), (9, 56, "train"), (57, 64, "val")):
+        if first <= sequence <= last:
+            return split
+    for first, last, _ in _EMOTION_BLOCKS:
+        if sequence == first:
+            return "test"
+        if sequence == last:
+            return "val"
+        if first < sequence < last:
             return "train"
-        return "none"
-    if sequence in split_sequences:
-        return {"a": "test", "b": "val"}.get(half or "", "test+val")
+    return "none"
+
+
+def _one_hour_conversation(speaker_id: int, sequence: int, halves: str) -> str:
+    if sequence == 1:
+        return halves
+    if 2 <= sequence <= 3 or (speaker_id == 29 and sequence in (0, 4)):
+        return "train"
+    return "none"
+
+
+def _one_hour_speech(sequence: int, halves: str) -> str:
+    if sequence in {first for first, _, _ in _EMOTION_BLOCKS}:
+        return halves
     if 1 <= sequence <= 4:
         return "test"
     if 5 <= sequence <= 8:

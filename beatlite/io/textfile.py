@@ -189,6 +189,23 @@ def resolve(path_or_stem: str | os.PathLike[str], ext: str) -> Path:
     raise FileNotFoundError(f"no file {tried[0]} or {tried[1]}")
 
 
+#: File signatures (magic bytes) -> what :func:`describe_bytes` calls them, checked in order.
+_MAGIC: tuple[tuple[bytes, str | object], ...] = (
+    (
+        b"RIFF",
+        lambda head: "a RIFF/WAVE file" if head[8:12] == b"WAVE" else f"a RIFF file of type {head[8:12]!r}",
+    ),
+    (b"RF64", "an RF64 WAVE file"),
+    (b"fLaC", "FLAC audio"),
+    (b"OggS", "an Ogg file"),
+    (GZIP_MAGIC, "gzip-compressed data"),
+    (b"PK\x03\x04", "a ZIP archive"),
+    (b"\x89PNG", "a PNG image"),
+    (b"\xff\xd8\xff", "a JPEG image"),
+    (b"%PDF", "a PDF document"),
+)
+
+
 def describe_bytes(head: bytes) -> str:
     """A short human description of what the first bytes of a file look like.
 
@@ -204,28 +221,11 @@ def describe_bytes(head: bytes) -> str:
         return f"{bom.upper()} text"
     if head.startswith(b"ID3") or (len(head) > 1 and head[0] == 0xFF and head[1] & 0xE0 == 0xE0):
         return "MP3 audio"
-    if head.startswith(b"RIFF") and head[8:12] == b"WAVE":
-        return "a RIFF/WAVE file"
-    if head.startswith(b"RIFF"):
-        return f"a RIFF file of type {head[8:12]!r}"
-    if head.startswith(b"RF64"):
-        return "an RF64 WAVE file"
-    if head.startswith(b"fLaC"):
-        return "FLAC audio"
-    if head.startswith(b"OggS"):
-        return "an Ogg file"
+    for magic, name in _MAGIC:
+        if head.startswith(magic):
+            return name(head) if callable(name) else name
     if head[4:8] == b"ftyp":
         return "an MP4/M4A file"
-    if head.startswith(GZIP_MAGIC):
-        return "gzip-compressed data"
-    if head.startswith(b"PK\x03\x04"):
-        return "a ZIP archive"
-    if head.startswith(b"\x89PNG"):
-        return "a PNG image"
-    if head.startswith(b"\xff\xd8\xff"):
-        return "a JPEG image"
-    if head.startswith(b"%PDF"):
-        return "a PDF document"
     low = stripped[:256].lower()
     if low.startswith((b"<!doctype html", b"<html")) or b"<html" in low:
         return "an HTML page (a download that returned a web page?)"

@@ -390,55 +390,65 @@ class HA2G(GestureModel):
             raise ValueError("the last body level must hold all 42 bones")
         self.n_levels = len(levels)
         self.level_dims: tuple[int, ...] = tuple(3 * len(lv) for lv in levels)
+        self._level_columns(levels)
+        # the modules are built in this order (it fixes the initial weights of a seed)
+        self._audio_modules(c)
+        self._style_modules(c)
+        self._text_modules(c)
+        text_features = c.text_features if c.use_text else 0
+        width = 1 + c.audio_features + text_features + c.z_dim
+        self.generators = nn.ModuleList(
+            [LevelGenerator(d + width, d, c.hidden, c.n_layers, c.dropout, c.slope) for d in self.level_dims]
+        )
+        if c.adversarial:
+            self.discriminator = HA2GDiscriminator(3 * N_BONES, c.d_hidden, c.d_layers, c.n_frames, c.slope)
+        self._statistic_buffers(c)
+
+    def _level_columns(self, levels: list[np.ndarray]) -> None:
+        """Buffers ``_cols{k}`` (level k's columns) and ``_dst{k}``/``_src{k}`` (channels shared with level k-1)."""
         for k, lv in enumerate(levels):
             self.register_buffer(f"_cols{k}", torch.as_tensor(_bone_columns(lv)), persistent=False)
-            if k:
-                prev = {int(b): i for i, b in enumerate(levels[k - 1])}
-                dst = [i for i, b in enumerate(lv) if int(b) in prev]
-                src = [prev[int(lv[i])] for i in dst]
-                self.register_buffer(
-                    f"_dst{k}",
-                    torch.as_tensor(_bone_columns(np.asarray(dst, dtype=np.int64))),
-                    persistent=False,
-                )
-                self.register_buffer(
-                    f"_src{k}",
-                    torch.as_tensor(_bone_columns(np.asarray(src, dtype=np.int64))),
-                    persistent=False,
-                )
+            if not k:
+                continue
+            prev = {int(b): i for i, b in enumerate(levels[k - 1])}
+            dst = [i for i, b in enumerate(lv) if int(b) in prev]
+            src = [prev[int(lv[i])] for i in dst]
+            for name, index in ((f"_dst{k}", dst), (f"_src{k}", src)):
+                columns = torch.as_tensor(_bone_columns(np.asarray(index, dtype=np.int64)))
+                self.register_buffer(name, columns, persistent=False)
 
-        # audio: which levels must be computed
+    def _audio_modules(self, c: HA2GConfig) -> None:
+        """The hierarchical audio learner (only the levels used) and the style coordinator."""
         needed = set(AUDIO_LEVELS) if c.audio_mode == "blend" else {c.audio_mode}
         if c.use_contrastive:
             needed |= {"low", "high"}
         self.audio = HierarchicalAudioEncoder(
-            c.audio_channels,
-            c.audio_blocks,
-            c.se_reduction,
-            c.audio_features,
-            sorted(needed),
-            c.n_frames,
+            c.audio_channels, c.audio_blocks, c.se_reduction, c.audio_features, sorted(needed), c.n_frames,
             c.audio_freq_stride,
-        )
-        n_columns = 1 if c.same_audio else self.n_levels
+        )  # fmt: skip
         self.coordinator: StyleCoordinator | None = None
         if c.audio_mode == "blend":
-            self.coordinator = StyleCoordinator(c.z_dim, c.style_hidden, n_columns)
+            self.coordinator = StyleCoordinator(c.z_dim, c.style_hidden, 1 if c.same_audio else self.n_levels)
+
+    def _style_modules(self, c: HA2GConfig) -> None:
+        """``style="shared"``: one sampled style for everything; ``"reference"``: the coordinator's own
+        speaker embedding and one style code per level."""
         if c.style == "shared":
-            # one style for everything: Embedding -> Linear -> LReLU -> (mu, logvar)
             self.speaker_embedding = nn.Sequential(
                 nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim), nn.LeakyReLU(c.slope)
             )
             self.speaker_mu = nn.Linear(c.z_dim, c.z_dim)
             self.speaker_logvar = nn.Linear(c.z_dim, c.z_dim)
-        else:
-            # reference: the coordinator's own speaker embedding, one style code per level
-            self.coordinator_embedding = (
-                nn.Sequential(nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim))
-                if self.coordinator is not None
-                else None
-            )
-            self.level_styles = nn.ModuleList([SpeakerStyle(c.n_speakers, c.z_dim) for _ in levels])
+            return
+        self.coordinator_embedding = (
+            nn.Sequential(nn.Embedding(c.n_speakers, c.z_dim), nn.Linear(c.z_dim, c.z_dim))
+            if self.coordinator is not None
+            else None
+        )
+        self.level_styles = nn.ModuleList([SpeakerStyle(c.n_speakers, c.z_dim) for _ in range(self.n_levels)])
+
+    def _text_modules(self, c: HA2GConfig) -> None:
+        """The text encoders (one per level or one shared) and the contrastive loss's own."""
 
         def text_encoder() -> TextEncoderTCN:
             return TextEncoderTCN(
@@ -448,24 +458,9 @@ class HA2G(GestureModel):
         n_text = (self.n_levels if c.text_per_level else 1) if c.use_text else 0
         self.text_encoders = nn.ModuleList([text_encoder() for _ in range(n_text)])
         self.contrastive_text = text_encoder() if c.use_contrastive else None
-        text_features = c.text_features if c.use_text else 0
-        self.generators = nn.ModuleList(
-            [
-                LevelGenerator(
-                    d + 1 + c.audio_features + text_features + c.z_dim,
-                    d,
-                    c.hidden,
-                    c.n_layers,
-                    c.dropout,
-                    c.slope,
-                )
-                for d in self.level_dims
-            ]
-        )
-        if c.adversarial:
-            self.discriminator = HA2GDiscriminator(3 * N_BONES, c.d_hidden, c.d_layers, c.n_frames, c.slope)
 
-        # data statistics (set by prepare / set_statistics; saved in the state dict)
+    def _statistic_buffers(self, c: HA2GConfig) -> None:
+        """Data statistics (set by prepare / set_statistics; saved in the state dict)."""
         pairs = default_angle_pairs() if c.use_physical else np.zeros((0, 2), dtype=np.int64)
         self.register_buffer("angle_pairs", torch.as_tensor(pairs), persistent=False)
         self.register_buffer("mean_dirvec", torch.zeros(3 * N_BONES))
