@@ -1,6 +1,8 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
 ``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume]`` trains one recipe
+(the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
+batch split over them, gradients summed with ``torch.distributed``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
 float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
 are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
@@ -126,17 +128,23 @@ def _fit_command(args: argparse.Namespace) -> int:
 
     from beatlite.paths import repo_root
     from beatlite.train.recipes import retrain, training_data
+    from beatlite.train.training import distributed_rank
 
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
     os.environ.setdefault("BEATLITE_BUILD", str(out / "build"))  # window caches under --out too
     extractor = None
+    rank, world = distributed_rank()  # under torchrun: process 0 trains the extractor, the others wait
     if data_dir != (repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
-        if not extractor.is_file():
+        if not extractor.is_file() and rank == 0:
             print(f"training the FGD extractor on {data_dir} -> {extractor}", flush=True)
             cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", "dirvec"]
             subprocess.run([*cmd, "--data", str(data_dir), "--out", str(extractor)], check=True)
+    if world > 1:
+        import torch.distributed as dist
+
+        dist.barrier()
     seconds = retrain(
         args.recipe,
         seed=args.seed,
@@ -147,7 +155,8 @@ def _fit_command(args: argparse.Namespace) -> int:
         device=args.device,
         extractor=extractor,
     )
-    print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
+    if rank == 0:
+        print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
     return 0
 
 

@@ -58,6 +58,12 @@ class TrainConfig:
     amp : bool
         Mixed precision (bfloat16 autocast) for the forward pass and losses on CUDA; ignored on the
         CPU, where training stays float32 and bitwise deterministic.
+    micro_batches : int
+        Split every batch into this many micro-batches whose gradients are averaged before the step
+        (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
+        batch is split into ``max(micro_batches, K)`` parts spread over the processes, so K processes
+        and one process with ``micro_batches=K`` take the same steps (BatchNorm statistics are per
+        micro-batch in both).
     """
 
     epochs: int = 30
@@ -76,6 +82,7 @@ class TrainConfig:
     progress: bool = True
     device: str = "cpu"
     amp: bool = False
+    micro_batches: int = 1
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -90,6 +97,8 @@ class TrainConfig:
             )
         if self.windows_per_epoch is not None and self.windows_per_epoch < 2:
             raise ValueError(f"TrainConfig: windows_per_epoch must be >= 2, got {self.windows_per_epoch}")
+        if self.micro_batches < 1:
+            raise ValueError(f"TrainConfig: micro_batches must be >= 1, got {self.micro_batches}")
         if self.threads is not None and self.threads < 1:
             raise ValueError(f"TrainConfig: threads must be >= 1, got {self.threads}")
         self.betas = (float(self.betas[0]), float(self.betas[1]))

@@ -292,7 +292,7 @@ def retrain(
     from beatlite.paths import build_dir, checkpoints_dir
     from beatlite.train.checkpoint import export_checkpoint
     from beatlite.train.config import TrainConfig
-    from beatlite.train.training import fit
+    from beatlite.train.training import distributed_rank, fit
 
     recipe = _recipe(name)
     data = training_data() if data is None else data
@@ -322,7 +322,8 @@ def retrain(
     start = time.perf_counter()
     fit(model, data.train, config, data.val, meta=data.meta, val_score=score)
     seconds = time.perf_counter() - start
-    export_checkpoint(full, export)
+    if distributed_rank()[0] == 0:  # under torchrun, process 0 writes
+        export_checkpoint(full, export)
     return seconds
 
 

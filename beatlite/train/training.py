@@ -140,6 +140,10 @@ def configure_torch(seed: int, threads: int | None) -> None:
     """Seed torch, force deterministic algorithms and set the CPU thread count."""
     from beatlite.paths import n_threads
 
+    import os
+
+    # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
+    os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
     torch.manual_seed(seed)
     torch.use_deterministic_algorithms(True)
     torch.set_num_threads(threads if threads is not None else n_threads())
@@ -241,19 +245,59 @@ def fit(
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
         return run.result()
-    bar = progress(
-        range(run.start_epoch, config.epochs), disable=not config.progress, desc=model.name, unit="epoch"
-    )
+    show = config.progress and run.rank == 0  # under torchrun, process 0 logs, scores and saves
+    bar = progress(range(run.start_epoch, config.epochs), disable=not show, desc=model.name, unit="epoch")
     for epoch in bar:
         entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch), "val": {}}
-        if val_windows is not None:
+        if val_windows is not None and run.rank == 0:
             entry["val"] = evaluate_losses(model, val_windows, epoch=epoch, batch_size=config.batch_size)
-        if val_score is not None:
+        if val_score is not None and run.rank == 0:
             run.score(epoch, val_score, entry)
         run.history.append(entry)
         bar.set_postfix(_shown_losses(entry))
         run.save(epoch + 1)
     return run.result()
+
+
+def distributed_rank() -> tuple[int, int]:
+    """``(rank, world size)`` of this process: ``(0, 1)`` unless started by ``torchrun`` with 2+ processes.
+
+    Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
+    ``nccl`` backend when CUDA is available and ``gloo`` (CPU) otherwise.
+    """
+    import os
+
+    import torch.distributed as dist
+
+    if int(os.environ.get("WORLD_SIZE", "1")) < 2 or not dist.is_available():
+        return 0, 1
+    if not dist.is_initialized():
+        dist.init_process_group(backend="nccl" if torch.cuda.is_available() else "gloo")
+    return dist.get_rank(), dist.get_world_size()
+
+
+def _sum_gradients(params: Any, world: int) -> None:
+    """Sum every parameter's gradient over the processes (each already divided by the micro-batch count)."""
+    if world < 2:
+        return
+    import torch.distributed as dist
+
+    for p in params:
+        if p.grad is None:
+            p.grad = torch.zeros_like(p)
+        dist.all_reduce(p.grad, op=dist.ReduceOp.SUM)
+
+
+def _sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
+    """The loss sums of all processes (every process has the same keys)."""
+    if world < 2:
+        return sums
+    import torch.distributed as dist
+
+    keys = sorted(sums)
+    values = torch.tensor([sums[k] for k in keys], dtype=torch.float64)
+    dist.all_reduce(values, op=dist.ReduceOp.SUM)
+    return dict(zip(keys, values.tolist(), strict=True))
 
 
 def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers | None:
@@ -299,8 +343,14 @@ class _Run:
         self, model: GestureModel, config: TrainConfig, fingerprint: str, meta: dict[str, Any]
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
+        self.rank, self.world = distributed_rank()
         self.device = config.torch_device()
         model.to(self.device)
+        if self.world > 1:  # every process starts from process 0's weights
+            import torch.distributed as dist
+
+            for tensor in model.state_dict().values():
+                dist.broadcast(tensor, 0)
         self.amp = config.amp and self.device.type == "cuda"
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
@@ -337,7 +387,7 @@ class _Run:
         self.best = data.get("best")
 
     def train_epoch(self, data: _Data, epoch: int) -> dict[str, float]:
-        """One epoch of optimiser steps; returns the mean losses over its windows."""
+        """One epoch of optimiser steps; returns the mean losses over its windows (over all processes)."""
         model, config = self.model, self.config
         model.train()
         factor = config.lr_factor(epoch)
@@ -349,34 +399,53 @@ class _Run:
             order = order[: config.windows_per_epoch]
         sums: dict[str, float] = {}
         seen = 0
+        parts = max(config.micro_batches, self.world)  # micro-batches per step, spread over the processes
         for start in range(0, len(order), config.batch_size):
             idx = np.sort(order[start : start + config.batch_size])
-            if len(idx) < 2:
+            micro = [idx[m::parts] for m in range(parts)]
+            if min(len(m) for m in micro) < 2:  # BatchNorm needs 2 windows per micro-batch
                 continue
-            self.step(_batch(data.arrays, data.keys, idx, self.device), len(idx), epoch, sums)
+            mine = micro[self.rank :: self.world]
+            batches = [(_batch(data.arrays, data.keys, m, self.device), len(m)) for m in mine]
+            self.step(batches, parts, epoch, sums)
             seen += len(idx)
-        return _mean_losses(sums, seen)
+        return _mean_losses(_sum_over_processes(sums, self.world), seen)
 
-    def step(self, batch: dict[str, torch.Tensor], weight: int, epoch: int, sums: dict[str, float]) -> None:
-        """The discriminator step (when adversarial) then the generator step on one batch of ``weight`` windows."""
+    def step(
+        self,
+        batches: list[tuple[dict[str, torch.Tensor], int]],
+        parts: int,
+        epoch: int,
+        sums: dict[str, float],
+    ) -> None:
+        """The discriminator step (when adversarial) then the generator step on one global batch.
+
+        ``batches`` are this process's micro-batches (tensors, windows) of a global batch split into
+        ``parts``: each loss is divided by ``parts`` and the gradients are summed over the processes, so
+        every optimiser step sees the average of the micro-batch gradients, whatever the process count.
+        """
         model, config = self.model, self.config
         with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
-            out = model(batch)
+            outs = [model(batch) for batch, _ in batches]
         if self.d_opt is not None and model.adversarial_active(epoch):
-            with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
-                d_losses = model.discriminator_losses(batch, out)
             self.d_opt.zero_grad(set_to_none=True)
-            d_losses["total"].backward()
+            for (batch, weight), out in zip(batches, outs, strict=True):
+                with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+                    d_losses = model.discriminator_losses(batch, out)
+                (d_losses["total"] / parts).backward()
+                _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
+            _sum_gradients(model.discriminator.parameters(), self.world)
             torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
             self.d_opt.step()
-            _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
-        with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
-            losses = model.losses(batch, out, epoch=epoch)
         self.g_opt.zero_grad(set_to_none=True)
-        losses["total"].backward()
+        for (batch, weight), out in zip(batches, outs, strict=True):
+            with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+                losses = model.losses(batch, out, epoch=epoch)
+            (losses["total"] / parts).backward()
+            _accumulate(sums, losses, weight)
+        _sum_gradients(self.g_params, self.world)
         torch.nn.utils.clip_grad_norm_(self.g_params, config.grad_clip)
         self.g_opt.step()
-        _accumulate(sums, losses, weight)
 
     def score(self, epoch: int, val_score: Callable[[GestureModel], float], entry: dict[str, Any]) -> None:
         """Score the epoch in eval mode; keep a copy of the weights when it is the best so far."""
@@ -389,8 +458,8 @@ class _Run:
             self.best = {"epoch": epoch, "score": score, "state": state}
 
     def save(self, epoch_done: int) -> None:
-        """Write the full (resumable) checkpoint, when a path is configured."""
-        if self.path is None:
+        """Write the full (resumable) checkpoint, when a path is configured (process 0 only)."""
+        if self.path is None or self.rank != 0:
             return
         save_checkpoint(
             self.path,
