@@ -138,9 +138,9 @@ def _needed_keys(model: GestureModel, arrays: Mapping[str, np.ndarray], who: str
 
 def configure_torch(seed: int, threads: int | None) -> None:
     """Seed torch, force deterministic algorithms and set the CPU thread count."""
-    from beatlite.paths import n_threads
-
     import os
+
+    from beatlite.paths import n_threads
 
     # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
