@@ -228,3 +228,12 @@ def test_torch_loader_over_the_store(store: WindowStore) -> None:
         assert sorted(map(bytes, seen.numpy())) == sorted(map(bytes, whole["pose"]))  # each window once
     item = WindowDataset(windows)[2]
     assert item["pose"].shape == (34, 141) and item["take"] == whole["take"][2]
+
+
+def test_unreadable_take_raises_its_format_error_from_a_worker(corpus: Path, tmp_path: Path) -> None:
+    bvh = corpus / "2_scott_0_9_9.bvh"
+    lines = bvh.read_text(encoding="utf-8").splitlines()
+    bvh.write_text("\n".join([*lines[:-1], "abc"]) + "\n", encoding="utf-8")  # header fine, last row broken
+    for workers in (0, 2):
+        with pytest.raises(FormatError, match=r"2_scott_0_9_9\.bvh, line \d+"):
+            build_store(index_folder(corpus), tmp_path / f"store{workers}", vocab=VOCAB, workers=workers)

@@ -691,6 +691,14 @@ def _is_current(folder: Path, record: TakeRecord, params: Mapping[str, Any]) -> 
     return True
 
 
+def _build_job(record: TakeRecord, folder: Path, params: dict) -> dict[str, Any]:
+    """:func:`build_take` in a worker; a ``FormatError`` comes back as data (it does not survive pickling)."""
+    try:
+        return build_take(record, folder, params)
+    except FormatError as e:
+        return {"_format_error": (e.path, e.reason, e.line, e.column, e.field)}
+
+
 def _run_builds(
     todo: list[TakeRecord], folder: Path, params: dict, workers: int | None, progress: bool
 ) -> None:
@@ -709,14 +717,18 @@ def _run_builds(
                 bar.update()
             return
         with ProcessPoolExecutor(n, mp_context=get_context("spawn")) as pool:
-            pending = {pool.submit(build_take, r, folder / "takes" / r.stem, params) for r in todo}
+            pending = {pool.submit(_build_job, r, folder / "takes" / r.stem, params) for r in todo}
             while pending:
                 done, pending = wait(pending, return_when=FIRST_EXCEPTION)
                 for fut in done:
-                    if fut.exception() is not None:
+                    error = fut.exception()
+                    if error is None and "_format_error" in fut.result():
+                        path, reason, line, column, field = fut.result()["_format_error"]
+                        error = FormatError(path, reason, line=line, column=column, field=field)
+                    if error is not None:
                         for other in pending:
                             other.cancel()
-                        raise fut.exception()
+                        raise error
                     bar.update()
 
 
