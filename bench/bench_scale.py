@@ -17,6 +17,8 @@ train, 1 test, 12 val) -- then measures, each step in a fresh subprocess so that
 Targets (issue 17): peak RSS of build and epoch <= 2 GiB at every size, store <= 0.5 GB per hour of
 mocap, build <= 30 s per hour on 2 cores, loader >= 5 x CaMN tiny's CPU training rate (151 windows/s).
 Growth exponents are least-squares slopes of log(value) against log(hours) (1 = linear, 0 = flat).
+CPU seconds (the step's process plus its finished workers) are printed beside wall time: on a shared
+machine ``CPU s / 2`` is what 2 free cores would take.
 
 Usage: ``python bench/bench_scale.py [--hours 0.25 1] [--workers 2] [--keep DIR]``. Needs about
 1.8 GB of temporary disk per corpus hour (plain BVH + WAV) plus the store; timings on a shared
@@ -198,17 +200,24 @@ def _peak_rss() -> dict[str, float]:
     }
 
 
+def _cpu_seconds() -> float:
+    """User + system CPU seconds of this process and its finished children (workers)."""
+    usage = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    return sum(u.ru_utime + u.ru_stime for u in usage)
+
+
 def step_store(corpus: Path, store: Path, workers: int) -> dict:
     from beatlite.data.index import index_folder
     from beatlite.data.store import build_store
 
-    tic = time.perf_counter()
+    tic, cpu = time.perf_counter(), _cpu_seconds()
     built = build_store(index_folder(corpus), store, workers=workers)
-    seconds = time.perf_counter() - tic
+    seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
     tic = time.perf_counter()
     build_store(index_folder(corpus), store, workers=workers)
     return {
         "seconds": seconds,
+        "cpu_s": cpu,
         "noop_rebuild_s": time.perf_counter() - tic,
         "disk_gb": built.disk_bytes() / 1e9,
         "mocap_hours": built.n_frames() / built.params["fps"] / 3600,
@@ -225,12 +234,12 @@ def step_epoch(store: Path, workers: int, keys: tuple[str, ...]) -> dict:
 
     torch.set_num_threads(1)
     windows = WindowStore.open(store).windows("train", keys=keys)
-    tic = time.perf_counter()
+    tic, cpu = time.perf_counter(), _cpu_seconds()
     n = 0
     for batch in window_loader(windows, batch_size=32, shuffle=True, num_workers=workers, seed=0):
         n += len(batch["speaker"]) if "speaker" in batch else len(next(iter(batch.values())))
-    seconds = time.perf_counter() - tic
-    return {"windows": n, "seconds": seconds, "windows_per_s": n / seconds, **_peak_rss()}
+    seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
+    return {"windows": n, "seconds": seconds, "cpu_s": cpu, "windows_per_s": n / seconds, **_peak_rss()}
 
 
 def step_build_windows(corpus: Path, cache: Path) -> dict:
@@ -270,6 +279,7 @@ def print_table(rows: list[dict]) -> None:
         ("source_gb", "source GB", "{:.2f}"),
         ("store_s", "store build s", "{:.1f}"),
         ("store_s_per_h", "build s/h", "{:.1f}"),
+        ("store_cpu_per_h", "build CPU s/h", "{:.1f}"),
         ("noop_s", "no-op rebuild s", "{:.2f}"),
         ("store_rss_main", "build RSS main GiB", "{:.2f}"),
         ("store_rss_child", "build RSS worker GiB", "{:.2f}"),
@@ -279,7 +289,9 @@ def print_table(rows: list[dict]) -> None:
         ("epoch_wps", "loader windows/s", "{:.0f}"),
         ("epoch_rss_main", "epoch RSS main GiB", "{:.2f}"),
         ("epoch_rss_child", "epoch RSS worker GiB", "{:.2f}"),
+        ("epoch_cpu_ms", "epoch CPU ms/window", "{:.2f}"),
         ("epoch0_wps", "loader 0 workers windows/s", "{:.0f}"),
+        ("epoch0_rss", "epoch 0 workers RSS GiB", "{:.2f}"),
         ("bw_s", "build_windows s", "{:.1f}"),
         ("bw_rss", "build_windows RSS GiB", "{:.2f}"),
         ("bw_gb", "build_windows cache GB", "{:.3f}"),
@@ -304,19 +316,20 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
     row: dict = {"takes": n_takes, "make_s": time.perf_counter() - tic}
     row["source_gb"] = sum(p.stat().st_size for p in corpus.rglob("*") if p.is_file()) / 1e9
     s = _run_step(["--step", "store", str(corpus), str(store), str(args.workers)])
+    h = s["mocap_hours"]
+    row.update(hours=h, store_s=s["seconds"], noop_s=s["noop_rebuild_s"], store_gb=s["disk_gb"])
+    row.update(store_rss_main=s["rss_main_gib"], store_rss_child=s["rss_child_gib"])
     row.update(
-        hours=s["mocap_hours"], store_s=s["seconds"], noop_s=s["noop_rebuild_s"], store_gb=s["disk_gb"]
+        train_windows=s["train_windows"], store_s_per_h=s["seconds"] / h, store_cpu_per_h=s["cpu_s"] / h
     )
-    row.update(
-        store_rss_main=s["rss_main_gib"], store_rss_child=s["rss_child_gib"], train_windows=s["train_windows"]
-    )
-    row.update(store_s_per_h=s["seconds"] / s["mocap_hours"], store_gb_per_h=s["disk_gb"] / s["mocap_hours"])
+    row["store_gb_per_h"] = s["disk_gb"] / h
     e = _run_step(["--step", "epoch", str(store), str(args.loader_workers), ",".join(CAMN_KEYS)])
     row.update(
         epoch_wps=e["windows_per_s"], epoch_rss_main=e["rss_main_gib"], epoch_rss_child=e["rss_child_gib"]
     )
+    row["epoch_cpu_ms"] = 1000 * e["cpu_s"] / e["windows"]
     e0 = _run_step(["--step", "epoch", str(store), "0", ",".join(CAMN_KEYS)])
-    row["epoch0_wps"] = e0["windows_per_s"]
+    row.update(epoch0_wps=e0["windows_per_s"], epoch0_rss=e0["rss_main_gib"])
     if hours <= args.compare_max_hours:
         b = _run_step(["--step", "build_windows", str(corpus), str(cache)])
         row.update(bw_s=b["seconds"], bw_rss=b["rss_main_gib"], bw_gb=b["disk_gb"])

@@ -237,3 +237,17 @@ def test_unreadable_take_raises_its_format_error_from_a_worker(corpus: Path, tmp
     for workers in (0, 2):
         with pytest.raises(FormatError, match=r"2_scott_0_9_9\.bvh, line \d+"):
             build_store(index_folder(corpus), tmp_path / f"store{workers}", vocab=VOCAB, workers=workers)
+
+
+def test_default_vocabulary_follows_the_textgrids(corpus: Path, tmp_path: Path) -> None:
+    from test_data_fixtures import write_textgrid
+
+    from beatlite.data.vocab import build_vocab
+
+    store = build_store(index_folder(corpus), tmp_path / "v", workers=0)
+    assert store.vocab.itos == build_vocab(index_folder(corpus)).itos
+    write_textgrid(corpus / "2_scott_0_9_9.TextGrid", [(0.5, 1.0, "Giraffe")], 100 / 15)
+    again = build_store(index_folder(corpus), tmp_path / "v", workers=0)
+    assert again.vocab.itos == build_vocab(index_folder(corpus)).itos and "giraffe" in again.vocab
+    word = again.windows("train").batch([0])["word"][0]
+    assert again.vocab["giraffe"] in word.tolist()  # the changed take was rebuilt with the new word

@@ -691,6 +691,29 @@ def _is_current(folder: Path, record: TakeRecord, params: Mapping[str, Any]) -> 
     return True
 
 
+def _text_fingerprint(index: TakeIndex) -> str:
+    """sha256 over (stem, name, size, mtime_ns) of every TextGrid of the index (what ``build_vocab`` reads)."""
+    h = hashlib.sha256()
+    for r in index:
+        if "text" in r.files:
+            st = Path(r.files["text"]).stat()
+            h.update(f"{r.stem}|{Path(r.files['text']).name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+    return h.hexdigest()
+
+
+def _stored_vocab(path: Path, text_fp: str) -> Vocab | None:
+    """The vocabulary of an existing ``store.json`` if it was built from the same TextGrids, else None."""
+    from beatlite.data.vocab import Vocab
+
+    try:
+        data = _read_json(path)
+        if data.get("vocab_fingerprint") == text_fp and data.get("version") == STORE_VERSION:
+            return Vocab(data["vocab"])
+    except (FormatError, KeyError, TypeError, ValueError):
+        pass
+    return None
+
+
 def _build_job(record: TakeRecord, folder: Path, params: dict) -> dict[str, Any]:
     """:func:`build_take` in a worker; a ``FormatError`` comes back as data (it does not survive pickling)."""
     try:
@@ -800,12 +823,16 @@ def build_store(
     for stale in (folder / "takes").iterdir():
         if stale.is_dir() and stale.name not in keep:
             shutil.rmtree(stale)
-    vocab = build_vocab(index) if vocab is None else vocab
+    text_fp = None
+    if vocab is None:  # build_vocab(index), reused while no TextGrid of the index changed
+        text_fp = _text_fingerprint(index)
+        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(index)
     manifest = {
         "version": STORE_VERSION,
         "params": params,
         "takes": [r.stem for r in records],
         "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
+        "vocab_fingerprint": text_fp,
     }
     from beatlite.io.atomic import atomic_write
 

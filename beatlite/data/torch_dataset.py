@@ -25,14 +25,17 @@ from beatlite.data.store import StoreWindows
 from beatlite.data.windows import Windows
 
 
-def _to_torch(batch: dict[str, Any]) -> dict[str, Any]:
-    """numpy arrays -> tensors (float32 / int64 as they are); ``take`` stays str (a list for a batch)."""
+def _to_torch(batch: dict[str, Any], *, copy: bool = True) -> dict[str, Any]:
+    """numpy arrays -> tensors (float32 / int64 as they are); ``take`` stays str (a list for a batch).
+
+    ``copy=False`` wraps arrays the caller owns (a fresh batch) without copying them.
+    """
     out: dict[str, Any] = {}
     for k, v in batch.items():
         if k == "take":
             out[k] = str(v) if np.ndim(v) == 0 else [str(s) for s in v]
         else:
-            out[k] = torch.from_numpy(np.array(v, copy=True))
+            out[k] = torch.from_numpy(np.array(v, copy=True) if copy or not v.flags.writeable else v)
     return out
 
 
@@ -75,7 +78,7 @@ class WindowDataset(Dataset):
             batch = self.windows.batch(idx, keys=self.keys)
         else:
             batch = self.windows.batch(idx)
-        return _to_torch({k: batch[k] for k in self.keys})
+        return _to_torch({k: batch[k] for k in self.keys}, copy=False)  # batch() returns new arrays
 
 
 def window_loader(
