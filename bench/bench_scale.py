@@ -11,6 +11,9 @@ train, 1 test, 12 val) -- then measures, each step in a fresh subprocess so that
   processes): seconds, peak RSS of the main process and of the largest worker, store size on disk;
 - ``epoch``: one shuffled pass over the train windows with :func:`beatlite.data.torch_dataset.window_loader`
   (batch 32, CaMN's keys, ``--loader-workers`` workers): windows/s and peak RSS (main, largest worker);
+- ``stats`` (``--stats``): :func:`beatlite.stats.emotion_separability` over :func:`beatlite.stats.iter_corpus`
+  (at most 2000 windows scored): seconds and peak RSS; ``--step stats CORPUS all`` scores every window (the
+  O(N^2) alternative);
 - ``build_windows`` (the alternative, for N <= ``--compare-max-hours``): the in-memory train
   windows of :func:`beatlite.data.windows.build_windows` with its ``.npz`` cache: seconds, peak RSS, cache size.
 
@@ -253,6 +256,23 @@ def step_build_windows(corpus: Path, cache: Path) -> dict:
     return {"seconds": seconds, "windows": len(w), "disk_gb": disk / 1e9, **_peak_rss()}
 
 
+def step_stats(corpus: Path, subset: bool) -> dict:
+    """Emotion separability streamed over the takes (``iter_corpus``); ``subset=False``: all windows (O(N^2))."""
+    from beatlite.data.index import index_folder
+    from beatlite.stats import emotion_separability, iter_corpus
+
+    tic, cpu = time.perf_counter(), _cpu_seconds()
+    sep = emotion_separability(iter_corpus(index_folder(corpus)), max_windows=2000 if subset else None)
+    seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
+    return {
+        "seconds": seconds,
+        "cpu_s": cpu,
+        "n": sep.n,
+        "balanced_accuracy": sep.balanced_accuracy,
+        **_peak_rss(),
+    }
+
+
 def _run_step(args: list[str]) -> dict:
     """Run this file with ``--step ...`` in a fresh interpreter; returns its JSON line."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
@@ -292,6 +312,9 @@ def print_table(rows: list[dict]) -> None:
         ("epoch_cpu_ms", "epoch CPU ms/window", "{:.2f}"),
         ("epoch0_wps", "loader 0 workers windows/s", "{:.0f}"),
         ("epoch0_rss", "epoch 0 workers RSS GiB", "{:.2f}"),
+        ("sep_s", "separability (streamed) s", "{:.1f}"),
+        ("sep_rss", "separability RSS GiB", "{:.2f}"),
+        ("sep_n", "separability windows", "{:d}"),
         ("bw_s", "build_windows s", "{:.1f}"),
         ("bw_rss", "build_windows RSS GiB", "{:.2f}"),
         ("bw_gb", "build_windows cache GB", "{:.3f}"),
@@ -330,6 +353,9 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
     row["epoch_cpu_ms"] = 1000 * e["cpu_s"] / e["windows"]
     e0 = _run_step(["--step", "epoch", str(store), "0", ",".join(CAMN_KEYS)])
     row.update(epoch0_wps=e0["windows_per_s"], epoch0_rss=e0["rss_main_gib"])
+    if args.stats:
+        st = _run_step(["--step", "stats", str(corpus), "subset"])
+        row.update(sep_s=st["seconds"], sep_rss=st["rss_main_gib"], sep_n=st["n"])
     if hours <= args.compare_max_hours:
         b = _run_step(["--step", "build_windows", str(corpus), str(cache)])
         row.update(bw_s=b["seconds"], bw_rss=b["rss_main_gib"], bw_gb=b["disk_gb"])
@@ -344,6 +370,8 @@ def main() -> int:
         step = sys.argv[2]
         if step == "store":
             out = step_store(Path(sys.argv[3]), Path(sys.argv[4]), int(sys.argv[5]))
+        elif step == "stats":
+            out = step_stats(Path(sys.argv[3]), sys.argv[4] == "subset")
         elif step == "epoch":
             out = step_epoch(Path(sys.argv[3]), int(sys.argv[4]), tuple(sys.argv[5].split(",")))
         else:
@@ -358,6 +386,7 @@ def main() -> int:
     p.add_argument("--workers", type=int, default=2, help="store build (and corpus making) processes")
     p.add_argument("--loader-workers", type=int, default=2, help="DataLoader workers of the epoch")
     p.add_argument("--compare-max-hours", type=float, default=1.0, help="run build_windows up to this size")
+    p.add_argument("--stats", action="store_true", help="also time emotion_separability over iter_corpus")
     p.add_argument("--keep", type=Path, default=None, help="keep corpora and stores under this folder")
     args = p.parse_args()
     print(f"bench_scale: {os.cpu_count()} CPUs; sizes {args.hours} h")
