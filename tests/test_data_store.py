@@ -251,3 +251,20 @@ def test_default_vocabulary_follows_the_textgrids(corpus: Path, tmp_path: Path) 
     assert again.vocab.itos == build_vocab(index_folder(corpus)).itos and "giraffe" in again.vocab
     word = again.windows("train").batch([0])["word"][0]
     assert again.vocab["giraffe"] in word.tolist()  # the changed take was rebuilt with the new word
+
+
+def test_whole_take_equals_build_windows_whole_takes(corpus: Path, store: WindowStore) -> None:
+    idx = index_folder(corpus)
+    train = build_windows(idx, split="train", vocab=VOCAB, cache=False)
+    stats = (train.pose_norm, train.dir_norm)
+    ref = build_windows(idx, split="val", vocab=VOCAB, stats=stats, whole_takes=True, cache=False)
+    for i, stem in enumerate(ref["take"]):
+        want, got = ref.item(i), store.whole_take(str(stem), stats=stats)
+        assert got["take"] == stem and got["pose"].shape == want["pose"].shape
+        for key in ref.keys():
+            if key == "audio":
+                assert got[key].shape == want[key].shape and np.abs(got[key] - want[key]).max() <= AUDIO_BOUND
+            else:
+                assert np.array_equal(got[key], want[key]), key
+    # 100 frames: 106666 samples, round((106666 - 1024) / 512 + 1) = 207 mel frames (HA2G's clip rule)
+    assert store.whole_take("2_scott_0_9_9", keys=("mel",))["mel"].shape == (207, 128)

@@ -485,6 +485,26 @@ class WindowStore:
             stats = self.statistics("train")
         return StoreWindows(self, split, length=length, stride=stride, keys=keys, stats=stats, vocab=vocab)
 
+    def whole_take(
+        self,
+        stem: str,
+        *,
+        keys: Sequence[str] | None = None,
+        stats: tuple[Normalizer, Normalizer] | None = None,
+        vocab: Vocab | None = None,
+    ) -> dict[str, Any]:
+        """One take at full length, as ``build_windows(..., whole_takes=True).item(i)`` (evaluation mode).
+
+        Per-frame keys are (T, ...), ``audio`` (audio_samples(T),), ``mel`` (mel_frames(len(audio)), 128),
+        ``speaker``/``start`` scalars, ``take`` the stem.
+        """
+        take = self.take(stem)
+        stats = self.statistics("train") if stats is None else stats
+        view = StoreWindows(
+            self, None, length=take.n_frames, stride=1, keys=keys, stats=stats, vocab=vocab, stems=(stem,)
+        )
+        return view.item(0)
+
 
 class StoreWindows:
     """The windows of one split of a :class:`WindowStore`: an index ``(take, start)`` read at batch time.
@@ -493,6 +513,8 @@ class StoreWindows:
     ``w.keys()``, ``w.batch(indices)`` (the batch contract of ``docs/architecture.md``),
     ``w.item(i)``, ``w.pose_norm``, ``w.dir_norm``, ``w.params``. ``w["pose"]`` reads every
     window of the split into memory (as ``Windows`` holds them); prefer ``batch``.
+
+    ``stems`` restricts the view to these takes (whatever their split).
 
     Attributes
     ----------
@@ -512,6 +534,7 @@ class StoreWindows:
         keys: Sequence[str] | None,
         stats: tuple[Normalizer, Normalizer],
         vocab: Vocab | None,
+        stems: Sequence[str] | None = None,
     ) -> None:
         for name, v in (("length", length), ("stride", stride)):
             if not isinstance(v, int | np.integer) or v < 1:
@@ -526,7 +549,8 @@ class StoreWindows:
         self.vocab = store.vocab if vocab is None else vocab
         positions = {t.stem: i for i, t in enumerate(store.takes)}
         ids, starts = [], []
-        for t in store._select(split):
+        chosen = store._select(split) if stems is None else [store.take(stem) for stem in stems]
+        for t in chosen:
             s = window_starts(t.n_frames, int(length), int(stride))
             ids.append(np.full(len(s), positions[t.stem], np.int64))
             starts.append(s)
