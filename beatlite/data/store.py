@@ -22,9 +22,10 @@ stream (file)  on disk               batch keys
 
 Batches equal :func:`beatlite.data.windows.build_windows`'s for the same takes, windows and
 statistics, bit for bit except ``audio``: it is stored as 16-bit PCM with a per-take step
-``audio_scale`` (``2**-15``, or ``peak / 32767`` for a take whose peak exceeds
-``32767 / 32768``), so ``|audio - stored| <= audio_scale / 2`` plus float32 rounding
-(``<= 2**-16 + 2**-24 |audio|`` for audio in [-1, 1]); audio that is already 16-bit PCM at
+``audio_scale``, so ``|audio - stored| <= audio_scale / 2 + 2**-24 |audio|`` (half a step plus
+float32 rounding). ``audio_scale = 2**-15`` when the take's samples lie in ``[-1, 32767/32768]``
+(then ``q * 2**-15`` is exact in float32 and the bound is ``2**-16 ~ 1.5e-5``), else
+``peak / 32767`` (resampling overshoot above 1). Audio that is already 16-bit PCM at
 the model rate (``data_samples/``) is stored exactly. The train statistics are accumulated
 per take (count, sum, centred sum of squares; Chan et al.'s pairwise update) and equal
 :meth:`Normalizer.fit` over all train frames up to float rounding.
