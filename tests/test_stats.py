@@ -403,3 +403,58 @@ def test_figures_label_every_axis_and_keep_legends_off_the_data() -> None:
     labels = [t.get_text() for t in table6.axes[0].get_legend().get_texts()]
     assert labels[-1] == "beatlite, generated (CaMN)"  # the generated row names its model
     plt.close("all")
+
+
+@pytest.mark.filterwarnings("ignore:The least populated class:UserWarning")
+def test_emotion_features_stream_and_subsample() -> None:
+    from beatlite.stats.emotion_clusters import (
+        emotion_features,
+        emotion_separability,
+        per_group_standardize,
+        subset_dims,
+    )
+
+    rng = np.random.default_rng(3)
+    takes = [
+        make_take(95, emotion=e, speaker=2 + k % 2, rotations=rng.normal(size=(95, 141)) + e, stem=f"t{k}")
+        for k, e in enumerate([0, 1, 2, 0, 1, 2, 3, 3])
+    ]
+    # oracle: all windows at once, as emotion_separability computed them before streaming
+    rw = rotation_windows(takes)
+    expected = per_group_standardize(window_features(rw.windows[:, :, subset_dims("body27")]), rw.speaker)
+    ef = emotion_features(iter(takes))  # a single-pass iterator is enough
+    assert len(ef) == 8 * 3 and np.array_equal(ef.features, expected) and np.array_equal(ef.take, rw.take)
+    whole = emotion_separability(takes)
+    assert emotion_separability(iter(takes), max_windows=None).balanced_accuracy == whole.balanced_accuracy
+    assert emotion_separability(takes, max_windows=24).silhouette == whole.silhouette  # 24 windows: no subset
+    # more windows than max_windows: a seeded uniform subset, kept in order, scored like any features
+    sub = emotion_separability(takes, max_windows=15, seed=4)
+    keep = np.sort(np.random.default_rng(4).choice(24, size=15, replace=False))
+    oracle = separability(expected[keep], rw.emotion[keep], groups=rw.take[keep], seed=4)
+    assert (
+        sub.n == 15
+        and sub.balanced_accuracy == oracle.balanced_accuracy
+        and sub.silhouette == oracle.silhouette
+    )
+    assert emotion_separability(takes, max_windows=15, seed=4).silhouette == sub.silhouette  # deterministic
+    with pytest.raises(ValueError, match="no takes"):
+        emotion_features(iter([]))
+
+
+def test_iter_corpus_is_lazy_and_equals_load_corpus(tmp_path: Path) -> None:
+    from test_data_windows import write_take
+
+    from beatlite.data.index import index_folder
+    from beatlite.stats.corpus import iter_corpus, load_corpus
+
+    write_take(tmp_path, "2_scott_0_9_9", 40)
+    write_take(tmp_path, "2_scott_0_57_57", 45)
+    idx = index_folder(tmp_path)
+    stream = iter_corpus(idx)
+    first = next(stream)  # one take loaded, the other not yet
+    rest = list(stream)
+    listed = load_corpus(idx)
+    assert [t.stem for t in [first, *rest]] == [t.stem for t in listed] == [r.stem for r in idx]
+    assert len(listed) == 2
+    assert all(np.array_equal(a.rotations, b.rotations) for a, b in zip([first, *rest], listed))
+    assert [t.stem for t in iter_corpus(idx, splits=("val",))] == ["2_scott_0_57_57"]

@@ -4,8 +4,9 @@
 ``index``               :func:`index_folder` -> :class:`TakeIndex` of :class:`TakeRecord`
 ``vocab``               :class:`Vocab` (PAD/SOS/EOS/UNK = 0..3), offline word vectors
 ``normalize``           :class:`Normalizer` (train-split mean/std)
-``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract)
-``torch_dataset``       ``WindowDataset`` (imports torch; import it explicitly)
+``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract, in memory)
+``store``               :func:`build_store` -> :class:`WindowStore` (per-take streams on disk; same batches)
+``torch_dataset``       ``WindowDataset``, ``window_loader`` (imports torch; import it explicitly)
 =====================  =============================================================
 
 Taught in notebooks/03_audio_and_text_features.ipynb, sections 5-7 (raw wave, words to frames, vocabulary) and notebooks/05_camn.ipynb, section 1 (a batch of training windows).
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 from beatlite.data.index import TakeIndex, TakeRecord, index_folder
 from beatlite.data.normalize import Normalizer
+from beatlite.data.store import StoreWindows, WindowStore, build_store
 from beatlite.data.vocab import EOS, PAD, SOS, UNK, Vocab, build_vocab, word_vectors
 from beatlite.data.windows import WINDOW_KEYS, Windows, build_windows, window_starts
 
@@ -25,10 +27,13 @@ __all__ = [
     "UNK",
     "WINDOW_KEYS",
     "Normalizer",
+    "StoreWindows",
     "TakeIndex",
     "TakeRecord",
     "Vocab",
+    "WindowStore",
     "Windows",
+    "build_store",
     "build_vocab",
     "build_windows",
     "index_folder",

@@ -3,7 +3,7 @@
 =========================  ================================================================
 ``table1``                  Table 1 analog: the corpus row beside the paper's rows
 ``distributions``           Fig. 2 analogs: emotion / language shares, minutes per speaker
-``corpus``                  :func:`load_corpus`: per-take streams shared by the analyses below
+``corpus``                  :func:`load_corpus` / :func:`iter_corpus`: per-take streams for the analyses below
 ``emotion_clusters``        Fig. 3a: t-SNE of 2-s rotation windows + measured separability
 ``semantic``                Fig. 4 analogs: semantic score histogram, per word, per speaker
 ``correlations``            gesture energy vs audio, face, emotion, speaker, with p-values
@@ -15,7 +15,7 @@ Taught in notebooks/02_dataset_statistics.ipynb (dataset statistics), sections 1
 
 from __future__ import annotations
 
-from beatlite.stats.corpus import CorpusTake, load_corpus
+from beatlite.stats.corpus import CorpusTake, iter_corpus, load_corpus
 from beatlite.stats.corpus_table import PAPER_TABLE1, corpus_row, table1, table1_markdown
 from beatlite.stats.correlations import gesture_correlations, plot_correlations, speed_by_emotion
 from beatlite.stats.distributions import emotion_shares, language_shares, plot_figure2, speaker_durations
@@ -26,7 +26,12 @@ from beatlite.stats.emotion_classifier import (
     table6,
     table6_windows,
 )
-from beatlite.stats.emotion_clusters import emotion_separability, plot_emotion_tsne, rotation_windows
+from beatlite.stats.emotion_clusters import (
+    emotion_features,
+    emotion_separability,
+    plot_emotion_tsne,
+    rotation_windows,
+)
 from beatlite.stats.semantic import plot_figure4, score_histogram, speaker_scores, word_scores
 
 __all__ = [
@@ -35,10 +40,12 @@ __all__ = [
     "CorpusTake",
     "EmotionClassifier",
     "corpus_row",
+    "emotion_features",
     "emotion_separability",
     "emotion_shares",
     "gesture_correlations",
     "language_shares",
+    "iter_corpus",
     "load_corpus",
     "plot_correlations",
     "plot_emotion_tsne",

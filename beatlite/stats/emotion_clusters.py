@@ -9,12 +9,19 @@ share; 1 / number of classes), with a permutation test. Folds are grouped by
 take (windows of one take never sit in both train and test), otherwise
 neighbouring windows of the same take would inflate the accuracy.
 
+Scale: features are computed take by take (:func:`emotion_features`; ``takes`` may be
+the single-pass :func:`beatlite.stats.iter_corpus`), 81 numbers per window for the default
+``"stats"`` of ``"body27"``. The distance matrix, silhouette and t-SNE are O(N^2), so with more
+than ``max_windows`` (2000) windows a uniform subset drawn with ``seed`` is scored
+(:meth:`EmotionFeatures.subsample`): bounded time and memory at any corpus size, and the
+same numbers as before on corpora with fewer windows (``data_samples/``: 341).
+
 Taught in notebooks/02_dataset_statistics.ipynb, section 3 (Figure 3a: do gestures differ by emotion?).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,35 +55,50 @@ class RotationWindows:
         return int(self.windows.shape[0])
 
 
+def _window_length(fps: float, seconds: float, stride_seconds: float | None) -> tuple[int, int]:
+    length = int(round(seconds * fps))
+    stride = length if stride_seconds is None else int(round(stride_seconds * fps))
+    if length < 2 or stride < 1:
+        raise ValueError(f"rotation_windows: window of {length} frames / stride {stride} is too short")
+    return length, stride
+
+
+def _take_windows(take: CorpusTake, length: int, stride: int) -> np.ndarray:
+    """(W, length, 141) rotation windows of one take (W may be 0)."""
+    starts = np.arange(0, take.n_frames - length + 1, stride)
+    return take.rotations[starts[:, None] + np.arange(length)]
+
+
 def rotation_windows(
-    takes: Sequence[CorpusTake], *, seconds: float = 2.0, stride_seconds: float | None = None
+    takes: Iterable[CorpusTake], *, seconds: float = 2.0, stride_seconds: float | None = None
 ) -> RotationWindows:
     """Cut every take's 141-d rotations into windows of ``seconds`` (paper: "2s-rotation").
 
     Parameters
     ----------
-    takes : sequence of CorpusTake
+    takes : iterable of CorpusTake
+        A list, or a single-pass iterator such as :func:`beatlite.stats.iter_corpus`.
     seconds : float
         Window length (2 s = 30 frames at 15 fps).
     stride_seconds : float, optional
         Hop between windows (default: ``seconds``, non-overlapping).
     """
-    if not takes:
-        raise ValueError("rotation_windows: no takes")
-    fps = takes[0].fps
-    length = int(round(seconds * fps))
-    stride = length if stride_seconds is None else int(round(stride_seconds * fps))
-    if length < 2 or stride < 1:
-        raise ValueError(f"rotation_windows: window of {length} frames / stride {stride} is too short")
     parts, emo, spk, tk = [], [], [], []
+    length = stride = None
+    n_takes = 0
     for i, t in enumerate(takes):
-        starts = np.arange(0, t.n_frames - length + 1, stride)
-        if len(starts) == 0:
+        n_takes += 1
+        if length is None:
+            length, stride = _window_length(t.fps, seconds, stride_seconds)
+        w = _take_windows(t, length, stride)
+        if len(w) == 0:
             continue
-        parts.append(t.rotations[starts[:, None] + np.arange(length)])
-        emo.append(np.full(len(starts), t.emotion))
-        spk.append(np.full(len(starts), t.speaker_id))
-        tk.append(np.full(len(starts), i))
+        parts.append(w)
+        emo.append(np.full(len(w), t.emotion))
+        spk.append(np.full(len(w), t.speaker_id))
+        tk.append(np.full(len(w), i))
+    if n_takes == 0:
+        raise ValueError("rotation_windows: no takes")
     if not parts:
         raise ValueError(f"rotation_windows: no take is at least {length} frames long")
     return RotationWindows(
@@ -316,8 +338,81 @@ def per_group_standardize(features: np.ndarray, groups: np.ndarray) -> np.ndarra
     return x
 
 
+#: Default cap on the windows that enter the O(N^2) steps (distances, silhouette, t-SNE).
+MAX_WINDOWS = 2000
+
+
+@dataclass
+class EmotionFeatures:
+    """Features of the 2-s rotation windows of several takes (see :func:`emotion_features`).
+
+    Attributes
+    ----------
+    features : (N, F) float64
+    emotion, speaker, take : (N,) int64
+        Take-level emotion id, speaker id (1..30), index of the take in the input order.
+    """
+
+    features: np.ndarray
+    emotion: np.ndarray
+    speaker: np.ndarray
+    take: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.features.shape[0])
+
+    def subsample(self, max_windows: int | None, seed: int = 0) -> EmotionFeatures:
+        """At most ``max_windows`` rows drawn uniformly without replacement (``default_rng(seed)``),
+        kept in their order; all rows (``self``) when there are no more than that or ``max_windows`` is None."""
+        if max_windows is None or len(self) <= max_windows:
+            return self
+        if max_windows < 2:
+            raise ValueError(f"EmotionFeatures.subsample: max_windows must be >= 2, got {max_windows}")
+        keep = np.sort(np.random.default_rng(seed).choice(len(self), size=int(max_windows), replace=False))
+        return EmotionFeatures(self.features[keep], self.emotion[keep], self.speaker[keep], self.take[keep])
+
+
+def emotion_features(
+    takes: Iterable[CorpusTake],
+    *,
+    seconds: float = 2.0,
+    kind: str = "stats",
+    joints: str = "body27",
+    per_speaker: bool = True,
+) -> EmotionFeatures:
+    """:func:`window_features` of the ``joints`` dims of every take's 2-s rotation windows, take by take.
+
+    Only the features are kept (O(N F) memory, e.g. 81 numbers per window for ``"stats"`` of
+    ``"body27"``), so ``takes`` may be a single-pass iterator (:func:`beatlite.stats.iter_corpus`).
+    ``per_speaker``: standardised within each speaker (:func:`per_group_standardize`) over all windows.
+    """
+    dims = subset_dims(joints)
+    feats, emo, spk, tk = [], [], [], []
+    length = stride = None
+    n_takes = 0
+    for i, t in enumerate(takes):
+        n_takes += 1
+        if length is None:
+            length, stride = _window_length(t.fps, seconds, None)
+        w = _take_windows(t, length, stride)
+        if len(w) == 0:
+            continue
+        feats.append(window_features(w[:, :, dims].astype(np.float32), kind=kind))
+        emo.append(np.full(len(w), t.emotion, np.int64))
+        spk.append(np.full(len(w), t.speaker_id, np.int64))
+        tk.append(np.full(len(w), i, np.int64))
+    if n_takes == 0:
+        raise ValueError("emotion_features: no takes")
+    if not feats:
+        raise ValueError(f"emotion_features: no take is at least {length} frames long")
+    out = EmotionFeatures(np.concatenate(feats), np.concatenate(emo), np.concatenate(spk), np.concatenate(tk))
+    if per_speaker:
+        out.features = per_group_standardize(out.features, out.speaker)
+    return out
+
+
 def emotion_separability(
-    takes: Sequence[CorpusTake],
+    takes: Iterable[CorpusTake],
     *,
     seconds: float = 2.0,
     kind: str = "stats",
@@ -325,13 +420,15 @@ def emotion_separability(
     per_speaker: bool = True,
     k: int = 5,
     n_permutations: int = 0,
+    max_windows: int | None = MAX_WINDOWS,
     seed: int = 0,
 ) -> Separability:
     """:func:`separability` of the emotion labels of 2-s rotation windows, folds grouped by take.
 
     Parameters
     ----------
-    takes : sequence of CorpusTake
+    takes : iterable of CorpusTake
+        A list or a single-pass iterator (features are computed take by take).
     seconds : float
         Window length.
     kind : {"stats", "flat"}
@@ -341,17 +438,25 @@ def emotion_separability(
         the 9 spine/arm joints that carry the gesture -- with all 47 joints the 38 hand joints
         make up 114 of 141 dimensions and dominate the distances) or ``"spine_neck_141"``.
     per_speaker : bool
-        Standardise the features within each speaker first (:func:`per_group_standardize`),
-        so that speaker style does not mask emotion (the paper's Fig. 3b compares emotions
-        within one speaker).
-    k, n_permutations, seed
+        Standardise the features within each speaker first (:func:`per_group_standardize`, over
+        all windows), so that speaker style does not mask emotion (the paper's Fig. 3b compares
+        emotions within one speaker).
+    k, n_permutations
         See :func:`separability`.
+    max_windows : int or None
+        The distance matrix, silhouette and k-NN folds are O(N^2): with more windows than this,
+        a uniform random subset of ``max_windows`` windows (drawn with ``seed``,
+        :meth:`EmotionFeatures.subsample`) is scored, so time and memory stay bounded (2000:
+        32 MB of distances). A corpus with fewer windows (``data_samples/``: 341) is scored whole,
+        so its numbers do not depend on it. None: always all windows.
+    seed : int
+        Seed of the subset, the folds and the permutations.
     """
-    rw = rotation_windows(takes, seconds=seconds)
-    feats = window_features(rw.windows[:, :, subset_dims(joints)], kind=kind)
-    if per_speaker:
-        feats = per_group_standardize(feats, rw.speaker)
-    return separability(feats, rw.emotion, groups=rw.take, k=k, n_permutations=n_permutations, seed=seed)
+    ef = emotion_features(takes, seconds=seconds, kind=kind, joints=joints, per_speaker=per_speaker)
+    ef = ef.subsample(max_windows, seed)
+    return separability(
+        ef.features, ef.emotion, groups=ef.take, k=k, n_permutations=n_permutations, seed=seed
+    )
 
 
 def tsne_embedding(features: np.ndarray, *, perplexity: float = 30.0, seed: int = 0) -> np.ndarray:
@@ -369,19 +474,21 @@ def tsne_embedding(features: np.ndarray, *, perplexity: float = 30.0, seed: int 
 
 
 def plot_emotion_tsne(
-    takes: Sequence[CorpusTake],
+    takes: Iterable[CorpusTake],
     *,
     seconds: float = 2.0,
     kind: str = "stats",
     joints: str = "body27",
     per_speaker: bool = True,
+    max_windows: int | None = MAX_WINDOWS,
     seed: int = 0,
     out: str | Path | None = None,
     formats: tuple[str, ...] = ("png", "svg"),
 ):
     """Figure 3a: t-SNE of 2-s rotation windows coloured by emotion, separability in the title.
 
-    Features as in :func:`emotion_separability` (per-speaker standardised by default).
+    Features and the ``max_windows`` subset (seeded, for the t-SNE too) as in
+    :func:`emotion_separability` (per-speaker standardised by default).
 
     Returns
     -------
@@ -391,17 +498,15 @@ def plot_emotion_tsne(
 
     from beatlite.viz.style import figure_style, legend_outside, save_figure
 
-    rw = rotation_windows(takes, seconds=seconds)
-    feats = window_features(rw.windows[:, :, subset_dims(joints)], kind=kind)
-    if per_speaker:
-        feats = per_group_standardize(feats, rw.speaker)
-    sep = separability(feats, rw.emotion, groups=rw.take, seed=seed)
-    emb = tsne_embedding(feats, seed=seed)
+    ef = emotion_features(takes, seconds=seconds, kind=kind, joints=joints, per_speaker=per_speaker)
+    ef = ef.subsample(max_windows, seed)
+    sep = separability(ef.features, ef.emotion, groups=ef.take, seed=seed)
+    emb = tsne_embedding(ef.features, seed=seed)
     with figure_style():
         fig, ax = plt.subplots(figsize=(8.0, 5.6), layout="constrained")
         cmap = plt.get_cmap("tab10")
-        for e in np.unique(rw.emotion):
-            m = rw.emotion == e
+        for e in np.unique(ef.emotion):
+            m = ef.emotion == e
             ax.scatter(emb[m, 0], emb[m, 1], s=10, color=cmap(int(e)), label=EMOTION_NAMES[int(e)], alpha=0.8)
         ax.set_xticks([])
         ax.set_yticks([])

@@ -1,0 +1,275 @@
+"""beatlite.data.store: the on-disk window store gives build_windows' batches, incrementally and safely."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_data_windows import TAKES, VOCAB, write_take
+
+from beatlite.data.index import index_folder
+from beatlite.data.normalize import Normalizer
+from beatlite.data.store import (
+    WindowStore,
+    _combine,
+    _moments,
+    _WordRecorder,
+    build_store,
+    quantize_audio,
+)
+from beatlite.data.windows import build_windows
+from beatlite.io import FormatError
+
+#: 16-bit storage of audio on the step 2**-15: at most half a step off (plus float32 rounding, 0 here).
+AUDIO_BOUND = 2.0**-16
+
+
+@pytest.fixture()
+def corpus(tmp_path: Path) -> Path:
+    root = tmp_path / "corpus"
+    root.mkdir()
+    for stem, n in TAKES.items():
+        write_take(root, stem, n)
+    return root
+
+
+@pytest.fixture()
+def store(corpus: Path, tmp_path: Path) -> WindowStore:
+    return build_store(index_folder(corpus), tmp_path / "store", vocab=VOCAB, workers=0)
+
+
+def _meta_times(store: WindowStore) -> dict[str, int]:
+    return {t.stem: (t.folder / "meta.json").stat().st_mtime_ns for t in store.takes}
+
+
+def test_batches_equal_build_windows(corpus: Path, store: WindowStore) -> None:
+    idx = index_folder(corpus)
+    ref = build_windows(idx, split="train", vocab=VOCAB, cache=False)
+    got = store.windows("train")
+    assert len(got) == len(ref) == 10 and got.keys() == [k for k in ref.keys()]
+    a, b = ref.batch(), got.batch()
+    for key in ref.keys():
+        assert b[key].dtype == a[key].dtype and b[key].shape == a[key].shape, key
+        if key == "audio":  # the ramp k / 2**20 is not on the 16-bit grid
+            assert 0 < np.abs(a[key] - b[key]).max() <= AUDIO_BOUND
+        elif key == "pose":  # statistics pooled per take: equal up to float rounding
+            assert np.allclose(a[key], b[key], rtol=0, atol=1e-5)
+        else:
+            assert np.array_equal(a[key], b[key]), key
+    # with build_windows' statistics every key but audio is bit-identical, also for the val split
+    stats = ref.normalizers
+    val_ref = build_windows(idx, split="val", vocab=VOCAB, stats=stats, cache=False)
+    val = store.windows("val", stats=stats).batch()
+    for key in val_ref.keys():
+        assert key == "audio" or np.array_equal(val_ref[key], val[key]), key
+    norms = store.statistics("train")
+    pose_norm, dir_norm = norms.pose, norms.dirvec
+    assert np.allclose(pose_norm.mean, ref.normalizers.pose.mean, rtol=1e-12, atol=1e-12)
+    assert np.allclose(pose_norm.std, ref.normalizers.pose.std, rtol=1e-12, atol=0)
+    assert np.allclose(dir_norm.mean, ref.normalizers.dirvec.mean, rtol=0, atol=1e-14) and np.all(
+        dir_norm.std == 1
+    )
+    # item / key access as Windows, the word key through the take-local ids
+    assert np.array_equal(got.item(3)["word"], a["word"][3]) and np.array_equal(got["start"], a["start"])
+    assert set(np.unique(b["word"])) >= {0, VOCAB["hello"], VOCAB["world"], 3}  # "zebra" -> UNK
+
+
+def test_word_recorder_maps_to_the_vocabulary() -> None:
+    from beatlite.io.textgrid import Interval, WordIntervals, words_to_frames
+
+    words = WordIntervals(
+        np.array([0.1, 0.5, 0.9]), np.array([0.4, 0.8, 1.2]), ("Hello", "zebra", "world,"), 1.5
+    )
+    tier = [
+        Interval(0.0, 0.1, ""),
+        Interval(0.1, 0.4, "Hello"),
+        Interval(0.4, 0.6, " "),
+        Interval(0.6, 1.0, "world"),
+    ]
+    for source, rule in ((words, "span"), (words, "onset"), (words, "beat"), (tier, "beat")):
+        rec = _WordRecorder()
+        local = words_to_frames(source, 25, 15, rec, rule=rule)
+        table = np.array([0, 1, 2, 3, *[VOCAB.get(m, 3) for m in rec.marks]])
+        assert np.array_equal(table[local], words_to_frames(source, 25, 15, VOCAB, rule=rule)), rule
+
+
+def test_quantize_audio() -> None:
+    q, step = quantize_audio(np.array([0.5, -1.0, 2.0**-15, 32767 / 32768], np.float32))
+    assert step == 2.0**-15 and q.tolist() == [16384, -32768, 1, 32767]
+    y = np.random.default_rng(0).uniform(-1.3, 1.1, 5000)  # peak above 1: step = peak / 32767
+    q, step = quantize_audio(y)
+    assert step == pytest.approx(np.abs(y).max() / 32767, rel=1e-15)
+    assert np.abs(q * step - y).max() <= step / 2 * (1 + 1e-9)
+    with pytest.raises(ValueError, match="NaN"):
+        quantize_audio(np.array([0.0, np.nan]))
+
+
+def test_streamed_moments_equal_the_whole_array() -> None:
+    rng = np.random.default_rng(1)
+    parts = [rng.normal(loc=30.0, scale=s, size=(n, 5)) for n, s in ((7, 1.0), (1, 2.0), (40, 0.5), (0, 1.0))]
+    n, mean, var = _combine([_moments(p) for p in parts], Path("x"))
+    whole = Normalizer.fit([p for p in parts if len(p)])
+    assert (
+        n == 48
+        and np.allclose(mean, whole.mean, rtol=1e-13)
+        and np.allclose(np.sqrt(var), whole.std, rtol=1e-12)
+    )
+
+
+def test_incremental_rebuild(corpus: Path, store: WindowStore, tmp_path: Path) -> None:
+    folder = tmp_path / "store"
+    before = _meta_times(store)
+    again = build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+    assert _meta_times(again) == before  # nothing changed: nothing rebuilt
+    changed = "2_scott_0_10_10"
+    write_take(corpus, changed, 75, scale=2.0)  # new content, new size/mtime
+    shutil.rmtree(corpus / "x", ignore_errors=True)
+    os.remove(corpus / "2_scott_0_1_1.bvh")  # a take without motion leaves the store
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        after = build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+    times = _meta_times(after)
+    assert [s for s in times if times[s] != before.get(s)] == [changed]
+    assert "2_scott_0_1_1" not in times and not (folder / "takes" / "2_scott_0_1_1").exists()
+    assert after.take(changed).n_frames == 75
+    ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
+    assert np.array_equal(after.windows("train", stats=ref.normalizers).batch()["pose"], ref["pose"])
+    # another parameter: every take is rebuilt
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0, word_rule="onset")
+    assert all(v != times[s] for s, v in _meta_times(WindowStore.open(folder)).items())
+
+
+def test_parallel_build_equals_serial(corpus: Path, store: WindowStore, tmp_path: Path) -> None:
+    par = build_store(index_folder(corpus), tmp_path / "par", vocab=VOCAB, workers=2, progress=True)
+    a, b = store.windows(None).batch(), par.windows(None).batch()
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    for t in store.takes:
+        for name in t.meta["shapes"]:
+            assert (t.folder / f"{name}.npy").read_bytes() == (
+                par.take(t.stem).folder / f"{name}.npy"
+            ).read_bytes()
+
+
+def test_only_the_asked_streams_are_read(store: WindowStore) -> None:
+    for t in store.takes:
+        os.remove(t.folder / "mel.npy")
+    reopened = WindowStore.open(store.folder)
+    camn = reopened.windows("train", keys=("pose", "audio", "word", "speaker"))
+    assert camn.batch([0, 4])["pose"].shape == (2, 34, 141) and camn.keys() == [
+        "pose",
+        "audio",
+        "word",
+        "speaker",
+    ]
+    with pytest.raises(FormatError, match="mel.npy"):
+        reopened.windows("train").batch([0])
+    with pytest.raises(KeyError, match="positions"):
+        reopened.windows("train", keys=("positions",))
+
+
+def test_corrupt_files_raise_format_error_naming_them(store: WindowStore) -> None:
+    take = store.takes[int(store.windows("train").take_ids[0])]
+    pose = take.folder / "pose_raw.npy"
+    pose.write_bytes(pose.read_bytes()[:-8])  # truncated
+    with pytest.raises(FormatError, match="pose_raw.npy.*truncated"):
+        WindowStore.open(store.folder).windows("train").batch([0])
+    np.save(pose, np.zeros((3, 141), np.float32))  # wrong dtype and shape
+    with pytest.raises(FormatError, match="pose_raw.npy.*meta.json says"):
+        WindowStore.open(store.folder).windows("train").batch([0])
+    (take.folder / "face.npy").write_bytes(b"not numpy")
+    with pytest.raises(FormatError, match="face.npy"):
+        WindowStore.open(store.folder).windows("train", keys=("face",)).batch([0])
+    (take.folder / "meta.json").write_text("{broken")
+    with pytest.raises(FormatError, match="meta.json"):
+        WindowStore.open(store.folder)
+    manifest = json.loads((store.folder / "store.json").read_text())
+    del manifest["vocab"]
+    (store.folder / "store.json").write_text(json.dumps(manifest))
+    with pytest.raises(FormatError, match="store.json.*vocab"):
+        WindowStore.open(store.folder)
+
+
+def test_build_heals_a_corrupt_entry(corpus: Path, store: WindowStore) -> None:
+    take = store.takes[0]
+    good = (take.folder / "audio.npy").read_bytes()
+    (take.folder / "audio.npy").write_bytes(good[:100])
+    healed = build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+    assert (healed.take(take.stem).folder / "audio.npy").read_bytes() == good
+
+
+def test_torch_loader_over_the_store(store: WindowStore) -> None:
+    import torch
+
+    from beatlite.data.torch_dataset import WindowDataset, window_loader
+
+    windows = store.windows("train", keys=("pose", "audio", "word", "speaker", "take", "start"))
+    whole = windows.batch()
+    for workers in (0, 2):
+        loader = window_loader(windows, batch_size=4, shuffle=False, num_workers=workers)
+        batches = list(loader)
+        assert [len(b["take"]) for b in batches] == [4, 4, 2]
+        for key in ("pose", "audio", "word", "speaker"):
+            got = torch.cat([b[key] for b in batches]).numpy()
+            assert np.array_equal(got, whole[key]), (workers, key)
+        assert sum((b["take"] for b in batches), []) == whole["take"].tolist()
+        first = [
+            b["start"].tolist() for b in window_loader(windows, keys=("start",), seed=3, num_workers=workers)
+        ]
+        again = [b["start"].tolist() for b in window_loader(windows, keys=("start",), seed=3)]
+        assert first == again  # a seed gives the same order, whatever the workers
+        assert sum(first, []) != whole["start"].tolist()  # and it is shuffled
+        seen = torch.cat(
+            [b["pose"] for b in window_loader(windows, batch_size=3, seed=3, num_workers=workers)]
+        )
+        assert len(seen) == len(whole["pose"])
+        assert sorted(map(bytes, seen.numpy())) == sorted(map(bytes, whole["pose"]))  # each window once
+    item = WindowDataset(windows)[2]
+    assert item["pose"].shape == (34, 141) and item["take"] == whole["take"][2]
+
+
+def test_unreadable_take_raises_its_format_error_from_a_worker(corpus: Path, tmp_path: Path) -> None:
+    bvh = corpus / "2_scott_0_9_9.bvh"
+    index = index_folder(corpus)  # indexed while the file is fine: the index calls the take usable
+    lines = bvh.read_text(encoding="utf-8").splitlines()
+    bvh.write_text("\n".join([*lines[:-1], "abc"]) + "\n", encoding="utf-8")  # header fine, last row broken
+    for workers in (0, 2):
+        with pytest.raises(FormatError, match=r"2_scott_0_9_9\.bvh, line \d+"):
+            build_store(index, tmp_path / f"store{workers}", vocab=VOCAB, workers=workers)
+    # indexed now, the take is unusable (the index runs the readers) and names the line
+    record = index_folder(corpus)["2_scott_0_9_9"]
+    assert not record.usable and any("line" in p for p in record.problems)
+
+
+def test_default_vocabulary_follows_the_textgrids(corpus: Path, tmp_path: Path) -> None:
+    from test_data_fixtures import write_textgrid
+
+    from beatlite.data.vocab import build_vocab
+
+    store = build_store(index_folder(corpus), tmp_path / "v", workers=0)
+    assert store.vocab.itos == build_vocab(index_folder(corpus)).itos
+    write_textgrid(corpus / "2_scott_0_9_9.TextGrid", [(0.5, 1.0, "Giraffe")], 100 / 15)
+    again = build_store(index_folder(corpus), tmp_path / "v", workers=0)
+    assert again.vocab.itos == build_vocab(index_folder(corpus)).itos and "giraffe" in again.vocab
+    word = again.windows("train").batch([0])["word"][0]
+    assert again.vocab["giraffe"] in word.tolist()  # the changed take was rebuilt with the new word
+
+
+def test_whole_take_equals_build_windows_whole_takes(corpus: Path, store: WindowStore) -> None:
+    idx = index_folder(corpus)
+    train = build_windows(idx, split="train", vocab=VOCAB, cache=False)
+    stats = train.normalizers
+    ref = build_windows(idx, split="val", vocab=VOCAB, stats=stats, whole_takes=True, cache=False)
+    for i, stem in enumerate(ref["take"]):
+        want, got = ref.item(i), store.whole_take(str(stem), stats=stats)
+        assert got["take"] == stem and got["pose"].shape == want["pose"].shape
+        for key in ref.keys():
+            if key == "audio":
+                assert got[key].shape == want[key].shape and np.abs(got[key] - want[key]).max() <= AUDIO_BOUND
+            else:
+                assert np.array_equal(got[key], want[key]), key
+    # 100 frames: 106666 samples, round((106666 - 1024) / 512 + 1) = 207 mel frames (HA2G's clip rule)
+    assert store.whole_take("2_scott_0_9_9", keys=("mel",))["mel"].shape == (207, 128)
