@@ -67,7 +67,13 @@ class Recipe:
     @property
     def uses_text(self) -> bool:
         """Whether the model reads word ids (needs the vocabulary size and word vectors)."""
-        return self.model in ("camn", "trimodal", "ha2g") and self.overrides.get("use_text", True)
+        return self.model in (
+            "camn",
+            "trimodal",
+            "ha2g",
+            "seq2seq",
+            "joint_embedding",
+        ) and self.overrides.get("use_text", True)
 
 
 CAMN_ABLATIONS: dict[str, dict[str, Any]] = {
@@ -114,6 +120,9 @@ RECIPES: dict[str, Recipe] = {
     **{name: Recipe("camn", kw, epochs=EPOCHS, lr=LR) for name, kw in CAMN_ABLATIONS.items()},
     "s2g_tiny": Recipe("s2g", epochs=EPOCHS, lr=LR),
     "trimodal_tiny": Recipe("trimodal", epochs=EPOCHS, lr=LR),
+    "seq2seq_tiny": Recipe("seq2seq", epochs=EPOCHS, lr=LR),
+    "a2g_tiny": Recipe("a2g", epochs=EPOCHS, lr=LR),
+    "joint_embedding_tiny": Recipe("joint_embedding", epochs=EPOCHS, lr=LR),
     "mean_pose": Recipe("mean_pose", epochs=0),
     "random_clip": Recipe("random_clip", epochs=0),
     **{name: Recipe("ha2g", kw, epochs=HA2G_EPOCHS, lr=HA2G_LR) for name, kw in HA2G_ABLATIONS.items()},
