@@ -1,8 +1,9 @@
 """A2G, Audio2Gestures (Li et al. 2021) as a compact conditional VAE, runnable on a CPU.
 
 Li, Kang, Pei, Zhe, Zhang, He, Bao: "Audio2Gestures: generating diverse gestures from speech audio
-with conditional variational autoencoders", ICCV 2021 (Sec. 3). It is the "A2G" row of BEAT
-Table 4 (BEAT Sec. 5: the VAE-based state of the art next to the GAN-based S2G).
+with conditional variational autoencoders", ICCV 2021 (method section; its abstract names the parts
+below). It is the "A2G" row of BEAT Table 4 (BEAT Sec. 6.3; Sec. 6.2 uses it as the VAE-based state of
+the art next to the GAN-based S2G).
 
 The idea kept: the latent code of a motion is split into a **shared code** ``z_s`` (what audio and
 motion have in common: beats, rhythm) and a **motion-specific code** ``z_m`` (everything the audio

@@ -1,7 +1,7 @@
 """Joint Embedding (text and pose in one latent space) in the style of Language2Pose, runnable on a CPU.
 
-Ahuja, Morency: "Language2Pose: natural language grounded pose forecasting", 3DV 2019 (Sec. 3,
-the Joint Language-to-Pose model JL2P). It is the "Joint Embedding" row of HA2G Table 1 (HA2G
+Ahuja, Morency: "Language2Pose: natural language grounded pose forecasting", 3DV 2019 (its Joint
+Language-to-Pose model, JL2P). It is the "Joint Embedding" row of HA2G Table 1 (HA2G
 Sec. 4.2: "maps the text and motion to the same embedding space and creates motion from
 description text").
 
@@ -25,8 +25,9 @@ Simplified or changed:
   in silences), encoded by the TCN text encoder beatlite's Trimodal uses
   (:class:`~beatlite.models.layers.TextEncoderTCN`) and summarised by a GRU, in place of the
   paper's recurrent sentence encoder over a motion description.
-- Both reconstructions are trained at every step (L1, ``rec_weight`` each), not by switching
-  between the two encoders at random; no curriculum over sequence lengths (windows are 34 frames).
+- Both reconstructions are trained at every step (L1, ``rec_weight`` each), where Yoon et al.
+  2020's released adaptation picks one of the two at random per step; no curriculum over sequence
+  lengths (Language2Pose's curriculum; windows here are always 34 frames).
 - Yoon et al. 2020's TED adaptation of this baseline, whose numbers HA2G Table 1 quotes, also
   feeds audio to the context encoder; this model reads text only, as Language2Pose.
 - The output is ``euler141`` (z-scored Euler channels, like CaMN, S2G and Trimodal), not joint

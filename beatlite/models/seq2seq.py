@@ -1,9 +1,10 @@
 """Attention Seq2Seq (text -> gesture) in the style of Yoon et al. 2019, runnable on a CPU.
 
 Yoon, Ko, Jang, Lee, Kim, Lee: "Robots learn social skills: end-to-end learning of co-speech
-gesture generation for humanoid robots", ICRA 2019 (Sec. III). It is the "Seq2Seq" row of BEAT
-Table 4 and the "Attention Seq2Seq" row of HA2G Table 1 (HA2G Sec. 4.2: "generates gestures from
-speech text by attention mechanism").
+gesture generation for humanoid robots", ICRA 2019 (its method section: a speech-text encoder and a
+gesture decoder with attention). It is the "Seq2Seq" row of BEAT Table 4 (BEAT Sec. 6.3) and the
+"Attention Seq2Seq" row of HA2G Table 1 (HA2G Sec. 4.2: "generates gestures from speech text by
+attention mechanism").
 
 Data flow for a window batch (T = 34 frames; sizes of the ``paper`` preset)::
 
@@ -16,10 +17,11 @@ Data flow for a window batch (T = 34 frames; sizes of the ``paper`` preset)::
                       y_t = pose[t] for t < n_pre (the seed), else out[t]   (free running)
 
 Kept from the paper: a bidirectional GRU encoder over words, a GRU decoder with Bahdanau attention
-over the encoder outputs that emits one pose per step from its previous pose, seed poses, and the
-training loss ``rec_weight * MSE + continuity_weight * mean |out[t] - out[t-1]| +
-variance_weight * (-mean_{b,d} ||out[b, :, d]||_2)``: the smoothness term and the motion-variance
-reward that counters the mean pose (weights 250 / 0.1 / 25 of the authors' TED baseline).
+over the encoder outputs that emits one pose per step from its previous pose, and seed poses. The
+loss is the one of the authors' released implementation of this baseline (Yoon et al. 2020's TED
+code, weights 250 / 0.1 / 25): ``rec_weight * MSE + continuity_weight * mean |out[t] - out[t-1]| +
+variance_weight * (-mean_{b,d} ||out[b, :, d]||_2)``, a smoothness term and a motion-variance
+reward that counters the mean pose.
 
 Simplified or changed:
 
