@@ -115,3 +115,12 @@ def test_paper_preset_builds_and_runs(batch):
     model = build_model("seq2seq", preset="paper", vocab_size=V).eval()
     assert model.config.hidden == 200 and model.config.n_layers == 2
     assert model(batch)["pose"].shape == (3, 34, 141)
+
+
+def test_recipes_give_the_text_models_the_vocabulary():
+    from beatlite.train.recipes import RECIPES
+
+    # build_recipe_model sets vocab_size and word vectors exactly for the models that read words
+    for name in ("seq2seq_tiny", "a2g_tiny", "joint_embedding_tiny"):
+        reads_words = "word" in build_model(RECIPES[name].model, preset="tiny").input_keys
+        assert RECIPES[name].uses_text == reads_words, name
