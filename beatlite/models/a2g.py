@@ -13,9 +13,10 @@ and the motion-specific code from the prior N(0, I), so one audio clip has many 
 
 Data flow (T = 34 frames, per-frame codes; sizes of the ``paper`` preset)::
 
-    audio (B,36266) -> PlainWavEncoder (Trimodal's 4 convs) -> Conv1d(k3) -> LReLU -> Conv1d(k1) -> z_a  (B,T,S)
-    pose (B,T,141)  -> Conv1d(k3) -> LReLU -> Conv1d(k3) -> LReLU -> Conv1d(k1) -> z_p (B,T,S), mu, logvar (B,T,M)
-    decoder(z_s, z_m) = Conv1d(k3) -> LReLU -> Conv1d(k3) -> LReLU -> Conv1d(k1) on cat[z_s, z_m] -> (B,T,141)
+    convs(c_in, c_out) = Conv1d(k3, hidden) -> LReLU -> Conv1d(k3, hidden) -> LReLU -> Conv1d(k1, c_out)
+    audio (B,36266) -> PlainWavEncoder (Trimodal's 4 convs, 34 frames of 32) -> convs(32, S)   -> z_a (B,T,S)
+    pose (B,T,141)  -> convs(141, S + 2M) -> z_p (B,T,S), mu (B,T,M), logvar (B,T,M)
+    decoder(z_s, z_m) = convs(S + M, 141) on cat[z_s, z_m]                             -> (B,T,141)
 
     "pose"        = decoder(z_a, eps)      eps ~ N(0, I) (training); see ``eval_z`` (inference)
     "pose_motion" = decoder(z_p, z_m)      z_m = mu + exp(logvar / 2) * N(0, I) (eval: mu)
