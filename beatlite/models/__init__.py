@@ -9,7 +9,6 @@ Usage (skipped by the doctests: building a network is covered by ``tests/test_mo
 :func:`model_class` import the model module on first use. Every model follows the
 :class:`beatlite.models.base.GestureModel` contract.
 
-==================  =============================================  ===============
 name                class                                          representation
 ==================  =============================================  ===============
 ``camn``            :class:`beatlite.models.camn.CaMN`             euler141
@@ -21,6 +20,20 @@ name                class                                          representatio
 ==================  =============================================  ===============
 
 Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
+=======
+===================  =======================================================  ==============
+name                 class                                                    representation
+===================  =======================================================  ==============
+``camn``             :class:`beatlite.models.camn.CaMN`                       euler141
+``ha2g``             ``beatlite.models.ha2g.HA2G``                            dirvec126
+``s2g``              :class:`beatlite.models.baselines.S2G`                   euler141
+``trimodal``         :class:`beatlite.models.baselines.Trimodal`              euler141
+``mean_pose``        :class:`beatlite.models.baselines.MeanPose`              euler141
+``random_clip``      :class:`beatlite.models.baselines.RandomClip`            euler141
+``seq2seq``          :class:`beatlite.models.seq2seq.Seq2Seq`                 euler141
+``a2g``              :class:`beatlite.models.a2g.A2G`                         euler141
+``joint_embedding``  :class:`beatlite.models.joint_embedding.JointEmbedding`  euler141
+===================  =======================================================  ==============
 """
 
 from __future__ import annotations
@@ -38,6 +51,9 @@ MODELS: dict[str, tuple[str, str] | type[GestureModel]] = {
     "trimodal": ("beatlite.models.baselines", "Trimodal"),
     "mean_pose": ("beatlite.models.baselines", "MeanPose"),
     "random_clip": ("beatlite.models.baselines", "RandomClip"),
+    "seq2seq": ("beatlite.models.seq2seq", "Seq2Seq"),
+    "a2g": ("beatlite.models.a2g", "A2G"),
+    "joint_embedding": ("beatlite.models.joint_embedding", "JointEmbedding"),
 }
 """Registry: model name -> (module, class name), imported on first use, or a registered class."""
 
