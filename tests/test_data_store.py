@@ -273,3 +273,30 @@ def test_whole_take_equals_build_windows_whole_takes(corpus: Path, store: Window
                 assert np.array_equal(got[key], want[key]), key
     # 100 frames: 106666 samples, round((106666 - 1024) / 512 + 1) = 207 mel frames (HA2G's clip rule)
     assert store.whole_take("2_scott_0_9_9", keys=("mel",))["mel"].shape == (207, 128)
+
+
+@pytest.mark.slow
+def test_fit_reads_a_store_through_a_dataloader_like_the_windows_in_memory(
+    corpus: Path, store: WindowStore
+) -> None:
+    """Training on a store (batches read by DataLoader workers) takes the same steps as on build_windows'
+    arrays when the model reads no audio (the store keeps audio as 16-bit PCM); workers change nothing."""
+    torch = pytest.importorskip("torch")
+    from beatlite.models import build_model
+    from beatlite.train import TrainConfig, fit
+
+    ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
+    runs = {}
+    for name, windows, workers in (
+        ("memory", ref, 0),
+        ("store", store.windows("train", stats=ref.normalizers), 0),
+        ("store, 2 workers", store.windows("train", stats=ref.normalizers), 2),
+    ):
+        torch.manual_seed(0)
+        model = build_model("s2g", preset="tiny")  # reads pose and mel
+        config = TrainConfig(epochs=2, batch_size=4, seed=1, threads=1, progress=False, workers=workers)
+        history = fit(model, windows, config).history
+        runs[name] = (history, [p.detach().clone() for p in model.parameters()])
+    for name in ("store", "store, 2 workers"):
+        assert runs[name][0] == runs["memory"][0], name
+        assert all(torch.equal(a, b) for a, b in zip(runs[name][1], runs["memory"][1], strict=True)), name

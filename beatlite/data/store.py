@@ -570,6 +570,19 @@ class StoreWindows:
         self.whole_takes = False
         self._word_tables: dict[int, np.ndarray] = {}
 
+    @property
+    def fingerprint(self) -> str:
+        """16 hex digits identifying these windows: the takes' fingerprints, the windows and the statistics
+        (what :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data)."""
+        import hashlib
+
+        h = hashlib.sha256(json.dumps({k: str(v) for k, v in self.params.items()}, sort_keys=True).encode())
+        for i in np.unique(self.take_ids):
+            h.update(self.store.takes[int(i)].meta["fingerprint"].encode())
+        for a in (self.take_ids, self.starts, *self.normalizers.to_meta().values()):
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()[:16]
+
     # mapping-like access, as Windows -------------------------------------------
     def keys(self) -> list[str]:
         """Batch keys this view reads, in contract order."""

@@ -58,6 +58,9 @@ class TrainConfig:
     amp : bool
         Mixed precision (bfloat16 autocast) for the forward pass and losses on CUDA; ignored on the
         CPU, where training stays float32 and bitwise deterministic.
+    workers : int
+        DataLoader worker processes that read the batches of a window store
+        (:class:`beatlite.data.store.StoreWindows`); in-memory windows are indexed in the loop.
     micro_batches : int
         Split every batch into this many micro-batches whose gradients are averaged before the step
         (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
@@ -83,6 +86,7 @@ class TrainConfig:
     device: str = "cpu"
     amp: bool = False
     micro_batches: int = 1
+    workers: int = 0
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -97,6 +101,8 @@ class TrainConfig:
             )
         if self.windows_per_epoch is not None and self.windows_per_epoch < 2:
             raise ValueError(f"TrainConfig: windows_per_epoch must be >= 2, got {self.windows_per_epoch}")
+        if self.workers < 0:
+            raise ValueError(f"TrainConfig: workers must be >= 0, got {self.workers}")
         if self.micro_batches < 1:
             raise ValueError(f"TrainConfig: micro_batches must be >= 1, got {self.micro_batches}")
         if self.threads is not None and self.threads < 1:

@@ -322,18 +322,49 @@ def _shown_losses(entry: dict[str, Any]) -> dict[str, str]:
 
 @dataclasses.dataclass(eq=False)
 class _Data:
-    """The training windows as the loop reads them."""
+    """The training windows as the loop reads them: in-memory arrays, or a window store read at batch time."""
 
-    arrays: Mapping[str, np.ndarray]
+    arrays: Mapping[str, np.ndarray] | None
     keys: tuple[str, ...]
     n: int
     fingerprint: str
+    store: Any = None
 
     @classmethod
     def of(cls, model: GestureModel, windows: Any) -> _Data:
+        if hasattr(windows, "store") and callable(getattr(windows, "batch", None)):  # a StoreWindows
+            missing = sorted((set(model.input_keys) | {model.target_key}) - set(windows.keys()))
+            if missing:
+                raise KeyError(f"fit: windows lack {missing} needed by {type(model).__name__}")
+            keys = tuple(k for k in TENSOR_KEYS if k in windows.keys())
+            return cls(None, keys, len(windows), data_fingerprint(windows), windows)
         arrays = as_arrays(windows)
         keys = _needed_keys(model, arrays, "fit")
         return cls(arrays, keys, _n_windows(arrays, keys, "fit"), data_fingerprint(windows))
+
+    def batches(self, steps: list[list[np.ndarray]], device: Any, workers: int) -> Any:
+        """For every step, its micro-batches as (tensor dict, windows) on ``device``.
+
+        A window store is read by a ``torch.utils.data.DataLoader`` (``workers`` processes, pinned
+        memory on CUDA) in exactly this order; in-memory arrays are indexed here.
+        """
+        if self.store is None:
+            for step in steps:
+                yield [(_batch(self.arrays, self.keys, m, device), len(m)) for m in step]
+            return
+        from torch.utils.data import DataLoader
+
+        from beatlite.data.torch_dataset import WindowDataset
+
+        flat = [m for step in steps for m in step]
+        pin = getattr(device, "type", "cpu") == "cuda"
+        loader = DataLoader(WindowDataset(self.store, self.keys), batch_size=None, sampler=flat,
+                            num_workers=workers, pin_memory=pin)  # fmt: skip
+        batches = iter(loader)
+        for step in steps:
+            yield [
+                ({k: v.to(device, non_blocking=True) for k, v in next(batches).items()}, len(m)) for m in step
+            ]
 
 
 class _Run:
@@ -400,15 +431,16 @@ class _Run:
         sums: dict[str, float] = {}
         seen = 0
         parts = max(config.micro_batches, self.world)  # micro-batches per step, spread over the processes
+        steps = []
         for start in range(0, len(order), config.batch_size):
             idx = np.sort(order[start : start + config.batch_size])
             micro = [idx[m::parts] for m in range(parts)]
             if min(len(m) for m in micro) < 2:  # BatchNorm needs 2 windows per micro-batch
                 continue
-            mine = micro[self.rank :: self.world]
-            batches = [(_batch(data.arrays, data.keys, m, self.device), len(m)) for m in mine]
-            self.step(batches, parts, epoch, sums)
+            steps.append(micro[self.rank :: self.world])
             seen += len(idx)
+        for batches in data.batches(steps, self.device, config.workers):
+            self.step(batches, parts, epoch, sums)
         return _mean_losses(_sum_over_processes(sums, self.world), seen)
 
     def step(
