@@ -367,3 +367,21 @@ def test_metrics_table_names_each_variant(results):
     assert lines[0] == "| method | FGD ↓ | BC ↑ |"
     assert lines[2].startswith("| Mean pose | ") and len(lines[2].split("|")) == 5
     assert "- **BC**: HA2G beat consistency" in text and "Ground truth" not in text
+
+
+def test_generated_euler_of_the_mean_pose_is_its_mean_and_directions_are_refused(test_set):
+    from beatlite.train.evaluation import generated_euler
+
+    mean_pose = build_model("mean_pose")
+    pose = np.full((2, 34, 141), 0.5, np.float32)  # z-scored mean 0.5 -> 0.5 degrees (std 1, mean 0)
+    mean_pose.prepare({"pose": pose})
+    euler = generated_euler(mean_pose, test_set)
+    assert [e.shape for e in euler] == [(t, 141) for t in LENGTHS]
+    # seeded by the first 4 ground-truth frames (0), then the mean pose from frame 4 on
+    np.testing.assert_allclose(euler[0][10:], 0.5, atol=1e-6)
+
+    class Still:
+        representation = "dirvec126"
+
+    with pytest.raises(ValueError, match="not Euler"):
+        generated_euler(Still(), test_set)

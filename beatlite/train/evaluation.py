@@ -786,3 +786,114 @@ def metrics_table(
     ]
     text = markdown_table(["method", *column_headers(metrics)], body)
     return text + ("\n\n" + describe(metrics) if caption else "")
+
+
+# ------------------------------------------------------------------------------------ the papers' rows
+#: BEAT (ECCV 2022) Table 4, on BEAT's 4-speaker English data: method -> metric -> value. Computed
+#: with BEAT's code: FGD of its own autoencoder on 141 Euler channels, SRGR and BeatAlign on Euler
+#: angles (our keys ``"SRGR (reference)"`` and ``"BeatAlign (reference)"``).
+PAPER_BEAT_TABLE4: dict[str, dict[str, float]] = {
+    "Seq2Seq": {"FGD": 261.3, "SRGR": 0.173, "BeatAlign": 0.729},
+    "S2G": {"FGD": 256.7, "SRGR": 0.092, "BeatAlign": 0.751},
+    "A2G": {"FGD": 223.8, "SRGR": 0.097, "BeatAlign": 0.766},
+    "MultiContext": {"FGD": 176.2, "SRGR": 0.196, "BeatAlign": 0.776},
+    "CaMN": {"FGD": 123.7, "SRGR": 0.239, "BeatAlign": 0.783},
+}
+
+#: BEAT Table 5 (ablations of CaMN), same metrics: row of the paper -> metric -> value.
+PAPER_BEAT_TABLE5: dict[str, dict[str, float]] = {
+    "full cascaded": {"FGD": 123.7, "SRGR": 0.239, "BeatAlign": 0.783},
+    "w/o cascaded": {"FGD": 137.2, "SRGR": 0.207, "BeatAlign": 0.776},
+    "w/o text": {"FGD": 149.4, "SRGR": 0.171, "BeatAlign": 0.781},
+    "w/o audio": {"FGD": 155.7, "SRGR": 0.225, "BeatAlign": 0.733},
+    "w/o speaker ID": {"FGD": 159.1, "SRGR": 0.207, "BeatAlign": 0.774},
+    "w/o face": {"FGD": 163.3, "SRGR": 0.217, "BeatAlign": 0.767},
+    "w/o emotion": {"FGD": 151.7, "SRGR": 0.231, "BeatAlign": 0.775},
+    "w/o semantic": {"FGD": 151.8, "SRGR": 0.194, "BeatAlign": 0.786},
+}
+
+#: HA2G (CVPR 2022) Table 1, TED-Expressive columns: FGD and Diversity of HA2G's own extractor, BC
+#: with HA2G's code on 34-frame clips (our key ``"BC (ha2g)"``).
+PAPER_HA2G_TABLE1: dict[str, dict[str, float]] = {
+    "Ground Truth": {"FGD": 0.0, "BC": 0.723, "Diversity": 175.231},
+    "Attention Seq2Seq": {"FGD": 54.920, "BC": 0.155, "Diversity": 122.693},
+    "Speech2Gesture": {"FGD": 54.650, "BC": 0.714, "Diversity": 142.489},
+    "Joint Embedding": {"FGD": 64.555, "BC": 0.131, "Diversity": 120.627},
+    "Trimodal": {"FGD": 12.613, "BC": 0.592, "Diversity": 154.088},
+    "HA2G": {"FGD": 5.306, "BC": 0.715, "Diversity": 173.899},
+}
+
+#: HA2G Tables 3 (audio learner) and 4 (pose inferer), TED-Expressive, same metrics as Table 1.
+PAPER_HA2G_ABLATIONS: dict[str, dict[str, float]] = {
+    "f_a^low only (T3)": {"FGD": 6.588, "BC": 0.704, "Diversity": 171.482},
+    "f_a^mid only (T3)": {"FGD": 7.212, "BC": 0.682, "Diversity": 168.223},
+    "f_a^high only (T3)": {"FGD": 7.421, "BC": 0.661, "Diversity": 165.741},
+    "w/o high-level negatives (T3)": {"FGD": 7.982, "BC": 0.652, "Diversity": 163.649},
+    "w/o low/mid-level negatives (T3)": {"FGD": 6.998, "BC": 0.701, "Diversity": 169.021},
+    "w/o text (T3)": {"FGD": 9.228, "BC": 0.619, "Diversity": 158.236},
+    "HA2G-ASR (T3)": {"FGD": 5.319, "BC": 0.716, "Diversity": 173.058},
+    "Holistic (T4)": {"FGD": 11.989, "BC": 0.594, "Diversity": 156.079},
+    "w/o hand hierarchy (T4)": {"FGD": 10.832, "BC": 0.606, "Diversity": 158.823},
+    "w/o body hierarchy (T4)": {"FGD": 5.882, "BC": 0.709, "Diversity": 173.066},
+    "Same audio f_a^h (T4)": {"FGD": 6.801, "BC": 0.701, "Diversity": 170.085},
+    "w/o L_phy (T4)": {"FGD": 5.907, "BC": 0.708, "Diversity": 172.651},
+    "HA2G Full": {"FGD": 5.306, "BC": 0.715, "Diversity": 173.899},
+}
+
+
+def paper_table(rows: Mapping[str, Mapping[str, float]], *, digits: int = 3) -> str:
+    """A Markdown table of a paper's published rows (one of the ``PAPER_*`` dicts above).
+
+    Examples
+    --------
+    >>> print(paper_table({"CaMN": {"FGD": 123.7, "SRGR": 0.239}}, digits=1))
+    | method | FGD | SRGR |
+    |---|---|---|
+    | CaMN | 123.7 | 0.2 |
+    """
+    from beatlite.report import markdown_table
+
+    keys = list(dict.fromkeys(k for values in rows.values() for k in values))
+    return markdown_table(
+        ["method", *keys],
+        [[m, *(float(v.get(k, math.nan)) for k in keys)] for m, v in rows.items()],
+        digits=digits,
+    )
+
+
+def generated_euler(
+    model: Any, test: EvaluationSet, normalizers: Normalizers | None = None
+) -> list[np.ndarray]:
+    """An Euler model's generation of every take of ``test``, in ``spine_neck_141`` degrees.
+
+    The same generation as :func:`evaluate_models` (whole takes, seeded by the first 4 ground-truth
+    frames), returned before the conversion to TED-43 directions: the input of BEAT Table 6
+    (:func:`beatlite.stats.table6`).
+
+    Parameters
+    ----------
+    model : GestureModel or str
+        A model in eval mode, or a checkpoint name / path (then its own training normalisers are used).
+    test : EvaluationSet
+    normalizers : Normalizers, optional
+        The statistics the model was trained with (default the checkpoint's, else ``test.normalizers``).
+
+    Returns
+    -------
+    list of (T_k, 141) float64, degrees
+
+    Raises
+    ------
+    ValueError
+        ``model`` predicts directions (``dirvec126``): it has no Euler angles.
+    """
+    import torch
+
+    if isinstance(model, str | Path):
+        model, stored, _, _ = _load_checkpoint(str(model), test)
+        normalizers = stored if normalizers is None else normalizers
+    if model.representation != "euler141":
+        raise ValueError(f"{type(model).__name__} predicts {model.representation}, not Euler angles")
+    with torch.no_grad():
+        _, euler = _generate(model, test, normalizers)
+    return euler
