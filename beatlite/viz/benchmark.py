@@ -20,6 +20,7 @@ notebooks/07_benchmark.ipynb (sections 4, 5) and notebooks/08_visualisation_3d.i
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -245,7 +246,7 @@ def plot_benchmark(results: Any, *, cut_factor: float = 1.6, out: Out = None) ->
     order = np.argsort(fgd)
     rest = np.sort(fgd)[:-1] if len(fgd) > 1 else fgd
     limit = rest.max() * 1.25 if len(fgd) > 1 and fgd.max() > cut_factor * rest.max() else fgd.max() * 1.1
-    colours = {lab: SYSTEM_COLOURS[k % len(SYSTEM_COLOURS)] for k, lab in enumerate(labels)}
+    colours = _row_colours(labels)
     with figure_style():
         fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1, 1]})
         y = np.arange(len(labels))[::-1]
@@ -265,11 +266,21 @@ def plot_benchmark(results: Any, *, cut_factor: float = 1.6, out: Out = None) ->
         ax0.set_xlim(0, limit)
         ax0.set_xlabel("FGD (lower is better)")
         shown = [i for i in range(len(labels)) if np.isfinite(bc[i]) and fgd[i] <= limit]
-        for i in shown:
-            ax1.scatter(fgd[i], bc[i], color=colours[labels[i]], s=30, zorder=3)
-            ax1.annotate(labels[i], (fgd[i], bc[i]), fontsize=8, xytext=(5, 3), textcoords="offset points")
         if shown:
             x_hi = max(fgd[i] for i in shown)
+            span = max(bc[i] for i in shown) - min(bc[i] for i in shown) + 1e-3
+            placed: list[tuple[float, float]] = []
+            for i in sorted(shown, key=lambda i: fgd[i]):
+                ax1.scatter(fgd[i], bc[i], color=colours[labels[i]], s=30, zorder=3)
+                crowded = any(
+                    abs(fgd[i] - x) < 0.25 * x_hi and abs(bc[i] - y) < 0.06 * span for x, y in placed
+                )
+                offset = (5, -11) if crowded else (5, 3)  # a neighbour's label is there: write below
+                ax1.annotate(
+                    labels[i], (fgd[i], bc[i]), fontsize=8, xytext=offset, textcoords="offset points"
+                )
+                if not crowded:
+                    placed.append((fgd[i], bc[i]))
             ax1.set_xlim(-0.05 * x_hi, 1.45 * x_hi)  # room for the labels right of the points
             lo, hi = min(bc[i] for i in shown), max(bc[i] for i in shown)
             ax1.set_ylim(lo - 0.1 * (hi - lo + 1e-3), hi + 0.15 * (hi - lo + 1e-3))
@@ -278,6 +289,18 @@ def plot_benchmark(results: Any, *, cut_factor: float = 1.6, out: Out = None) ->
         ax1.set_title("closeness to the data vs synchrony")
         fig.tight_layout()
     return _finish(fig, out)
+
+
+def _row_colours(labels: Sequence[str]) -> dict[str, str]:
+    """One colour per row: the system colours for the ground truth, CaMN and HA2G, tab10 for the rest."""
+    import matplotlib
+
+    fixed = {"Ground truth": SYSTEM_COLOURS[0], "CaMN": SYSTEM_COLOURS[1], "HA2G": SYSTEM_COLOURS[2]}
+    others = [
+        c for c in matplotlib.colormaps["tab10"].colors if matplotlib.colors.to_hex(c) not in fixed.values()
+    ]
+    free = itertools.cycle(others)
+    return {lab: fixed.get(lab) or matplotlib.colors.to_hex(next(free)) for lab in labels}
 
 
 def plot_table6_rows(
@@ -305,10 +328,9 @@ def plot_table6_rows(
     import matplotlib.pyplot as plt
 
     from beatlite.stats import PAPER_TABLE6
-    from beatlite.stats.distributions import EMOTION_NAMES
 
     paper = {"real": "paper: real", "generated": "paper: CaMN (generated)"} if paper is None else paper
-    names = [*EMOTION_NAMES, "avg"]
+    names = list(PAPER_TABLE6["real"])  # the paper's order, then "avg"
     bars = [(label, [PAPER_TABLE6[k][n] for n in names]) for k, label in paper.items()]
     bars += [(f"beatlite: {k}", [100 * acc.get(n, math.nan) for n in names]) for k, acc in rows.items()]
     greys = ["0.55", "0.75"]
