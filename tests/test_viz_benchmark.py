@@ -41,6 +41,9 @@ def test_keyframes_share_one_scale_and_title_times():
     assert len(spans) == 1  # one scale for both systems
     # the largest extent: 100 cm (+ 2 x 5 cm margin)
     assert spans.pop() == pytest.approx(110.0)
+    # one horizontal span for both systems too
+    widths = {round(float(np.ptp(ax.get_xlim())), 6) for ax in axes}
+    assert len(widths) == 1
     assert [ax.get_title() for ax in axes[:3]] == ["0.0 s", "0.2 s", "0.4 s"]
     assert not [ax for ax in axes if ax.get_title() and ax in axes[3:]]
 

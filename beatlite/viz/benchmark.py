@@ -83,8 +83,9 @@ def plot_keyframes(
 ) -> Any:
     """Key frames of several systems (rows) at the same frames (columns), all on one scale.
 
-    Every panel spans the same number of centimetres (the largest extent over all systems and
-    frames), centred on its own skeleton, without a floor; joints keep one colour per group (body,
+    Every panel spans the same number of centimetres on each axis (the largest extent over all
+    systems and frames), centred on its own skeleton, without a floor, and is as wide as that
+    extent needs (a standing body gets narrow, tall panels); joints keep one colour per group (body,
     hands, head) whatever the skeleton (BEAT or TED-43), so rows compare like with like.
 
     Parameters
@@ -98,7 +99,7 @@ def plot_keyframes(
     view : str
         Camera, as :func:`beatlite.viz.plot_frame` (``"front"``: the character faces us).
     panel_size : float
-        Inches per panel.
+        Panel height, inches.
     out : str or Path, optional
         Save as ``<out>.png`` / ``.svg``.
 
@@ -115,22 +116,23 @@ def plot_keyframes(
         raise ValueError("plot_keyframes needs at least one system and one frame")
     shown = {k: np.asarray(p, np.float64)[frames] for k, (p, _) in systems.items()}
     pts = {k: to_plot_coords(v.reshape(-1, 3)) for k, v in shown.items()}
-    half = max(float((p.max(0) - p.min(0)).max()) for p in pts.values()) / 2 + 5.0
+    # one half-extent per plot axis (x, depth, up), the largest over all systems: one scale for all
+    half = np.max([(p.max(0) - p.min(0)) / 2 for p in pts.values()], axis=0) + 5.0
+    width = panel_size * float(np.clip(half[0] / half[2], 0.6, 2.0))
     with figure_style():
-        fig = plt.figure(figsize=(panel_size * len(frames) + 0.6, panel_size * len(systems)))
+        fig = plt.figure(figsize=(width * len(frames) + 0.4, panel_size * len(systems)))
         for row, (label, (positions, skeleton)) in enumerate(systems.items()):
             skel, names = _skeleton_of(skeleton)
+            centre = (pts[label].max(0) + pts[label].min(0)) / 2
             for col, frame in enumerate(frames):
                 ax = fig.add_subplot(len(systems), len(frames), row * len(frames) + col + 1, projection="3d")
                 plot_frame(positions, skel, frame, ax=ax, view=view, floor=False, names=names)
-                centre = (pts[label].max(0) + pts[label].min(0)) / 2
-                for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
-                    setter(c - half, c + half)
-                ax.set_box_aspect((1, 1, 1), zoom=1.25)
-                if row == 0:
-                    ax.set_title(f"{frame / fps:.1f} s", fontsize=9)
+                for setter, c, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, half, strict=True):
+                    setter(c - h, c + h)
+                ax.set_box_aspect(tuple(half), zoom=1.0)
+                ax.set_title(f"{frame / fps:.1f} s" if row == 0 else "", fontsize=9)
             fig.text(0.005, 1 - (row + 0.5) / len(systems), label, rotation=90, va="center", fontsize=10)
-        fig.subplots_adjust(left=0.03, right=1, bottom=0, top=0.95, wspace=0, hspace=0)
+        fig.subplots_adjust(left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=0.94, wspace=0, hspace=0)
     return _finish(fig, out)
 
 
