@@ -83,9 +83,9 @@ def plot_keyframes(
 ) -> Any:
     """Key frames of several systems (rows) at the same frames (columns), all on one scale.
 
-    Every panel spans the same number of centimetres on each axis (the largest extent over all
-    systems and frames), centred on its own skeleton, without a floor, and is as wide as that
-    extent needs (a standing body gets narrow, tall panels); joints keep one colour per group (body,
+    Every panel spans the same centimetres on each axis (the largest extent over all systems and
+    frames), centred on its own skeleton, without a floor, and is as wide as that extent needs (a
+    standing body gets narrow, tall panels); joints keep one colour per group (body,
     hands, head) whatever the skeleton (BEAT or TED-43), so rows compare like with like.
 
     Parameters
@@ -129,7 +129,7 @@ def plot_keyframes(
                 plot_frame(positions, skel, frame, ax=ax, view=view, floor=False, names=names)
                 for setter, c, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, half, strict=True):
                     setter(c - h, c + h)
-                ax.set_box_aspect(tuple(half), zoom=1.0)
+                ax.set_box_aspect(tuple(half), zoom=1.15)
                 ax.set_title(f"{frame / fps:.1f} s" if row == 0 else "", fontsize=9)
             fig.text(0.005, 1 - (row + 0.5) / len(systems), label, rotation=90, va="center", fontsize=10)
         fig.subplots_adjust(left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=0.94, wspace=0, hspace=0)
