@@ -203,6 +203,7 @@ def plot_training_history(
                 if first_adversarial is not None and first_adversarial > epochs.max():
                     why = f"off until epoch {first_adversarial}:\nnot reached in {len(epochs)} epochs"
                 ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes, color="0.4")
+                ax.set(xticks=[], yticks=[])
             else:
                 for k, (name, v) in enumerate(values.items()):
                     label = "validation takes" if key == "val_score" else name
