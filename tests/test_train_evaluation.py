@@ -346,7 +346,7 @@ def test_score_models_reference_variants_closed_forms(test_set):
 def test_score_models_direction_rows_have_no_euler_variant(test_set):
     from beatlite.train.evaluation import score_models
 
-    class Still:  # a direction model that repeats the mean direction (dirvec 0)
+    class Still(torch.nn.Module):  # a direction model that repeats the mean direction (dirvec 0)
         representation, input_keys, target_key, pose_dim, n_pre = "dirvec126", ("dirvec",), "dirvec", 126, 4
 
         def generate(self, batch):
