@@ -215,3 +215,39 @@ def test_real_files_untouched(real_samples: Path) -> None:
     read_textgrid(real_samples / "2_scott_0_2_2.TextGrid")
     after = {p.name: (p.read_bytes(), os.stat(p).st_mtime_ns) for p in real_samples.iterdir()}
     assert after == before
+
+
+def test_clip_take_cuts_every_modality_onto_one_timeline(tmp_path: Path) -> None:
+    from beatlite.io.take import clip_take
+
+    take = load_take(make_take(tmp_path), fps=15)  # 2 s: 30 frames, frame k of the bvh is 8k at 120 fps
+    clip = clip_take(take, 0.4, 1.2)  # frames round(6.0) = 6 to round(18.0) = 18
+    assert clip.n_frames == 12 and clip.fps == 15
+    np.testing.assert_array_equal(clip.motion.channels, take.motion.channels[6:18])
+    np.testing.assert_array_equal(clip.face, take.face[6:18])
+    np.testing.assert_array_equal(clip.emotion, take.emotion[6:18])
+    np.testing.assert_array_equal(clip.semantic, take.semantic[6:18])
+    # audio: samples 0.4 * sr to 1.2 * sr
+    a, b = int(round(0.4 * take.sr)), int(round(1.2 * take.sr))
+    np.testing.assert_array_equal(clip.audio, take.audio[a:b])
+    # words "hello" [0.2, 0.6) and "world" [0.6, 1.0): shifted by 0.4 s, hello cut at 0
+    assert clip.words.words == ("hello", "world")
+    np.testing.assert_allclose(clip.words.starts, [0.0, 0.2], atol=1e-12)
+    np.testing.assert_allclose(clip.words.ends, [0.2, 0.6], atol=1e-12)
+    # semantic segment [0.5, 1.0] -> [0.1, 0.6]; emotion [1.0, 1.5] -> [0.6, 0.8] (cut at the clip's end)
+    (sem,) = clip.semantic_segments
+    assert (sem.start, sem.end, sem.score) == pytest.approx((0.1, 0.6, 0.25))
+    (emo,) = clip.emotion_segments
+    assert (emo.start, emo.end, emo.duration, emo.emotion) == pytest.approx((0.6, 0.8, 0.2, 5))
+    assert take.n_frames == 30  # the source is untouched
+
+
+def test_clip_take_past_the_end_and_bad_intervals(tmp_path: Path) -> None:
+    from beatlite.io.take import clip_take
+
+    take = load_take(make_take(tmp_path), fps=15)
+    tail = clip_take(take, 1.8, 5.0)  # cut to the end: frames 27..29
+    assert tail.n_frames == 3 and tail.words.words == ()
+    for t0, t1 in ((1.0, 1.0), (-0.1, 1.0), (2.5, 3.0)):
+        with pytest.raises(ValueError, match="clip_take"):
+            clip_take(take, t0, t1)

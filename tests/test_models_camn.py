@@ -263,3 +263,25 @@ def test_word_vectors_are_loaded():
     assert np.array_equal(model.text_encoder.embedding.weight.detach().numpy(), vectors)
     with pytest.raises(ValueError, match="vectors"):
         model.set_word_vectors(vectors[:, :3])
+
+
+def test_input_widths_match_the_built_layers_and_the_paper():
+    from beatlite.models import build_model
+    from beatlite.models.camn import PARTS, input_widths, part_parameters
+
+    for preset in ("tiny", "paper"):
+        model = build_model("camn", preset=preset, vocab_size=20)
+        w = input_widths(model.config)
+        assert w["audio fusion in"] == model.audio_fusion[0].in_features
+        assert w["face fusion in"] == model.face_fusion[0].in_features
+        assert w["body decoder in"] == model.body_decoder.lstm.input_size
+        assert w["hands decoder in"] == model.hands_decoder.lstm.input_size
+        counts = part_parameters(model)
+        assert list(counts) == [*PARTS, "total"] and sum(counts[p] for p in PARTS) == counts["total"]
+    # BEAT's reference code: context 8 + 8 + 128 = 144; audio fusion 128 + 144 = 272; face 32 + 128 + 144 = 304
+    assert input_widths(model.config) == {
+        "audio fusion in": 272,
+        "face fusion in": 304,
+        "body decoder in": 446,
+        "hands decoder in": 473,
+    }

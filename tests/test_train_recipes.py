@@ -255,3 +255,29 @@ def test_fit_command_writes_only_under_out(tmp_path):
     full = load_checkpoint(out / "train" / "s2g_tiny.pt")
     assert full["epoch"] == 1 and full["train_config"]["device"] == "cpu"
     assert full["best"] is not None  # the validation FGD scored the epoch
+
+
+def test_ablation_table_values_changes_and_paper_rows():
+    from beatlite.train.seeds import SeedResults, ablation_table
+
+    rec = SeedResults(
+        {
+            "Full": {"FGD": [1.0, 2.0, 3.0], "SRGR": [0.2, 0.2, 0.2]},
+            "No X": {"FGD": [5.0, 6.0, 7.0], "SRGR": [0.1, 0.1, 0.1]},
+        },
+        [1, 2, 3],
+        {},
+    )
+    paper = {"full": {"FGD": 9.0}, "w/o X": {"FGD": 12.0}}
+    text = ablation_table(rec, "Full", {"Full": "full", "No X": "w/o X"}, paper, deltas=("FGD", "SRGR"))
+    lines = text.splitlines()
+    assert lines[0].startswith(
+        "| variant | paper row | paper FGD ↓ | paper SRGR ↑ | ours FGD ↓ | ours SRGR ↑ |"
+    )
+    full, no_x = lines[2].split(" | "), lines[3].split(" | ")
+    assert full[2:6] == ["9.00", "—", "2.00 ± 1.00", "0.200 ± 0.000"]
+    # FGD: +4 with SE sqrt(1/3 + 1/3) = 0.816 -> 2 SE 1.63: worse (FGD is lower-is-better)
+    assert no_x[6] == "+4.00 ± 1.63 worse"
+    # SRGR: -0.1 with SE 0 -> worse
+    assert no_x[7] == "-0.100 ± 0.000 worse"
+    assert lines[3].endswith("| 3 |")

@@ -68,6 +68,7 @@ __all__ = [
     "reconcile_rate",
     "reference_duration",
     "resample_frames",
+    "clip_take",
     "PHASES",
     "TAKE_EXTENSIONS",
     "RATE_GAP_S",
@@ -467,4 +468,88 @@ def load_take(
         info=info,
         paths=paths,
         **_annotations(paths, info, motion.n_frames, fps),  # type: ignore[arg-type]
+    )
+
+
+def clip_take(take: Take, t0: float, t1: float) -> Take:
+    """The part of ``take`` in ``[t0, t1)`` seconds, on a timeline that starts at 0.
+
+    Frames ``a = round(t0 * fps)`` to ``b = round(t1 * fps)`` (exclusive, at most ``n_frames``) of
+    every per-frame array are kept; the audio keeps samples ``round(a / fps * sr)`` to
+    ``round(b / fps * sr)``. Words and semantic / emotion segments that overlap the clip are kept,
+    shifted by ``-a / fps`` and cut to ``[0, (b - a) / fps]``, so they line up with the clipped
+    frames (a word caption, an animation's timeline).
+
+    Parameters
+    ----------
+    take : Take
+    t0, t1 : float
+        Seconds, ``0 <= t0 < t1``; ``t1`` past the end is cut to the end.
+
+    Returns
+    -------
+    Take
+        A new take (arrays are copies); ``name`` and ``info`` as the source's.
+
+    Raises
+    ------
+    ValueError
+        An empty or negative interval, or ``t0`` at or after the end.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> sk = Skeleton(("Hips",), np.array([-1]), np.zeros((1, 3)), (("Xrotation",),))
+    >>> take = Take("t", 15.0, Motion(sk, np.arange(30.0)[:, None], 15.0), np.zeros(32000, np.float32),
+    ...             16000, None, (), WordIntervals(np.array([0.5]), np.array([1.2]), ("hi",)),
+    ...             np.zeros(30, np.float32), [], np.zeros(30, np.int64))
+    >>> clip = clip_take(take, 1.0, 1.6)  # frames 15 to 23, 0.6 s
+    >>> clip.motion.channels[:, 0].tolist(), len(clip.audio), clip.words.ends.round(6).tolist()
+    ([15.0, 16.0, 17.0, 18.0, 19.0, 20.0, 21.0, 22.0, 23.0], 9600, [0.2])
+    """
+    import dataclasses
+
+    if not 0 <= t0 < t1:
+        raise ValueError(f"clip_take: need 0 <= t0 < t1, got t0={t0!r}, t1={t1!r}")
+    a, b = int(round(t0 * take.fps)), min(int(round(t1 * take.fps)), take.n_frames)
+    if a >= b:
+        raise ValueError(f"clip_take: [{t0}, {t1}) s holds no frame of the {take.duration:.2f} s take")
+    start, duration = a / take.fps, (b - a) / take.fps
+
+    def cut(s: float, e: float) -> tuple[float, float] | None:  # shifted into the clip, None if outside
+        if e <= start or s >= start + duration:
+            return None
+        return max(s - start, 0.0), min(e - start, duration)
+
+    words = take.words
+    if words is not None:
+        kept = [(cut(s, e), w) for s, e, w in zip(words.starts, words.ends, words.words, strict=True)]
+        kept = [(se, w) for se, w in kept if se is not None]
+        words = WordIntervals(
+            np.array([se[0] for se, _ in kept]),
+            np.array([se[1] for se, _ in kept]),
+            tuple(w for _, w in kept),
+            duration,
+        )
+    segments = {}
+    for key in ("semantic_segments", "emotion_segments"):
+        out = []
+        for seg in getattr(take, key):
+            se = cut(seg.start, seg.end)
+            if se is not None:
+                out.append(seg._replace(start=se[0], end=se[1], duration=se[1] - se[0]))
+        segments[key] = out
+    audio = take.audio
+    if audio is not None:
+        audio = audio[int(round(start * take.sr)) : int(round((start + duration) * take.sr))].copy()
+    return dataclasses.replace(
+        take,
+        motion=Motion(take.motion.skeleton, take.motion.channels[a:b].copy(), take.motion.fps),
+        audio=audio,
+        face=None if take.face is None else take.face[a:b].copy(),
+        words=words,
+        semantic=take.semantic[a:b].copy(),
+        emotion=take.emotion[a:b].copy(),
+        paths=dict(take.paths),
+        **segments,
     )

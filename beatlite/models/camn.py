@@ -460,3 +460,53 @@ class CaMN(GestureModel):
         fake = self.discriminator(out["pose"].detach())
         d = ns_gan_d_loss(real, fake)
         return {"d": d, "total": d}
+
+
+#: The parts of :class:`CaMN`, in the order of the data flow (encoders, fusions, decoders, discriminator).
+PARTS = (
+    "text_encoder",
+    "speaker_encoder",
+    "emotion_encoder",
+    "audio_encoder",
+    "face_encoder",
+    "audio_fusion",
+    "face_fusion",
+    "body_decoder",
+    "hands_decoder",
+    "discriminator",
+)
+
+
+def input_widths(config: CaMNConfig) -> dict[str, int]:
+    """The input width of each fusion and decoder, computed from a configuration (BEAT §4, Fig. 5).
+
+    The context is emotion + speaker + text features; the audio fusion reads the last audio
+    channels and the context; the face fusion the last face channels, the fused audio and the
+    context; the body decoder the seed pose (141 angles + 1 indicator bit), the context and both
+    fused features; the hands decoder the same plus the 27 body outputs.
+
+    Returns
+    -------
+    dict
+        ``{"audio fusion in", "face fusion in", "body decoder in", "hands decoder in"}`` -> width.
+
+    Examples
+    --------
+    >>> w = input_widths(CaMNConfig(**PRESETS["paper"], preset="paper"))
+    >>> w["body decoder in"], w["hands decoder in"]  # 142 + 144 + 128 + 32 and + 27
+    (446, 473)
+    """
+    ctx = config.emotion_features + config.speaker_features + config.text_features
+    body = POSE_DIM + 1 + ctx + config.audio_fused + config.face_fused
+    return {
+        "audio fusion in": config.audio_channels[-1] + ctx,
+        "face fusion in": config.face_channels[-1] + config.audio_fused + ctx,
+        "body decoder in": body,
+        "hands decoder in": body + BODY_DIM,
+    }
+
+
+def part_parameters(model: CaMN) -> dict[str, int]:
+    """Number of parameters of each of :data:`PARTS` of ``model``, plus ``"total"``."""
+    counts = {part: sum(p.numel() for p in getattr(model, part).parameters()) for part in PARTS}
+    return {**counts, "total": int(model.n_parameters())}

@@ -723,3 +723,223 @@ def write_results(results: ModelResults, stem: str | Path | None = None) -> tupl
         + f"\n\nEvaluation time: {info['seconds']:.1f} s.\n"
     )
     return write_markdown_and_json(stem, text, results.to_dict())
+
+
+# ------------------------------------------------------------------------------------ other metric variants
+def score_models(
+    models: Sequence[Any] | None = None,
+    metrics: Sequence[str] = COLUMNS,
+    *,
+    test: EvaluationSet | None = None,
+    extractor: Any = None,
+    ground_truth: bool = True,
+    seed: int = 0,
+) -> ModelResults:
+    """:func:`evaluate_models` with the metric keys of your choice, e.g. the papers' reference variants.
+
+    Each model generates the test takes once and is scored with every key of ``metrics`` (keys of
+    :data:`beatlite.metrics.METRICS`, such as ``"SRGR (reference)"``, ``"BeatAlign (reference)"``,
+    ``"FGD (reference)"`` or ``"BC (ha2g)"``), so one call gives both our columns and the variants
+    a paper used. A key a row cannot be scored with (the Euler-only reference SRGR of a direction
+    model) is NaN. Show the result with :func:`metrics_table`; :meth:`ModelResults.to_markdown`
+    shows only :data:`COLUMNS`.
+
+    Parameters
+    ----------
+    models, test, extractor, ground_truth, seed
+        As :func:`evaluate_models`.
+    metrics : sequence of str
+        Metric keys (default :data:`COLUMNS`).
+
+    Returns
+    -------
+    ModelResults
+        ``row.metrics`` holds every key of ``metrics``; ``info["metrics"]`` lists them.
+    """
+    import torch
+
+    from beatlite.metrics.extractor import load_extractor
+
+    unknown = [key for key in metrics if key not in METRICS]
+    if unknown:
+        raise ValueError(f"unknown metric keys {unknown}; known: {sorted(METRICS)}")
+    start = time.perf_counter()
+    test = load_test_set() if test is None else test
+    extractor = load_extractor("dirvec") if extractor is None else extractor
+    truth = test.ground_truth(extractor)
+    rows = []
+    if ground_truth:
+        for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):
+            values = score_directions(
+                dirs, test, extractor, truth, euler=test.gt_euler, columns=metrics, seed=seed
+            )
+            rows.append(ResultRow(label, "ground_truth", "ground_truth", values))
+    for label, source, model, norms in _as_entries(models):
+        fingerprint, stale = "", False
+        if model is None:
+            model, norms, fingerprint, stale = _load_checkpoint(source, test)
+        t0 = time.perf_counter()
+        with torch.no_grad():
+            dirs, euler = _generate(model, test, norms)
+        seconds = time.perf_counter() - t0
+        values = score_directions(dirs, test, extractor, truth, euler=euler, columns=metrics, seed=seed)
+        rows.append(ResultRow(label, source, model.representation, values, seconds, fingerprint, stale))
+    info = {
+        "split": test.split,
+        "takes": list(test.takes),
+        "frames": test.n_frames,
+        "windows": int(len(truth.takes.features)),
+        "metrics": list(metrics),
+        "columns": {key: METRICS[key].describe for key in metrics},
+        "seconds": round(time.perf_counter() - start, 2),
+    }
+    return ModelResults(rows, info)
+
+
+def metrics_table(
+    results: ModelResults, metrics: Sequence[str], *, rows: Sequence[str] | None = None, caption: bool = True
+) -> str:
+    """A Markdown table of ``results`` with the columns ``metrics``, each header naming its variant.
+
+    Parameters
+    ----------
+    results : ModelResults
+        From :func:`score_models` (or :func:`evaluate_models` for keys of :data:`COLUMNS`).
+    metrics : sequence of str
+        Metric keys to show, in order; the header is the key (``"SRGR (reference) ↑"``).
+    rows : sequence of str, optional
+        Row labels or checkpoint names to show, in order (default every row).
+    caption : bool
+        Append the definition of every column (:func:`beatlite.metrics.scoring.describe`).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> res = ModelResults([ResultRow("A", "a", "euler141", {"SRGR": 0.25, "BC": math.nan})], {})
+    >>> print(metrics_table(res, ["SRGR", "BC"], caption=False))
+    | method | SRGR ↑ | BC ↑ |
+    |---|---|---|
+    | A | 0.250 | — |
+    """
+    from beatlite.report import markdown_table
+
+    chosen = results.rows if rows is None else [results.get(r) for r in rows]
+    body = [
+        [row.label, *[fmt_metric(row.metrics.get(key, math.nan), key) for key in metrics]] for row in chosen
+    ]
+    text = markdown_table(["method", *column_headers(metrics)], body)
+    return text + ("\n\n" + describe(metrics) if caption else "")
+
+
+# ------------------------------------------------------------------------------------ the papers' rows
+#: BEAT (ECCV 2022) Table 4, on BEAT's 4-speaker English data: method -> metric -> value. Computed
+#: with BEAT's code: FGD of its own autoencoder on 141 Euler channels, SRGR and BeatAlign on Euler
+#: angles (our keys ``"SRGR (reference)"`` and ``"BeatAlign (reference)"``).
+PAPER_BEAT_TABLE4: dict[str, dict[str, float]] = {
+    "Seq2Seq": {"FGD": 261.3, "SRGR": 0.173, "BeatAlign": 0.729},
+    "S2G": {"FGD": 256.7, "SRGR": 0.092, "BeatAlign": 0.751},
+    "A2G": {"FGD": 223.8, "SRGR": 0.097, "BeatAlign": 0.766},
+    "MultiContext": {"FGD": 176.2, "SRGR": 0.196, "BeatAlign": 0.776},
+    "CaMN": {"FGD": 123.7, "SRGR": 0.239, "BeatAlign": 0.783},
+}
+
+#: BEAT Table 5 (ablations of CaMN), same metrics: row of the paper -> metric -> value.
+PAPER_BEAT_TABLE5: dict[str, dict[str, float]] = {
+    "full cascaded": {"FGD": 123.7, "SRGR": 0.239, "BeatAlign": 0.783},
+    "w/o cascaded": {"FGD": 137.2, "SRGR": 0.207, "BeatAlign": 0.776},
+    "w/o text": {"FGD": 149.4, "SRGR": 0.171, "BeatAlign": 0.781},
+    "w/o audio": {"FGD": 155.7, "SRGR": 0.225, "BeatAlign": 0.733},
+    "w/o speaker ID": {"FGD": 159.1, "SRGR": 0.207, "BeatAlign": 0.774},
+    "w/o face": {"FGD": 163.3, "SRGR": 0.217, "BeatAlign": 0.767},
+    "w/o emotion": {"FGD": 151.7, "SRGR": 0.231, "BeatAlign": 0.775},
+    "w/o semantic": {"FGD": 151.8, "SRGR": 0.194, "BeatAlign": 0.786},
+}
+
+#: HA2G (CVPR 2022) Table 1, TED-Expressive columns: FGD and Diversity of HA2G's own extractor, BC
+#: with HA2G's code on 34-frame clips (our key ``"BC (ha2g)"``).
+PAPER_HA2G_TABLE1: dict[str, dict[str, float]] = {
+    "Ground Truth": {"FGD": 0.0, "BC": 0.723, "Diversity": 175.231},
+    "Attention Seq2Seq": {"FGD": 54.920, "BC": 0.155, "Diversity": 122.693},
+    "Speech2Gesture": {"FGD": 54.650, "BC": 0.714, "Diversity": 142.489},
+    "Joint Embedding": {"FGD": 64.555, "BC": 0.131, "Diversity": 120.627},
+    "Trimodal": {"FGD": 12.613, "BC": 0.592, "Diversity": 154.088},
+    "HA2G": {"FGD": 5.306, "BC": 0.715, "Diversity": 173.899},
+}
+
+#: HA2G Tables 3 (audio learner) and 4 (pose inferer), TED-Expressive, same metrics as Table 1.
+PAPER_HA2G_ABLATIONS: dict[str, dict[str, float]] = {
+    "f_a^low only (T3)": {"FGD": 6.588, "BC": 0.704, "Diversity": 171.482},
+    "f_a^mid only (T3)": {"FGD": 7.212, "BC": 0.682, "Diversity": 168.223},
+    "f_a^high only (T3)": {"FGD": 7.421, "BC": 0.661, "Diversity": 165.741},
+    "w/o high-level negatives (T3)": {"FGD": 7.982, "BC": 0.652, "Diversity": 163.649},
+    "w/o low/mid-level negatives (T3)": {"FGD": 6.998, "BC": 0.701, "Diversity": 169.021},
+    "w/o text (T3)": {"FGD": 9.228, "BC": 0.619, "Diversity": 158.236},
+    "HA2G-ASR (T3)": {"FGD": 5.319, "BC": 0.716, "Diversity": 173.058},
+    "Holistic (T4)": {"FGD": 11.989, "BC": 0.594, "Diversity": 156.079},
+    "w/o hand hierarchy (T4)": {"FGD": 10.832, "BC": 0.606, "Diversity": 158.823},
+    "w/o body hierarchy (T4)": {"FGD": 5.882, "BC": 0.709, "Diversity": 173.066},
+    "Same audio f_a^h (T4)": {"FGD": 6.801, "BC": 0.701, "Diversity": 170.085},
+    "w/o L_phy (T4)": {"FGD": 5.907, "BC": 0.708, "Diversity": 172.651},
+    "HA2G Full": {"FGD": 5.306, "BC": 0.715, "Diversity": 173.899},
+}
+
+
+def paper_table(rows: Mapping[str, Mapping[str, float]], *, digits: int = 3) -> str:
+    """A Markdown table of a paper's published rows (one of the ``PAPER_*`` dicts above).
+
+    Examples
+    --------
+    >>> print(paper_table({"CaMN": {"FGD": 123.7, "SRGR": 0.239}}, digits=1))
+    | method | FGD | SRGR |
+    |---|---|---|
+    | CaMN | 123.7 | 0.2 |
+    """
+    from beatlite.report import markdown_table
+
+    keys = list(dict.fromkeys(k for values in rows.values() for k in values))
+    return markdown_table(
+        ["method", *keys],
+        [[m, *(float(v.get(k, math.nan)) for k in keys)] for m, v in rows.items()],
+        digits=digits,
+    )
+
+
+def generated_euler(
+    model: Any, test: EvaluationSet, normalizers: Normalizers | None = None
+) -> list[np.ndarray]:
+    """An Euler model's generation of every take of ``test``, in ``spine_neck_141`` degrees.
+
+    The same generation as :func:`evaluate_models` (whole takes, seeded by the first 4 ground-truth
+    frames), returned before the conversion to TED-43 directions: the input of BEAT Table 6
+    (:func:`beatlite.stats.table6`).
+
+    Parameters
+    ----------
+    model : GestureModel or str
+        A model in eval mode, or a checkpoint name / path (then its own training normalisers are used).
+    test : EvaluationSet
+    normalizers : Normalizers, optional
+        The statistics the model was trained with (default the checkpoint's, else ``test.normalizers``).
+
+    Returns
+    -------
+    list of (T_k, 141) float64, degrees
+
+    Raises
+    ------
+    ValueError
+        ``model`` predicts directions (``dirvec126``): it has no Euler angles.
+    """
+    import torch
+
+    if isinstance(model, str | Path):
+        model, stored, _, _ = _load_checkpoint(str(model), test)
+        normalizers = stored if normalizers is None else normalizers
+    if model.representation != "euler141":
+        raise ValueError(f"{type(model).__name__} predicts {model.representation}, not Euler angles")
+    with torch.no_grad():
+        _, euler = _generate(model, test, normalizers)
+    return euler

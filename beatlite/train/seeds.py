@@ -476,3 +476,65 @@ def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> 
         + "\n"
     )
     return write_markdown_and_json(stem, text, results.to_dict())
+
+
+def ablation_table(
+    record: SeedResults,
+    full: str,
+    rows: Mapping[str, str | None],
+    paper: Mapping[str, Mapping[str, float]],
+    *,
+    metrics: Sequence[str] = ("FGD", "SRGR"),
+    deltas: Sequence[str] = ("FGD", "SRGR", "BeatAlign"),
+) -> str:
+    """An ablation study as a Markdown table: the paper's row beside ours (mean ± sd) and each change ± 2 SE.
+
+    Parameters
+    ----------
+    record : SeedResults
+        Per-seed values (:func:`recorded_seed_results`).
+    full : str
+        The full model's row label (its change columns stay empty).
+    rows : mapping our row label -> the paper's row name (None: no paper row)
+        In table order.
+    paper : mapping paper row -> metric -> value
+        E.g. :data:`beatlite.train.evaluation.PAPER_BEAT_TABLE5`.
+    metrics : sequence of str
+        Columns shown as values, for the paper (when it has them) and for us.
+    deltas : sequence of str
+        Columns shown as changes vs ``full`` (:func:`compare_rows`: ``"+0.52 ± 0.31 worse"``).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> rec = SeedResults({"Full": {"FGD": [1.0, 2.0, 3.0]}, "A": {"FGD": [2.0, 3.0, 4.0]}}, [1, 2, 3], {})
+    >>> print(ablation_table(rec, "Full", {"Full": "full", "A": None}, {"full": {"FGD": 5.0}},
+    ...                      metrics=("FGD",), deltas=("FGD",)))
+    | variant | paper row | paper FGD ↓ | ours FGD ↓ | Δ FGD ± 2 SE | seeds |
+    |---|---|---|---|---|---|
+    | Full | full | 5.00 | 2.00 ± 1.00 |  | 3 |
+    | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise | 3 |
+    """
+    from beatlite.report import markdown_table
+    from beatlite.train.evaluation import column_headers, fmt_metric
+
+    variants = [label for label in rows if label != full]
+    by = {(e.variant, e.metric): e for e in compare_rows(record, full, variants, metrics=deltas)}
+    heads = column_headers(metrics)
+    header = ["variant", "paper row", *[f"paper {h}" for h in heads], *[f"ours {h}" for h in heads]]
+    header += [f"Δ {m} ± 2 SE" for m in deltas] + ["seeds"]
+    body = []
+    for label, paper_row in rows.items():
+        published = paper.get(paper_row, {}) if paper_row else {}
+        cells = [label, paper_row or "—"]
+        cells += [fmt_metric(published.get(m, math.nan), m) for m in metrics]
+        cells += [record.cell(label, m) for m in metrics]
+        cells += [
+            "" if label == full else by[label, m].cell(3 if m in ("SRGR", "BeatAlign", "BC") else 2)
+            for m in deltas
+        ]
+        body.append([*cells, record.count(label, metrics[0])])
+    return markdown_table(header, body)
