@@ -54,6 +54,12 @@ def _record_times(seconds: dict[str, float]) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    command = {"fit": _fit_command, "results": _results_command, "seeds": _seeds_command}
+    return command.get(args.command, _retrain_all_command)(args)
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m beatlite.train", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     f = sub.add_parser("fit", help="train one recipe on a BEAT-format folder, writing under --out")
@@ -84,28 +90,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     s.add_argument(
         "--force", action="store_true", help="retrain checkpoints that exist and match their recipe"
     )
-    args = parser.parse_args(argv)
-    if args.command == "fit":
-        return _fit_command(args)
-    if args.command == "results":
-        from beatlite.train.evaluation import evaluate_models, write_results
+    return parser
 
-        results = evaluate_models(args.only or None, progress=True)
-        md, js = write_results(results, args.out)
-        print(results.to_markdown())
-        print(f"wrote {md} and {js} in {results.info['seconds']:.1f} s")
-        return 0
-    if args.command == "seeds":
-        from beatlite.train.seeds import evaluate_seeds, train_seeds, write_seed_results
 
-        if not args.evaluate_only:
-            train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
-        missing = "skip" if args.evaluate_only else "error"
-        table = evaluate_seeds(args.only or None, args.seeds, missing=missing, progress=True)
-        md, js = write_seed_results(table, args.out)
-        print(table.to_markdown())
-        print(f"wrote {md} and {js}")
-        return 0
+def _results_command(args: argparse.Namespace) -> int:
+    from beatlite.train.evaluation import evaluate_models, write_results
+
+    results = evaluate_models(args.only or None, progress=True)
+    md, js = write_results(results, args.out)
+    print(results.to_markdown())
+    print(f"wrote {md} and {js} in {results.info['seconds']:.1f} s")
+    return 0
+
+
+def _seeds_command(args: argparse.Namespace) -> int:
+    from beatlite.train.seeds import evaluate_seeds, train_seeds, write_seed_results
+
+    if not args.evaluate_only:
+        train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
+    missing = "skip" if args.evaluate_only else "error"
+    table = evaluate_seeds(args.only or None, args.seeds, missing=missing, progress=True)
+    md, js = write_seed_results(table, args.out)
+    print(table.to_markdown())
+    print(f"wrote {md} and {js}")
+    return 0
+
+
+def _retrain_all_command(args: argparse.Namespace) -> int:
     from beatlite.train.recipes import retrain_many
 
     def report(name: str, seed: int, seconds: float) -> None:
@@ -116,9 +127,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     retrain_many(runs, jobs=args.jobs, epochs=args.epochs, on_done=report)
     if not args.skip_extractor and not args.only:
         for space in ("dirvec", "pose"):
-            subprocess.run(
-                [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", space], check=True
-            )
+            cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", space]
+            subprocess.run(cmd, check=True)
     return 0
 
 
