@@ -7,8 +7,9 @@ TextGrid / semantic / emotion annotations shifted along, BEAT's ``{speaker_id}/`
 stems with every split populated (speech sequences 9.. train, 1.. test, 57.. val; conversation 2..
 train, 1 test, 12 val) -- then measures, each step in a fresh subprocess so that its peak RSS is its own:
 
-- ``store``: ``index_folder`` + :func:`beatlite.data.store.build_store` (``--workers`` spawned
-  processes): seconds, peak RSS of the main process and of the largest worker, store size on disk;
+- ``store``: ``index_folder`` (timed apart), then :func:`beatlite.data.store.build_store` (``--workers``
+  spawned processes) and a second, no-op ``build_store``: seconds, CPU seconds, peak RSS of the main
+  process and of the largest worker, store size on disk;
 - ``epoch``: one shuffled pass over the train windows with :func:`beatlite.data.torch_dataset.window_loader`
   (batch 32, CaMN's keys, ``--loader-workers`` workers): windows/s and peak RSS (main, largest worker);
 - ``stats`` (``--stats``): :func:`beatlite.stats.emotion_separability` over :func:`beatlite.stats.iter_corpus`
@@ -213,12 +214,16 @@ def step_store(corpus: Path, store: Path, workers: int) -> dict:
     from beatlite.data.index import index_folder
     from beatlite.data.store import build_store
 
+    tic = time.perf_counter()
+    index = index_folder(corpus)
+    index_s = time.perf_counter() - tic
     tic, cpu = time.perf_counter(), _cpu_seconds()
-    built = build_store(index_folder(corpus), store, workers=workers)
+    built = build_store(index, store, workers=workers)
     seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
     tic = time.perf_counter()
-    build_store(index_folder(corpus), store, workers=workers)
+    build_store(index, store, workers=workers)
     return {
+        "index_s": index_s,
         "seconds": seconds,
         "cpu_s": cpu,
         "noop_rebuild_s": time.perf_counter() - tic,
@@ -297,6 +302,7 @@ def print_table(rows: list[dict]) -> None:
         ("hours", "mocap h", "{:.2f}"),
         ("make_s", "make corpus s", "{:.0f}"),
         ("source_gb", "source GB", "{:.2f}"),
+        ("index_s", "index_folder s", "{:.1f}"),
         ("store_s", "store build s", "{:.1f}"),
         ("store_s_per_h", "build s/h", "{:.1f}"),
         ("store_cpu_per_h", "build CPU s/h", "{:.1f}"),
@@ -340,6 +346,7 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
     row["source_gb"] = sum(p.stat().st_size for p in corpus.rglob("*") if p.is_file()) / 1e9
     s = _run_step(["--step", "store", str(corpus), str(store), str(args.workers)])
     h = s["mocap_hours"]
+    row["index_s"] = s["index_s"]
     row.update(hours=h, store_s=s["seconds"], noop_s=s["noop_rebuild_s"], store_gb=s["disk_gb"])
     row.update(store_rss_main=s["rss_main_gib"], store_rss_child=s["rss_child_gib"])
     row.update(
