@@ -4,11 +4,12 @@ For each N (hours) it builds a BEAT-rate corpus from ``data_samples/`` in a temp
 beatlite's own readers and writers -- every speaker's takes joined (cycled) to 1-min speech and
 10-min conversation takes, 120 fps plain BVH (6 decimals), 48 kHz stereo 16-bit WAV, 60 fps JSON,
 TextGrid / semantic / emotion annotations shifted along, BEAT's ``{speaker_id}/`` layout, valid
-stems with every split populated (speech sequences 9.. train, 1.. test, 57.. val; conversation 2..
-train, 1 test, 12 val) -- then measures, each step in a fresh subprocess so that its peak RSS is its own:
+stems with every split populated (speech: neutral sequences 9.. train, 1.. test, 57.. val, and the
+emotional blocks 65-118 alternately; conversation 2.. train, 1 test, 12 val) -- then measures, each step in a fresh subprocess so that its peak RSS is its own:
 
-- ``store``: ``index_folder`` + :func:`beatlite.data.store.build_store` (``--workers`` spawned
-  processes): seconds, peak RSS of the main process and of the largest worker, store size on disk;
+- ``store``: ``index_folder`` (timed apart), then :func:`beatlite.data.store.build_store` (``--workers``
+  spawned processes) and a second, no-op ``build_store``: seconds, CPU seconds, peak RSS of the main
+  process and of the largest worker, store size on disk;
 - ``epoch``: one shuffled pass over the train windows with :func:`beatlite.data.torch_dataset.window_loader`
   (batch 32, CaMN's keys, ``--loader-workers`` workers): windows/s and peak RSS (main, largest worker);
 - ``stats`` (``--stats``): :func:`beatlite.stats.emotion_separability` over :func:`beatlite.stats.iter_corpus`
@@ -55,14 +56,25 @@ CAMN_TINY_WINDOWS_PER_S = 151.0  # issue 17: CaMN tiny training, 1 thread, batch
 
 # ---------------------------------------------------------------------- corpus
 def _sequences(conversation: bool) -> list[int]:
-    """Sequence ids in an order that fills train, test and val early (4-hour speakers' splits)."""
+    """Sequence ids in an order that fills train, test and val early (4-hour speakers' splits).
+
+    Speech: a neutral train, test and val sequence first, then emotional (65-118, one block per
+    emotion, inner = train sequences first) and further neutral ones alternately, so every corpus
+    from 0.25 h on has several emotions, as BEAT (64 neutral and 54 emotional sequences).
+    """
     if conversation:
         return [2, 1, 12, *range(3, 12)]
     train, test, val = list(range(9, 57)), list(range(1, 9)), list(range(57, 65))
-    order = [train.pop(0), test.pop(0), val.pop(0)]
+    neutral = [train.pop(0), test.pop(0), val.pop(0)]
     while train or test or val:
-        order += [train.pop(0) for _ in range(min(8, len(train)))]
-        order += [x.pop(0) for x in (test, val) if x]
+        neutral += [train.pop(0) for _ in range(min(8, len(train)))]
+        neutral += [x.pop(0) for x in (test, val) if x]
+    blocks = [(65, 72), (73, 80), (81, 86), (87, 94), (95, 102), (103, 110), (111, 118)]
+    inner = [first + k for k in range(1, 7) for first, last in blocks if first + k < last]
+    emotional = inner + [first for first, _ in blocks] + [last for _, last in blocks]
+    order = neutral[:3]
+    for k in range(max(len(neutral) - 3, len(emotional))):
+        order += [x[k] for x in (emotional, neutral[3:]) if k < len(x)]
     return order
 
 
@@ -74,7 +86,7 @@ def corpus_plan(hours: float, speakers: list[tuple[int, str]]) -> list[tuple[int
     per_speaker = hours * 3600.0 / len(speakers)
     n_conv = int(round(per_speaker / 2 / CONVERSATION_S))
     n_speech = max(1, int(round((per_speaker - n_conv * CONVERSATION_S) / SPEECH_S)))
-    if n_speech > 64 or n_conv > 12:
+    if n_speech > 118 or n_conv > 12:
         raise ValueError(f"corpus_plan: {hours} h needs more sequences per speaker than BEAT's splits list")
     plan = []
     for sid, name in speakers:
@@ -213,12 +225,16 @@ def step_store(corpus: Path, store: Path, workers: int) -> dict:
     from beatlite.data.index import index_folder
     from beatlite.data.store import build_store
 
+    tic = time.perf_counter()
+    index = index_folder(corpus)
+    index_s = time.perf_counter() - tic
     tic, cpu = time.perf_counter(), _cpu_seconds()
-    built = build_store(index_folder(corpus), store, workers=workers)
+    built = build_store(index, store, workers=workers)
     seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
     tic = time.perf_counter()
-    build_store(index_folder(corpus), store, workers=workers)
+    build_store(index, store, workers=workers)
     return {
+        "index_s": index_s,
         "seconds": seconds,
         "cpu_s": cpu,
         "noop_rebuild_s": time.perf_counter() - tic,
@@ -257,20 +273,35 @@ def step_build_windows(corpus: Path, cache: Path) -> dict:
 
 
 def step_stats(corpus: Path, subset: bool) -> dict:
-    """Emotion separability streamed over the takes (``iter_corpus``); ``subset=False``: all windows (O(N^2))."""
-    from beatlite.data.index import index_folder
-    from beatlite.stats import emotion_separability, iter_corpus
+    """Emotion separability streamed over the takes (``iter_corpus``), loading timed apart from scoring.
 
-    tic, cpu = time.perf_counter(), _cpu_seconds()
-    sep = emotion_separability(iter_corpus(index_folder(corpus)), max_windows=2000 if subset else None)
-    seconds, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu
-    return {
-        "seconds": seconds,
-        "cpu_s": cpu,
-        "n": sep.n,
-        "balanced_accuracy": sep.balanced_accuracy,
-        **_peak_rss(),
-    }
+    ``subset=False`` also scores every window (the O(N^2) alternative) after the 2000-window subset.
+    """
+    from beatlite.data.index import index_folder
+    from beatlite.stats import emotion_features, iter_corpus
+    from beatlite.stats.emotion_clusters import MAX_WINDOWS, separability
+
+    tic = time.perf_counter()
+    features = emotion_features(iter_corpus(index_folder(corpus)))
+    load_s, rss_load = time.perf_counter() - tic, _peak_rss()["rss_main_gib"]
+    out = {"load_s": load_s, "rss_load_gib": rss_load, "n_windows": len(features)}
+    for name, max_windows in [("subset", MAX_WINDOWS)] + ([] if subset else [("all", None)]):
+        tic = time.perf_counter()
+        ef = features.subsample(max_windows, 0)
+        if len(np.unique(ef.emotion)) < 2:  # e.g. only neutral takes: separability is undefined
+            out.update({f"{name}_s": float("nan"), f"{name}_n": 0, "note": "fewer than 2 emotions"})
+            continue
+        sep = separability(ef.features, ef.emotion, groups=ef.take, seed=0)
+        out.update(
+            {
+                f"{name}_s": time.perf_counter() - tic,
+                f"{name}_n": sep.n,
+                f"rss_{name}_gib": _peak_rss()["rss_main_gib"],
+            }
+        )
+        out[f"{name}_balanced_accuracy"] = sep.balanced_accuracy
+    out.update(seconds=load_s + out["subset_s"], n=out["subset_n"], **_peak_rss())
+    return out
 
 
 def _run_step(args: list[str]) -> dict:
@@ -297,6 +328,7 @@ def print_table(rows: list[dict]) -> None:
         ("hours", "mocap h", "{:.2f}"),
         ("make_s", "make corpus s", "{:.0f}"),
         ("source_gb", "source GB", "{:.2f}"),
+        ("index_s", "index_folder s", "{:.1f}"),
         ("store_s", "store build s", "{:.1f}"),
         ("store_s_per_h", "build s/h", "{:.1f}"),
         ("store_cpu_per_h", "build CPU s/h", "{:.1f}"),
@@ -340,6 +372,7 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
     row["source_gb"] = sum(p.stat().st_size for p in corpus.rglob("*") if p.is_file()) / 1e9
     s = _run_step(["--step", "store", str(corpus), str(store), str(args.workers)])
     h = s["mocap_hours"]
+    row["index_s"] = s["index_s"]
     row.update(hours=h, store_s=s["seconds"], noop_s=s["noop_rebuild_s"], store_gb=s["disk_gb"])
     row.update(store_rss_main=s["rss_main_gib"], store_rss_child=s["rss_child_gib"])
     row.update(
