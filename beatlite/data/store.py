@@ -635,28 +635,27 @@ class StoreWindows:
         if missing:
             raise KeyError(f"StoreWindows.batch: keys {missing} not in this view ({self.keys()})")
         raw = self._read(idx, {KEY_STREAM[k] for k in keys} - {None})
-        out: dict[str, np.ndarray] = {}
-        for k in keys:
-            if k == "pose":
-                out[k] = self.normalizers.pose.transform(raw["pose_raw"]).astype(np.float32)
-            elif k == "dirvec":
-                out[k] = self.normalizers.dirvec.transform(raw["dirs"]).astype(np.float32)
-            elif k == "word":
-                out[k] = np.stack(
-                    [self._word_table(int(t))[w] for t, w in zip(self.take_ids[idx], raw["word"])]
-                )
-                out[k] = out[k].reshape(len(idx), self.length)
-            elif k in ("emotion",):
-                out[k] = raw[k].astype(np.int64)
-            elif k == "speaker":
-                out[k] = np.array([self.store.takes[t].meta["speaker"] for t in self.take_ids[idx]], np.int64)
-            elif k == "take":
-                out[k] = np.array([self.store.takes[t].stem for t in self.take_ids[idx]])
-            elif k == "start":
-                out[k] = self.starts[idx].copy()
-            else:
-                out[k] = raw[KEY_STREAM[k]].astype(np.float32, copy=False)
-        return out
+        return {k: self._key_values(k, idx, raw) for k in keys}
+
+    def _key_values(self, k: str, idx: np.ndarray, raw: dict[str, np.ndarray]) -> np.ndarray:
+        """Batch key ``k`` of the windows ``idx`` from their raw streams (normalised, mapped to the vocabulary)."""
+        takes = self.store.takes
+        if k == "pose":
+            return self.normalizers.pose.transform(raw["pose_raw"]).astype(np.float32)
+        if k == "dirvec":
+            return self.normalizers.dirvec.transform(raw["dirs"]).astype(np.float32)
+        if k == "word":
+            rows = [self._word_table(int(t))[w] for t, w in zip(self.take_ids[idx], raw["word"])]
+            return np.stack(rows).reshape(len(idx), self.length)
+        if k == "emotion":
+            return raw[k].astype(np.int64)
+        if k == "speaker":
+            return np.array([takes[t].meta["speaker"] for t in self.take_ids[idx]], np.int64)
+        if k == "take":
+            return np.array([takes[t].stem for t in self.take_ids[idx]])
+        if k == "start":
+            return self.starts[idx].copy()
+        return raw[KEY_STREAM[k]].astype(np.float32, copy=False)
 
     def _read(self, idx: np.ndarray, streams: set[str]) -> dict[str, np.ndarray]:
         """Rows of ``streams`` for the windows ``idx``: frame streams (B, L, ...), audio (B, n), mel (B, M, 128)."""
@@ -795,6 +794,40 @@ def _run_builds(
                     bar.update()
 
 
+def _usable_records(index: TakeIndex) -> list[TakeRecord]:
+    """The usable takes of ``index`` (the others skipped with one warning); ``ValueError`` if none."""
+    records = [r for r in index if r.usable]
+    skipped = [r.stem for r in index if not r.usable]
+    if skipped:
+        warnings.warn(f"build_store: skipping {len(skipped)} unusable takes: {skipped[:5]}", stacklevel=3)
+    if not records:
+        raise ValueError(f"build_store: no usable takes ({len(index)} takes indexed)")
+    return records
+
+
+def _write_manifest(
+    folder: Path, index: TakeIndex, records: list[TakeRecord], params: dict, vocab: Vocab | None
+) -> None:
+    """``store.json``: version, parameters, takes and vocabulary (``build_vocab(index)``, reused while no
+    TextGrid of the index changed)."""
+    from beatlite.data.vocab import build_vocab
+    from beatlite.io.atomic import atomic_write
+
+    text_fp = None
+    if vocab is None:
+        text_fp = _text_fingerprint(index)
+        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(index)
+    manifest = {
+        "version": STORE_VERSION,
+        "params": params,
+        "takes": [r.stem for r in records],
+        "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
+        "vocab_fingerprint": text_fp,
+    }
+    with atomic_write(folder / "store.json") as f:
+        json.dump(manifest, f, indent=1)
+
+
 def build_store(
     index: TakeIndex,
     folder: str | Path | None = None,
@@ -842,18 +875,11 @@ def build_store(
         Bad parameters or no usable take. A take that cannot be read raises its reader's
         ``FormatError``.
     """
-    from beatlite.data.vocab import build_vocab
-
     if not isinstance(sr, int | np.integer) or sr < 1 or not fps > 0:
         raise ValueError(f"build_store: fps and sr must be positive (sr an int), got {fps!r}, {sr!r}")
     if workers is not None and (not isinstance(workers, int) or workers < 0):
         raise ValueError(f"build_store: workers must be a non-negative int or None, got {workers!r}")
-    records = [r for r in index if r.usable]
-    skipped = [r.stem for r in index if not r.usable]
-    if skipped:
-        warnings.warn(f"build_store: skipping {len(skipped)} unusable takes: {skipped[:5]}", stacklevel=2)
-    if not records:
-        raise ValueError(f"build_store: no usable takes ({len(index)} takes indexed)")
+    records = _usable_records(index)
     params = store_params(fps=fps, sr=sr, positions=positions, word_rule=word_rule)
     folder = Path(folder) if folder is not None else default_store_folder(index, params)
     (folder / "takes").mkdir(parents=True, exist_ok=True)
@@ -863,19 +889,5 @@ def build_store(
     for stale in (folder / "takes").iterdir():
         if stale.is_dir() and stale.name not in keep:
             shutil.rmtree(stale)
-    text_fp = None
-    if vocab is None:  # build_vocab(index), reused while no TextGrid of the index changed
-        text_fp = _text_fingerprint(index)
-        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(index)
-    manifest = {
-        "version": STORE_VERSION,
-        "params": params,
-        "takes": [r.stem for r in records],
-        "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
-        "vocab_fingerprint": text_fp,
-    }
-    from beatlite.io.atomic import atomic_write
-
-    with atomic_write(folder / "store.json") as f:
-        json.dump(manifest, f, indent=1)
+    _write_manifest(folder, index, records, params, vocab)
     return WindowStore.open(folder)
