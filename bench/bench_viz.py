@@ -95,7 +95,7 @@ def main() -> None:
     print(f"{args.frames}-frame GIF of the 75-joint BEAT skeleton, {SIZE[0]}x{SIZE[1]} px, {fps:g} fps")
 
     def beatlite_mpl() -> None:
-        anim = animate_skeletons(pos, skel, fps, out_fps=None, panel_size=SIZE[0] / 100, dpi=100)
+        anim = animate_skeletons(pos, skel, fps, out_fps=None, width=SIZE[0], dpi=100)  # square: one panel
         anim.save_as(args.out / "mpl.gif")
 
     t_mpl = timed(beatlite_mpl)

@@ -341,59 +341,46 @@ def test_ha2g_code_protocol_is_seeded_and_differs_from_the_deterministic_one():
         SampledProtocol(model, ())
 
 
-# ------------------------------------------------------------------ score_models / metrics_table
-def test_score_models_with_the_columns_equals_evaluate_models(test_set, results):
-    from beatlite.train.evaluation import score_models
-
-    mean_pose = build_model("mean_pose")
-    mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
-    again = score_models([("Mean pose", mean_pose)], COLUMNS, test=test_set, extractor=_features)
-    assert [r.label for r in again.rows] == [r.label for r in results.rows]
-    for row in results.rows:
-        for key in COLUMNS:
-            np.testing.assert_allclose(again.value(row.label, key), row.metrics[key], rtol=1e-12, atol=1e-12)
-
-
-def test_score_models_reference_variants_closed_forms(test_set):
-    from beatlite.train.evaluation import score_models
-
+# ------------------------------------------------------------------ reference variants, column tables
+def test_reference_variant_columns_closed_forms(test_set):
     mean_pose = build_model("mean_pose")
     mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})  # Euler 0 everywhere = gt_euler
     keys = ("SRGR (reference)", "FGD (reference)")
-    res = score_models([("Mean pose", mean_pose)], keys, test=test_set, extractor=_features)
+    res = evaluate_models([("Mean pose", mean_pose)], test=test_set, extractor=_features, columns=keys)
     # every joint of every frame within 4 degrees: reference SRGR = sum(semantic / 0.165) / frames
     sem = np.concatenate(test_set.semantic)
     expected = sem.sum() / sem.size / 0.165
     assert res.value(GROUND_TRUTH, "SRGR (reference)") == pytest.approx(expected, rel=1e-9)
     assert res.value("Mean pose", "SRGR (reference)") == pytest.approx(expected, rel=1e-9)
     assert res.value(GROUND_TRUTH, "FGD (reference)") == pytest.approx(0.0, abs=1e-6)
-    assert set(res.get("Mean pose").metrics) == set(keys) and res.info["metrics"] == list(keys)
+    assert set(res.get("Mean pose").metrics) == set(keys) and res.columns == keys
 
 
-def test_score_models_direction_rows_have_no_euler_variant(test_set):
-    from beatlite.train.evaluation import score_models
-
+def test_direction_rows_have_no_euler_variant(test_set):
     class Still(torch.nn.Module):  # a direction model that repeats the mean direction (dirvec 0)
         representation, input_keys, target_key, pose_dim, n_pre = "dirvec126", ("dirvec",), "dirvec", 126, 4
 
         def generate(self, batch):
             return torch.zeros_like(batch["dirvec"])
 
-    res = score_models([("Still", Still())], ("SRGR (reference)", "SRGR"), test=test_set, extractor=_features)
+    columns = ("SRGR (reference)", "SRGR")
+    res = evaluate_models([("Still", Still())], test=test_set, extractor=_features, columns=columns)
     assert math.isnan(res.value("Still", "SRGR (reference)"))  # BEAT's code needs Euler angles
     assert np.isfinite(res.value("Still", "SRGR"))
     with pytest.raises(ValueError, match="unknown metric"):
-        score_models([], ("SRGR (paper)",), test=test_set, extractor=_features)
+        evaluate_models([], test=test_set, extractor=_features, columns=("SRGR (paper)",))
 
 
-def test_metrics_table_names_each_variant(results):
-    from beatlite.train.evaluation import metrics_table
-
-    text = metrics_table(results, ["FGD", "BC"], rows=["Mean pose"])
+def test_to_markdown_shows_the_chosen_columns_and_names_each_variant(results):
+    text = results.to_markdown(["FGD", "BC"])
     lines = text.splitlines()
-    assert lines[0] == "| method | FGD ↓ | BC ↑ |"
-    assert lines[2].startswith("| Mean pose | ") and len(lines[2].split("|")) == 5
-    assert "- **BC**: HA2G beat consistency" in text and "Ground truth" not in text
+    assert lines[0] == "| method | FGD ↓ | BC ↑ | gen. s |"
+    mean_pose = next(line for line in lines if line.startswith("| Mean pose | "))
+    assert len(mean_pose.split("|")) == 6  # label, 2 metrics, seconds
+    assert "- **BC**: HA2G beat consistency" in text and "- **SRGR**" not in text
+    assert results.to_markdown() == results.to_markdown(results.columns)
+    with pytest.raises(ValueError, match="unknown metric"):
+        results.to_markdown(["SRGR (paper)"])
 
 
 def test_generated_euler_of_the_mean_pose_is_its_mean_and_directions_are_refused(test_set):

@@ -252,12 +252,9 @@ def _animation(**kwargs):
         {"ground truth": pos, "CaMN": pos[::-1]},
         tiny_skeleton(),
         fps=15,
-        audio=audio,
-        sr=sr,
-        audio_beats=[0.2, 0.9],
-        motion_beats=[0.5],
+        timeline=animation.Timeline(audio, sr, audio_beats=[0.2, 0.9], motion_beats=[0.5]),
         words=([0.0, 1.0], [0.5, 1.5], ["hello", "world"]),
-        panel_size=2.0,
+        width=300,
         dpi=50,
         **kwargs,
     )
@@ -269,8 +266,9 @@ def test_animation_frames_are_in_sync_and_differ():
     assert np.allclose(anim.times, np.arange(10) * 0.2)
     assert anim.fps == pytest.approx(5.0)
     img0, img3 = anim.frame_image(0), anim.frame_image(3)
-    # two 2-inch panels at 50 dpi, but the timeline panel widens the figure to 6 inches -> 300 px
+    # 300 px at 50 dpi: 6 inches, two square 3-inch panels (under the 3.6-inch cap) above the timeline
     assert img0.shape[1] == 300
+    assert [ax.get_position().width * 6 for ax in anim.figure.axes[:2]] == pytest.approx([3.0, 3.0])
     assert img0.std() > 5
     assert np.abs(img0.astype(int) - img3).sum() > 0
     caption = anim.figure.texts[-1]
@@ -284,9 +282,11 @@ def test_animation_frames_are_in_sync_and_differ():
     assert caption.get_text() == ""
 
 
-def test_animation_size_is_panels_times_dpi():
-    anim = animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, panel_size=2.0, dpi=50)
-    assert anim.frame_image(0).shape == (100, 100, 3)  # one 2 x 2 inch panel at 50 dpi
+def test_animation_size_is_width_in_pixels_with_square_panels():
+    anim = animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, width=100, dpi=50)
+    assert anim.frame_image(0).shape == (100, 100, 3)  # one square 2-inch panel at 50 dpi
+    with pytest.raises(TypeError):
+        animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, panel_size=2.0)  # beatlite 0.1
 
 
 def test_animation_gif_round_trip(tmp_path):
@@ -328,25 +328,38 @@ def test_animation_face_panels_follow_the_clock():
     rng = np.random.default_rng(0)
     weights = rng.random((120, 51))  # 2 s at 60 fps
     anim = animation.animate_skeletons(
-        wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, out_fps=15, dpi=40
+        wave_motion(30),
+        tiny_skeleton(),
+        fps=15,
+        face=animation.FacePanel(weights, fps=60, kind="bars"),
+        out_fps=15,
+        dpi=40,
     )
     ax_face = anim.figure.axes[-1]
     anim.frame_image(10)  # t = 10 / 15 s -> face frame round(40.0) = 40
     heights = [r.get_height() for r in ax_face.patches]
     assert np.allclose(heights, weights[40, face.most_active(weights, 12)])  # the 12 most active blendshapes
     heat = animation.animate_skeletons(
-        wave_motion(30), tiny_skeleton(), fps=15, face=weights, face_fps=60, face_panel="heatmap", dpi=40
+        wave_motion(30),
+        tiny_skeleton(),
+        fps=15,
+        face=animation.FacePanel(weights, fps=60, kind="heatmap"),
+        dpi=40,
     )
     assert heat.frame_image(5).std() > 0
-    with pytest.raises(ValueError, match="face_panel"):
-        animation.animate_skeletons(wave_motion(3), tiny_skeleton(), 15, face=weights, face_panel="pie")
+    with pytest.raises(ValueError, match="kind"):
+        animation.animate_skeletons(
+            wave_motion(3), tiny_skeleton(), 15, face=animation.FacePanel(weights, kind="pie")
+        )
 
 
 def test_animation_rejects_mismatched_inputs():
     with pytest.raises(ValueError, match="labels"):
         animation.animate_skeletons([wave_motion(3)], tiny_skeleton(), 15, labels=["a", "b"])
     with pytest.raises(ValueError, match="audio"):
-        animation.animate_skeletons(wave_motion(3), tiny_skeleton(), 15, audio=np.zeros((2, 5)))
+        animation.animate_skeletons(
+            wave_motion(3), tiny_skeleton(), 15, timeline=animation.Timeline(np.zeros((2, 5)))
+        )
     with pytest.raises(ValueError, match=r"positions\[0\]"):
         animation.animate_skeletons(np.zeros((3, 4, 3)), tiny_skeleton(), 15)
 
@@ -529,7 +542,7 @@ def test_animation_is_slide_size_with_one_scale_and_readable_panels():
 def test_face_panel_and_timeline_check_their_inputs():
     with pytest.raises(ValueError, match="timeline"):
         animation.Timeline().checked()
-    with pytest.raises(ValueError, match="face_panel"):
+    with pytest.raises(ValueError, match="kind"):
         animation.FacePanel(np.zeros((3, 2)), kind="pie").checked(15)
     checked = animation.FacePanel(np.zeros((3, 2)), top=None).checked(15)
     assert checked.names == ["blendshape 0", "blendshape 1"] and checked.fps == 15
@@ -592,6 +605,25 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
     labels = [t for t in ax.texts if t.get_text()]
     assert len(labels) == 3 and all(_inside(t.get_window_extent(renderer), ax.get_window_extent(renderer))
                                     for t in labels)  # fmt: skip
+    plt.close("all")
+
+
+def test_effects_draw_the_paper_bars_beside_ours_with_error_bars():
+    from matplotlib.container import BarContainer, ErrorbarContainer
+
+    from beatlite.viz import charts
+
+    fig = charts.plot_effects(["a", "b"], [10.0, 20.0], [-5.0, 3.0], [1.0, 2.0], "FGD change (%)")
+    (ax,) = fig.axes
+    bars = [c for c in ax.containers if isinstance(c, BarContainer)]
+    assert [p.get_height() for p in bars[0]] == [10.0, 20.0]  # the paper's, no error bar
+    assert [p.get_height() for p in bars[1]] == [-5.0, 3.0]
+    (errors,) = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+    spans = [np.ptp(seg[:, 1]) for seg in errors.lines[2][0].get_segments()]
+    assert spans == pytest.approx([2.0, 4.0])  # +- the half-lengths given
+    assert ax.get_ylabel() == "FGD change (%)" and [t.get_text() for t in ax.get_xticklabels()] == ["a", "b"]
+    with pytest.raises(ValueError, match="same length"):
+        charts.plot_effects(["a"], [1.0, 2.0], [1.0], [1.0], "x")
     plt.close("all")
 
 

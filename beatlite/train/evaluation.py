@@ -122,23 +122,46 @@ class ModelResults:
         """``get(row).metrics[metric]``."""
         return self.get(row).metrics[metric]
 
-    def to_markdown(self, *, caption: bool = True) -> str:
-        """A Markdown table: one row per model, the metrics of :attr:`columns`, generation seconds.
+    def to_markdown(self, columns: Sequence[str] | None = None, *, caption: bool = True) -> str:
+        """A Markdown table: one row per model, its metrics, generation seconds.
 
-        With ``caption`` the variant and parameters of every column follow the table.
+        Parameters
+        ----------
+        columns : sequence of str, optional
+            Metric keys to show, in order (default :attr:`columns`, all that were scored); the
+            header names the variant (``"SRGR (reference) ↑"``). A key a row was not scored with
+            shows as ``—``.
+        caption : bool
+            Append the variant and parameters of every column.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> res = ModelResults([ResultRow("A", "a", "ground_truth", {"SRGR": 0.25, "BC": math.nan})], {})
+        >>> print(res.to_markdown(["SRGR", "BC"], caption=False))
+        | method | SRGR ↑ | BC ↑ | gen. s |
+        |---|---|---|---|
+        | A | 0.250 | — |  |
         """
         from beatlite.report import markdown_table
 
+        columns = self.columns if columns is None else tuple(columns)
+        unknown = [key for key in columns if key not in METRICS]
+        if unknown:
+            raise ValueError(f"unknown metric keys {unknown}; known: {sorted(METRICS)}")
         rows = []
         for row in self.rows:
             cells = [row.label + (" †" if row.stale else "")]
-            cells += [fmt_metric(row.metrics.get(key, math.nan), key) for key in self.columns]
+            cells += [fmt_metric(row.metrics.get(key, math.nan), key) for key in columns]
             cells.append(f"{row.seconds:.2f}" if row.representation != "ground_truth" else "")
             rows.append(cells)
-        text = markdown_table(["method", *column_headers(self.columns), "gen. s"], rows)
+        text = markdown_table(["method", *column_headers(columns), "gen. s"], rows)
         if any(row.stale for row in self.rows):
             text += "\n\n† trained on another version of the data than the one evaluated: retrain it."
-        return text + ("\n\n" + describe(self.columns) if caption else "")
+        return text + ("\n\n" + describe(columns) if caption else "")
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -616,6 +639,9 @@ def evaluate_models(
     from beatlite.metrics.extractor import load_extractor
     from beatlite.paths import n_threads
 
+    unknown = [key for key in columns if key not in METRICS]
+    if unknown:
+        raise ValueError(f"unknown metric keys {unknown}; known: {sorted(METRICS)}")
     start = time.perf_counter()
     torch.set_num_threads(n_threads())
     entries = _as_entries(models)
@@ -723,115 +749,6 @@ def write_results(results: ModelResults, stem: str | Path | None = None) -> tupl
         + f"\n\nEvaluation time: {info['seconds']:.1f} s.\n"
     )
     return write_markdown_and_json(stem, text, results.to_dict())
-
-
-# ------------------------------------------------------------------------------------ other metric variants
-def score_models(
-    models: Sequence[Any] | None = None,
-    metrics: Sequence[str] = COLUMNS,
-    *,
-    test: EvaluationSet | None = None,
-    extractor: Any = None,
-    ground_truth: bool = True,
-    seed: int = 0,
-) -> ModelResults:
-    """:func:`evaluate_models` with the metric keys of your choice, e.g. the papers' reference variants.
-
-    Each model generates the test takes once and is scored with every key of ``metrics`` (keys of
-    :data:`beatlite.metrics.METRICS`, such as ``"SRGR (reference)"``, ``"BeatAlign (reference)"``,
-    ``"FGD (reference)"`` or ``"BC (ha2g)"``), so one call gives both our columns and the variants
-    a paper used. A key a row cannot be scored with (the Euler-only reference SRGR of a direction
-    model) is NaN. Show the result with :func:`metrics_table`; :meth:`ModelResults.to_markdown`
-    shows only :data:`COLUMNS`.
-
-    Parameters
-    ----------
-    models, test, extractor, ground_truth, seed
-        As :func:`evaluate_models`.
-    metrics : sequence of str
-        Metric keys (default :data:`COLUMNS`).
-
-    Returns
-    -------
-    ModelResults
-        ``row.metrics`` holds every key of ``metrics``; ``info["metrics"]`` lists them.
-    """
-    import torch
-
-    from beatlite.metrics.extractor import load_extractor
-
-    unknown = [key for key in metrics if key not in METRICS]
-    if unknown:
-        raise ValueError(f"unknown metric keys {unknown}; known: {sorted(METRICS)}")
-    start = time.perf_counter()
-    test = load_test_set() if test is None else test
-    extractor = load_extractor("dirvec") if extractor is None else extractor
-    truth = test.ground_truth(extractor)
-    rows = []
-    if ground_truth:
-        for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):
-            values = score_directions(
-                dirs, test, extractor, truth, euler=test.gt_euler, columns=metrics, seed=seed
-            )
-            rows.append(ResultRow(label, "ground_truth", "ground_truth", values))
-    for label, source, model, norms in _as_entries(models):
-        fingerprint, stale = "", False
-        if model is None:
-            model, norms, fingerprint, stale = _load_checkpoint(source, test)
-        t0 = time.perf_counter()
-        with torch.no_grad():
-            dirs, euler = _generate(model, test, norms)
-        seconds = time.perf_counter() - t0
-        values = score_directions(dirs, test, extractor, truth, euler=euler, columns=metrics, seed=seed)
-        rows.append(ResultRow(label, source, model.representation, values, seconds, fingerprint, stale))
-    info = {
-        "split": test.split,
-        "takes": list(test.takes),
-        "frames": test.n_frames,
-        "windows": int(len(truth.takes.features)),
-        "metrics": list(metrics),
-        "columns": {key: METRICS[key].describe for key in metrics},
-        "seconds": round(time.perf_counter() - start, 2),
-    }
-    return ModelResults(rows, info)
-
-
-def metrics_table(
-    results: ModelResults, metrics: Sequence[str], *, rows: Sequence[str] | None = None, caption: bool = True
-) -> str:
-    """A Markdown table of ``results`` with the columns ``metrics``, each header naming its variant.
-
-    Parameters
-    ----------
-    results : ModelResults
-        From :func:`score_models` (or :func:`evaluate_models` for keys of :data:`COLUMNS`).
-    metrics : sequence of str
-        Metric keys to show, in order; the header is the key (``"SRGR (reference) ↑"``).
-    rows : sequence of str, optional
-        Row labels or checkpoint names to show, in order (default every row).
-    caption : bool
-        Append the definition of every column (:func:`beatlite.metrics.scoring.describe`).
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> res = ModelResults([ResultRow("A", "a", "euler141", {"SRGR": 0.25, "BC": math.nan})], {})
-    >>> print(metrics_table(res, ["SRGR", "BC"], caption=False))
-    | method | SRGR ↑ | BC ↑ |
-    |---|---|---|
-    | A | 0.250 | — |
-    """
-    from beatlite.report import markdown_table
-
-    chosen = results.rows if rows is None else [results.get(r) for r in rows]
-    body = [
-        [row.label, *[fmt_metric(row.metrics.get(key, math.nan), key) for key in metrics]] for row in chosen
-    ]
-    text = markdown_table(["method", *column_headers(metrics)], body)
-    return text + ("\n\n" + describe(metrics) if caption else "")
 
 
 # ------------------------------------------------------------------------------------ the papers' rows

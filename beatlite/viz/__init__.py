@@ -15,7 +15,8 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ``face``                     :func:`plot_blendshapes` (ARKit heat map / bars, by name),
                              :func:`plot_blendshape_curves` (the most active ones over time)
 ``charts``                   :func:`plot_training_curves`, :func:`plot_scores` (bars, outliers cut),
-                             :func:`plot_score_scatter` (labelled points), :func:`plot_signals`
+                             :func:`plot_score_scatter` (labelled points), :func:`plot_effects`
+                             (ablation changes, paper vs ours ± error), :func:`plot_signals`
                              (curves + event lines), :func:`plot_waveform` (amplitude, words, onsets)
 ``render``                   pyvista: :func:`render_frame`, :func:`render_animation`, :func:`show_skeleton`
 ``probe``                    :func:`probe_offscreen`, :func:`use_pyvista` (subprocess probe, cached)
@@ -58,6 +59,7 @@ _EXPORTS: dict[str, str] = {
     "plot_training_curves": "charts",
     "plot_scores": "charts",
     "plot_score_scatter": "charts",
+    "plot_effects": "charts",
     "plot_signals": "charts",
     "plot_waveform": "charts",
     "plot_blendshape_curves": "face",

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import shutil
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -256,7 +256,7 @@ class FacePanel:
         rows = np.arange(w.shape[1])
         if self.top is not None:
             rows = most_active(w, self.top)
-        f_fps = fps if self.fps is None else check_fps(self.fps, "face_fps")
+        f_fps = fps if self.fps is None else check_fps(self.fps, "FacePanel fps")
         return FacePanel(w[:, rows], [names[k] for k in rows], f_fps, self.kind, None)
 
 
@@ -266,9 +266,9 @@ def _check_face(weights: Any, names: Sequence[str] | None, kind: str) -> np.ndar
     if w.ndim != 2 or w.shape[0] == 0:
         raise ValueError(f"face must be (T, 51) blendshape weights, got shape {w.shape}")
     if names is not None and len(names) != w.shape[1]:
-        raise ValueError(f"face_names: {len(names)} names for {w.shape[1]} blendshapes")
+        raise ValueError(f"FacePanel names: {len(names)} names for {w.shape[1]} blendshapes")
     if kind not in FACE_PANELS:
-        raise ValueError(f"face_panel must be one of {FACE_PANELS}, got {kind!r}")
+        raise ValueError(f"FacePanel kind must be one of {FACE_PANELS}, got {kind!r}")
     return w
 
 
@@ -311,27 +311,6 @@ def _clock(
     return idx, idx / fps, play_fps
 
 
-_LEGACY = ("audio", "sr", "audio_beats", "motion_beats", "face_names", "face_fps", "face_panel", "panel_size")
-
-
-def _legacy_options(timeline: Any, face: Any, legacy: dict[str, Any]) -> tuple[Any, Any, float | None]:
-    """The keyword arguments of beatlite <= 0.1 (``audio=``, ``face_names=``, ...) as Timeline / FacePanel.
-
-    Returns ``(timeline, face, panel_size)``; ``panel_size`` (inches) is ``None`` unless given.
-    """
-    unknown = sorted(set(legacy) - set(_LEGACY))
-    if unknown:
-        raise TypeError(f"animate_skeletons() got unexpected keyword arguments {unknown}")
-    if timeline is None and any(legacy.get(k) is not None for k in ("audio", "audio_beats", "motion_beats")):
-        timeline = Timeline(*(legacy.get(k) for k in ("audio", "sr", "audio_beats", "motion_beats")))
-        timeline = replace(timeline, sr=16000 if timeline.sr is None else timeline.sr)
-    if face is not None and not isinstance(face, FacePanel):
-        face = FacePanel(
-            face, legacy.get("face_names"), legacy.get("face_fps"), legacy.get("face_panel", "bars")
-        )
-    return timeline, face, legacy.get("panel_size")
-
-
 @dataclass(frozen=True)
 class _Layout:
     """Step 3: the figure size and the rectangle (figure fractions) of every panel."""
@@ -352,17 +331,9 @@ def _face_heights(face: FacePanel | None) -> tuple[float, float]:
     return 1.3, 1.5  # bars, names written vertically below
 
 
-def _skeleton_row(n: int, width: float, panel_size: float | None, below: bool) -> tuple[float, float]:
-    """Height of the skeleton row and figure width, inches: square panels up to 3.6 in (5.4 alone)."""
-    if panel_size is None:
-        return min(width / n, 3.6 if below else 5.4), width
-    return panel_size, max(panel_size * n, 6.0 if below else 0.0)  # beatlite 0.1's panel_size layout
-
-
 def _layout(
     n: int,
     width: float,
-    panel_size: float | None,
     *,
     titles: bool,
     timeline: bool,
@@ -371,7 +342,7 @@ def _layout(
 ) -> _Layout:
     """Stack from the top: skeleton row, caption band, timeline, face; side margins for names and legends."""
     below = timeline or face is not None
-    sk_h, width = _skeleton_row(n, width, panel_size, below)
+    sk_h = min(width / n, 3.6 if below else 5.4)  # square panels up to 3.6 in (5.4 alone), inches
     title_h, cap_h, tl_h = 0.4 * titles, 0.55 * caption, 1.55 * timeline
     face_h, face_below = _face_heights(face)
     height = title_h + sk_h + cap_h + tl_h + face_h + face_below + 0.1 * below
@@ -487,7 +458,6 @@ def animate_skeletons(
     width: float = SLIDE_WIDTH_PX,
     dpi: float = 100,
     max_frames: int | None = None,
-    **legacy: Any,
 ) -> SkeletonAnimation:
     """Animate one or several skeletons side by side, in sync, with optional timeline, face and word panels.
 
@@ -521,12 +491,6 @@ def animate_skeletons(
         ``width`` makes the text larger.
     max_frames : int, optional
         Stop after this many animation frames.
-    **legacy
-        The keywords of beatlite 0.1, still accepted: ``audio``, ``sr``,
-        ``audio_beats``, ``motion_beats`` (-> ``timeline``), ``face`` as an array with
-        ``face_names``, ``face_fps``, ``face_panel`` (-> ``FacePanel``, its 12 most
-        active rows, bars by default), and ``panel_size`` (inches per skeleton panel; the figure is
-        then ``max(panel_size * n, 6)`` inches wide when panels are shown below).
 
     Returns
     -------
@@ -538,7 +502,6 @@ def animate_skeletons(
     from matplotlib.figure import Figure
 
     fps, dpi = check_fps(fps), check_fps(dpi, "dpi")
-    timeline, face, panel_size = _legacy_options(timeline, face, legacy)
     labels, seqs, bones = _sequences(positions, skeleton, labels)
     n_frames = max(len(p) for p in seqs)
     idx, times, play_fps = _clock(n_frames, fps, out_fps, max_frames)
@@ -548,7 +511,6 @@ def animate_skeletons(
     layout = _layout(
         len(seqs),
         check_fps(width, "width") / dpi,
-        panel_size,
         titles=labels is not None,
         timeline=timeline is not None,
         caption=word_table is not None,

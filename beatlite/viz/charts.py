@@ -1,12 +1,13 @@
-"""2D charts for the notebooks' results: training curves, model scores (bars), one score against another.
+"""2D charts for the notebooks' results: training curves, model scores (bars), one score against another, ablations.
 
 Each function follows :mod:`beatlite.viz.style`: a y label on every panel, legends
 outside the data, one colour per system (:func:`beatlite.viz.style.system_colour`).
-Taught in notebooks 05 and 06 (training curves) and 07 (benchmark).
+Taught in notebooks 05 and 06 (training curves, ablations) and 07 (benchmark).
 
 >>> fig = plot_training_curves(history, {"reconstruction loss (Huber)": {"train": "train.rec",
 ...                                                                        "validation": "val.rec"}})  # doctest: +SKIP
 >>> fig = plot_scores({"CaMN": 1.2, "HA2G": 2.0, "mean pose": 25.0}, "FGD")                  # doctest: +SKIP
+>>> fig = plot_effects(["w/o text"], [20.8], [12.0], [4.0], "FGD change vs full (%)")          # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -256,6 +257,70 @@ def plot_score_scatter(
         ax.margins(x=0.15, y=0.2)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
+    return ax.figure
+
+
+def plot_effects(
+    variants: Sequence[str],
+    paper: Sequence[float],
+    ours: Sequence[float],
+    ours_error: Sequence[float],
+    ylabel: str,
+    *,
+    labels: tuple[str, str] = ("paper (one run)", "beatlite, mean over seeds (± 2 SE)"),
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.6, 3.2),
+) -> Any:
+    """An ablation study at a glance: each variant's change vs the full model, the paper's bar beside ours.
+
+    The paper's tables have one run per row, so its bars have no error bar; ours are seed means
+    with an error bar (e.g. 2 standard errors of the difference, :mod:`beatlite.train.seeds`), so a
+    bar whose error bar crosses 0 is noise at this sample size.
+
+    Parameters
+    ----------
+    variants : sequence of str
+        Bar group labels (e.g. ``"w/o text"``).
+    paper, ours : sequence of float
+        Changes vs the full model (e.g. % FGD change), one per variant.
+    ours_error : sequence of float
+        Error bar half-lengths of ``ours`` (e.g. 2 standard errors), same unit.
+    ylabel : str
+        y-axis label with its unit, e.g. ``"FGD change vs full (%)"``.
+    labels : (str, str)
+        Legend entries of the paper's and our bars.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> fig = plot_effects(["w/o text", "w/o audio"], [20.8, 25.9], [12.0, 3.0], [4.0, 5.0], "FGD change (%)")
+    >>> [float(p.get_height()) for p in fig.axes[0].patches[2:]]  # ours, after the paper's two
+    [12.0, 3.0]
+    """
+    if not len(variants) == len(paper) == len(ours) == len(ours_error):
+        raise ValueError(
+            f"variants, paper, ours and ours_error must have the same length, got "
+            f"{len(variants)}, {len(paper)}, {len(ours)}, {len(ours_error)}"
+        )
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        x = np.arange(len(variants))
+        ax.bar(x - 0.2, paper, 0.4, label=labels[0], color="0.6")
+        ax.bar(
+            x + 0.2, ours, 0.4, yerr=ours_error, capsize=3, label=labels[1], color=system_colour("CaMN", 1)
+        )
+        ax.axhline(0, color="k", lw=0.8)
+        ax.set_xticks(x, variants, rotation=20, ha="right")
+        ax.set_ylabel(ylabel)
+        ax.grid(axis="x", visible=False)
+        legend_outside(ax, "right")
     return ax.figure
 
 
