@@ -94,3 +94,21 @@ def test_bad_names(name: str, field: str) -> None:
     with pytest.raises(FormatError) as info:
         parse_take_name(name)
     assert info.value.field == field and name in str(info.value)
+
+
+def test_format_error_survives_pickling_with_its_fields():
+    """A reader's FormatError raised in a worker process comes back whole (worker pools pickle it)."""
+    import pickle
+
+    from beatlite.io.errors import FormatError
+
+    err = FormatError("take.bvh", "'abc' is not a number", line=433, column=17, field="rows")
+    back = pickle.loads(pickle.dumps(err))
+    assert type(back) is FormatError and str(back) == str(err)
+    assert (back.path, back.reason, back.line, back.column, back.field) == (
+        err.path,
+        err.reason,
+        433,
+        17,
+        "rows",
+    )

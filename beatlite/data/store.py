@@ -753,14 +753,6 @@ def _stored_vocab(path: Path, text_fp: str) -> Vocab | None:
     return None
 
 
-def _build_job(record: TakeRecord, folder: Path, params: dict) -> dict[str, Any]:
-    """:func:`build_take` in a worker; a ``FormatError`` comes back as data (it does not survive pickling)."""
-    try:
-        return build_take(record, folder, params)
-    except FormatError as e:
-        return {"_format_error": (e.path, e.reason, e.line, e.column, e.field)}
-
-
 def _run_builds(
     todo: list[TakeRecord], folder: Path, params: dict, workers: int | None, progress: bool
 ) -> None:
@@ -768,25 +760,22 @@ def _run_builds(
     from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
     from multiprocessing import get_context
 
-    from tqdm import tqdm
+    from beatlite.notebook import progress as progress_bar
 
     n = min(len(todo), workers if workers is not None else (os.cpu_count() or 1))
     todo = sorted(todo, key=lambda r: -r.duration if r.duration else 0.0)  # long takes first: balance
-    with tqdm(total=len(todo), desc="store takes", unit="take", disable=not progress) as bar:
+    with progress_bar(total=len(todo), desc="store takes", unit="take", disable=not progress) as bar:
         if n <= 1:
             for r in todo:
                 build_take(r, folder / "takes" / r.stem, params)
                 bar.update()
             return
         with ProcessPoolExecutor(n, mp_context=get_context("spawn")) as pool:
-            pending = {pool.submit(_build_job, r, folder / "takes" / r.stem, params) for r in todo}
+            pending = {pool.submit(build_take, r, folder / "takes" / r.stem, params) for r in todo}
             while pending:
                 done, pending = wait(pending, return_when=FIRST_EXCEPTION)
                 for fut in done:
-                    error = fut.exception()
-                    if error is None and "_format_error" in fut.result():
-                        path, reason, line, column, field = fut.result()["_format_error"]
-                        error = FormatError(path, reason, line=line, column=column, field=field)
+                    error = fut.exception()  # a reader's FormatError, pickled back from the worker
                     if error is not None:
                         for other in pending:
                             other.cancel()

@@ -52,6 +52,15 @@ class FormatError(ValueError):
             where.append(f"field {field!r}")
         super().__init__(f"{', '.join(where)}: {message}")
 
+    def __reduce__(self) -> tuple:
+        """Pickle by the constructor's arguments, so the error crosses process boundaries (worker pools)."""
+        kwargs = {"line": self.line, "column": self.column, "field": self.field}
+        return (_format_error, (self.path, self.reason, kwargs))
+
+
+def _format_error(path: Path | None, reason: str, kwargs: dict) -> FormatError:
+    return FormatError(path, reason, **kwargs)
+
 
 class FormatWarning(UserWarning):
     """A file is readable but inconsistent (truncated audio, annotation times that disagree, ...).
