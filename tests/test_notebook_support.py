@@ -206,3 +206,20 @@ def test_figures_have_units_and_legends_outside(tmp_path: Path) -> None:
     )
     assert fig3.axes[0].get_ylim()[1] < 30  # the swing at 0-0.6 s (500 cm/s) does not set the scale
     plt.close("all")
+
+
+# ------------------------------------------------------------------ skeleton.core.tree_text
+def test_tree_text_lists_every_beat_joint_once_in_21_branches() -> None:
+    import re
+
+    from beatlite.skeleton import beat_skeleton
+    from beatlite.skeleton.core import tree_text
+
+    skeleton = beat_skeleton()
+    lines = tree_text(skeleton).splitlines()
+    indices = [int(i) for i in re.findall(r"(?:^|> )(\d+) ", "\n".join(line.strip() for line in lines), re.M)]
+    assert sorted(indices) == list(range(75))  # each joint exactly once
+    # branches: root, spine, neck/head, 2 x (shoulder..hand, 5 finger chains, 2 finger roots), 2 legs
+    assert len(lines) == 21 and lines[0] == "0 Hips (6)"
+    assert lines[2] == "    5 Neck (3) > 6 Neck1 (3) > 7 Head (3) > 8 HeadEnd (3) *"
+    assert sum(line.endswith("*") for line in lines) == len(skeleton.end_sites) == 13
