@@ -404,7 +404,7 @@ def plot_beat_curves(
     curves: Mapping[str, tuple[np.ndarray, np.ndarray, str]],
     fps: float,
     *,
-    t_end: float = 6.0,
+    t_range: tuple[float, float] = (0.0, 6.0),
     out: str | Path | None = None,
 ):
     """The waveform with its onsets above motion curves with their beats; onsets drawn across all panels.
@@ -418,8 +418,8 @@ def plot_beat_curves(
         One panel each, e.g. ``{"right wrist speed": (speed, minima, "cm/s")}``.
     fps : float
         Frame rate of the curves.
-    t_end : float
-        Seconds shown.
+    t_range : (float, float)
+        Seconds shown (start it at the speech to keep a swing before it from setting the scale).
     out : str or Path, optional
 
     Returns
@@ -428,6 +428,7 @@ def plot_beat_curves(
     """
     import matplotlib.pyplot as plt
 
+    t0, t_end = max(0.0, float(t_range[0])), float(t_range[1])
     y = np.asarray(audio)[: int(t_end * sr)]
     with figure_style():
         fig, axes = plt.subplots(1 + len(curves), 1, figsize=(10, 1.6 + 1.5 * len(curves)), sharex=True)
@@ -438,22 +439,19 @@ def plot_beat_curves(
         axes[0].legend(**_OUTSIDE)
         for k, (ax, (label, (curve, beats, unit))) in enumerate(zip(axes[1:], curves.items())):
             c = np.asarray(curve)
-            ax.plot(np.arange(len(c)) / fps, c, lw=1, color=f"C{k + 1}", label=label)
+            t = np.arange(len(c)) / fps
+            ax.plot(t, c, lw=1, color=f"C{k + 1}", label=label)
             b = np.asarray(beats)
-            ax.plot(
-                b,
-                np.interp(b, np.arange(len(c)) / fps, c),
-                "v",
-                ms=5,
-                color=BEAT_COLOUR,
-                label="motion beats",
-            )
+            ax.plot(b, np.interp(b, t, c), "v", ms=5, color=BEAT_COLOUR, label="motion beats")
+            shown = c[(t >= t0) & (t <= t_end)]
+            if shown.size:  # the scale of the shown window only
+                ax.set_ylim(min(0.0, float(shown.min())), 1.1 * float(shown.max()) + 1e-9)
             ax.set_ylabel(unit)
             ax.legend(**_OUTSIDE)
         for ax in axes:
-            for t in onsets[onsets < t_end]:
+            for t in onsets[(onsets >= t0) & (onsets < t_end)]:
                 ax.axvline(t, color=ONSET_COLOUR, lw=0.6, alpha=0.6)
-        axes[-1].set_xlim(0, t_end)
+        axes[-1].set_xlim(t0, t_end)
         axes[-1].set_xlabel("time (s)")
         return _finish(fig, out)
 
