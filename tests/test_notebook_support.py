@@ -223,3 +223,10 @@ def test_tree_text_lists_every_beat_joint_once_in_21_branches() -> None:
     assert len(lines) == 21 and lines[0] == "0 Hips (6)"
     assert lines[2] == "    5 Neck (3) > 6 Neck1 (3) > 7 Head (3) > 8 HeadEnd (3) *"
     assert sum(line.endswith("*") for line in lines) == len(skeleton.end_sites) == 13
+
+
+def test_speaker_split_table_default_columns_are_the_splits_present() -> None:
+    idx = TakeIndex([_speech("a", 2, 0, "train", 1, 60.0), _speech("b", 5, 0, "none", 9, 120.0)])
+    lines = speaker_split_table(idx).splitlines()
+    assert lines[0] == "| speaker | train takes | none takes | train min | none min |"
+    assert lines[-1] == "| **all** | 1 | 1 | 1.0 | 2.0 |"

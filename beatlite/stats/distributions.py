@@ -38,24 +38,28 @@ def paper_language_shares() -> dict[str, float]:
     return {k: v / total for k, v in PAPER_LANGUAGE_HOURS.items()}
 
 
-def speaker_split_table(index: TakeIndex, *, splits: tuple[str, ...] = ("train", "val", "test")) -> str:
+def speaker_split_table(index: TakeIndex, *, splits: tuple[str, ...] | None = None) -> str:
     """Markdown table: takes and minutes per speaker and split, with a total row.
 
     Parameters
     ----------
     index : TakeIndex
         Usable takes count (durations from the headers).
-    splits : tuple of str
-        Columns, in order.
+    splits : tuple of str, optional
+        Columns, in order (default: the splits present, in :data:`beatlite.io.names.SPLITS` order; BEAT's
+        1-hour speakers add ``"test+val"`` and ``"none"`` to train, val and test).
 
     Returns
     -------
     str
         Columns ``speaker``, ``<split> takes`` ..., ``<split> min`` ... (minutes with 1 decimal).
     """
+    from beatlite.io.names import SPLITS
     from beatlite.report import markdown_table
 
     usable = index.where(usable=True)
+    if splits is None:
+        splits = tuple(s for s in SPLITS if len(usable.where(split=s)))
     speakers = sorted({(r.speaker_id, r.speaker) for r in usable}, key=lambda s: (s[0] is None, s[0] or 0))
     rows = []
     for label, sub in [(f"{sid}_{name}", usable.where(speaker_id=sid)) for sid, name in speakers] + [
