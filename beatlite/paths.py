@@ -72,3 +72,12 @@ def n_threads() -> int:
     if n < 1:
         raise ValueError(f"BEATLITE_THREADS must be a positive integer, got {value!r}")
     return n
+
+
+def on_data_samples() -> bool:
+    """Whether :func:`data_dir` is the repository's own synthetic ``data_samples/`` folder.
+
+    Notebooks assert the effects planted in ``data_samples/`` only when this is true; on any other
+    BEAT-format folder they report the same quantities without asserting them.
+    """
+    return data_dir().resolve() == (repo_root() / "data_samples").resolve()

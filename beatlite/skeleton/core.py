@@ -138,3 +138,40 @@ class Skeleton:
             and np.array_equal(self.parents, other.parents)
             and self.channels == other.channels
         )
+
+
+def tree_text(skeleton: Skeleton) -> str:
+    """The joint tree one *branch* per line: a chain of single-child joints joined by ``>``.
+
+    A branch starts at the root or at a child of a joint with several children, and ends at a
+    joint with zero or several children; it is indented by two spaces per branch level. Each
+    name carries its joint index and channel count, ``*`` marks a joint that owns an End Site.
+    BEAT's 75 joints fit in 21 lines this way (a plain one-joint-per-line tree takes 75).
+
+    Examples
+    --------
+    >>> s = Skeleton(("Hips", "Spine", "Head", "LeftLeg", "LeftFoot"), [-1, 0, 1, 0, 3],
+    ...              np.zeros((5, 3)), [("Xrotation",) * 6] + [("Xrotation",) * 3] * 4, {2: np.zeros(3)})
+    >>> print(tree_text(s))
+    0 Hips (6)
+      1 Spine (3) > 2 Head (3) *
+      3 LeftLeg (3) > 4 LeftFoot (3)
+    """
+    children: list[list[int]] = [[] for _ in range(skeleton.n_joints)]
+    for j in range(1, skeleton.n_joints):
+        children[int(skeleton.parents[j])].append(j)
+
+    def label(j: int) -> str:
+        end = " *" if j in skeleton.end_sites else ""
+        return f"{j} {skeleton.names[j]} ({len(skeleton.channels[j])}){end}"
+
+    lines: list[str] = []
+    stack = [(0, 0)] if skeleton.n_joints else []
+    while stack:
+        j, level = stack.pop()
+        chain = [j]
+        while len(children[chain[-1]]) == 1:
+            chain.append(children[chain[-1]][0])
+        lines.append("  " * level + " > ".join(label(k) for k in chain))
+        stack.extend((c, level + 1) for c in reversed(children[chain[-1]]))
+    return "\n".join(lines)

@@ -205,3 +205,62 @@ def load_corpus(
             f"load_corpus: no readable usable takes in the index ({len(index)} takes, splits={splits})"
         )
     return takes
+
+
+def analysis_subset(
+    index: TakeIndex, *, max_minutes: float = 30.0, per_group: int = 2, max_speakers: int = 4
+) -> TakeIndex:
+    """The takes the per-take analyses of notebook 02 load: all of a small corpus, a sample of a big one.
+
+    Loading a take at 15 fps costs about 20 s per hour of 120-fps BVH, so on a corpus longer than
+    ``max_minutes`` the analyses use a sample that keeps every emotion and split present:
+
+    - speech takes only (conversation takes are neutral, so they add no emotion contrast), unless
+      the corpus has none;
+    - the ``max_speakers`` speakers with the most speech takes (ties: lower id first);
+    - for each (speaker, emotion, split), the first ``per_group`` takes by sequence id.
+
+    Parameters
+    ----------
+    index : TakeIndex
+        The indexed corpus (unusable takes are dropped).
+    max_minutes : float
+        Corpora up to this many minutes of usable takes are returned whole.
+    per_group : int
+        Takes kept per (speaker, emotion, split) in a big corpus.
+    max_speakers : int
+        Speakers kept in a big corpus.
+
+    Returns
+    -------
+    TakeIndex
+        The chosen takes, in index order.
+
+    Examples
+    --------
+    Skipped by the doctests (needs a big corpus); on real BEAT-4english this keeps at most
+    4 x 8 x 3 x 2 = 192 one-minute speech takes:
+
+    >>> analysis_subset(index_folder("/data/beat_english_v0.2.1"))  # doctest: +SKIP
+    """
+    if per_group < 1 or max_speakers < 1:
+        raise ValueError(
+            f"analysis_subset: per_group and max_speakers must be >= 1, got {per_group}, {max_speakers}"
+        )
+    usable = index.where(usable=True)
+    if usable.total_duration / 60 <= max_minutes:
+        return usable
+    speech = usable.where(conversation=False)
+    pool = speech if len(speech) else usable
+    counts: dict[int | None, int] = {}
+    for r in pool:
+        counts[r.speaker_id] = counts.get(r.speaker_id, 0) + 1
+    speakers = sorted(counts, key=lambda s: (-counts[s], s if s is not None else -1))[:max_speakers]
+    kept: set[str] = set()
+    groups: dict[tuple, list] = {}
+    for r in pool.where(speaker_id=speakers):
+        groups.setdefault((r.speaker_id, r.emotion, r.split), []).append(r)
+    for members in groups.values():
+        members.sort(key=lambda r: (r.sequence if r.sequence is not None else 0, r.stem))
+        kept.update(r.stem for r in members[:per_group])
+    return pool.filter(lambda r: r.stem in kept)

@@ -60,6 +60,13 @@ def word_scores(takes: Sequence[CorpusTake], *, top: int = 9) -> list[tuple[str,
     -------
     list of (word, count, mean score), by decreasing count then alphabetically.
     """
+    scores = word_occurrence_scores(takes)
+    ranked = sorted(scores, key=lambda w: (-len(scores[w]), w))[:top]
+    return [(w, len(scores[w]), float(np.mean(scores[w]))) for w in ranked]
+
+
+def word_occurrence_scores(takes: Sequence[CorpusTake]) -> dict[str, list[float]]:
+    """Lower-cased word -> the score of each of its occurrences (see :func:`word_scores`)."""
     scores: dict[str, list[float]] = defaultdict(list)
     for t in takes:
         for start, end, word in zip(t.word_starts, t.word_ends, t.words):
@@ -71,8 +78,48 @@ def word_scores(takes: Sequence[CorpusTake], *, top: int = 9) -> list[tuple[str,
             seg = t.semantic[a:b]
             if seg.size:
                 scores[w].append(float(seg.mean()))
-    ranked = sorted(scores, key=lambda w: (-len(scores[w]), w))[:top]
-    return [(w, len(scores[w]), float(np.mean(scores[w]))) for w in ranked]
+    return dict(scores)
+
+
+def word_class_scores(
+    takes: Sequence[CorpusTake], *, function_words: frozenset[str] | None = None
+) -> dict[str, dict[str, float]]:
+    """Mean semantic score of function words vs content words (the contrast of BEAT's Fig. 4c).
+
+    BEAT's Figure 4c colours nine frequent words by lexical class. Here a word is a *function
+    word* when it is in ``function_words`` (default: scikit-learn's ``ENGLISH_STOP_WORDS``, 318
+    pronouns, articles, prepositions, auxiliaries, ...) and a *content word* otherwise.
+
+    Returns
+    -------
+    dict ``{"function": {...}, "content": {...}}``, each with ``"occurrences"`` (int), ``"words"``
+    (distinct words) and ``"mean"`` (mean score over occurrences, NaN when there are none).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> take = SimpleNamespace(fps=1.0, semantic=np.array([0.1, 0.9, 0.5]),
+    ...                        word_starts=np.array([0.0, 1.0, 2.0]), word_ends=np.array([1.0, 2.0, 3.0]),
+    ...                        words=("the", "idea", "of"))
+    >>> out = word_class_scores([take])
+    >>> round(out["function"]["mean"], 3), out["function"]["occurrences"], out["content"]["mean"]
+    (0.3, 2, 0.9)
+    """
+    if function_words is None:
+        from sklearn.feature_extraction.text import ENGLISH_STOP_WORDS
+
+        function_words = ENGLISH_STOP_WORDS
+    scores = word_occurrence_scores(takes)
+    out = {}
+    for name, keep in (("function", True), ("content", False)):
+        words = [w for w in scores if (w in function_words) == keep]
+        values = [s for w in words for s in scores[w]]
+        out[name] = {
+            "occurrences": len(values),
+            "words": len(words),
+            "mean": float(np.mean(values)) if values else float("nan"),
+        }
+    return out
 
 
 def speaker_scores(takes: Sequence[CorpusTake]) -> dict[int, dict[str, float]]:

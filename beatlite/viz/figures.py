@@ -1,0 +1,489 @@
+"""The 2-D figures of the data and metrics notebooks (00-04): time series, audio, annotations, spreads.
+
+Every function draws one figure in the beatlite style (:func:`beatlite.viz.style.figure_style`),
+with units on every axis and legends outside the data, optionally saves it
+(``out=`` path stem, :func:`beatlite.viz.style.save_figure`) and returns it.
+
+===============================  ===========================================================
+:func:`plot_lines`               curves over time (degrees, weights, cm/s, ...), legend outside
+:func:`plot_corpus_overview`     minutes per speaker and split, minutes per emotion (00)
+:func:`plot_waveform`            a waveform with its words shaded (00, 03)
+:func:`plot_transcript`          waveform, word and phone tiers of a TextGrid (01)
+:func:`plot_annotations`         emotion segments, semantic scores and their 15-fps frames (01)
+:func:`plot_onsets`              waveform and onset strength with detected onsets (03)
+:func:`plot_speed_minima`        joint speeds, their minima and the audio onsets (03)
+:func:`plot_beat_curves`         audio onsets, speed minima and HA2G angle-change beats (04)
+:func:`plot_spread`              box plots of SRGR and L1 diversity per system (04, BEAT Fig. 6)
+===============================  ===========================================================
+
+Taught in notebooks/00_setup_and_tour.ipynb to notebooks/04_metrics.ipynb (their figures).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from beatlite.viz.style import figure_style, save_figure
+
+#: Colours of audio onsets, word onsets and motion beats across the figures.
+ONSET_COLOUR, WORD_COLOUR, BEAT_COLOUR = "#c44e52", "#4c72b0", "#55a868"
+_OUTSIDE = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "borderaxespad": 0.0}
+
+
+def _finish(fig: Any, out: str | Path | None) -> Any:
+    fig.tight_layout()
+    if out is not None:
+        save_figure(fig, out)
+    return fig
+
+
+def plot_lines(
+    t: np.ndarray,
+    curves: Mapping[str, np.ndarray],
+    *,
+    ylabel: str,
+    xlabel: str = "time (s)",
+    title: str | None = None,
+    xlim: tuple[float, float] | None = None,
+    styles: Mapping[str, dict] | None = None,
+    figsize: tuple[float, float] = (9, 2.6),
+    out: str | Path | None = None,
+):
+    """Curves sharing one x axis, the legend to the right of the axes (it never covers a curve).
+
+    Parameters
+    ----------
+    t : (T,) float
+        x values (seconds by default).
+    curves : mapping label -> (T,) float
+        One line each, in order.
+    ylabel, xlabel : str
+        Axis labels with units, e.g. ``"degrees"``.
+    title : str, optional
+    xlim : (float, float), optional
+    styles : mapping label -> dict, optional
+        Extra ``Axes.plot`` keywords per curve (e.g. ``{"ls": "--"}``).
+    figsize : (float, float)
+    out : str or Path, optional
+        Save to ``out.png`` / ``out.svg``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    with figure_style():
+        fig, ax = plt.subplots(figsize=figsize)
+        for label, y in curves.items():
+            ax.plot(t, y, lw=1, label=label, **(styles or {}).get(label, {}))
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        if title:
+            ax.set_title(title)
+        if xlim is not None:
+            ax.set_xlim(*xlim)
+        ax.legend(**_OUTSIDE)
+        return _finish(fig, out)
+
+
+def plot_corpus_overview(index: Any, *, out: str | Path | None = None):
+    """Two panels: minutes per speaker stacked by split, and minutes per take-level emotion.
+
+    Parameters
+    ----------
+    index : TakeIndex
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    from beatlite.io import EMOTIONS
+
+    usable = index.where(usable=True)
+    speakers = sorted({(r.speaker_id, r.speaker) for r in usable}, key=lambda s: (s[0] is None, s[0] or 0))
+    with figure_style():
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.2))
+        bottom = np.zeros(len(speakers))
+        for split in ("train", "val", "test"):
+            values = np.array(
+                [usable.where(speaker_id=s, split=split).total_duration / 60 for s, _ in speakers]
+            )
+            ax1.bar([f"{s}_{n}" for s, n in speakers], values, bottom=bottom, label=split)
+            bottom += values
+        ax1.set_ylabel("minutes")
+        ax1.set_title("duration per speaker and split")
+        ax1.legend(**_OUTSIDE)
+        names = list(EMOTIONS)
+        ax2.barh(names, [usable.where(emotion_name=e).total_duration / 60 for e in names], color="#8172b3")
+        ax2.invert_yaxis()
+        ax2.set_xlabel("minutes (take-level emotion)")
+        ax2.set_title("duration per emotion")
+        return _finish(fig, out)
+
+
+def _shade_words(ax: Any, words: Any, t_end: float, y: float, *, fontsize: float = 8) -> None:
+    for start, end, word in zip(words.starts, words.ends, words.words):
+        if start >= t_end:
+            break
+        ax.axvspan(start, min(end, t_end), color=WORD_COLOUR, alpha=0.12, lw=0)
+        ax.text((start + end) / 2, y, word, ha="center", va="bottom", fontsize=fontsize, clip_on=True)
+
+
+def plot_waveform(
+    audio: np.ndarray,
+    sr: int,
+    *,
+    words: Any = None,
+    t_end: float | None = None,
+    title: str | None = None,
+    out: str | Path | None = None,
+):
+    """A mono waveform (amplitude in full-scale units, [-1, 1]) with its words shaded and written above.
+
+    Parameters
+    ----------
+    audio : (N,) float
+        Samples in [-1, 1].
+    sr : int
+        Sample rate, Hz.
+    words : Words, optional
+        ``starts``, ``ends`` (s) and ``words`` (e.g. ``take.words``).
+    t_end : float, optional
+        Show ``[0, t_end)`` seconds (default: everything).
+    title : str, optional
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    y = np.asarray(audio, dtype=np.float64)
+    t_end = len(y) / sr if t_end is None else float(t_end)
+    n = min(len(y), int(np.ceil(t_end * sr)))
+    peak = float(np.abs(y[:n]).max()) if n else 1.0
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(9, 2.4))
+        ax.plot(np.arange(n) / sr, y[:n], lw=0.4, color="0.35")
+        if words is not None:
+            _shade_words(ax, words, t_end, 1.05 * peak)
+        ax.set_xlim(0, t_end)
+        ax.set_ylim(-1.25 * peak, 1.3 * peak)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("amplitude\n(full scale = 1)")
+        if title:
+            ax.set_title(title)
+        return _finish(fig, out)
+
+
+def plot_transcript(
+    audio: np.ndarray,
+    sr: int,
+    tiers: Mapping[str, Sequence[Any]],
+    *,
+    t_end: float = 4.0,
+    out: str | Path | None = None,
+):
+    """The waveform above the ``words`` and ``phones`` tiers of a TextGrid (intervals with text shaded).
+
+    Parameters
+    ----------
+    audio : (N,) float, [-1, 1]
+    sr : int
+    tiers : mapping tier name -> intervals with ``start``, ``end`` (s) and ``text``
+        :func:`beatlite.io.read_textgrid`'s result; ``words`` and ``phones`` are drawn.
+    t_end : float
+        Seconds shown.
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    y = np.asarray(audio, dtype=np.float64)[: int(t_end * sr)]
+    with figure_style():
+        fig, axes = plt.subplots(
+            3, 1, figsize=(9, 3.4), sharex=True, gridspec_kw={"height_ratios": [2, 1, 1]}
+        )
+        axes[0].plot(np.arange(len(y)) / sr, y, lw=0.4, color="0.35")
+        axes[0].set_ylabel("amplitude")
+        for ax, tier, colour, size in ((axes[1], "words", WORD_COLOUR, 7), (axes[2], "phones", "#dd8452", 6)):
+            for iv in tiers.get(tier, ()):
+                if iv.start >= t_end:
+                    break
+                if iv.text.strip():
+                    ax.axvspan(iv.start, iv.end, color=colour, alpha=0.25, ec="white")
+                    ax.text((iv.start + iv.end) / 2, 0.5, iv.text, ha="center", va="center", fontsize=size)
+            ax.set_yticks([])
+            ax.grid(False)
+            ax.set_ylabel(tier, rotation=0, ha="right", va="center")
+        axes[2].set_xlim(0, t_end)
+        axes[2].set_xlabel("time (s)")
+        return _finish(fig, out)
+
+
+def plot_annotations(
+    emotions: Sequence[Any],
+    semantic: Sequence[Any],
+    semantic_frames: np.ndarray,
+    fps: float,
+    duration: float,
+    *,
+    out: str | Path | None = None,
+):
+    """Emotion segments, semantic segments (score, coloured by gesture type) and the per-frame score.
+
+    Parameters
+    ----------
+    emotions : sequence of EmotionSegment
+        ``start``, ``end`` (s), ``name``, ``emotion`` (id 0..7).
+    semantic : sequence of SemanticSegment
+        ``start``, ``end`` (s), ``score`` in [0, 1], ``type``.
+    semantic_frames : (T,) float
+        The per-frame scores at ``fps`` (:func:`beatlite.io.semantic_to_frames`).
+    fps, duration : float
+        Frame rate and take length (s).
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    types = sorted({s.type for s in semantic})
+    type_colour = {name: plt.cm.tab20(i % 20) for i, name in enumerate(types)}
+    with figure_style():
+        fig, axes = plt.subplots(
+            3, 1, figsize=(10, 3.8), sharex=True, gridspec_kw={"height_ratios": [1, 2, 1.5]}
+        )
+        for seg in emotions:
+            axes[0].axvspan(seg.start, seg.end, color=plt.cm.Set2(seg.emotion % 8))
+            axes[0].text((seg.start + seg.end) / 2, 0.5, seg.name, ha="center", va="center", fontsize=8)
+        axes[0].set_yticks([])
+        axes[0].grid(False)
+        axes[0].set_ylabel("emotion", rotation=0, ha="right", va="center")
+        for seg in semantic:
+            axes[1].bar(seg.start, seg.score, width=seg.end - seg.start, align="edge",
+                        color=type_colour[seg.type], ec="white", lw=0.3)  # fmt: skip
+        axes[1].set_ylabel("score\n(segments)")
+        handles = [plt.Rectangle((0, 0), 1, 1, color=type_colour[name]) for name in types]
+        axes[1].legend(handles, types, fontsize=7, title="gesture type", title_fontsize=8, **_OUTSIDE)
+        axes[2].step(np.arange(len(semantic_frames)) / fps, semantic_frames, where="post", lw=1)
+        axes[2].set_ylabel(f"score\n({fps:g} fps)")
+        axes[2].set_xlabel("time (s)")
+        axes[2].set_xlim(0, duration)
+        return _finish(fig, out)
+
+
+def plot_onsets(
+    audio: np.ndarray,
+    sr: int,
+    onsets: np.ndarray,
+    *,
+    onsets_librosa: np.ndarray | None = None,
+    word_starts: np.ndarray | None = None,
+    hop_length: int = 512,
+    t_end: float = 6.0,
+    out: str | Path | None = None,
+):
+    """Two panels: the waveform with audio and word onsets, and librosa's onset strength with the picks.
+
+    Parameters
+    ----------
+    audio : (N,) float, [-1, 1]
+    sr : int
+    onsets : (A,) float, seconds
+        beatlite's peak picking (:func:`beatlite.metrics.audio_beats`).
+    onsets_librosa : (B,) float, optional
+        librosa's default peak picking.
+    word_starts : (W,) float, optional
+        Word onsets of the TextGrid.
+    hop_length : int
+        Hop of the onset strength (512).
+    t_end : float
+        Seconds shown.
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import librosa
+    import matplotlib.pyplot as plt
+
+    y = np.asarray(audio, dtype=np.float32)
+    strength = librosa.onset.onset_strength(y=y, sr=sr, hop_length=hop_length)
+    t_strength = librosa.times_like(strength, sr=sr, hop_length=hop_length)
+    n = int(t_end * sr)
+    with figure_style():
+        fig, (ax0, ax1) = plt.subplots(2, 1, figsize=(10, 3.8), sharex=True)
+        ax0.plot(np.arange(min(n, len(y))) / sr, y[:n], lw=0.3, color="0.45")
+        ax0.vlines(onsets, -1, 1, color=ONSET_COLOUR, lw=1, label="audio onsets (beatlite)")
+        if word_starts is not None:
+            ax0.vlines(word_starts, -1, -0.6, color=WORD_COLOUR, lw=2, label="word onsets (TextGrid)")
+        ax0.set_ylim(-1, 1)
+        ax0.set_ylabel("amplitude")
+        ax0.legend(**_OUTSIDE)
+        ax1.plot(t_strength, strength, lw=0.8, color="0.2", label="onset strength")
+        if onsets_librosa is not None:
+            ax1.plot(onsets_librosa, np.interp(onsets_librosa, t_strength, strength), "x", ms=5,
+                     color="#dd8452", label="onsets (librosa defaults)")  # fmt: skip
+        ax1.plot(onsets, np.interp(onsets, t_strength, strength), "o", ms=5, mfc="none", color=ONSET_COLOUR,
+                 label="onsets (beatlite)")  # fmt: skip
+        ax1.set_ylabel("spectral flux\n(dB per frame)")
+        ax1.set_xlim(0, t_end)
+        ax1.set_xlabel("time (s)")
+        ax1.legend(**_OUTSIDE)
+        return _finish(fig, out)
+
+
+def plot_speed_minima(
+    t: np.ndarray,
+    speeds: Mapping[str, np.ndarray],
+    minima: Mapping[str, np.ndarray],
+    onsets: np.ndarray,
+    *,
+    t_range: tuple[float, float],
+    out: str | Path | None = None,
+):
+    """Joint speeds with their minima (triangles) and the audio onsets, y scaled to the shown window.
+
+    The y axis ends at the 98th percentile of the speeds inside ``t_range`` (times 1.15), so one
+    fast swing outside the window, or a single spike inside it, does not flatten the minima.
+
+    Parameters
+    ----------
+    t : (T,) float, seconds
+    speeds : mapping label -> (T,) float, cm/s
+    minima : mapping label -> (K,) float, seconds
+        Minima of each speed curve (same labels).
+    onsets : (A,) float, seconds
+    t_range : (float, float)
+        Seconds shown.
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    inside = (t >= t_range[0]) & (t <= t_range[1])
+    top = 1.15 * max(float(np.percentile(np.asarray(v)[inside], 98)) for v in speeds.values())
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(10, 2.8))
+        for k, (label, v) in enumerate(speeds.items()):
+            line = ax.plot(t, v, lw=1, label=f"{label} speed", color=f"C{k + 1}")[0]
+            m = np.asarray(minima[label])
+            ax.plot(m, np.interp(m, t, v), "v", ms=5, color=line.get_color(), label=f"{label} speed minima")
+        ax.vlines(onsets, 0, top, color=ONSET_COLOUR, lw=0.8, alpha=0.6, label="audio onsets")
+        ax.set_xlim(*t_range)
+        ax.set_ylim(0, top)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("speed (cm/s)")
+        ax.legend(**_OUTSIDE)
+        return _finish(fig, out)
+
+
+def plot_beat_curves(
+    audio: np.ndarray,
+    sr: int,
+    onsets: np.ndarray,
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray, str]],
+    fps: float,
+    *,
+    t_range: tuple[float, float] = (0.0, 6.0),
+    out: str | Path | None = None,
+):
+    """The waveform with its onsets above motion curves with their beats; onsets drawn across all panels.
+
+    Parameters
+    ----------
+    audio : (N,) float, [-1, 1]
+    sr : int
+    onsets : (A,) float, seconds
+    curves : mapping label -> (curve (T,), beat times (K,) s, y label with units)
+        One panel each, e.g. ``{"right wrist speed": (speed, minima, "cm/s")}``.
+    fps : float
+        Frame rate of the curves.
+    t_range : (float, float)
+        Seconds shown (start it at the speech to keep a swing before it from setting the scale).
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    t0, t_end = max(0.0, float(t_range[0])), float(t_range[1])
+    y = np.asarray(audio)[: int(t_end * sr)]
+    with figure_style():
+        fig, axes = plt.subplots(1 + len(curves), 1, figsize=(10, 1.6 + 1.5 * len(curves)), sharex=True)
+        axes[0].plot(np.arange(len(y)) / sr, y, lw=0.3, color="0.5")
+        axes[0].set_ylabel("amplitude")
+        axes[0].set_ylim(-1, 1)
+        axes[0].plot([], [], color=ONSET_COLOUR, lw=1, label="audio onsets")
+        axes[0].legend(**_OUTSIDE)
+        for k, (ax, (label, (curve, beats, unit))) in enumerate(zip(axes[1:], curves.items())):
+            c = np.asarray(curve)
+            t = np.arange(len(c)) / fps
+            ax.plot(t, c, lw=1, color=f"C{k + 1}", label=label)
+            b = np.asarray(beats)
+            ax.plot(b, np.interp(b, t, c), "v", ms=5, color=BEAT_COLOUR, label="motion beats")
+            shown = c[(t >= t0) & (t <= t_end)]
+            if shown.size:  # the scale of the shown window only
+                ax.set_ylim(min(0.0, float(shown.min())), 1.1 * float(shown.max()) + 1e-9)
+            ax.set_ylabel(unit)
+            ax.legend(**_OUTSIDE)
+        for ax in axes:
+            for t in onsets[(onsets >= t0) & (onsets < t_end)]:
+                ax.axvline(t, color=ONSET_COLOUR, lw=0.6, alpha=0.6)
+        axes[-1].set_xlim(t0, t_end)
+        axes[-1].set_xlabel("time (s)")
+        return _finish(fig, out)
+
+
+def plot_spread(
+    spread: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    *,
+    titles: tuple[str, str] = ("SRGR (paper, 10 cm)", "L1 diversity (degrees)"),
+    out: str | Path | None = None,
+):
+    """Box plots of two metrics per system across evaluation subsets (BEAT Fig. 6 analog).
+
+    Parameters
+    ----------
+    spread : mapping system -> (values of metric 1, values of metric 2)
+        E.g. :func:`beatlite.metrics.perturb.subset_spread` per system.
+    titles : (str, str)
+        Panel titles, with units.
+    out : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    names = list(spread)
+    with figure_style():
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
+        for i, (ax, title) in enumerate(zip(axes, titles)):
+            ax.boxplot([spread[n][i] for n in names], showfliers=False)
+            ax.set_xticks(range(1, len(names) + 1), names, rotation=30, ha="right")
+            ax.set_title(title)
+            ax.set_ylabel(title.split(" (")[0] + " per subset")
+        return _finish(fig, out)
