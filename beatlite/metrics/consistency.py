@@ -273,7 +273,9 @@ def _same_takes(n_audio: int, many_audio: bool, n_dirs: int, many_dirs: bool) ->
 def _clips(y: np.ndarray, sr: int, v: np.ndarray, fps: float, length: int, stride: int):
     if length < 3 or stride < 1:
         raise ValueError(f"clip_length must be >= 3 and clip_stride >= 1, got {length}, {stride}")
+    from beatlite.data.windows import window_starts
+
     n_samples = int(round(length / fps * sr))
-    for start in range(0, v.shape[0] - length + 1, stride):
+    for start in window_starts(int(v.shape[0]), length, stride).tolist():
         a = int(round(start / fps * sr))
         yield y[a : a + n_samples], v[start : start + length]

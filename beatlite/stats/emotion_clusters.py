@@ -65,8 +65,9 @@ def _window_length(fps: float, seconds: float, stride_seconds: float | None) -> 
 
 def _take_windows(take: CorpusTake, length: int, stride: int) -> np.ndarray:
     """(W, length, 141) rotation windows of one take (W may be 0)."""
-    starts = np.arange(0, take.n_frames - length + 1, stride)
-    return take.rotations[starts[:, None] + np.arange(length)]
+    from beatlite.data.windows import sliding_windows
+
+    return sliding_windows(take.rotations, length, stride)
 
 
 def rotation_windows(
