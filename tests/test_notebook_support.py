@@ -190,21 +190,19 @@ def test_figures_have_units_and_legends_outside(tmp_path: Path) -> None:
 
     from beatlite.viz import figures
 
-    t = np.arange(30) / 15
-    fig = figures.plot_lines(t, {"a": np.sin(t), "b": np.cos(t)}, ylabel="degrees", out=tmp_path / "lines")
-    ax = fig.axes[0]
-    assert ax.get_ylabel() == "degrees" and ax.get_xlabel() == "time (s)"
-    legend_box = ax.get_legend().get_window_extent(fig.canvas.get_renderer())
-    assert legend_box.x0 >= ax.get_window_extent().x1  # right of the axes: it covers no curve
-    assert (tmp_path / "lines.png").is_file() and (tmp_path / "lines.svg").is_file()
-    words = SimpleNamespace(starts=np.array([0.1]), ends=np.array([0.5]), words=("hello",))
-    fig2 = figures.plot_waveform(np.sin(np.arange(16000) / 10).astype(np.float32) * 0.5, 16000, words=words)
-    assert "amplitude" in fig2.axes[0].get_ylabel()
-    speeds = {"wrist": np.r_[np.full(10, 500.0), np.abs(np.sin(np.arange(50) / 3)) * 20]}
-    fig3 = figures.plot_speed_minima(
-        np.arange(60) / 15, speeds, {"wrist": np.array([1.0])}, np.array([1.5]), t_range=(1.0, 3.9)
-    )
-    assert fig3.axes[0].get_ylim()[1] < 30  # the swing at 0-0.6 s (500 cm/s) does not set the scale
+    sr = 16000
+    y = (0.5 * np.sin(np.arange(3 * sr) / 10)).astype(np.float32)
+    fig = figures.plot_onsets(y, sr, np.array([0.5, 1.5]), word_starts=np.array([0.4]), t_end=2.0,
+                              out=tmp_path / "onsets")  # fmt: skip
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert [ax.get_ylabel() for ax in fig.axes] == ["amplitude", "spectral flux\n(dB per frame)"]
+    for ax in fig.axes:  # right of the axes: the legends cover no curve
+        assert ax.get_legend().get_window_extent(renderer).x0 >= ax.get_window_extent(renderer).x1
+    assert (tmp_path / "onsets.png").is_file() and (tmp_path / "onsets.svg").is_file()
+    spread = {"a": (np.array([0.1, 0.2]), np.array([3.0, 4.0])), "b": (np.array([0.3]), np.array([5.0]))}
+    fig2 = figures.plot_spread(spread)
+    assert [ax.get_ylabel() for ax in fig2.axes] == ["SRGR per subset", "L1 diversity per subset"]
     plt.close("all")
 
 

@@ -646,6 +646,11 @@ def test_signals_label_the_axes_keep_the_legend_outside_and_cut_one_large_swing(
     assert [txt.get_text() for txt in ax.get_legend().get_texts()] == ["wrist", "onsets"]
     with pytest.raises(ValueError, match="curves"):
         charts.plot_signals(t, {"short": speed[:10]}, "x")
+    fig = charts.plot_signals(t, {"a": speed, "b": speed}, "score", xlabel="motion shifted by (s)", title="T",
+                              styles={"b": {"ls": "--"}})  # fmt: skip
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_title()) == ("motion shifted by (s)", "T")
+    assert [ln.get_linestyle() for ln in ax.lines if ln.get_label() in ("a", "b")] == ["-", "--"]
     plt.close("all")
 
 
@@ -655,10 +660,13 @@ def test_waveform_has_an_amplitude_axis_and_the_words_of_the_window():
     sr = 1000
     y = 0.5 * np.sin(2 * np.pi * 50 * np.arange(3 * sr) / sr)
     words = ([0.2, 1.0, 2.5], [0.6, 1.4, 2.9], ["one", "two", "three"])
-    ax = charts.plot_waveform(y, sr, words=words, onsets={"onsets": [0.2]}, xlim=(0, 2)).axes[0]
-    assert ax.get_ylabel() == "amplitude (full scale)" and ax.get_xlabel() == "time (s)"
+    y[int(2.5 * sr)] = 1.0  # a click after the window shown
+    ax = charts.plot_waveform(y, sr, words=words, onsets={"onsets": [0.2]}, xlim=(0, 2), title="t").axes[0]
+    assert ax.get_ylabel() == "amplitude (full scale = 1)" and ax.get_xlabel() == "time (s)"
     assert [t.get_text() for t in ax.texts] == ["one", "two"]  # "three" starts after the 2 s shown
-    assert ax.get_xlim() == (0.0, 2.0)
+    assert ax.get_xlim() == (0.0, 2.0) and ax.get_title() == "t"
+    assert ax.get_ylim() == pytest.approx((-1.05 * 0.5, 1.45 * 0.5), rel=1e-3)  # the click sets no scale
+    assert ax.lines[0].get_xdata().max() <= 2.0 + 1.0 / sr  # only the window's samples are drawn
     plt.close("all")
 
 

@@ -17,7 +17,10 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ``charts``                   :func:`plot_training_curves`, :func:`plot_scores` (bars, outliers cut),
                              :func:`plot_score_scatter` (labelled points), :func:`plot_effects`
                              (ablation changes, paper vs ours ± error), :func:`plot_signals`
-                             (curves + event lines), :func:`plot_waveform` (amplitude, words, onsets)
+                             (curves + event lines + markers), :func:`plot_waveform` (amplitude, words, onsets)
+``figures``                  multi-panel figures of notebooks 00-04: :func:`plot_corpus_overview`,
+                             :func:`plot_transcript`, :func:`plot_annotations`, :func:`plot_onsets`,
+                             :func:`plot_beat_curves`, :func:`plot_spread`
 ``render``                   pyvista: :func:`render_frame`, :func:`render_animation`, :func:`show_skeleton`
 ``probe``                    :func:`probe_offscreen`, :func:`use_pyvista` (subprocess probe, cached)
 ``bvh_export``               :func:`motion_from_subset`, :func:`export_bvh` (Blender import steps)
@@ -36,7 +39,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-_SUBMODULES = ("style", "plot3d", "animation", "face", "charts", "render", "probe", "bvh_export")
+_SUBMODULES = ("style", "plot3d", "animation", "face", "charts", "figures", "render", "probe", "bvh_export")
 _EXPORTS: dict[str, str] = {
     "STYLE": "style",
     "GROUP_COLOURS": "style",
@@ -62,6 +65,12 @@ _EXPORTS: dict[str, str] = {
     "plot_effects": "charts",
     "plot_signals": "charts",
     "plot_waveform": "charts",
+    "plot_corpus_overview": "figures",
+    "plot_transcript": "figures",
+    "plot_annotations": "figures",
+    "plot_onsets": "figures",
+    "plot_beat_curves": "figures",
+    "plot_spread": "figures",
     "plot_blendshape_curves": "face",
     "plot_blendshapes": "face",
     "render_frame": "render",

@@ -333,6 +333,9 @@ def plot_signals(
     markers: Mapping[str, Any] | None = None,
     xlim: tuple[float, float] | None = None,
     clip_quantile: float | None = None,
+    xlabel: str = "time (s)",
+    title: str | None = None,
+    styles: Mapping[str, dict] | None = None,
     ax: Any = None,
     figsize: tuple[float, float] = (9.6, 2.8),
 ) -> Any:
@@ -355,6 +358,12 @@ def plot_signals(
     clip_quantile : float in (0, 1], optional
         Upper y limit = 1.2 x this quantile of the shown values, so that one large
         swing does not flatten the rest (the cut is written in the corner); ``None``: all data.
+    xlabel : str
+        x-axis label with its unit (``times`` need not be time, e.g. ``"motion shifted by (s)"``).
+    title : str, optional
+        Axes title.
+    styles : mapping curve label -> dict, optional
+        Extra ``Axes.plot`` keywords per curve, e.g. ``{"ls": "--"}`` or ``{"marker": "o", "ms": 3}``.
     ax : matplotlib Axes, optional
         Draw into it; a new figure otherwise.
     figsize : (float, float)
@@ -382,13 +391,15 @@ def plot_signals(
     with figure_style():
         ax = _new_axes(ax, figsize)
         for i, (label, y) in enumerate(curves.items()):
-            ax.plot(t, y, lw=1.1, color=f"C{i}", label=label)
+            ax.plot(t, y, **{"lw": 1.1, "color": f"C{i}", "label": label, **(styles or {}).get(label, {})})
             when = np.asarray((markers or {}).get(label, []), dtype=np.float64)
             ax.plot(when, np.interp(when, t, y), "v", ms=5, color=f"C{i}", ls="none")
         _draw_events(ax, events)
         _set_signal_limits(ax, t, np.stack(list(curves.values()))[:, shown], xlim, clip_quantile)
-        ax.set_xlabel("time (s)")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
+        if title:
+            ax.set_title(title)
         legend_outside(ax, "right")
     return ax.figure
 
@@ -428,6 +439,7 @@ def plot_waveform(
     words: Any = None,
     onsets: Mapping[str, Any] | None = None,
     xlim: tuple[float, float] | None = None,
+    title: str | None = None,
     ax: Any = None,
     figsize: tuple[float, float] = (9.6, 2.6),
 ) -> Any:
@@ -444,7 +456,10 @@ def plot_waveform(
     onsets : mapping label -> (E,) float seconds, optional
         Event times drawn as vertical lines (e.g. ``{"audio onsets": onsets}``); legend right of the data.
     xlim : (float, float), optional
-        Time range shown, seconds (default the whole waveform).
+        Time range shown, seconds (default the whole waveform); only its samples are drawn
+        and set the amplitude scale.
+    title : str, optional
+        Axes title.
     ax : matplotlib Axes, optional
         Draw into it; a new figure otherwise.
     figsize : (float, float)
@@ -460,13 +475,14 @@ def plot_waveform(
     if y.size == 0:
         raise ValueError("audio must be a non-empty (N,) waveform")
     sr = check_fps(sr, "sr")
-    t = np.arange(len(y)) / sr
     xlim = xlim if xlim is not None else (0.0, len(y) / sr)
+    i0, i1 = max(0, int(np.floor(xlim[0] * sr))), min(len(y), int(np.ceil(xlim[1] * sr)) + 1)
+    y = y[i0:i1] if i1 > i0 else y[:0]
     with figure_style():
         ax = _new_axes(ax, figsize)
-        ax.plot(t, y, lw=0.4, color="0.4")
+        ax.plot((i0 + np.arange(len(y))) / sr, y, lw=0.4, color="0.4")
         _draw_events(ax, onsets)
-        peak = max(float(np.abs(y).max()), 1e-6)
+        peak = max(float(np.abs(y).max()) if y.size else 0.0, 1e-6)
         ax.set_ylim(-1.05 * peak, 1.45 * peak)  # the top margin holds the words
         if words is not None:
             for start, end, word in zip(*check_words(words)):
@@ -475,6 +491,8 @@ def plot_waveform(
                     ax.text((start + end) / 2, 1.2 * peak, word, ha="center", va="center", fontsize=8)
         ax.set_xlim(*xlim)
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("amplitude (full scale)")
+        ax.set_ylabel("amplitude (full scale = 1)")
+        if title:
+            ax.set_title(title)
         legend_outside(ax, "right")
     return ax.figure

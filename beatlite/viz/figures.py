@@ -1,17 +1,18 @@
-"""The 2-D figures of the data and metrics notebooks (00-04): time series, audio, annotations, spreads.
+"""The multi-panel figures of the data and metrics notebooks (00-04): corpus, annotations, onsets, spreads.
+
+Single curves over time and single waveforms have one home, :mod:`beatlite.viz.charts`
+(:func:`~beatlite.viz.charts.plot_signals`, :func:`~beatlite.viz.charts.plot_waveform`); this module
+holds the figures those cannot draw (several panels, several marker kinds per curve, bars by split).
 
 Every function draws one figure in the beatlite style (:func:`beatlite.viz.style.figure_style`),
 with units on every axis and legends outside the data, optionally saves it
 (``out=`` path stem, :func:`beatlite.viz.style.save_figure`) and returns it.
 
 ===============================  ===========================================================
-:func:`plot_lines`               curves over time (degrees, weights, cm/s, ...), legend outside
 :func:`plot_corpus_overview`     minutes per speaker and split, minutes per emotion (00)
-:func:`plot_waveform`            a waveform with its words shaded (00, 03)
 :func:`plot_transcript`          waveform, word and phone tiers of a TextGrid (01)
 :func:`plot_annotations`         emotion segments, semantic scores and their 15-fps frames (01)
 :func:`plot_onsets`              waveform and onset strength with detected onsets (03)
-:func:`plot_speed_minima`        joint speeds, their minima and the audio onsets (03)
 :func:`plot_beat_curves`         audio onsets, speed minima and HA2G angle-change beats (04)
 :func:`plot_spread`              box plots of SRGR and L1 diversity per system (04, BEAT Fig. 6)
 ===============================  ===========================================================
@@ -39,56 +40,6 @@ def _finish(fig: Any, out: str | Path | None) -> Any:
     if out is not None:
         save_figure(fig, out)
     return fig
-
-
-def plot_lines(
-    t: np.ndarray,
-    curves: Mapping[str, np.ndarray],
-    *,
-    ylabel: str,
-    xlabel: str = "time (s)",
-    title: str | None = None,
-    xlim: tuple[float, float] | None = None,
-    styles: Mapping[str, dict] | None = None,
-    figsize: tuple[float, float] = (9, 2.6),
-    out: str | Path | None = None,
-):
-    """Curves sharing one x axis, the legend to the right of the axes (it never covers a curve).
-
-    Parameters
-    ----------
-    t : (T,) float
-        x values (seconds by default).
-    curves : mapping label -> (T,) float
-        One line each, in order.
-    ylabel, xlabel : str
-        Axis labels with units, e.g. ``"degrees"``.
-    title : str, optional
-    xlim : (float, float), optional
-    styles : mapping label -> dict, optional
-        Extra ``Axes.plot`` keywords per curve (e.g. ``{"ls": "--"}``).
-    figsize : (float, float)
-    out : str or Path, optional
-        Save to ``out.png`` / ``out.svg``.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    import matplotlib.pyplot as plt
-
-    with figure_style():
-        fig, ax = plt.subplots(figsize=figsize)
-        for label, y in curves.items():
-            ax.plot(t, y, lw=1, label=label, **(styles or {}).get(label, {}))
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        if title:
-            ax.set_title(title)
-        if xlim is not None:
-            ax.set_xlim(*xlim)
-        ax.legend(**_OUTSIDE)
-        return _finish(fig, out)
 
 
 def plot_corpus_overview(index: Any, *, out: str | Path | None = None):
@@ -126,62 +77,6 @@ def plot_corpus_overview(index: Any, *, out: str | Path | None = None):
         ax2.invert_yaxis()
         ax2.set_xlabel("minutes (take-level emotion)")
         ax2.set_title("duration per emotion")
-        return _finish(fig, out)
-
-
-def _shade_words(ax: Any, words: Any, t_end: float, y: float, *, fontsize: float = 8) -> None:
-    for start, end, word in zip(words.starts, words.ends, words.words):
-        if start >= t_end:
-            break
-        ax.axvspan(start, min(end, t_end), color=WORD_COLOUR, alpha=0.12, lw=0)
-        ax.text((start + end) / 2, y, word, ha="center", va="bottom", fontsize=fontsize, clip_on=True)
-
-
-def plot_waveform(
-    audio: np.ndarray,
-    sr: int,
-    *,
-    words: Any = None,
-    t_end: float | None = None,
-    title: str | None = None,
-    out: str | Path | None = None,
-):
-    """A mono waveform (amplitude in full-scale units, [-1, 1]) with its words shaded and written above.
-
-    Parameters
-    ----------
-    audio : (N,) float
-        Samples in [-1, 1].
-    sr : int
-        Sample rate, Hz.
-    words : Words, optional
-        ``starts``, ``ends`` (s) and ``words`` (e.g. ``take.words``).
-    t_end : float, optional
-        Show ``[0, t_end)`` seconds (default: everything).
-    title : str, optional
-    out : str or Path, optional
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    import matplotlib.pyplot as plt
-
-    y = np.asarray(audio, dtype=np.float64)
-    t_end = len(y) / sr if t_end is None else float(t_end)
-    n = min(len(y), int(np.ceil(t_end * sr)))
-    peak = float(np.abs(y[:n]).max()) if n else 1.0
-    with figure_style():
-        fig, ax = plt.subplots(figsize=(9, 2.4))
-        ax.plot(np.arange(n) / sr, y[:n], lw=0.4, color="0.35")
-        if words is not None:
-            _shade_words(ax, words, t_end, 1.05 * peak)
-        ax.set_xlim(0, t_end)
-        ax.set_ylim(-1.25 * peak, 1.3 * peak)
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("amplitude\n(full scale = 1)")
-        if title:
-            ax.set_title(title)
         return _finish(fig, out)
 
 
@@ -346,54 +241,6 @@ def plot_onsets(
         ax1.set_xlim(0, t_end)
         ax1.set_xlabel("time (s)")
         ax1.legend(**_OUTSIDE)
-        return _finish(fig, out)
-
-
-def plot_speed_minima(
-    t: np.ndarray,
-    speeds: Mapping[str, np.ndarray],
-    minima: Mapping[str, np.ndarray],
-    onsets: np.ndarray,
-    *,
-    t_range: tuple[float, float],
-    out: str | Path | None = None,
-):
-    """Joint speeds with their minima (triangles) and the audio onsets, y scaled to the shown window.
-
-    The y axis ends at the 98th percentile of the speeds inside ``t_range`` (times 1.15), so one
-    fast swing outside the window, or a single spike inside it, does not flatten the minima.
-
-    Parameters
-    ----------
-    t : (T,) float, seconds
-    speeds : mapping label -> (T,) float, cm/s
-    minima : mapping label -> (K,) float, seconds
-        Minima of each speed curve (same labels).
-    onsets : (A,) float, seconds
-    t_range : (float, float)
-        Seconds shown.
-    out : str or Path, optional
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    import matplotlib.pyplot as plt
-
-    inside = (t >= t_range[0]) & (t <= t_range[1])
-    top = 1.15 * max(float(np.percentile(np.asarray(v)[inside], 98)) for v in speeds.values())
-    with figure_style():
-        fig, ax = plt.subplots(figsize=(10, 2.8))
-        for k, (label, v) in enumerate(speeds.items()):
-            line = ax.plot(t, v, lw=1, label=f"{label} speed", color=f"C{k + 1}")[0]
-            m = np.asarray(minima[label])
-            ax.plot(m, np.interp(m, t, v), "v", ms=5, color=line.get_color(), label=f"{label} speed minima")
-        ax.vlines(onsets, 0, top, color=ONSET_COLOUR, lw=0.8, alpha=0.6, label="audio onsets")
-        ax.set_xlim(*t_range)
-        ax.set_ylim(0, top)
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("speed (cm/s)")
-        ax.legend(**_OUTSIDE)
         return _finish(fig, out)
 
 
