@@ -21,7 +21,7 @@ Taught in notebooks/02_dataset_statistics.ipynb, section 3 (Figure 3a: do gestur
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -85,29 +85,40 @@ def rotation_windows(
         Hop between windows (default: ``seconds``, non-overlapping).
     """
     parts, emo, spk, tk = [], [], [], []
-    length = stride = None
-    n_takes = 0
-    for i, t in enumerate(takes):
-        n_takes += 1
-        if length is None:
-            length, stride = _window_length(t.fps, seconds, stride_seconds)
-        w = _take_windows(t, length, stride)
-        if len(w) == 0:
-            continue
+    for i, t, w in _windows_by_take(takes, seconds, stride_seconds, "rotation_windows"):
         parts.append(w)
         emo.append(np.full(len(w), t.emotion))
         spk.append(np.full(len(w), t.speaker_id))
         tk.append(np.full(len(w), i))
-    if n_takes == 0:
-        raise ValueError("rotation_windows: no takes")
-    if not parts:
-        raise ValueError(f"rotation_windows: no take is at least {length} frames long")
     return RotationWindows(
         np.concatenate(parts).astype(np.float32),
         np.concatenate(emo).astype(np.int64),
         np.concatenate(spk).astype(np.int64),
         np.concatenate(tk).astype(np.int64),
     )
+
+
+def _windows_by_take(
+    takes: Iterable[CorpusTake], seconds: float, stride_seconds: float | None, who: str
+) -> Iterator[tuple[int, CorpusTake, np.ndarray]]:
+    """``(take number, take, its (W, L, 141) windows)`` for every take with a window, in one pass over ``takes``.
+
+    Raises ``ValueError`` (naming ``who``) when there is no take, or no take has a whole window.
+    """
+    length = stride = None
+    n_takes = found = 0
+    for i, t in enumerate(takes):
+        n_takes += 1
+        if length is None:
+            length, stride = _window_length(t.fps, seconds, stride_seconds)
+        w = _take_windows(t, length, stride)
+        if len(w):
+            found += 1
+            yield i, t, w
+    if n_takes == 0:
+        raise ValueError(f"{who}: no takes")
+    if not found:
+        raise ValueError(f"{who}: no take is at least {length} frames long")
 
 
 def subset_dims(joints: str) -> np.ndarray:
@@ -389,23 +400,11 @@ def emotion_features(
     """
     dims = subset_dims(joints)
     feats, emo, spk, tk = [], [], [], []
-    length = stride = None
-    n_takes = 0
-    for i, t in enumerate(takes):
-        n_takes += 1
-        if length is None:
-            length, stride = _window_length(t.fps, seconds, None)
-        w = _take_windows(t, length, stride)
-        if len(w) == 0:
-            continue
+    for i, t, w in _windows_by_take(takes, seconds, None, "emotion_features"):
         feats.append(window_features(w[:, :, dims].astype(np.float32), kind=kind))
         emo.append(np.full(len(w), t.emotion, np.int64))
         spk.append(np.full(len(w), t.speaker_id, np.int64))
         tk.append(np.full(len(w), i, np.int64))
-    if n_takes == 0:
-        raise ValueError("emotion_features: no takes")
-    if not feats:
-        raise ValueError(f"emotion_features: no take is at least {length} frames long")
     out = EmotionFeatures(np.concatenate(feats), np.concatenate(emo), np.concatenate(spk), np.concatenate(tk))
     if per_speaker:
         out.features = per_group_standardize(out.features, out.speaker)
