@@ -423,6 +423,8 @@ def main() -> int:
     p.add_argument("--keep", type=Path, default=None, help="keep corpora and stores under this folder")
     args = p.parse_args()
     print(f"bench_scale: {os.cpu_count()} CPUs; sizes {args.hours} h")
+    if args.keep is not None:
+        args.keep.mkdir(parents=True, exist_ok=True)
     rows = []
     for hours in sorted(args.hours):
         base = Path(tempfile.mkdtemp(prefix=f"bench_scale_{hours:g}h_", dir=args.keep))
