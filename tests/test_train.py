@@ -65,6 +65,39 @@ def test_resume_reproduces_an_uninterrupted_run(windows, tmp_path):
     assert not list(tmp_path.glob("*.tmp"))  # atomic writes leave no temp file
 
 
+def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path, monkeypatch):
+    """checkpoint_every=1: a run stopped after 4 optimiser steps (epoch 2, step 1 of 3) resumes there and
+    ends with the weights and history of an uninterrupted run."""
+    from beatlite.train import training
+
+    train, val = windows
+    full = fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "full.pt"), val)
+    calls = {"n": 0}
+    real_step = training._Run.step
+
+    def dying_step(self, *args):
+        if calls["n"] == 4:
+            raise KeyboardInterrupt("killed")
+        calls["n"] += 1
+        return real_step(self, *args)
+
+    monkeypatch.setattr(training._Run, "step", dying_step)
+    with pytest.raises(KeyboardInterrupt):
+        fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt", checkpoint_every=1), val)
+    monkeypatch.setattr(training._Run, "step", real_step)
+    saved = torch.load(tmp_path / "part.pt", weights_only=False)
+    assert saved["epoch"] == 1 and saved["partial"]["step"] == 1  # 3 steps per epoch: killed in epoch 2
+    resumed = fit(
+        camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt", checkpoint_every=1, resume=True), val
+    )
+    assert resumed.history == full.history
+    a, _ = load_model(tmp_path / "full.pt")
+    b, _ = load_model(tmp_path / "part.pt")
+    for (name, p), q in zip(a.state_dict().items(), b.state_dict().values(), strict=True):
+        assert torch.equal(p, q), name
+    assert torch.load(tmp_path / "part.pt", weights_only=False)["partial"] is None
+
+
 def test_cosine_schedule_factors_closed_form():
     c = TrainConfig(epochs=4, lr_schedule="cosine")
     # (1 + cos(pi e / 4)) / 2 for e = 0..4: 1, (2 + sqrt 2) / 4, 1/2, (2 - sqrt 2) / 4, 0

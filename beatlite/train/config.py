@@ -58,6 +58,11 @@ class TrainConfig:
     amp : bool
         Mixed precision (bfloat16 autocast) for the forward pass and losses on CUDA; ignored on the
         CPU, where training stays float32 and bitwise deterministic.
+    checkpoint_every : int or None
+        Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
+        BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as
+        an uninterrupted run. Under ``torchrun`` the logged losses of a resumed epoch count the other
+        processes' part only from the resumed step on (training itself is exact).
     workers : int
         DataLoader worker processes that read the batches of a window store
         (:class:`beatlite.data.store.StoreWindows`); in-memory windows are indexed in the loop.
@@ -87,6 +92,7 @@ class TrainConfig:
     amp: bool = False
     micro_batches: int = 1
     workers: int = 0
+    checkpoint_every: int | None = None
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -101,6 +107,10 @@ class TrainConfig:
             )
         if self.windows_per_epoch is not None and self.windows_per_epoch < 2:
             raise ValueError(f"TrainConfig: windows_per_epoch must be >= 2, got {self.windows_per_epoch}")
+        if self.checkpoint_every is not None and self.checkpoint_every < 1:
+            raise ValueError(
+                f"TrainConfig: checkpoint_every must be >= 1 or None, got {self.checkpoint_every}"
+            )
         if self.workers < 0:
             raise ValueError(f"TrainConfig: workers must be >= 0, got {self.workers}")
         if self.micro_batches < 1:

@@ -394,6 +394,9 @@ class _Run:
             self.d_opt = torch.optim.Adam(model.discriminator.parameters(), lr=d_lr, betas=config.betas)
         self.history: list[dict[str, Any]] = []
         self.start_epoch = 0
+        self.partial: dict[str, Any] | None = (
+            None  # a mid-epoch checkpoint's position: epoch, step, loss sums
+        )
         self.best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
         self.path = None if config.checkpoint is None else Path(config.checkpoint)
 
@@ -415,6 +418,7 @@ class _Run:
             torch.set_rng_state(data["rng"])
         self.history = list(data.get("history", []))
         self.start_epoch = int(data["epoch"])
+        self.partial = data.get("partial")
         self.best = data.get("best")
 
     def train_epoch(self, data: _Data, epoch: int) -> dict[str, float]:
@@ -428,7 +432,6 @@ class _Run:
         order = np.random.default_rng([config.seed, epoch]).permutation(data.n)
         if config.windows_per_epoch is not None:
             order = order[: config.windows_per_epoch]
-        sums: dict[str, float] = {}
         seen = 0
         parts = max(config.micro_batches, self.world)  # micro-batches per step, spread over the processes
         steps = []
@@ -439,8 +442,17 @@ class _Run:
                 continue
             steps.append(micro[self.rank :: self.world])
             seen += len(idx)
-        for batches in data.batches(steps, self.device, config.workers):
+        first, sums = 0, {}
+        if self.partial is not None and self.partial["epoch"] == epoch:  # resuming inside this epoch
+            first, sums = int(self.partial["step"]), dict(self.partial["sums"])
+        self.partial = None
+        every = config.checkpoint_every
+        for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
             self.step(batches, parts, epoch, sums)
+            if every and (k + 1) % every == 0 and k + 1 < len(steps):
+                self.partial = {"epoch": epoch, "step": k + 1, "sums": dict(sums)}
+                self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
+                self.partial = None
         return _mean_losses(_sum_over_processes(sums, self.world), seen)
 
     def step(
@@ -508,6 +520,7 @@ class _Run:
                 "rng": torch.get_rng_state(),  # the CPU generator; CUDA kernels are not bitwise reproducible
                 "meta": self.meta,
                 "best": self.best,
+                "partial": self.partial,
             },
         )
 
