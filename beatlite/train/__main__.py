@@ -70,6 +70,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--seed", type=int, default=SEED)
     f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
+    f.add_argument("--checkpoint-every", type=int, help="also checkpoint every N steps inside an epoch")
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
     p.add_argument("--seed", type=int, default=SEED)
     p.add_argument("--epochs", type=int, help="override every recipe's epochs (for quick checks)")
@@ -164,6 +165,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         resume=args.resume,
         device=args.device,
         extractor=extractor,
+        checkpoint_every=args.checkpoint_every,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

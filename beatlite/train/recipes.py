@@ -261,6 +261,7 @@ def retrain(
     progress: bool = True,
     device: str = "cpu",
     extractor: str | Path | None = None,
+    checkpoint_every: int | None = None,
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -287,6 +288,8 @@ def retrain(
     extractor : str or Path, optional
         The FGD extractor of the per-epoch validation score (default the shipped
         ``checkpoints/fgd_dirvec.pt``, trained on ``data_samples/``).
+    checkpoint_every : int, optional
+        :attr:`beatlite.train.TrainConfig.checkpoint_every` (mid-epoch checkpoints, resumable).
 
     Returns
     -------
@@ -315,6 +318,7 @@ def retrain(
         resume=resume,
         progress=progress,
         device=device,
+        checkpoint_every=checkpoint_every,
     )
     score = None
     if recipe.select_best and config.epochs > 0:
