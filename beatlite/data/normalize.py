@@ -101,6 +101,8 @@ class Normalizer:
 
 #: The pose representations of the batch contract and the window key of each.
 REPRESENTATIONS = {"euler141": "pose", "dirvec126": "dirvec"}
+#: The checkpoint-metadata entries of :meth:`Normalizers.to_meta`.
+META_KEYS = ("pose_mean", "pose_std", "dirvec_mean")
 #: Directions shorter than this after the mean is added back are returned as zero vectors.
 MIN_DIRECTION_NORM = 1e-9
 
@@ -177,13 +179,18 @@ class Normalizers:
     @classmethod
     def from_meta(cls, meta: dict) -> Normalizers:
         """Inverse of :meth:`to_meta` (a checkpoint's ``meta``); ``KeyError`` naming a missing entry."""
-        missing = [k for k in ("pose_mean", "pose_std", "dirvec_mean") if k not in meta]
+        missing = [k for k in META_KEYS if k not in meta]
         if missing:
             raise KeyError(
                 f"Normalizers.from_meta: the metadata has no {missing} (a checkpoint without statistics)"
             )
         mean = np.asarray(meta["dirvec_mean"], np.float64)
         return cls(Normalizer(meta["pose_mean"], meta["pose_std"]), Normalizer(mean, np.ones_like(mean)))
+
+    @classmethod
+    def in_meta(cls, meta: dict | None) -> Normalizers | None:
+        """:meth:`from_meta` when ``meta`` holds all of :data:`META_KEYS`, else None (older or other checkpoints)."""
+        return cls.from_meta(meta) if meta and all(k in meta for k in META_KEYS) else None
 
     def matches(self, other: Normalizers, *, rtol: float = 1e-5, atol: float = 1e-6) -> bool:
         """Whether ``other`` holds the same statistics (float32 round trips of a checkpoint included)."""

@@ -56,7 +56,6 @@ from beatlite.constants import FPS, SR, WINDOW_LENGTH
 from beatlite.data.normalize import Normalizers
 from beatlite.metrics.scoring import METRICS, GroundTruth, Takes, describe, evaluate
 
-NORMALIZER_KEYS = ("pose_mean", "pose_std", "dirvec_mean")
 COLUMNS: tuple[str, ...] = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div")
 """The results table's columns, in order: keys of :data:`beatlite.metrics.scoring.METRICS`
 (each names its variant and parameters; the table caption lists them)."""
@@ -706,7 +705,7 @@ def _load_checkpoint(source: str, test: EvaluationSet) -> tuple[Any, Normalizers
 
     model, data = load_model(source)
     meta = data.get("meta") or {}
-    norms = Normalizers.from_meta(meta) if all(k in meta for k in NORMALIZER_KEYS) else None
+    norms = Normalizers.in_meta(meta)
     _check_vocab(model, data, test, source)
     fingerprint = str(data.get("fingerprint") or "")
     if norms is not None:

@@ -305,9 +305,7 @@ def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers
     norms = getattr(windows, "normalizers", None)
     if isinstance(norms, Normalizers):
         return norms
-    if meta and all(k in meta for k in ("pose_mean", "pose_std", "dirvec_mean")):
-        return Normalizers.from_meta(meta)
-    return None
+    return Normalizers.in_meta(meta)
 
 
 def _shown_losses(entry: dict[str, Any]) -> dict[str, str]:
