@@ -54,6 +54,30 @@ def test_ha2g_ablations_really_switch_something():
             assert getattr(tiny, field) != value, (name, field)
 
 
+def test_every_generator_parameter_gets_a_gradient_in_every_recipe():
+    """The contract DistributedDataParallel relies on (beatlite.train.distributed): one step's generator
+    loss reaches every generator parameter, before and after the adversarial epochs start."""
+    torch = pytest.importorskip("torch")
+    from beatlite.train.recipes import build_recipe_model, training_data
+    from beatlite.train.training import _batch, _Data
+
+    torch.set_num_threads(1)
+    data = training_data()
+    for name in RECIPES:
+        model = build_recipe_model(name, data, seed=1)
+        generator = model.generator_parameters()
+        if not generator:  # the untrained baselines
+            continue
+        windows = _Data.of(model, data.train)
+        model.prepare(windows.arrays, data.train.normalizers)
+        batch = _batch(windows.arrays, windows.keys, np.arange(4), torch.device("cpu"))
+        for epoch in (0, 1000):
+            model.zero_grad(set_to_none=True)
+            model.losses(batch, model(batch), epoch=epoch)["total"].backward()
+            names = {id(p): n for n, p in model.named_parameters()}
+            assert [names[id(p)] for p in generator if p.grad is None] == [], (name, epoch)
+
+
 def test_unknown_names_and_bad_jobs_are_rejected_before_any_work():
     with pytest.raises(ValueError, match="camn_tiny_typo"):
         retrain("camn_tiny_typo")

@@ -24,7 +24,10 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
   ``"dirvec126"``), ``config_class`` (a dataclass with a ``preset`` field);
 - ``forward(batch) -> dict`` with at least ``"pose"``: (B, T, D) in the normalised
   representation (for dirvec126 models too: the key is always ``"pose"``);
-- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` with a scalar ``"total"``;
+- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` with a scalar ``"total"`` whose backward reaches
+  every generator parameter in every step (``torchrun`` training reduces gradients with
+  DistributedDataParallel, which needs that; losses may call modules that ``forward`` does not);
+- the discriminator's parameters live in the ``discriminator`` child alone, the others in child modules;
 - ``discriminator``: an ``nn.Module`` or ``None``; when present,
   ``discriminator_losses(batch, out) -> dict`` with ``"total"`` and the harness runs a
   discriminator step whenever :meth:`GestureModel.adversarial_active` says so;

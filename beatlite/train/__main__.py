@@ -2,7 +2,7 @@
 
 ``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
-batch split over them, gradients summed with ``torch.distributed``, process 0 writing)
+batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
 float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
 are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
@@ -138,8 +138,8 @@ def _fit_command(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from beatlite.paths import repo_root
+    from beatlite.train.distributed import distributed_rank
     from beatlite.train.recipes import retrain, training_data
-    from beatlite.train.training import distributed_rank
 
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)

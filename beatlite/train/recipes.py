@@ -299,7 +299,8 @@ def retrain(
     from beatlite.paths import build_dir, checkpoints_dir
     from beatlite.train.checkpoint import export_checkpoint
     from beatlite.train.config import TrainConfig
-    from beatlite.train.training import distributed_rank, fit
+    from beatlite.train.distributed import distributed_rank
+    from beatlite.train.training import fit
 
     recipe = _recipe(name)
     data = training_data() if data is None else data

@@ -19,6 +19,13 @@ from beatlite.data.normalize import Normalizers
 from beatlite.models.base import GestureModel
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
 from beatlite.train.config import TrainConfig
+from beatlite.train.distributed import (
+    distributed_rank,
+    local_device,
+    sum_over_processes,
+    sync_on_last,
+    wrap_for_ddp,
+)
 
 TENSOR_KEYS = ("pose", "dirvec", "audio", "mel", "face", "word", "emotion", "semantic", "speaker")
 """Window keys converted to tensors for the models (others, e.g. ``"take"``, are ignored)."""
@@ -259,45 +266,19 @@ def fit(
     return run.result()
 
 
-def distributed_rank() -> tuple[int, int]:
-    """``(rank, world size)`` of this process: ``(0, 1)`` unless started by ``torchrun`` with 2+ processes.
+def _backward(totals: list[torch.Tensor], ddp: Any) -> None:
+    """Backpropagate the micro-batch losses of one optimiser step.
 
-    Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
-    ``nccl`` backend when CUDA is available and ``gloo`` (CPU) otherwise.
+    One backward per micro-batch, so that the gradients add up micro-batch by micro-batch (the sums
+    of one process taking them in turn equal, to the bit, DDP's reduction of one micro-batch per
+    process); under DDP with several micro-batches in this process, one backward over their sum (DDP
+    reduces once per backward, after the forward outside ``no_sync``).
     """
-    import os
-
-    import torch.distributed as dist
-
-    if int(os.environ.get("WORLD_SIZE", "1")) < 2 or not dist.is_available():
-        return 0, 1
-    if not dist.is_initialized():
-        dist.init_process_group(backend="nccl" if torch.cuda.is_available() else "gloo")
-    return dist.get_rank(), dist.get_world_size()
-
-
-def _sum_gradients(params: Any, world: int) -> None:
-    """Sum every parameter's gradient over the processes (each already divided by the micro-batch count)."""
-    if world < 2:
+    if ddp is not None and len(totals) > 1:
+        torch.stack(totals).sum().backward()
         return
-    import torch.distributed as dist
-
-    for p in params:
-        if p.grad is None:
-            p.grad = torch.zeros_like(p)
-        dist.all_reduce(p.grad, op=dist.ReduceOp.SUM)
-
-
-def _sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
-    """The loss sums of all processes (every process has the same keys)."""
-    if world < 2:
-        return sums
-    import torch.distributed as dist
-
-    keys = sorted(sums)
-    values = torch.tensor([sums[k] for k in keys], dtype=torch.float64)
-    dist.all_reduce(values, op=dist.ReduceOp.SUM)
-    return dict(zip(keys, values.tolist(), strict=True))
+    for total in totals:
+        total.backward()
 
 
 def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers | None:
@@ -373,13 +354,8 @@ class _Run:
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
         self.rank, self.world = distributed_rank()
-        self.device = config.torch_device()
+        self.device = local_device(config.torch_device())
         model.to(self.device)
-        if self.world > 1:  # every process starts from process 0's weights
-            import torch.distributed as dist
-
-            for tensor in model.state_dict().values():
-                dist.broadcast(tensor, 0)
         self.amp = config.amp and self.device.type == "cuda"
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
@@ -390,6 +366,13 @@ class _Run:
         if model.discriminator is not None:
             d_lr = self.lr * config.d_lr_weight
             self.d_opt = torch.optim.Adam(model.discriminator.parameters(), lr=d_lr, betas=config.betas)
+        self.g_ddp = self.d_ddp = (
+            None  # under torchrun: DistributedDataParallel over the generator, the discriminator
+        )
+        if (
+            self.world > 1 and self.g_opt is not None
+        ):  # (building them gives every process process 0's weights)
+            self.g_ddp, self.d_ddp = wrap_for_ddp(model, self.device)
         self.history: list[dict[str, Any]] = []
         self.start_epoch = 0
         self.partial: dict[str, Any] | None = (
@@ -451,7 +434,7 @@ class _Run:
                 self.partial = {"epoch": epoch, "step": k + 1, "sums": dict(sums)}
                 self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
                 self.partial = None
-        return _mean_losses(_sum_over_processes(sums, self.world), seen)
+        return _mean_losses(sum_over_processes(sums, self.world), seen)
 
     def step(
         self,
@@ -463,31 +446,41 @@ class _Run:
         """The discriminator step (when adversarial) then the generator step on one global batch.
 
         ``batches`` are this process's micro-batches (tensors, windows) of a global batch split into
-        ``parts``: each loss is divided by ``parts`` and the gradients are summed over the processes, so
-        every optimiser step sees the average of the micro-batch gradients, whatever the process count.
+        ``parts``, each loss scaled by ``world / parts``: under ``torchrun`` DDP averages the gradients
+        over the ``world`` processes, so every step sees the mean of the micro-batch gradients, whatever
+        the process count (see :func:`_backward`).
         """
         model, config = self.model, self.config
-        with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
-            outs = [model(batch) for batch, _ in batches]
+        last = len(batches) - 1
+        outs = []
+        for i, (batch, _) in enumerate(batches):
+            with sync_on_last(self.g_ddp, i == last), self._autocast():
+                outs.append((self.g_ddp or model)(batch))
         if self.d_opt is not None and model.adversarial_active(epoch):
             self.d_opt.zero_grad(set_to_none=True)
-            for (batch, weight), out in zip(batches, outs, strict=True):
-                with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
-                    d_losses = model.discriminator_losses(batch, out)
-                (d_losses["total"] / parts).backward()
+            d_totals = []
+            for i, ((batch, weight), out) in enumerate(zip(batches, outs, strict=True)):
+                with sync_on_last(self.d_ddp, i == last), self._autocast():
+                    d_losses = (self.d_ddp or model.discriminator_losses)(batch, out)
+                d_totals.append(d_losses["total"] * self.world / parts)
                 _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
-            _sum_gradients(model.discriminator.parameters(), self.world)
+            _backward(d_totals, self.d_ddp)
             torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
             self.d_opt.step()
         self.g_opt.zero_grad(set_to_none=True)
+        totals = []
         for (batch, weight), out in zip(batches, outs, strict=True):
-            with torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp):
+            with self._autocast():
                 losses = model.losses(batch, out, epoch=epoch)
-            (losses["total"] / parts).backward()
+            totals.append(losses["total"] * self.world / parts)
             _accumulate(sums, losses, weight)
-        _sum_gradients(self.g_params, self.world)
+        _backward(totals, self.g_ddp)
         torch.nn.utils.clip_grad_norm_(self.g_params, config.grad_clip)
         self.g_opt.step()
+
+    def _autocast(self) -> Any:
+        """bfloat16 autocast on CUDA when ``config.amp`` (a no-op otherwise)."""
+        return torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp)
 
     def score(self, epoch: int, val_score: Callable[[GestureModel], float], entry: dict[str, Any]) -> None:
         """Score the epoch in eval mode; keep a copy of the weights when it is the best so far."""

@@ -1,0 +1,131 @@
+"""Multi-process training with torch's own engine: ``torchrun`` starts the processes, and
+:class:`torch.nn.parallel.DistributedDataParallel` (DDP) averages the gradients.
+
+Described in docs/architecture.md ("Scale"). :func:`beatlite.train.fit` calls :func:`distributed_rank`
+and, with two or more processes, :func:`wrap_for_ddp`; nothing else changes for a model.
+
+A :class:`~beatlite.models.base.GestureModel` takes two optimiser steps per batch when it has a
+discriminator, and some models compute losses with modules that their ``forward`` does not call
+(HA2G's contrastive audio heads). DDP needs one forward through the wrapper before each backward, so
+the model is wrapped twice, over disjoint parameters:
+
+- the generator view (every child module but the discriminator): its forward is ``model(batch)``;
+  the generator losses are computed after it, outside the wrapper, and their backward is reduced by
+  it (every generator parameter gets a gradient in every step, a contract of ``GestureModel``);
+- the discriminator view: its forward is ``model.discriminator_losses(batch, out)``.
+
+Both use ``find_unused_parameters=False`` (nothing is searched; a parameter without a gradient
+stops training with DDP's own error). The processes split each global batch into micro-batches
+(``TrainConfig.micro_batches``); every process reads only its own (the window index is the
+sampler), and DDP's average of the per-process gradients is scaled so that an optimiser step sees
+the mean over the micro-batches, as one process taking them one after the other would.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from typing import Any
+
+import torch
+from torch import nn
+
+
+def distributed_rank() -> tuple[int, int]:
+    """``(rank, world size)`` of this process: ``(0, 1)`` unless started by ``torchrun`` with 2+ processes.
+
+    Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
+    ``nccl`` backend when CUDA is available (each process on GPU ``LOCAL_RANK``) and ``gloo`` (CPU)
+    otherwise.
+    """
+    import torch.distributed as dist
+
+    if int(os.environ.get("WORLD_SIZE", "1")) < 2 or not dist.is_available():
+        return 0, 1
+    if not dist.is_initialized():
+        if torch.cuda.is_available():
+            torch.cuda.set_device(local_device(torch.device("cuda")))
+        dist.init_process_group(backend="nccl" if torch.cuda.is_available() else "gloo")
+    return dist.get_rank(), dist.get_world_size()
+
+
+def local_device(device: torch.device) -> torch.device:
+    """``device``, made ``cuda:LOCAL_RANK`` for an un-numbered CUDA device under ``torchrun``."""
+    if device.type == "cuda" and device.index is None and "LOCAL_RANK" in os.environ:
+        return torch.device("cuda", int(os.environ["LOCAL_RANK"]))
+    return device
+
+
+class _View(nn.Module):
+    """Some child modules (and the direct parameters and buffers) of ``owner``, whose forward is ``call``.
+
+    The modules are shared, not copied: DDP over a view synchronises the owner's own tensors.
+    """
+
+    def __init__(self, owner: nn.Module, children: dict[str, nn.Module], call: Any) -> None:
+        super().__init__()
+        for name, child in children.items():
+            self.add_module(name, child)
+        object.__setattr__(self, "_call", call)  # a bound method of the owner: not a submodule
+
+    def forward(self, *args: Any) -> Any:
+        return self._call(*args)
+
+
+def generator_view(model: Any) -> nn.Module:
+    """The model without its discriminator; ``view(batch)`` is ``model(batch)``.
+
+    Raises ``ValueError`` when the model holds parameters outside its child modules (a view could
+    not share them) or when the view's trainable parameters are not ``model.generator_parameters()``.
+    """
+    if list(model.named_parameters(recurse=False)):
+        raise ValueError(f"{type(model).__name__}: DDP needs every parameter inside a child module")
+    children = {n: c for n, c in model.named_children() if c is not model.discriminator}
+    view = _View(model, children, model.forward)
+    got = {id(p) for p in view.parameters() if p.requires_grad}
+    if got != {id(p) for p in model.generator_parameters()}:
+        raise ValueError(f"{type(model).__name__}: the discriminator shares modules with the generator")
+    return view
+
+
+def discriminator_view(model: Any) -> nn.Module:
+    """The discriminator alone; ``view(batch, out)`` is ``model.discriminator_losses(batch, out)``."""
+    return _View(model, {"discriminator": model.discriminator}, model.discriminator_losses)
+
+
+def wrap_for_ddp(model: Any, device: torch.device) -> tuple[nn.Module, nn.Module | None]:
+    """DDP wrappers ``(generator, discriminator or None)`` of ``model`` (already on ``device``).
+
+    Building them broadcasts process 0's parameters and buffers, so every process starts equal.
+    """
+    from torch.nn.parallel import DistributedDataParallel as DDP
+
+    ids = [device.index] if device.type == "cuda" else None
+    generator = DDP(generator_view(model), device_ids=ids)
+    if model.discriminator is None:
+        return generator, None
+    return generator, DDP(discriminator_view(model), device_ids=ids)
+
+
+def sync_on_last(ddp: nn.Module | None, last: bool) -> Any:
+    """Context for one micro-batch's forward: gradients are reduced only after the last one's backward.
+
+    Every micro-batch but the last runs under ``ddp.no_sync()``; the caller then takes a single
+    backward over the sum of the micro-batch losses, which DDP reduces once.
+    """
+    if ddp is None or last:
+        return contextlib.nullcontext()
+    return ddp.no_sync()
+
+
+def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
+    """The loss sums of all processes (every process has the same keys)."""
+    if world < 2:
+        return sums
+    import torch.distributed as dist
+
+    keys = sorted(sums)
+    device = torch.device("cuda", torch.cuda.current_device()) if dist.get_backend() == "nccl" else None
+    values = torch.tensor([sums[k] for k in keys], dtype=torch.float64, device=device)
+    dist.all_reduce(values, op=dist.ReduceOp.SUM)
+    return dict(zip(keys, values.cpu().tolist(), strict=True))
