@@ -70,3 +70,25 @@ def test_emotion_classifier_beats_chance_on_test_takes(takes: list) -> None:
     assert acc["sadness"] > 0.5 and acc["anger"] > 0.3, acc
     majority = np.mean(test.emotion == np.bincount(train.emotion).argmax())
     assert acc["overall"] >= majority, acc
+
+
+def test_take_analyses_stream_in_one_pass(index: TakeIndex, takes: list) -> None:
+    """Each take analysis reads its takes once: given the one-shot iterator iter_corpus, the same numbers as
+    on the loaded list (so a corpus of any size streams, holding one take at a time)."""
+    from beatlite.stats.corpus import iter_corpus
+    from beatlite.stats.semantic import score_histogram, speaker_scores, word_class_scores, word_scores
+
+    subset = index.where(usable=True)
+
+    def stream():
+        return iter_corpus(subset)  # a generator: a second pass would see nothing
+
+    assert speed_by_emotion(stream()) == speed_by_emotion(takes)
+    assert word_scores(stream()) == word_scores(takes)
+    assert word_class_scores(stream()) == word_class_scores(takes)
+    assert speaker_scores(stream()) == speaker_scores(takes)
+    a, b = score_histogram(stream()), score_histogram(takes)
+    assert (a.counts == b.counts).all() and a.share_low == b.share_low and a.n == b.n
+    x, y = gesture_correlations(stream(), n_permutations=50), gesture_correlations(takes, n_permutations=50)
+    assert x.keys() == y.keys() == {"audio", "face", "emotion", "speaker"}
+    assert all(x[k] == y[k] for k in x)

@@ -16,11 +16,15 @@ over non-overlapping windows (2 s by default) to tame autocorrelation.
   effect size eta^2, and a permutation p-value from shuffling the take labels.
 
 Taught in notebooks/02_dataset_statistics.ipynb, section 5 (the correlation claims of §3.3).
+
+:func:`window_means`, :func:`speed_by_emotion` and :func:`gesture_correlations` read their takes once,
+in order, keeping a few numbers per window and per take: pass
+:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -188,7 +192,7 @@ def group_effect_test(
     )
 
 
-def window_means(takes: Sequence[CorpusTake], *, seconds: float = 2.0) -> dict[str, np.ndarray]:
+def window_means(takes: Iterable[CorpusTake], *, seconds: float = 2.0) -> dict[str, np.ndarray]:
     """Means of gesture speed, audio RMS and face activity over non-overlapping windows.
 
     Returns
@@ -219,7 +223,7 @@ def window_means(takes: Sequence[CorpusTake], *, seconds: float = 2.0) -> dict[s
     return {k: np.concatenate(v) for k, v in out.items()}
 
 
-def speed_by_emotion(takes: Sequence[CorpusTake]) -> dict[str, float]:
+def speed_by_emotion(takes: Iterable[CorpusTake]) -> dict[str, float]:
     """Mean gesture speed (cm/s, frame-weighted) per emotion name present in the takes."""
     sums: dict[int, float] = {}
     counts: dict[int, int] = {}
@@ -230,7 +234,7 @@ def speed_by_emotion(takes: Sequence[CorpusTake]) -> dict[str, float]:
 
 
 def gesture_correlations(
-    takes: Sequence[CorpusTake], *, seconds: float = 2.0, n_permutations: int = 1000, seed: int = 0
+    takes: Iterable[CorpusTake], *, seconds: float = 2.0, n_permutations: int = 1000, seed: int = 0
 ) -> dict[str, CorrelationResult | GroupEffectResult]:
     """Gesture energy vs audio energy, facial activity, emotion and speaker.
 
@@ -241,7 +245,8 @@ def gesture_correlations(
         take has a JSON); ``"emotion"``, ``"speaker"``: :class:`GroupEffectResult` over takes
         (speaker only with >= 2 speakers; emotion over self-talk takes).
     """
-    wm = window_means(takes, seconds=seconds)
+    per_take: list[tuple[float, int, int | None]] = []  # mean speed, emotion, speaker: one pass over takes
+    wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
     out: dict[str, CorrelationResult | GroupEffectResult] = {
         "audio": correlation_test(
             wm["speed"], wm["audio"], groups=wm["take"], n_permutations=n_permutations, seed=seed
@@ -251,14 +256,21 @@ def gesture_correlations(
         out["face"] = correlation_test(
             wm["speed"], wm["face"], groups=wm["take"], n_permutations=n_permutations, seed=seed
         )
-    take_speed = np.array([float(np.mean(t.speed)) for t in takes])
-    emotions = np.array([t.emotion for t in takes])
-    speakers = np.array([t.speaker_id for t in takes])
+    take_speed = np.array([speed for speed, _, _ in per_take])
+    emotions = np.array([emotion for _, emotion, _ in per_take])
+    speakers = np.array([speaker for _, _, speaker in per_take])
     if len(np.unique(emotions)) >= 2:
         out["emotion"] = group_effect_test(take_speed, emotions, n_permutations=n_permutations, seed=seed)
     if len(np.unique(speakers)) >= 2:
         out["speaker"] = group_effect_test(take_speed, speakers, n_permutations=n_permutations, seed=seed)
     return out
+
+
+def _noting_takes(takes: Iterable[CorpusTake], notes: list) -> Iterator[CorpusTake]:
+    """``takes`` unchanged, appending (mean speed, emotion, speaker id) of each to ``notes`` as it passes."""
+    for t in takes:
+        notes.append((float(np.mean(t.speed)), t.emotion, t.speaker_id))
+        yield t
 
 
 def correlations_markdown(results: dict[str, CorrelationResult | GroupEffectResult]) -> str:
@@ -298,7 +310,8 @@ def plot_correlations(
 
     from beatlite.viz.style import SYSTEM_COLOURS, figure_style, save_figure
 
-    wm = window_means(takes, seconds=seconds)
+    per_take: list[tuple[float, int, int | None]] = []  # mean speed, emotion, speaker: one pass over takes
+    wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
     speeds = speed_by_emotion(takes)
     with figure_style():
         fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")

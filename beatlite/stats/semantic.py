@@ -1,12 +1,15 @@
 """Figure 4 analogs: distribution of semantic-relevance scores, per frequent word, per speaker.
 
 Taught in notebooks/02_dataset_statistics.ipynb, section 4 (Figure 4: semantic relevance).
+
+Every function reads its takes once, in order, keeping only per-segment or per-word scores: pass
+:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,9 +42,9 @@ class ScoreHistogram:
     n: int
 
 
-def score_histogram(takes: Sequence[CorpusTake], *, bins: int = 10) -> ScoreHistogram:
+def score_histogram(takes: Iterable[CorpusTake], *, bins: int = 10) -> ScoreHistogram:
     """Histogram of the scores of all annotated semantic segments (one count per gesture)."""
-    scores = np.concatenate([t.semantic_scores for t in takes]) if takes else np.zeros(0)
+    scores = np.concatenate([np.zeros(0, np.float32), *(t.semantic_scores for t in takes)])
     if scores.size == 0:
         raise ValueError("score_histogram: no semantic segments in the takes")
     counts, edges = np.histogram(scores, bins=bins, range=(0.0, 1.0))
@@ -49,7 +52,7 @@ def score_histogram(takes: Sequence[CorpusTake], *, bins: int = 10) -> ScoreHist
     return ScoreHistogram(counts.astype(np.int64), edges, share, int(scores.size))
 
 
-def word_scores(takes: Sequence[CorpusTake], *, top: int = 9) -> list[tuple[str, int, float]]:
+def word_scores(takes: Iterable[CorpusTake], *, top: int = 9) -> list[tuple[str, int, float]]:
     """Mean semantic score of the ``top`` most frequent words.
 
     A word occurrence's score is the mean per-frame semantic score over the frames its
@@ -65,7 +68,7 @@ def word_scores(takes: Sequence[CorpusTake], *, top: int = 9) -> list[tuple[str,
     return [(w, len(scores[w]), float(np.mean(scores[w]))) for w in ranked]
 
 
-def word_occurrence_scores(takes: Sequence[CorpusTake]) -> dict[str, list[float]]:
+def word_occurrence_scores(takes: Iterable[CorpusTake]) -> dict[str, list[float]]:
     """Lower-cased word -> the score of each of its occurrences (see :func:`word_scores`)."""
     scores: dict[str, list[float]] = defaultdict(list)
     for t in takes:
@@ -82,7 +85,7 @@ def word_occurrence_scores(takes: Sequence[CorpusTake]) -> dict[str, list[float]
 
 
 def word_class_scores(
-    takes: Sequence[CorpusTake], *, function_words: frozenset[str] | None = None
+    takes: Iterable[CorpusTake], *, function_words: frozenset[str] | None = None
 ) -> dict[str, dict[str, float]]:
     """Mean semantic score of function words vs content words (the contrast of BEAT's Fig. 4c).
 
@@ -122,7 +125,7 @@ def word_class_scores(
     return out
 
 
-def speaker_scores(takes: Sequence[CorpusTake]) -> dict[int, dict[str, float]]:
+def speaker_scores(takes: Iterable[CorpusTake]) -> dict[int, dict[str, float]]:
     """Per speaker id: ``mean`` segment score, ``share_low`` (<= 0.2) and ``n`` segments."""
     by: dict[int, list[np.ndarray]] = defaultdict(list)
     for t in takes:
@@ -140,7 +143,7 @@ def speaker_scores(takes: Sequence[CorpusTake]) -> dict[int, dict[str, float]]:
 
 
 def plot_figure4(
-    takes: Sequence[CorpusTake],
+    takes: Iterable[CorpusTake],
     *,
     top: int = 9,
     out: str | Path | None = None,
