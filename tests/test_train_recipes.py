@@ -232,6 +232,7 @@ def test_recipe_mismatch_sees_changed_settings_and_model_configs():
 
 def test_train_seeds_keeps_current_checkpoints_and_retrains_stale_ones(tmp_path, monkeypatch):
     pytest.importorskip("torch")
+    from beatlite.paths import checkpoints_dir
     from beatlite.train import checkpoint, seeds
 
     monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path))
@@ -241,8 +242,10 @@ def test_train_seeds_keeps_current_checkpoints_and_retrains_stale_ones(tmp_path,
     )
     asked = []
     monkeypatch.setattr(seeds, "retrain_many", lambda todo, **kw: asked.extend(todo) or {})
-    seeds.train_seeds(["s2g_tiny", "trimodal_tiny", "mean_pose"], seeds=[SEED, 7], verbose=False)
+    own = seeds.shipped_seed(checkpoints_dir() / "s2g_tiny.pt")  # the shipped one stands for its seed
+    seeds.train_seeds(["s2g_tiny", "trimodal_tiny", "mean_pose"], seeds=[own, 7], verbose=False)
     assert [(name, seed) for name, seed, _ in asked] == [("trimodal_tiny", 7), ("mean_pose", 7)]
+    assert all(out == tmp_path / "seeds" / "7" for _, _, out in asked)  # never into checkpoints/
     asked.clear()
     seeds.train_seeds(["s2g_tiny"], seeds=[7], force=True, verbose=False)
     assert [(name, seed) for name, seed, _ in asked] == [("s2g_tiny", 7)]
@@ -305,3 +308,41 @@ def test_ablation_table_values_changes_and_paper_rows():
     # SRGR: -0.1 with SE 0 -> worse
     assert no_x[7] == "-0.100 ± 0.000 worse"
     assert lines[3].endswith("| 3 |")
+
+
+def test_the_shipped_checkpoint_is_the_median_seed_and_the_replaced_one_is_kept(tmp_path, monkeypatch):
+    pytest.importorskip("torch")
+    from beatlite.train import checkpoint, seeds
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    import beatlite.paths
+
+    monkeypatch.setattr(beatlite.paths, "checkpoints_dir", lambda: tmp_path / "checkpoints")
+    for seed in (1, 2, 3):
+        data = _checkpoint_of("s2g_tiny")
+        data["train_config"]["seed"] = seed
+        target = (
+            tmp_path / "checkpoints" / "s2g_tiny.pt" if seed == 1 else seeds.checkpoint_path("s2g_tiny", seed)
+        )
+        checkpoint.save_checkpoint(target, data)
+    assert seeds.checkpoint_path("s2g_tiny", 1) == tmp_path / "checkpoints" / "s2g_tiny.pt"
+    # FGD 5.0, 3.0, 4.0 over seeds 1, 2, 3: the median is seed 3's
+    record = SeedResults({"S2G-style": {"FGD": [5.0, 3.0, 4.0]}}, [1, 2, 3], {})
+    assert seeds.ship_median_seeds(record) == {"s2g_tiny": 3}
+    assert seeds.shipped_seed(tmp_path / "checkpoints" / "s2g_tiny.pt") == 3
+    assert record.info["shipped"] == {"S2G-style": 3}
+    # seed 1's checkpoint (shipped until now) is still there for its seed
+    assert seeds.shipped_seed(seeds.checkpoint_path("s2g_tiny", 1)) == 1
+    assert seeds.checkpoint_path("s2g_tiny", 3) == tmp_path / "build" / "seeds" / "3" / "s2g_tiny.pt"
+
+
+def test_an_undecided_difference_says_how_many_seeds_would_decide_it():
+    from beatlite.train.seeds import compare_rows
+
+    # sd 1 in both rows, delta 1: se(n) = sqrt(2 / n) <= 0.5 from n = 8 seeds
+    rec = SeedResults({"Full": {"FGD": [1.0, 2.0, 3.0]}, "A": {"FGD": [2.0, 3.0, 4.0]}}, [1, 2, 3], {})
+    (effect,) = compare_rows(rec, "Full", ["A"], metrics=("FGD",))
+    assert effect.verdict == "noise" and effect.seeds_needed == 8
+    assert effect.cell() == "+1.00 ± 1.63 noise (8 seeds)"
+    n = effect.seeds_needed
+    assert 2 * math.sqrt(2 / n) <= abs(effect.delta) < 2 * math.sqrt(2 / (n - 1))

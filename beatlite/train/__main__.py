@@ -20,11 +20,12 @@ a float16 inference copy to ``checkpoints/<name>.pt`` and the training times to
 test split (:func:`beatlite.train.evaluation.evaluate_models`) and writes
 ``build/results_models.md`` and ``.json``.
 
-``seeds [--seeds S ...] [--only NAME ...] [--jobs J] [--force]`` trains the recipes again with the
-other seeds (``build/seeds/<seed>/``; existing ones are kept when their stored settings and model
-config match today's recipe, see :func:`beatlite.train.seeds.recipe_mismatch`) and writes the mean ± sd table over
-all seeds (shipped = seed 2021) to ``build/results_seeds.md`` and ``.json``
-(:mod:`beatlite.train.seeds`).
+``seeds [--seeds S ...] [--only NAME ...] [--jobs J] [--force] [--ship]`` trains the recipes with every
+seed (``build/seeds/<seed>/``; existing ones, the shipped checkpoint for its own seed included, are
+kept when their stored settings and model config match today's recipe, see
+:func:`beatlite.train.seeds.recipe_mismatch`), writes the mean ± sd table over the seeds to
+``build/results_seeds.md`` and ``.json`` and, with ``--ship``, copies each row's median-FGD seed to
+``checkpoints/`` (:mod:`beatlite.train.seeds`).
 """
 
 from __future__ import annotations
@@ -91,6 +92,11 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument(
         "--force", action="store_true", help="retrain checkpoints that exist and match their recipe"
     )
+    s.add_argument(
+        "--ship",
+        action="store_true",
+        help="copy each row's median-FGD seed to checkpoints/ (ship_median_seeds)",
+    )
     return parser
 
 
@@ -105,12 +111,18 @@ def _results_command(args: argparse.Namespace) -> int:
 
 
 def _seeds_command(args: argparse.Namespace) -> int:
-    from beatlite.train.seeds import evaluate_seeds, train_seeds, write_seed_results
+    from beatlite.train.evaluation import RECORD_COLUMNS
+    from beatlite.train.seeds import evaluate_seeds, ship_median_seeds, train_seeds, write_seed_results
 
     if not args.evaluate_only:
         train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
     missing = "skip" if args.evaluate_only else "error"
-    table = evaluate_seeds(args.only or None, args.seeds, missing=missing, progress=True)
+    table = evaluate_seeds(
+        args.only or None, args.seeds, missing=missing, progress=True, columns=RECORD_COLUMNS
+    )
+    if args.ship:
+        for name, seed in ship_median_seeds(table, args.only or None).items():
+            print(f"shipped {name}: seed {seed}", flush=True)
     md, js = write_seed_results(table, args.out)
     print(table.to_markdown())
     print(f"wrote {md} and {js}")

@@ -60,6 +60,17 @@ COLUMNS: tuple[str, ...] = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1di
 """The results table's columns, in order: keys of :data:`beatlite.metrics.scoring.METRICS`
 (each names its variant and parameters; the table caption lists them)."""
 
+RECORD_COLUMNS: tuple[str, ...] = (
+    *COLUMNS,
+    "FGD (reference)",
+    "SRGR (reference)",
+    "BeatAlign (reference)",
+    "BC (ha2g)",
+)
+"""The metrics of the recorded seed table (``checkpoints/results_seeds.json``): :data:`COLUMNS`, then
+the variants the papers' code computes (BEAT's Euler autoencoder FGD, SRGR and BeatAlign; HA2G's BC on
+34-frame clips) for the side-by-side tables of notebooks 06-07."""
+
 GROUND_TRUTH = "Ground truth"
 GROUND_TRUTH_141 = "Ground truth (141 Euler channels)"
 

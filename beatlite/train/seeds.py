@@ -11,9 +11,12 @@ One seed is one draw: on the 143 test windows of ``data_samples/`` the FGD of on
 by about ±1 between seeds, as much as the gap between some rows. A claim such as "CaMN beats
 Trimodal on FGD" is therefore checked on the mean over seeds, against the spread.
 
-Seed :data:`beatlite.train.recipes.SEED` is the shipped checkpoint (``checkpoints/<name>.pt``);
-every other seed ``s`` is trained by :func:`beatlite.train.recipes.retrain` into
-``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``).
+Every seed ``s`` of a recipe is trained by :func:`beatlite.train.recipes.retrain` into
+``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``). The shipped checkpoint
+``checkpoints/<name>.pt`` is a copy of the seed whose FGD is nearest the median over the seeds
+(:func:`ship_median_seeds`), not an arbitrary one; it stores its seed, and the recorded table names it
+(``info["shipped"]``). Where ``build/seeds/<s>/`` lacks a checkpoint, the shipped one stands for its own
+seed (a fresh clone has only those).
 
 Taught in notebooks/07_benchmark.ipynb, section 2 (one run is one draw: the table over three seeds) and notebooks/05_camn.ipynb, section 7.
 """
@@ -21,6 +24,7 @@ Taught in notebooks/07_benchmark.ipynb, section 2 (one run is one draw: the tabl
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -40,12 +44,84 @@ def seeds_dir() -> Path:
 
 
 def checkpoint_path(name: str, seed: int) -> Path:
-    """Where the checkpoint of recipe ``name`` trained with ``seed`` lives (shipped for :data:`SEED`)."""
+    """Where the checkpoint of recipe ``name`` trained with ``seed`` lives.
+
+    ``build/seeds/<seed>/<name>.pt``; when that file does not exist and the shipped
+    ``checkpoints/<name>.pt`` was trained with ``seed``, the shipped one.
+    """
     from beatlite.paths import checkpoints_dir
 
-    if seed == SEED:
-        return checkpoints_dir() / f"{name}.pt"
-    return seeds_dir() / str(seed) / f"{name}.pt"
+    path = seeds_dir() / str(seed) / f"{name}.pt"
+    shipped = checkpoints_dir() / f"{name}.pt"
+    if not path.is_file() and shipped_seed(shipped) == seed:
+        return shipped
+    return path
+
+
+def shipped_seed(path: str | Path) -> int | None:
+    """The training seed stored in the checkpoint at ``path`` (None when there is no file or no seed)."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    return _stored_seed(str(path), path.stat().st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=256)
+def _stored_seed(path: str, mtime_ns: int) -> int | None:
+    from beatlite.train.checkpoint import load_checkpoint
+
+    seed = (load_checkpoint(path).get("train_config") or {}).get("seed")
+    return None if seed is None else int(seed)
+
+
+def median_seed(values: Sequence[float], seeds: Sequence[int]) -> int:
+    """The seed whose value is nearest the median of the finite ``values`` (ties: the earlier seed).
+
+    Examples
+    --------
+    >>> median_seed([3.1, 5.2, 4.0], [2021, 2022, 2023])
+    2023
+    >>> median_seed([3.0, float("nan"), 5.0, 4.5], [1, 2, 3, 4])
+    4
+    """
+    v = np.asarray(values, float)
+    ok = np.flatnonzero(np.isfinite(v))
+    if len(ok) == 0:
+        raise ValueError(f"median_seed: no finite value among {list(values)}")
+    median = float(np.median(v[ok]))
+    return int(seeds[int(ok[np.argmin(np.abs(v[ok] - median))])])
+
+
+def ship_median_seeds(
+    results: SeedResults, names: Sequence[str] | None = None, *, metric: str = "FGD"
+) -> dict[str, int]:
+    """Copy each recipe's median-seed checkpoint (:func:`median_seed` of ``metric``) to ``checkpoints/``.
+
+    Every seed's checkpoint must be in ``build/seeds/<seed>/`` (or be the shipped one). The copies are
+    written atomically; ``results.info["shipped"]`` (row label -> seed) records the choice.
+
+    Returns
+    -------
+    dict recipe name -> shipped seed
+    """
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train.recipes import label_of
+
+    names = [n for n in RECIPES if label_of(n) in results.values] if names is None else list(names)
+    chosen = {}
+    for name in names:
+        seed = median_seed(results.values[label_of(name)][metric], results.seeds)
+        src, dst = checkpoint_path(name, seed), checkpoints_dir() / f"{name}.pt"
+        if src.resolve() == dst.resolve():
+            chosen[name] = seed
+            continue
+        kept = shipped_seed(dst)  # the replaced checkpoint stays its seed's copy in build/seeds/
+        if kept is not None and not (seeds_dir() / str(kept) / dst.name).is_file():
+            _copy(dst, seeds_dir() / str(kept) / dst.name)
+        _copy(src, dst)
+        chosen[name] = seed
+    results.info["shipped"] = {label_of(n): seed for n, seed in chosen.items()}
+    return chosen
 
 
 def _current(name: str, seed: int, verbose: bool) -> bool:
@@ -96,6 +172,17 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     return None
 
 
+def _copy(src: Path, dst: Path) -> None:
+    """Copy a file atomically (the folder of ``dst`` created)."""
+    import shutil
+
+    from beatlite.io.atomic import atomic_write
+
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    with open(src, "rb") as fin, atomic_write(dst, "wb") as fout:
+        shutil.copyfileobj(fin, fout)
+
+
 def train_seeds(
     names: Sequence[str] | None = None,
     seeds: Sequence[int] = (2022, 2023),
@@ -111,7 +198,8 @@ def train_seeds(
     names : sequence of str, optional
         Keys of :data:`beatlite.train.recipes.RECIPES` (default all).
     seeds : sequence of int
-        :data:`~beatlite.train.recipes.SEED` is skipped (that is the shipped checkpoint).
+        Each is trained into ``build/seeds/<seed>/`` unless :func:`checkpoint_path` already has a
+        current checkpoint (the shipped one counts for its own seed).
     jobs : int
         Training processes run at once, one torch thread each (2 on a 2-core machine that
         does nothing else; 1 otherwise: two busy processes on two cores slow each other).
@@ -130,10 +218,10 @@ def train_seeds(
     if unknown:
         raise ValueError(f"unknown checkpoint name(s) {unknown}; known: {sorted(RECIPES)}")
     todo = [
-        (name, int(seed), checkpoint_path(name, int(seed)).parent)
+        (name, int(seed), seeds_dir() / str(int(seed)))
         for seed in seeds
         for name in names
-        if int(seed) != SEED and (force or not _current(name, int(seed), verbose))
+        if force or not _current(name, int(seed), verbose)
     ]
 
     def report(name: str, seed: int, seconds: float) -> None:
@@ -199,23 +287,31 @@ class SeedResults:
         }
         return cls(values, [int(s) for s in data["seeds"]], dict(data.get("info", {})))
 
-    def to_markdown(self) -> str:
-        """A Markdown table of ``mean ± sd`` over seeds for every metric of :data:`COLUMNS`."""
+    def to_markdown(self, columns: Sequence[str] | None = None, rows: Sequence[str] | None = None) -> str:
+        """A Markdown table of ``mean ± sd`` over seeds, the seed count and the shipped seed.
+
+        ``columns``: metric keys (default :data:`~beatlite.train.evaluation.COLUMNS`); ``rows``: row
+        labels in table order (default every row, ground truth first, then in recipe order).
+        """
         from beatlite.report import markdown_table
         from beatlite.train.evaluation import COLUMNS, GROUND_TRUTH, GROUND_TRUTH_141, column_headers
         from beatlite.train.recipes import RECIPES
 
-        order = [GROUND_TRUTH, GROUND_TRUTH_141, *(r.label for r in RECIPES.values())]
-        labels = sorted(self.values, key=lambda r: order.index(r) if r in order else len(order))
-        rows = [
+        columns = COLUMNS if columns is None else tuple(columns)
+        if rows is None:
+            order = [GROUND_TRUTH, GROUND_TRUTH_141, *(r.label for r in RECIPES.values())]
+            rows = sorted(self.values, key=lambda r: order.index(r) if r in order else len(order))
+        shipped = self.info.get("shipped") or {}
+        body = [
             [
                 row,
-                *[self.cell(row, key) if key in self.values[row] else "" for key in COLUMNS],
+                *[self.cell(row, key) if key in self.values[row] else "" for key in columns],
                 self.count(row, "FGD" if "FGD" in self.values[row] else next(iter(self.values[row]))),
+                shipped.get(row) or "",
             ]
-            for row in labels
+            for row in rows
         ]
-        return markdown_table(["method", *column_headers(COLUMNS), "seeds"], rows)
+        return markdown_table(["method", *column_headers(columns), "seeds", "shipped"], body)
 
     def cell(self, row: str, metric: str) -> str:
         """``"mean ± sd"`` of one row and metric as the tables print it (``"mean"`` with one seed)."""
@@ -258,6 +354,10 @@ class Effect:
     verdict : str
         ``"worse"`` or ``"better"`` than the full model when ``|delta| > 2 se``, else ``"noise"``
         (``"unknown"`` without a standard error).
+    seeds_needed : int or None
+        Seeds per row at which the standard error would be at most half of ``|delta|`` (so that
+        ``|delta| > 2 se`` decides), if the two rows' spreads and the difference stay as measured:
+        ``ceil(4 (sd_variant² + sd_full²) / delta²)``. None without a standard error.
     """
 
     variant: str
@@ -265,10 +365,15 @@ class Effect:
     delta: float
     se: float
     verdict: str
+    seeds_needed: int | None = None
 
     def cell(self, digits: int = 2) -> str:
-        """``"+0.52 ± 0.31 worse"``: delta ± 2 standard errors and the verdict."""
-        return f"{self.delta:+.{digits}f} ± {2 * self.se:.{digits}f} {self.verdict}"
+        """``"+0.52 ± 0.31 worse"``: delta ± 2 standard errors and the verdict; an undecided one says
+        how many seeds would decide it (``"+0.10 ± 0.31 noise (38 seeds)"``)."""
+        text = f"{self.delta:+.{digits}f} ± {2 * self.se:.{digits}f} {self.verdict}"
+        if self.verdict == "noise" and self.seeds_needed is not None:
+            text += f" ({self.seeds_needed} seeds)"
+        return text
 
 
 def compare_rows(
@@ -302,8 +407,22 @@ def compare_rows(
                 verdict = "noise"
             else:
                 verdict = "better" if (delta > 0) == higher[metric] else "worse"
-            effects.append(Effect(variant, metric, delta, se, verdict))
+            effects.append(
+                Effect(
+                    variant, metric, delta, se, verdict, _seeds_needed(results, variant, full, metric, delta)
+                )
+            )
     return effects
+
+
+def _seeds_needed(results: SeedResults, variant: str, full: str, metric: str, delta: float) -> int | None:
+    """Seeds per row that would make ``|delta|`` two standard errors (:attr:`Effect.seeds_needed`)."""
+    spread = results.sd(variant, metric) ** 2 + results.sd(full, metric) ** 2
+    if not math.isfinite(spread) or not math.isfinite(delta):
+        return None
+    if delta == 0:
+        return None if spread > 0 else 2
+    return max(2, math.ceil(4 * spread / delta**2))
 
 
 def evaluate_seeds(
@@ -314,6 +433,7 @@ def evaluate_seeds(
     extractor: Any = None,
     missing: str = "error",
     progress: bool = False,
+    columns: Sequence[str] | None = None,
 ) -> SeedResults:
     """Score the checkpoints of every (name, seed) on the test split and collect them by row.
 
@@ -323,7 +443,7 @@ def evaluate_seeds(
         Keys of :data:`~beatlite.train.recipes.RECIPES`; default those whose checkpoints exist
         for every seed.
     seeds : sequence of int
-        Checkpoints from :func:`checkpoint_path` (:data:`~beatlite.train.recipes.SEED` = shipped).
+        Checkpoints from :func:`checkpoint_path`.
     test, extractor
         As :func:`beatlite.train.evaluate_models` (loaded once for all seeds).
     missing : {"error", "skip"}
@@ -331,11 +451,15 @@ def evaluate_seeds(
         values; the table's ``seeds`` column gives the count).
     progress : bool
         Print one line per seed.
+    columns : sequence of str, optional
+        Metric keys (default :data:`~beatlite.train.evaluation.COLUMNS`; :data:`~beatlite.train.evaluation.RECORD_COLUMNS`
+        adds the papers' variants).
 
     Returns
     -------
     SeedResults
         Rows in :data:`~beatlite.train.recipes.RECIPES` order; the two ground-truth rows first.
+        ``info["shipped"]``: row label -> seed of the shipped checkpoint.
 
     Raises
     ------
@@ -343,7 +467,8 @@ def evaluate_seeds(
         A requested checkpoint is missing (names the file and the command that trains it).
     """
     from beatlite.metrics.extractor import load_extractor
-    from beatlite.train.evaluation import evaluate_models, load_test_set
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train.evaluation import COLUMNS, evaluate_models, load_test_set
     from beatlite.train.recipes import label_of
 
     seeds = [int(s) for s in seeds]
@@ -359,7 +484,9 @@ def evaluate_seeds(
     for i, seed in enumerate(seeds):
         present = [n for n in names if checkpoint_path(n, seed).is_file()]
         paths = [str(checkpoint_path(n, seed)) for n in present]
-        res = evaluate_models(paths, test=test, extractor=extractor, ground_truth=i == 0)
+        res = evaluate_models(
+            paths, test=test, extractor=extractor, ground_truth=i == 0, columns=columns or COLUMNS
+        )
         info = dict(res.info)
         for row in res.rows:
             slot = values.setdefault(row.label, {})
@@ -373,6 +500,7 @@ def evaluate_seeds(
     info["checkpoints"] = {
         n: [str(checkpoint_path(n, s)) for s in seeds if checkpoint_path(n, s).is_file()] for n in names
     }
+    info["shipped"] = {label_of(n): shipped_seed(checkpoints_dir() / f"{n}.pt") for n in names}
     return SeedResults(values, seeds, info)
 
 
@@ -431,21 +559,23 @@ RECORD_RTOL, RECORD_ATOL = 1e-3, 1e-9
 def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None) -> None:
     """Assert that a live :func:`~beatlite.train.evaluation.evaluate_models` table equals the record.
 
-    Each row's value must equal the record's seed-:data:`~beatlite.train.recipes.SEED` value (ground-truth
-    rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`.
+    Each row's value must equal the record's value for the seed of the shipped checkpoint
+    (``record.info["shipped"]``, :data:`~beatlite.train.recipes.SEED` for a row it does not name;
+    ground-truth rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`.
 
     Raises
     ------
     AssertionError
         Naming the row and metric and ``make seeds``: the record or the checkpoint is stale.
     """
-    k = record.seeds.index(SEED)
+    shipped = record.info.get("shipped") or {}
     for row in results.rows:
         assert row.label in record.values, f"{row.label} is not in the recorded table: make seeds"
+        k = 0 if row.representation == "ground_truth" else record.seeds.index(shipped.get(row.label) or SEED)
         for metric, value in row.metrics.items():
             if metrics is not None and metric not in metrics:
                 continue
-            recorded = record.values[row.label][metric][0 if row.representation == "ground_truth" else k]
+            recorded = record.values[row.label][metric][k]
             np.testing.assert_allclose(
                 recorded,
                 value,
@@ -468,7 +598,8 @@ def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> 
         f"# Gesture models on the `{info.get('split', 'test')}` split, seeds {results.seeds}\n\n"
         f"Mean ± sample standard deviation over the training seeds of each row (column `seeds`: how many; "
         f"{info.get('windows', '?')} FGD windows; ground-truth rows do not depend on a seed). "
-        f"Seed {SEED} is the shipped checkpoint; the others are in `build/seeds/<seed>/`.\n\n"
+        "The shipped checkpoint of each row is its seed nearest the median FGD (column `shipped`); every "
+        "seed's checkpoint is in `build/seeds/<seed>/`.\n\n"
         + results.to_markdown()
         + "\n\n"
         + describe(COLUMNS)
@@ -516,7 +647,7 @@ def ablation_table(
     | variant | paper row | paper FGD ↓ | ours FGD ↓ | Δ FGD ± 2 SE | seeds |
     |---|---|---|---|---|---|
     | Full | full | 5.00 | 2.00 ± 1.00 |  | 3 |
-    | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise | 3 |
+    | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise (8 seeds) | 3 |
     """
     from beatlite.report import markdown_table
     from beatlite.train.evaluation import column_headers, fmt_metric
