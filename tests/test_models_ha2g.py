@@ -513,3 +513,27 @@ def test_shipped_checkpoint_loads_and_generates(name: str) -> None:
     pose = model.generate(batch)
     assert tuple(pose.shape) == (2, 34, 126) and bool(torch.isfinite(pose).all())
     assert float(pose[:, 4:].std(dim=1).mean()) > 0.0  # not a frozen pose
+
+
+@pytest.mark.parametrize("style", ["reference", "shared"])
+def test_coordinator_weights_are_eq3_mixes_from_the_coordinators_input(style: str) -> None:
+    model = _model(style=style).eval()
+    speaker = torch.tensor([0, 3, 3])
+    with torch.no_grad():
+        w = model.coordinator_weights(speaker)
+        # the coordinator's input: its own embedding (reference) or the mean style (shared, z = mu)
+        coord = (
+            model.coordinator_embedding(speaker) if style == "reference" else model.speaker_style(speaker)[0]
+        )
+        expected = model.coordinator(coord)
+    assert w.shape == (3, 3, 6)
+    torch.testing.assert_close(w, expected)
+    torch.testing.assert_close(w.sum(dim=1), torch.ones(3, 6))
+    torch.testing.assert_close(w[1], w[2])  # one speaker, one mix
+
+
+def test_coordinator_weights_of_a_single_audio_level_are_one_hot() -> None:
+    model = _model(audio_mode="mid").eval()
+    with torch.no_grad():
+        w = model.coordinator_weights(torch.tensor([0, 1]))
+    assert w[:, 1].eq(1).all() and w[:, [0, 2]].eq(0).all()

@@ -556,6 +556,17 @@ class HA2G(GestureModel):
         style = self._styles(speaker, self.training if sample is None else sample, generator)
         return style["mu"], style["logvar"], style["z"]
 
+    def coordinator_weights(self, speaker: torch.Tensor) -> torch.Tensor:
+        """Speaker ids (B,) -> (B, 3, H) weights of the low, mid and high audio levels for each of the H
+        body levels (eq. 3; each column sums to 1), as evaluation uses them (no sampling).
+
+        ``"reference"``: from the coordinator's own speaker embedding; ``"shared"``: from the mean style.
+        A model without a coordinator (one audio level) gives that level weight 1 everywhere.
+        """
+        styles = self._styles(speaker, False)
+        like = next(self.parameters())
+        return self._style_weights(styles["coord"], len(speaker), like)
+
     def _styles(
         self, speaker: torch.Tensor, sample: bool, generator: torch.Generator | None = None
     ) -> dict[str, torch.Tensor | None]:
