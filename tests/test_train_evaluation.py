@@ -356,6 +356,38 @@ def test_reference_variant_columns_closed_forms(test_set):
     assert set(res.get("Mean pose").metrics) == set(keys) and res.columns == keys
 
 
+def test_fgd_in_beats_euler_space_closed_form(test_set):
+    """FGD (BEAT AE): the extractor reads z-scored 34-frame Euler windows. The mean pose (Euler 0) has
+    constant windows, features 0: FGD = |mu_real|^2 + tr(Sigma_real); a direction model has none."""
+    import dataclasses
+
+    rng = np.random.default_rng(1)
+    euler = [np.cumsum(rng.normal(size=(t, 141)), axis=0) for t in LENGTHS]
+    moving = dataclasses.replace(test_set, gt_euler=euler)
+    mean_pose = build_model("mean_pose")
+    mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
+
+    class Still(torch.nn.Module):
+        representation, input_keys, target_key, pose_dim, n_pre = "dirvec126", ("dirvec",), "dirvec", 126, 4
+
+        def generate(self, batch):
+            return torch.zeros_like(batch["dirvec"])
+
+    key = "FGD (BEAT AE)"
+    entries = [("Mean pose", mean_pose), ("Still", Still())]
+    res = evaluate_models(
+        entries, test=moving, extractor=_features, euler_extractor=_features, columns=(key,)
+    )
+    assert res.value(GROUND_TRUTH, key) == pytest.approx(0.0, abs=1e-6)
+    windows = np.concatenate([[e[s : s + 34] for s in range(0, len(e) - 33, 10)] for e in euler])
+    real = _features(windows)  # the normalisers are mean 0, std 1: z-scoring changes nothing here
+    low = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T, bias=True))
+    high = (real.mean(0) ** 2).sum() + np.trace(np.cov(real.T))
+    # the windows reach the extractor as float32: relative rounding of ~1e-7
+    assert low * (1 - 1e-6) <= res.value("Mean pose", key) <= high * (1 + 1e-6)
+    assert math.isnan(res.value("Still", key))  # no Euler angles
+
+
 def test_direction_rows_have_no_euler_variant(test_set):
     class Still(torch.nn.Module):  # a direction model that repeats the mean direction (dirvec 0)
         representation, input_keys, target_key, pose_dim, n_pre = "dirvec126", ("dirvec",), "dirvec", 126, 4

@@ -48,12 +48,16 @@ class Takes:
         ``spine_neck_141`` Euler channels (the reference SRGR / BeatAlign / L1div of BEAT's code).
     features : (N, F) float, optional
         Extractor features of the system's 34-frame windows (FGD, Diversity).
+    euler_features : (N, F) float, optional
+        Features of the same windows of the Euler channels by an autoencoder trained on them
+        (BEAT's FGD space: ``"FGD (BEAT AE)"``).
     """
 
     positions: list[np.ndarray]
     directions: list[np.ndarray] | None = None
     euler: list[np.ndarray] | None = None
     features: np.ndarray | None = None
+    euler_features: np.ndarray | None = None
 
 
 @dataclass(eq=False)
@@ -208,7 +212,7 @@ def describe(keys: Sequence[str]) -> str:
 
 
 def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:
-    if need in ("positions", "directions", "euler", "features"):
+    if need in ("positions", "directions", "euler", "features", "euler_features"):
         return getattr(gen, need) is not None and getattr(truth.takes, need) is not None
     if need == "beats":
         return truth.beats() is not None
@@ -231,6 +235,12 @@ def _fgd(reference: bool) -> Callable[[Takes, GroundTruth, int], float]:
     from beatlite.metrics.frechet import fgd
 
     return lambda g, t, seed: fgd(g.features, t.takes.features, reference=reference)
+
+
+def _fgd_euler(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.frechet import fgd
+
+    return fgd(g.euler_features, t.takes.euler_features)
 
 
 def _srgr_paper(g: Takes, t: GroundTruth, seed: int) -> float:
@@ -304,6 +314,9 @@ def _metrics() -> dict[str, Metric]:
                       f"Fréchet distance of extractor features of {win} (stable square root)"),
         "FGD (reference)": Metric("FGD", "reference", False, ("features",), _fgd(True),
                                   "the same with scipy's sqrtm, 1e10 on a complex result (BEAT's code)"),
+        "FGD (BEAT AE)": Metric("FGD", "beat_ae", False, ("euler_features",), _fgd_euler,
+                                f"the same on {win} of the 141 z-scored Euler channels, features of an "
+                                "autoencoder trained on them (BEAT's space; Euler models only)"),
         "SRGR": Metric("SRGR", "paper", True, ("positions", "semantic"), _srgr_paper,
                        "BEAT eq. 11 on joint positions, δ = 10 cm, ground-truth semantic scores"),
         "SRGR (reference)": Metric("SRGR", "reference", True, ("euler", "semantic"), _srgr_reference,

@@ -62,14 +62,16 @@ COLUMNS: tuple[str, ...] = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1di
 
 RECORD_COLUMNS: tuple[str, ...] = (
     *COLUMNS,
+    "FGD (BEAT AE)",
     "FGD (reference)",
     "SRGR (reference)",
     "BeatAlign (reference)",
     "BC (ha2g)",
 )
 """The metrics of the recorded seed table (``checkpoints/results_seeds.json``): :data:`COLUMNS`, then
-the variants the papers' code computes (BEAT's Euler autoencoder FGD, SRGR and BeatAlign; HA2G's BC on
-34-frame clips) for the side-by-side tables of notebooks 06-07."""
+the variants the papers' code computes (FGD in BEAT's Euler space and with scipy's square root, BEAT's
+SRGR and BeatAlign on Euler angles, HA2G's BC on 34-frame clips) for the side-by-side tables of
+notebooks 06-07."""
 
 GROUND_TRUTH = "Ground truth"
 GROUND_TRUTH_141 = "Ground truth (141 Euler channels)"
@@ -269,9 +271,12 @@ class EvaluationSet:
             self.audio_beats = [audio_beats(y, SR) for y in self.audio]
         return self.audio_beats
 
-    def ground_truth(self, extractor: Any) -> GroundTruth:
-        """The :class:`~beatlite.metrics.scoring.GroundTruth` every row is scored against."""
-        takes = directions_takes(self.gt_directions, self, extractor, euler=self.gt_euler)
+    def ground_truth(self, extractor: Any, euler_extractor: Any = None) -> GroundTruth:
+        """The :class:`~beatlite.metrics.scoring.GroundTruth` every row is scored against
+        (``euler_extractor``: the Euler autoencoder of ``"FGD (BEAT AE)"``, optional)."""
+        takes = directions_takes(
+            self.gt_directions, self, extractor, euler=self.gt_euler, euler_extractor=euler_extractor
+        )
         return GroundTruth(
             takes,
             semantic=self.semantic,
@@ -548,8 +553,10 @@ def directions_takes(
     extractor: Any,
     *,
     euler: list[np.ndarray] | None = None,
+    euler_extractor: Any = None,
 ) -> Takes:
-    """A row's :class:`~beatlite.metrics.scoring.Takes`: TED-43 positions, directions, features (+ Euler)."""
+    """A row's :class:`~beatlite.metrics.scoring.Takes`: TED-43 positions, directions, features (+ Euler,
+    + the Euler autoencoder's features when both ``euler`` and ``euler_extractor`` are given)."""
     if len(directions) != len(test.takes):
         raise ValueError(f"directions has {len(directions)} takes, the test set {len(test.takes)}")
     for i, (d, s) in enumerate(zip(directions, test.streams, strict=True)):
@@ -560,7 +567,18 @@ def directions_takes(
         directions=list(directions),
         euler=euler,
         features=direction_features(directions, test, extractor),
+        euler_features=None
+        if euler is None or euler_extractor is None
+        else euler_features(euler, test, euler_extractor),
     )
+
+
+def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
+    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10)."""
+    from beatlite.data.windows import sliding_windows
+
+    windows = sliding_windows([test.normalizers.transform(e, "euler141") for e in euler])
+    return np.asarray(extractor(windows.astype(np.float32)), np.float64)
 
 
 def score_directions(
@@ -572,9 +590,10 @@ def score_directions(
     euler: list[np.ndarray] | None = None,
     columns: Sequence[str] = COLUMNS,
     seed: int = 0,
+    euler_extractor: Any = None,
 ) -> dict[str, float]:
     """The metrics of ``columns`` for one row's per-take directions (T, 42, 3) (NaN where undefined)."""
-    takes = directions_takes(directions, test, extractor, euler=euler)
+    takes = directions_takes(directions, test, extractor, euler=euler, euler_extractor=euler_extractor)
     values = evaluate(takes, truth, metrics=columns, seed=seed).values()
     return {key: values[key] for key in columns}
 
@@ -615,6 +634,7 @@ def evaluate_models(
     seed: int = 0,
     progress: bool = False,
     columns: Sequence[str] = COLUMNS,
+    euler_extractor: Any = None,
 ) -> ModelResults:
     """Generate every test take with each model and score all of them in the TED-43 space.
 
@@ -639,6 +659,9 @@ def evaluate_models(
     columns : sequence of str
         Metric keys of :data:`beatlite.metrics.scoring.METRICS` to score (default :data:`COLUMNS`; e.g.
         the reference variants ``"SRGR (reference)"``, ``"BC (ha2g)"`` for a like-for-like table).
+    euler_extractor : callable, optional
+        (N, 34, 141) -> (N, F) features of z-scored Euler windows for ``"FGD (BEAT AE)"``; default
+        ``load_extractor("pose")``, loaded only when that column is asked for.
 
     Returns
     -------
@@ -657,16 +680,18 @@ def evaluate_models(
     entries = _as_entries(models)
     test = load_test_set() if test is None else test
     extractor = load_extractor("dirvec") if extractor is None else extractor
-    truth = test.ground_truth(extractor)
+    euler_ae = None
+    if "FGD (BEAT AE)" in columns:
+        euler_ae = load_extractor("pose") if euler_extractor is None else euler_extractor
+    truth = test.ground_truth(extractor, euler_ae)
+    scoring = {"columns": columns, "seed": seed, "euler_extractor": euler_ae}
     rows: list[ResultRow] = []
     if ground_truth:
         for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):
-            metrics = score_directions(
-                dirs, test, extractor, truth, euler=test.gt_euler, columns=columns, seed=seed
-            )
+            metrics = score_directions(dirs, test, extractor, truth, euler=test.gt_euler, **scoring)
             rows.append(ResultRow(label, "ground_truth", "ground_truth", metrics))
     for label, source, model, norms in entries:
-        rows.append(_model_row(label, source, model, norms, test, extractor, truth, (columns, seed)))
+        rows.append(_model_row(label, source, model, norms, test, extractor, truth, scoring))
         if progress:
             values = ", ".join(f"{k} {v:.4g}" for k, v in rows[-1].metrics.items())
             print(f"{label}: {values} ({rows[-1].seconds:.1f} s)", flush=True)
@@ -693,9 +718,10 @@ def _model_row(
     test: EvaluationSet,
     extractor: Any,
     truth: GroundTruth,
-    scoring: tuple[Sequence[str], int],
+    scoring: dict[str, Any],
 ) -> ResultRow:
-    """Load (when ``model`` is None), generate and score one model's row (``scoring``: columns, seed)."""
+    """Load (when ``model`` is None), generate and score one model's row (``scoring``: keywords of
+    :func:`score_directions`)."""
     import torch
 
     fingerprint, stale = "", False
@@ -705,8 +731,7 @@ def _model_row(
     with torch.no_grad():
         dirs, euler = _generate(model, test, norms)
     seconds = time.perf_counter() - t0
-    columns, seed = scoring
-    metrics = score_directions(dirs, test, extractor, truth, euler=euler, columns=columns, seed=seed)
+    metrics = score_directions(dirs, test, extractor, truth, euler=euler, **scoring)
     return ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale)
 
 
