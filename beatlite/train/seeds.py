@@ -617,6 +617,7 @@ def ablation_table(
     *,
     metrics: Sequence[str] = ("FGD", "SRGR"),
     deltas: Sequence[str] = ("FGD", "SRGR", "BeatAlign"),
+    absent: Mapping[str, str] | None = None,
 ) -> str:
     """An ablation study as a Markdown table: the paper's row beside ours (mean ± sd) and each change ± 2 SE.
 
@@ -633,7 +634,10 @@ def ablation_table(
     metrics : sequence of str
         Columns shown as values, for the paper (when it has them) and for us.
     deltas : sequence of str
-        Columns shown as changes vs ``full`` (:func:`compare_rows`: ``"+0.52 ± 0.31 worse"``).
+        Columns shown as changes vs ``full`` (:func:`compare_rows`: ``"+0.52 ± 0.31 worse"``; an undecided
+        change says how many seeds would decide it).
+    absent : mapping paper row -> reason, optional
+        Paper rows we have no model for, listed last with the paper's values and the reason.
 
     Returns
     -------
@@ -648,6 +652,12 @@ def ablation_table(
     |---|---|---|---|---|---|
     | Full | full | 5.00 | 2.00 ± 1.00 |  | 3 |
     | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise (8 seeds) | 3 |
+
+    A paper row with no model of ours:
+
+    >>> print(ablation_table(rec, "Full", {"Full": "full"}, {"full": {"FGD": 5.0}, "B": {"FGD": 6.0}},
+    ...                      metrics=("FGD",), deltas=("FGD",), absent={"B": "needs X"}).splitlines()[-1])
+    | — | B | 6.00 | not trained: needs X |  | 0 |
     """
     from beatlite.report import markdown_table
     from beatlite.train.evaluation import column_headers, fmt_metric
@@ -668,4 +678,8 @@ def ablation_table(
             for m in deltas
         ]
         body.append([*cells, record.count(label, metrics[0])])
+    for paper_row, reason in (absent or {}).items():
+        published = paper.get(paper_row, {})
+        cells = ["—", paper_row, *[fmt_metric(published.get(m, math.nan), m) for m in metrics]]
+        body.append([*cells, f"not trained: {reason}", *[""] * (len(metrics) - 1 + len(deltas)), 0])
     return markdown_table(header, body)
