@@ -346,3 +346,18 @@ def test_an_undecided_difference_says_how_many_seeds_would_decide_it():
     assert effect.cell() == "+1.00 ± 1.63 noise (8 seeds)"
     n = effect.seeds_needed
     assert 2 * math.sqrt(2 / n) <= abs(effect.delta) < 2 * math.sqrt(2 / (n - 1))
+
+
+def test_retrain_all_uses_the_recorded_shipped_seed(tmp_path):
+    import json
+
+    from beatlite.train.seeds import recorded_shipped_seed
+
+    record = SeedResults(
+        {"S2G-style": {"FGD": [1.0, 2.0, 3.0]}}, [2021, 2022, 2023], {"shipped": {"S2G-style": 2022}}
+    )
+    path = tmp_path / "results_seeds.json"
+    path.write_text(json.dumps(record.to_dict()))
+    assert recorded_shipped_seed("s2g_tiny", path) == 2022
+    assert recorded_shipped_seed("camn_tiny", path) == SEED  # a row the record does not name
+    assert recorded_shipped_seed("camn_tiny", tmp_path / "none.json") == SEED

@@ -10,7 +10,8 @@ for the per-epoch validation FGD.
 
 ``retrain-all [--only NAME ...] [--seed S] [--jobs J]`` rebuilds every shipped checkpoint of
 :data:`beatlite.train.recipes.RECIPES` (CaMN and its ablations, the baselines, HA2G and its
-ablations) from the ``data_samples/`` (``$BEATLITE_DATA``) train split with its recipe and
+ablations) from the ``data_samples/`` (``$BEATLITE_DATA``) train split with its recipe, its shipped seed
+(:func:`beatlite.train.seeds.recorded_shipped_seed`; ``--seed`` overrides) and
 ``BEATLITE_THREADS`` threads, writing the full training checkpoint to ``build/train/<name>.pt``,
 a float16 inference copy to ``checkpoints/<name>.pt`` and the training times to
 ``build/train/times.json``. Without ``--only`` it then retrains the FGD extractors
@@ -73,7 +74,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
     f.add_argument("--checkpoint-every", type=int, help="also checkpoint every N steps inside an epoch")
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
-    p.add_argument("--seed", type=int, default=SEED)
+    p.add_argument("--seed", type=int, help="default: each recipe's shipped seed in the recorded seed table")
     p.add_argument("--epochs", type=int, help="override every recipe's epochs (for quick checks)")
     p.add_argument("--only", nargs="*", choices=sorted(RECIPES), help="retrain only these")
     p.add_argument("--jobs", type=int, default=1, help="training processes at once (1 thread each)")
@@ -136,7 +137,10 @@ def _retrain_all_command(args: argparse.Namespace) -> int:
         print(f"{name}: {seconds:.1f} s", flush=True)
         _record_times({name: seconds})
 
-    runs = [(name, args.seed, None) for name in args.only or list(RECIPES)]
+    from beatlite.train.seeds import recorded_shipped_seed
+
+    names = args.only or list(RECIPES)
+    runs = [(name, recorded_shipped_seed(name) if args.seed is None else args.seed, None) for name in names]
     retrain_many(runs, jobs=args.jobs, epochs=args.epochs, on_done=report)
     if not args.skip_extractor and not args.only:
         for space in ("dirvec", "pose"):

@@ -548,6 +548,19 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
         raise FormatError(path, f"not a seed table written by write_seed_results ({exc})") from exc
 
 
+def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
+    """The seed of recipe ``name``'s shipped checkpoint in the recorded seed table (``info["shipped"]``),
+    :data:`~beatlite.train.recipes.SEED` when there is no record or it does not name the row."""
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train.recipes import label_of
+
+    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    if not path.is_file():
+        return SEED
+    seed = (recorded_seed_results(path).info.get("shipped") or {}).get(label_of(name))
+    return SEED if seed is None else int(seed)
+
+
 #: Tolerances of :func:`check_against_record`. Generation runs float32 torch kernels whose rounding
 #: differs between CPUs (oneDNN picks kernels per instruction set), and the autoregressive units
 #: carry it forward: scores agree to ~1e-5 relative, so 1e-3 is safe. Values that are zero by
