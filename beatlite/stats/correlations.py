@@ -19,7 +19,8 @@ Taught in notebooks/02_dataset_statistics.ipynb, section 5 (the correlation clai
 
 :func:`window_means`, :func:`speed_by_emotion` and :func:`gesture_correlations` read their takes once,
 in order, keeping a few numbers per window and per take: pass
-:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus.
+:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus
+(:func:`plot_correlations` reads its takes twice: give it a list).
 """
 
 from __future__ import annotations
@@ -310,8 +311,7 @@ def plot_correlations(
 
     from beatlite.viz.style import SYSTEM_COLOURS, figure_style, save_figure
 
-    per_take: list[tuple[float, int, int | None]] = []  # mean speed, emotion, speaker: one pass over takes
-    wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
+    wm = window_means(takes, seconds=seconds)
     speeds = speed_by_emotion(takes)
     with figure_style():
         fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")

@@ -2,14 +2,15 @@
 
 Taught in notebooks/02_dataset_statistics.ipynb, section 4 (Figure 4: semantic relevance).
 
-Every function reads its takes once, in order, keeping only per-segment or per-word scores: pass
-:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus.
+Every analysis reads its takes once, in order, keeping only per-segment or per-word scores: pass
+:func:`beatlite.stats.corpus.iter_corpus` instead of a loaded list to stream over a large corpus
+(:func:`plot_figure4` reads them three times: give it a list).
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -143,7 +144,7 @@ def speaker_scores(takes: Iterable[CorpusTake]) -> dict[int, dict[str, float]]:
 
 
 def plot_figure4(
-    takes: Iterable[CorpusTake],
+    takes: Sequence[CorpusTake],
     *,
     top: int = 9,
     out: str | Path | None = None,

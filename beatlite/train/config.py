@@ -61,8 +61,7 @@ class TrainConfig:
     checkpoint_every : int or None
         Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
         BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as
-        an uninterrupted run. Under ``torchrun`` the logged losses of a resumed epoch count the other
-        processes' part only from the resumed step on (training itself is exact).
+        an uninterrupted run (under ``torchrun`` too: the checkpoint keeps the loss sums of all processes).
     workers : int
         DataLoader worker processes that read the batches of a window store
         (:class:`beatlite.data.store.StoreWindows`); in-memory windows are indexed in the loop.

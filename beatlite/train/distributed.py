@@ -35,8 +35,8 @@ def distributed_rank() -> tuple[int, int]:
     """``(rank, world size)`` of this process: ``(0, 1)`` unless started by ``torchrun`` with 2+ processes.
 
     Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
-    ``nccl`` backend when CUDA is available (each process on GPU ``LOCAL_RANK``) and ``gloo`` (CPU)
-    otherwise.
+    ``nccl`` backend for CUDA tensors when CUDA is available (each process on GPU ``LOCAL_RANK``) and
+    ``gloo`` for CPU tensors.
     """
     import torch.distributed as dist
 
@@ -45,7 +45,8 @@ def distributed_rank() -> tuple[int, int]:
     if not dist.is_initialized():
         if torch.cuda.is_available():
             torch.cuda.set_device(local_device(torch.device("cuda")))
-        dist.init_process_group(backend="nccl" if torch.cuda.is_available() else "gloo")
+        # gloo for CPU tensors, nccl for CUDA ones (training on the CPU of a GPU machine works too)
+        dist.init_process_group(backend="cpu:gloo,cuda:nccl" if torch.cuda.is_available() else "gloo")
     return dist.get_rank(), dist.get_world_size()
 
 
@@ -57,9 +58,11 @@ def local_device(device: torch.device) -> torch.device:
 
 
 class _View(nn.Module):
-    """Some child modules (and the direct parameters and buffers) of ``owner``, whose forward is ``call``.
+    """Some child modules of ``owner``, whose forward is ``call``.
 
-    The modules are shared, not copied: DDP over a view synchronises the owner's own tensors.
+    The modules are shared, not copied: DDP over a view synchronises the owner's own tensors. Buffers
+    held by the owner itself (HA2G's angle statistics, CaMN's assembly map) are not synchronised:
+    ``prepare`` computes them from the same windows in every process.
     """
 
     def __init__(self, owner: nn.Module, children: dict[str, nn.Module], call: Any) -> None:
@@ -125,7 +128,7 @@ def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
     import torch.distributed as dist
 
     keys = sorted(sums)
-    device = torch.device("cuda", torch.cuda.current_device()) if dist.get_backend() == "nccl" else None
+    device = torch.device("cuda", torch.cuda.current_device()) if torch.cuda.is_available() else None
     values = torch.tensor([sums[k] for k in keys], dtype=torch.float64, device=device)
     dist.all_reduce(values, op=dist.ReduceOp.SUM)
     return dict(zip(keys, values.cpu().tolist(), strict=True))

@@ -63,11 +63,13 @@ def shipped_seed(path: str | Path) -> int | None:
     path = Path(path)
     if not path.is_file():
         return None
-    return _stored_seed(str(path), path.stat().st_mtime_ns)
+    stat = path.stat()
+    return _stored_seed(str(path), stat.st_mtime_ns, stat.st_ino, stat.st_size)
 
 
 @functools.lru_cache(maxsize=256)
-def _stored_seed(path: str, mtime_ns: int) -> int | None:
+def _stored_seed(path: str, mtime_ns: int, inode: int, size: int) -> int | None:  # the file's identity
+
     from beatlite.train.checkpoint import load_checkpoint
 
     seed = (load_checkpoint(path).get("train_config") or {}).get("seed")
@@ -75,7 +77,8 @@ def _stored_seed(path: str, mtime_ns: int) -> int | None:
 
 
 def median_seed(values: Sequence[float], seeds: Sequence[int]) -> int:
-    """The seed whose value is nearest the median of the finite ``values`` (ties: the earlier seed).
+    """The seed of the median of the finite ``values`` (the lower median of an even count; equal values:
+    the earlier seed).
 
     Examples
     --------
@@ -83,13 +86,15 @@ def median_seed(values: Sequence[float], seeds: Sequence[int]) -> int:
     2023
     >>> median_seed([3.0, float("nan"), 5.0, 4.5], [1, 2, 3, 4])
     4
+    >>> median_seed([5.3, 4.1, float("nan")], [1, 2, 3])
+    2
     """
     v = np.asarray(values, float)
     ok = np.flatnonzero(np.isfinite(v))
     if len(ok) == 0:
         raise ValueError(f"median_seed: no finite value among {list(values)}")
-    median = float(np.median(v[ok]))
-    return int(seeds[int(ok[np.argmin(np.abs(v[ok] - median))])])
+    ranked = ok[np.lexsort((ok, v[ok]))]  # by value, then by position: the lower median of an even count
+    return int(seeds[int(ranked[(len(ranked) - 1) // 2])])
 
 
 def ship_median_seeds(
@@ -120,7 +125,14 @@ def ship_median_seeds(
             _copy(dst, seeds_dir() / str(kept) / dst.name)
         _copy(src, dst)
         chosen[name] = seed
-    results.info["shipped"] = {label_of(n): seed for n, seed in chosen.items()}
+    results.info.setdefault("shipped", {}).update({label_of(n): seed for n, seed in chosen.items()})
+    if "checkpoints" in results.info:  # the files each seed's values came from, after the copies
+        results.info["checkpoints"].update(
+            {
+                n: [str(checkpoint_path(n, s)) for s in results.seeds if checkpoint_path(n, s).is_file()]
+                for n in chosen
+            }
+        )
     return chosen
 
 
@@ -307,7 +319,7 @@ class SeedResults:
                 row,
                 *[self.cell(row, key) if key in self.values[row] else "" for key in columns],
                 self.count(row, "FGD" if "FGD" in self.values[row] else next(iter(self.values[row]))),
-                shipped.get(row) or "",
+                "" if shipped.get(row) is None else shipped[row],
             ]
             for row in rows
         ]
@@ -357,7 +369,7 @@ class Effect:
     seeds_needed : int or None
         Seeds per row at which the standard error would be at most half of ``|delta|`` (so that
         ``|delta| > 2 se`` decides), if the two rows' spreads and the difference stay as measured:
-        ``ceil(4 (sd_variant² + sd_full²) / delta²)``. None without a standard error.
+        the least n > ``4 (sd_variant² + sd_full²) / delta²``. None without a standard error or a difference.
     """
 
     variant: str
@@ -369,7 +381,7 @@ class Effect:
 
     def cell(self, digits: int = 2) -> str:
         """``"+0.52 ± 0.31 worse"``: delta ± 2 standard errors and the verdict; an undecided one says
-        how many seeds would decide it (``"+0.10 ± 0.31 noise (38 seeds)"``)."""
+        how many seeds would decide it (``"+0.10 ± 0.31 noise (39 seeds)"``)."""
         text = f"{self.delta:+.{digits}f} ± {2 * self.se:.{digits}f} {self.verdict}"
         if self.verdict == "noise" and self.seeds_needed is not None:
             text += f" ({self.seeds_needed} seeds)"
@@ -418,11 +430,9 @@ def compare_rows(
 def _seeds_needed(results: SeedResults, variant: str, full: str, metric: str, delta: float) -> int | None:
     """Seeds per row that would make ``|delta|`` two standard errors (:attr:`Effect.seeds_needed`)."""
     spread = results.sd(variant, metric) ** 2 + results.sd(full, metric) ** 2
-    if not math.isfinite(spread) or not math.isfinite(delta):
+    if not math.isfinite(spread) or not math.isfinite(delta) or delta == 0:
         return None
-    if delta == 0:
-        return None if spread > 0 else 2
-    return max(2, math.ceil(4 * spread / delta**2))
+    return max(2, math.floor(4 * spread / delta**2) + 1)  # |delta| > 2 se, strictly, decides
 
 
 def evaluate_seeds(
@@ -584,7 +594,9 @@ def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence
     shipped = record.info.get("shipped") or {}
     for row in results.rows:
         assert row.label in record.values, f"{row.label} is not in the recorded table: make seeds"
-        k = 0 if row.representation == "ground_truth" else record.seeds.index(shipped.get(row.label) or SEED)
+        seed = SEED if shipped.get(row.label) is None else int(shipped[row.label])
+        assert seed in record.seeds, f"{row.label}: shipped seed {seed} is not in the record: make seeds"
+        k = 0 if row.representation == "ground_truth" else record.seeds.index(seed)
         for metric, value in row.metrics.items():
             if metrics is not None and metric not in metrics:
                 continue
@@ -664,7 +676,7 @@ def ablation_table(
     | variant | paper row | paper FGD ↓ | ours FGD ↓ | Δ FGD ± 2 SE | seeds |
     |---|---|---|---|---|---|
     | Full | full | 5.00 | 2.00 ± 1.00 |  | 3 |
-    | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise (8 seeds) | 3 |
+    | A | — | — | 3.00 ± 1.00 | +1.00 ± 1.63 noise (9 seeds) | 3 |
 
     A paper row with no model of ours:
 

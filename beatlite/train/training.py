@@ -249,6 +249,7 @@ def fit(
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
     if config.resume and run.path is not None and run.path.is_file():
         run.resume()
+    run.wrap()
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
         return run.result()
@@ -366,13 +367,9 @@ class _Run:
         if model.discriminator is not None:
             d_lr = self.lr * config.d_lr_weight
             self.d_opt = torch.optim.Adam(model.discriminator.parameters(), lr=d_lr, betas=config.betas)
-        self.g_ddp = self.d_ddp = (
-            None  # under torchrun: DistributedDataParallel over the generator, the discriminator
-        )
-        if (
-            self.world > 1 and self.g_opt is not None
-        ):  # (building them gives every process process 0's weights)
-            self.g_ddp, self.d_ddp = wrap_for_ddp(model, self.device)
+        # under torchrun: DistributedDataParallel over the generator and the discriminator (see wrap)
+        self.g_ddp: Any = None
+        self.d_ddp: Any = None
         self.history: list[dict[str, Any]] = []
         self.start_epoch = 0
         self.partial: dict[str, Any] | None = (
@@ -380,6 +377,12 @@ class _Run:
         )
         self.best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
         self.path = None if config.checkpoint is None else Path(config.checkpoint)
+
+    def wrap(self) -> None:
+        """Under ``torchrun``, build the DDP wrappers (after :meth:`resume`: they give every process process
+        0's weights)."""
+        if self.world > 1 and self.g_opt is not None:
+            self.g_ddp, self.d_ddp = wrap_for_ddp(self.model, self.device)
 
     def resume(self) -> None:
         """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``)."""
@@ -425,13 +428,15 @@ class _Run:
             seen += len(idx)
         first, sums = 0, {}
         if self.partial is not None and self.partial["epoch"] == epoch:  # resuming inside this epoch
-            first, sums = int(self.partial["step"]), dict(self.partial["sums"])
+            first = int(self.partial["step"])
+            sums = dict(self.partial["sums"]) if self.rank == 0 else {}  # all processes' sums so far
         self.partial = None
         every = config.checkpoint_every
         for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
             self.step(batches, parts, epoch, sums)
             if every and (k + 1) % every == 0 and k + 1 < len(steps):
-                self.partial = {"epoch": epoch, "step": k + 1, "sums": dict(sums)}
+                total = sum_over_processes(dict(sums), self.world)  # (a collective: every process calls it)
+                self.partial = {"epoch": epoch, "step": k + 1, "sums": total}
                 self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
                 self.partial = None
         return _mean_losses(sum_over_processes(sums, self.world), seen)
