@@ -71,3 +71,26 @@ def test_two_micro_batches_per_process_give_the_mean_gradient(tmp_path):
     assert 0 < float(ga.norm()) and error < 1e-5, error
     la, lb = a["history"][0]["train"], b["history"][0]["train"]
     assert all(abs(la[k] - lb[k]) <= 1e-5 * (1 + abs(la[k])) for k in la)
+
+
+@pytest.mark.slow
+def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path):
+    """Under torchrun, process 0 checkpoints after every step; a run stopped in epoch 2 resumes there and
+    ends with the weights of an uninterrupted run, and logs the same mean losses (the checkpoint keeps
+    the loss sums of both processes)."""
+    torchrun = shutil.which("torchrun", path=str(Path(sys.executable).parent)) or shutil.which("torchrun")
+    if torchrun is None:
+        pytest.skip("torchrun is not installed")
+    script = Path(__file__).with_name("ddp_resume.py")
+    out = {}
+    for mode in ("whole", "kill"):
+        path = tmp_path / f"{mode}.pt"
+        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode]
+        subprocess.run(cmd, check=True, env=_env(), timeout=900)
+        out[mode] = torch.load(str(path) + ".out", weights_only=False)
+    whole, resumed = out["whole"], out["kill"]
+    for name, p in whole["params"].items():
+        assert torch.equal(p, resumed["params"][name]), name
+    for a, b in zip(whole["history"], resumed["history"], strict=True):
+        assert a["train"].keys() == b["train"].keys()
+        assert all(abs(a["train"][k] - b["train"][k]) <= 1e-9 * (1 + abs(a["train"][k])) for k in a["train"])

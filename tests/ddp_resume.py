@@ -1,0 +1,54 @@
+"""Run by tests/test_train_distributed.py under ``torchrun``: two epochs of the CaMN tiny recipe (dropout 0)
+over 48 windows (3 steps of 16 per epoch) with a checkpoint after every step, written to ``argv[1]``.
+With ``argv[2] == "kill"`` every process stops in its 5th optimiser step (epoch 2, step 2), then resumes
+from the checkpoint; process 0 saves the final parameters and history to ``argv[1] + ".out"``."""
+
+import sys
+
+import torch
+
+from beatlite.train import TrainConfig, fit, training
+from beatlite.train.distributed import distributed_rank
+from beatlite.train.recipes import RECIPES, build_recipe_model, training_data
+
+path, mode = sys.argv[1], sys.argv[2]
+data = training_data()
+
+
+def model():
+    m = build_recipe_model("camn_tiny", data, seed=7)
+    for module in m.modules():
+        if isinstance(module, torch.nn.Dropout):
+            module.p = 0.0
+    return m
+
+
+def config(resume: bool) -> TrainConfig:
+    return TrainConfig(
+        epochs=2, batch_size=16, lr=RECIPES["camn_tiny"].lr, seed=7, windows_per_epoch=48, no_adv_epochs=0,
+        threads=1, progress=False, checkpoint=path, checkpoint_every=1, resume=resume,
+    )  # fmt: skip
+
+
+net = model()
+if mode == "kill":
+    real_step, calls = training._Run.step, {"n": 0}
+
+    def dying_step(self, *args):
+        if calls["n"] == 4:
+            raise KeyboardInterrupt("killed")
+        calls["n"] += 1
+        return real_step(self, *args)
+
+    training._Run.step = dying_step
+    try:
+        fit(net, data.train, config(False), meta=data.meta)
+    except KeyboardInterrupt:
+        pass
+    training._Run.step = real_step
+    net = model()
+history = fit(net, data.train, config(mode == "kill"), meta=data.meta).history
+if distributed_rank()[0] == 0:
+    torch.save(
+        {"params": {k: v.detach() for k, v in net.named_parameters()}, "history": history}, path + ".out"
+    )
