@@ -538,8 +538,8 @@ def _seed_names(names: Sequence[str] | None, seeds: list[int], missing: str) -> 
 def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
     """The seed table recorded beside the shipped checkpoints (``checkpoints/results_seeds.json``).
 
-    Written by ``make seeds`` (``python -m beatlite.train seeds --out checkpoints/results_seeds``)
-    when the checkpoints were trained; its seed-2021 column is the shipped checkpoints.
+    Written by ``make seeds`` (``python -m beatlite.train seeds --ship --out checkpoints/results_seeds``)
+    when the checkpoints were trained; ``info["shipped"]`` names each row's shipped seed.
 
     Raises
     ------
