@@ -77,8 +77,8 @@ def _stored_seed(path: str, mtime_ns: int, inode: int, size: int) -> int | None:
 
 
 def median_seed(values: Sequence[float], seeds: Sequence[int]) -> int:
-    """The seed of the median of the finite ``values`` (the lower median of an even count; equal values:
-    the earlier seed).
+    """The seed of the median of the finite ``values``: the values ranked, equal ones in seed order, the
+    middle one (the lower middle one of an even count).
 
     Examples
     --------
