@@ -707,3 +707,20 @@ def test_inline_player_resolution_and_format_are_chosen_per_call():
     assert len(small) < len(large)
     assert "data:image/jpeg" in anim.to_html(dpi=20, frame_format="jpeg")
     assert "data:image/png" in small
+
+
+def test_score_scatter_labels_of_close_points_do_not_overlap():
+    from beatlite.viz import charts
+
+    x = {"Ground truth": 0.0, "Ground truth (141 Euler channels)": 0.04, "CaMN": 3.0, "HA2G": 3.1}
+    y = {"Ground truth": 0.66, "Ground truth (141 Euler channels)": 0.67, "CaMN": 0.73, "HA2G": 0.74}
+    fig = charts.plot_score_scatter(x, y, "FGD", "BC")
+    fig.canvas.draw()
+    boxes = [t.get_window_extent() for t in fig.axes[0].texts]
+    assert len(boxes) == 4
+    for i in range(4):
+        for j in range(i + 1, 4):
+            assert not boxes[i].overlaps(boxes[j]), (
+                fig.axes[0].texts[i].get_text(),
+                fig.axes[0].texts[j].get_text(),
+            )

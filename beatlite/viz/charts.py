@@ -249,15 +249,38 @@ def plot_score_scatter(
     with figure_style():
         ax = _new_axes(ax, figsize)
         for label, xi, yi in zip(keep, xs, ys):
-            colour = system_colour(label, list(x).index(label))
-            ax.scatter(xi, yi, color=colour, s=40, zorder=3)
-            left = xi > middle and len(keep) > 1
-            ax.annotate(label, (xi, yi), xytext=(-6 if left else 6, 4), textcoords="offset points",
-                        ha="right" if left else "left", fontsize=9, color=colour)  # fmt: skip
+            ax.scatter(xi, yi, color=system_colour(label, list(x).index(label)), s=40, zorder=3)
         ax.margins(x=0.15, y=0.2)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
+        left = [xi > middle and len(keep) > 1 for xi in xs]
+        for label, xi, yi, lift, is_left in zip(keep, xs, ys, _label_lifts(ax, keep, xs, ys, left), left):
+            ax.annotate(label, (xi, yi), xytext=(-6 if is_left else 6, 4 + lift), textcoords="offset points",
+                        ha="right" if is_left else "left", va="bottom", fontsize=9,
+                        color=system_colour(label, list(x).index(label)))  # fmt: skip
     return ax.figure
+
+
+def _label_lifts(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, left: list[bool]) -> list[float]:
+    """Vertical offsets (points) that keep point labels from overlapping: from the top point down, a label
+    whose box (about 5.5 points per character, 11 high) meets a placed one moves below it."""
+    to_points = 72.0 / ax.figure.dpi
+    xy = ax.transData.transform(np.column_stack([xs, ys])) * to_points
+    boxes: list[tuple[float, float, float, float]] = []  # x0, x1, y0, y1 in points
+    lifts = [0.0] * len(labels)
+    for i in sorted(range(len(labels)), key=lambda k: -ys[k]):
+        width = 5.5 * len(labels[i])
+        x0 = xy[i, 0] - 6 - width if left[i] else xy[i, 0] + 6
+        lift = 0.0
+        for _ in range(len(labels)):
+            y0 = xy[i, 1] + 4 + lift
+            hit = [b for b in boxes if x0 < b[1] and b[0] < x0 + width and y0 < b[3] and b[2] < y0 + 11]
+            if not hit:
+                break
+            lift = min(b[2] for b in hit) - 11 - 4 - xy[i, 1]
+        boxes.append((x0, x0 + width, xy[i, 1] + 4 + lift, xy[i, 1] + 15 + lift))
+        lifts[i] = lift
+    return lifts
 
 
 def plot_effects(
