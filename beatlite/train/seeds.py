@@ -13,8 +13,8 @@ Trimodal on FGD" is therefore checked on the mean over seeds, against the spread
 
 Every seed ``s`` of a recipe is trained by :func:`beatlite.train.recipes.retrain` into
 ``build/seeds/<s>/<name>.pt`` (``python -m beatlite.train seeds``). The shipped checkpoint
-``checkpoints/<name>.pt`` is a copy of the seed whose FGD is nearest the median over the seeds
-(:func:`ship_median_seeds`), not an arbitrary one; it stores its seed, and the recorded table names it
+``checkpoints/<name>.pt`` is a copy of the seed whose FGD is the median over the seeds
+(:func:`median_seed`, :func:`ship_median_seeds`), not an arbitrary one; it stores its seed, and the recorded table names it
 (``info["shipped"]``). Where ``build/seeds/<s>/`` lacks a checkpoint, the shipped one stands for its own
 seed (a fresh clone has only those).
 
@@ -69,7 +69,6 @@ def shipped_seed(path: str | Path) -> int | None:
 
 @functools.lru_cache(maxsize=256)
 def _stored_seed(path: str, mtime_ns: int, inode: int, size: int) -> int | None:  # the file's identity
-
     from beatlite.train.checkpoint import load_checkpoint
 
     seed = (load_checkpoint(path).get("train_config") or {}).get("seed")
@@ -117,23 +116,21 @@ def ship_median_seeds(
     for name in names:
         seed = median_seed(results.values[label_of(name)][metric], results.seeds)
         src, dst = checkpoint_path(name, seed), checkpoints_dir() / f"{name}.pt"
-        if src.resolve() == dst.resolve():
-            chosen[name] = seed
-            continue
-        kept = shipped_seed(dst)  # the replaced checkpoint stays its seed's copy in build/seeds/
-        if kept is not None and not (seeds_dir() / str(kept) / dst.name).is_file():
-            _copy(dst, seeds_dir() / str(kept) / dst.name)
-        _copy(src, dst)
+        if src.resolve() != dst.resolve():
+            kept = shipped_seed(dst)  # the replaced checkpoint stays its seed's copy in build/seeds/
+            if kept is not None and not (seeds_dir() / str(kept) / dst.name).is_file():
+                _copy(dst, seeds_dir() / str(kept) / dst.name)
+            _copy(src, dst)
         chosen[name] = seed
     results.info.setdefault("shipped", {}).update({label_of(n): seed for n, seed in chosen.items()})
     if "checkpoints" in results.info:  # the files each seed's values came from, after the copies
-        results.info["checkpoints"].update(
-            {
-                n: [str(checkpoint_path(n, s)) for s in results.seeds if checkpoint_path(n, s).is_file()]
-                for n in chosen
-            }
-        )
+        results.info["checkpoints"].update({n: _seed_files(n, results.seeds) for n in chosen})
     return chosen
+
+
+def _seed_files(name: str, seeds: Sequence[int]) -> list[str]:
+    """The checkpoint files of recipe ``name`` for those of ``seeds`` that have one (:func:`checkpoint_path`)."""
+    return [str(checkpoint_path(name, s)) for s in seeds if checkpoint_path(name, s).is_file()]
 
 
 def _current(name: str, seed: int, verbose: bool) -> bool:
@@ -421,14 +418,16 @@ def compare_rows(
                 verdict = "better" if (delta > 0) == higher[metric] else "worse"
             effects.append(
                 Effect(
-                    variant, metric, delta, se, verdict, _seeds_needed(results, variant, full, metric, delta)
+                    variant, metric, delta, se, verdict, seeds_needed(results, variant, full, metric, delta)
                 )
             )
     return effects
 
 
-def _seeds_needed(results: SeedResults, variant: str, full: str, metric: str, delta: float) -> int | None:
-    """Seeds per row that would make ``|delta|`` two standard errors (:attr:`Effect.seeds_needed`)."""
+def seeds_needed(results: SeedResults, variant: str, full: str, metric: str, delta: float) -> int | None:
+    """Seeds per row at which a difference ``delta`` between rows ``variant`` and ``full`` would exceed two
+    standard errors, with the two rows' spreads as measured (:attr:`Effect.seeds_needed`; pass another
+    ``delta``, e.g. a paper's effect, to ask what it would take to see that)."""
     spread = results.sd(variant, metric) ** 2 + results.sd(full, metric) ** 2
     if not math.isfinite(spread) or not math.isfinite(delta) or delta == 0:
         return None
@@ -489,13 +488,20 @@ def evaluate_seeds(
     names = _seed_names(names, seeds, missing)
     test = load_test_set() if test is None else test
     extractor = load_extractor("dirvec") if extractor is None else extractor
+    columns = tuple(columns or COLUMNS)
+    euler_extractor = load_extractor("pose") if "FGD (BEAT AE)" in columns else None  # once for all seeds
     values: dict[str, dict[str, list[float]]] = {}
     info: dict[str, Any] = {}
     for i, seed in enumerate(seeds):
         present = [n for n in names if checkpoint_path(n, seed).is_file()]
         paths = [str(checkpoint_path(n, seed)) for n in present]
         res = evaluate_models(
-            paths, test=test, extractor=extractor, ground_truth=i == 0, columns=columns or COLUMNS
+            paths,
+            test=test,
+            extractor=extractor,
+            ground_truth=i == 0,
+            columns=columns,
+            euler_extractor=euler_extractor,
         )
         info = dict(res.info)
         for row in res.rows:
@@ -507,9 +513,7 @@ def evaluate_seeds(
                 vals.append(math.nan)
         if progress:
             print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
-    info["checkpoints"] = {
-        n: [str(checkpoint_path(n, s)) for s in seeds if checkpoint_path(n, s).is_file()] for n in names
-    }
+    info["checkpoints"] = {n: _seed_files(n, seeds) for n in names}
     info["shipped"] = {label_of(n): shipped_seed(checkpoints_dir() / f"{n}.pt") for n in names}
     return SeedResults(values, seeds, info)
 
