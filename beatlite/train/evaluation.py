@@ -539,9 +539,22 @@ def fgd_scorer(
 # ------------------------------------------------------------------------------------ scoring
 def direction_features(directions: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
     """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes."""
+    return _window_features(directions, "dirvec126", test, extractor)
+
+
+def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
+    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10)."""
+    return _window_features(euler, "euler141", test, extractor)
+
+
+def _window_features(
+    takes: list[np.ndarray], representation: str, test: EvaluationSet, extractor: Any
+) -> np.ndarray:
+    """``extractor`` features of the 34-frame windows (stride 10) of every take, normalised with the
+    train statistics of ``representation``."""
     from beatlite.data.windows import sliding_windows
 
-    windows = sliding_windows([test.normalizers.transform(d, "dirvec126") for d in directions])
+    windows = sliding_windows([test.normalizers.transform(x, representation) for x in takes])
     if not len(windows):
         raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
     return np.asarray(extractor(windows.astype(np.float32)), np.float64)
@@ -571,14 +584,6 @@ def directions_takes(
         if euler is None or euler_extractor is None
         else euler_features(euler, test, euler_extractor),
     )
-
-
-def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
-    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10)."""
-    from beatlite.data.windows import sliding_windows
-
-    windows = sliding_windows([test.normalizers.transform(e, "euler141") for e in euler])
-    return np.asarray(extractor(windows.astype(np.float32)), np.float64)
 
 
 def score_directions(
