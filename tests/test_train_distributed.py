@@ -25,11 +25,16 @@ def _env() -> dict[str, str]:
     return env
 
 
-def _one_and_two_processes(tmp_path: Path, micro: int, windows: int) -> tuple[dict, dict]:
-    """What tests/ddp_fit.py saves for 1 process and for ``torchrun`` with 2 (``micro`` micro-batches)."""
+def _torchrun() -> str:
     torchrun = shutil.which("torchrun", path=str(Path(sys.executable).parent)) or shutil.which("torchrun")
     if torchrun is None:
         pytest.skip("torchrun is not installed")
+    return torchrun
+
+
+def _one_and_two_processes(tmp_path: Path, micro: int, windows: int) -> tuple[dict, dict]:
+    """What tests/ddp_fit.py saves for 1 process and for ``torchrun`` with 2 (``micro`` micro-batches)."""
+    torchrun = _torchrun()
     one, two = tmp_path / "one.pt", tmp_path / "two.pt"
     args = [str(micro), str(windows)]
     subprocess.run([sys.executable, str(SCRIPT), str(one), *args], check=True, env=_env(), timeout=900)
@@ -78,9 +83,7 @@ def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path)
     """Under torchrun, process 0 checkpoints after every step; a run stopped in epoch 2 resumes there and
     ends with the weights of an uninterrupted run, and logs the same mean losses (the checkpoint keeps
     the loss sums of both processes)."""
-    torchrun = shutil.which("torchrun", path=str(Path(sys.executable).parent)) or shutil.which("torchrun")
-    if torchrun is None:
-        pytest.skip("torchrun is not installed")
+    torchrun = _torchrun()
     script = Path(__file__).with_name("ddp_resume.py")
     out = {}
     for mode in ("whole", "kill"):
@@ -94,3 +97,26 @@ def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path)
     for a, b in zip(whole["history"], resumed["history"], strict=True):
         assert a["train"].keys() == b["train"].keys()
         assert all(abs(a["train"][k] - b["train"][k]) <= 1e-9 * (1 + abs(a["train"][k])) for k in a["train"])
+
+
+EXIT_CHECK = """
+import atexit, sys
+import torch.distributed as dist
+from beatlite.train.distributed import distributed_rank
+
+# registered before distributed_rank's handler, so it runs after it (atexit is last in, first out)
+atexit.register(lambda: print(f"group alive at exit: {dist.is_initialized()}", flush=True))
+rank, world = distributed_rank()
+print(f"rank {rank} of {world}", flush=True)
+"""
+
+
+def test_the_process_group_is_destroyed_before_the_interpreter_exits(tmp_path):
+    """A process group left alive at exit can abort a process in gloo's threads (it did once in CI):
+    the group distributed_rank initialises is gone by the time later exit handlers run."""
+    script = tmp_path / "exit_check.py"
+    script.write_text(EXIT_CHECK)
+    cmd = [_torchrun(), "--standalone", "--nproc_per_node=2", str(script)]
+    done = subprocess.run(cmd, check=True, env=_env(), timeout=300, capture_output=True, text=True)
+    assert done.stdout.count("group alive at exit: False") == 2, done.stdout + done.stderr
+    assert "rank 0 of 2" in done.stdout and "rank 1 of 2" in done.stdout

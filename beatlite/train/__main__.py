@@ -154,7 +154,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from beatlite.paths import repo_root
-    from beatlite.train.distributed import distributed_rank
+    from beatlite.train.distributed import distributed_rank, wait_for_all
     from beatlite.train.recipes import retrain, training_data
 
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
@@ -168,10 +168,7 @@ def _fit_command(args: argparse.Namespace) -> int:
             print(f"training the FGD extractor on {data_dir} -> {extractor}", flush=True)
             cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", "dirvec"]
             subprocess.run([*cmd, "--data", str(data_dir), "--out", str(extractor)], check=True)
-    if world > 1:
-        import torch.distributed as dist
-
-        dist.barrier()
+    wait_for_all(world)
     seconds = retrain(
         args.recipe,
         seed=args.seed,

@@ -23,6 +23,7 @@ the mean over the micro-batches, as one process taking them one after the other 
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 from typing import Any
@@ -36,7 +37,10 @@ def distributed_rank() -> tuple[int, int]:
 
     Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
     ``nccl`` backend for CUDA tensors when CUDA is available (each process on GPU ``LOCAL_RANK``) and
-    ``gloo`` for CPU tensors.
+    ``gloo`` for CPU tensors. A group initialised here is destroyed at interpreter exit (``atexit``),
+    while Python is still whole: a process that exits with the group alive can abort in gloo's worker
+    threads during interpreter shutdown (SIGABRT, "terminate called without an active exception"), as
+    it once did in this project's CI.
     """
     import torch.distributed as dist
 
@@ -47,7 +51,15 @@ def distributed_rank() -> tuple[int, int]:
             torch.cuda.set_device(local_device(torch.device("cuda")))
         # gloo for CPU tensors, nccl for CUDA ones (training on the CPU of a GPU machine works too)
         dist.init_process_group(backend="cpu:gloo,cuda:nccl" if torch.cuda.is_available() else "gloo")
+        atexit.register(_destroy_process_group)
     return dist.get_rank(), dist.get_world_size()
+
+
+def _destroy_process_group() -> None:
+    import torch.distributed as dist
+
+    if dist.is_initialized():
+        dist.destroy_process_group()
 
 
 def local_device(device: torch.device) -> torch.device:
@@ -119,6 +131,15 @@ def sync_on_last(ddp: nn.Module | None, last: bool) -> Any:
     if ddp is None or last:
         return contextlib.nullcontext()
     return ddp.no_sync()
+
+
+def wait_for_all(world: int) -> None:
+    """Return when every process has called this (a barrier); nothing with one process."""
+    if world < 2:
+        return
+    import torch.distributed as dist
+
+    dist.barrier()
 
 
 def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:

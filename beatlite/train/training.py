@@ -24,6 +24,7 @@ from beatlite.train.distributed import (
     local_device,
     sum_over_processes,
     sync_on_last,
+    wait_for_all,
     wrap_for_ddp,
 )
 
@@ -247,8 +248,10 @@ def fit(
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
-    if config.resume and run.path is not None and run.path.is_file():
-        run.resume()
+    if config.resume:
+        wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
+        if run.path is not None and run.path.is_file():
+            run.resume()
     run.wrap()
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
