@@ -724,3 +724,23 @@ def test_score_scatter_labels_of_close_points_do_not_overlap():
                 fig.axes[0].texts[i].get_text(),
                 fig.axes[0].texts[j].get_text(),
             )
+
+
+def test_score_scatter_labels_cover_no_marker_and_stay_inside():
+    """Notebook 07's crowded corner: HA2G, S2G and Trimodal within 1.4 FGD and 0.03 BC of each other
+    (a label written beside its point crossed the next marker before)."""
+    from beatlite.viz import charts
+
+    x = {"CaMN": 2.97, "HA2G": 3.92, "S2G-style": 4.86, "Trimodal-style": 5.31, "A2G-style": 8.0, "Mean": 0.0}
+    y = {"CaMN": 0.727, "HA2G": 0.786, "S2G-style": 0.815, "Trimodal-style": 0.784, "A2G-style": 0.75, "Mean": 0.66}
+    fig = charts.plot_score_scatter(x, y, "FGD", "BC")
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    labels = [t.get_window_extent() for t in ax.texts]
+    points = ax.transData.transform(np.column_stack([list(x.values()), list(y.values())]))
+    assert len(labels) == len(x)
+    for text, box in zip(ax.texts, labels, strict=True):
+        assert _inside(box, ax.get_window_extent()), text.get_text()
+        assert not any(box.contains(px, py) for px, py in points), text.get_text()  # no marker centre under a label
+        assert sum(box.overlaps(other) for other in labels) == 1, text.get_text()  # itself only
+    plt.close("all")

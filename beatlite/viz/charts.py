@@ -219,11 +219,13 @@ def plot_score_scatter(
     ax: Any = None,
     figsize: tuple[float, float] = (6.4, 4.0),
 ) -> Any:
-    """One point per system (e.g. FGD against BC), labelled in its colour; no label is clipped.
+    """One point per system (e.g. FGD against BC), labelled in its colour, labels clear of each other.
 
-    Labels right of the middle are written to the left of their point, and the
-    axes have a margin, so a label never leaves the axes. Systems missing from
-    ``y`` or with a non-finite value are left out.
+    Each label takes the first of a few places around its point (beside it, above or below, on
+    the side facing the middle first) where it stays inside the axes and meets neither a placed
+    label nor a marker (:func:`_place_labels`); with no such place it takes the first. Labels are
+    placed for the figure's layout at call time: give the axes their title before calling.
+    Systems missing from ``y`` or with a non-finite value are left out.
 
     Parameters
     ----------
@@ -245,42 +247,72 @@ def plot_score_scatter(
         raise ValueError("plot_score_scatter: no system has both scores")
     xs = np.array([float(x[k]) for k in keep])
     ys = np.array([float(y[k]) for k in keep])
-    middle = (xs.min() + xs.max()) / 2
+    colours = [system_colour(label, list(x).index(label)) for label in keep]
     with figure_style():
         ax = _new_axes(ax, figsize)
-        for label, xi, yi in zip(keep, xs, ys):
-            ax.scatter(xi, yi, color=system_colour(label, list(x).index(label)), s=40, zorder=3)
+        ax.scatter(xs, ys, color=colours, s=40, zorder=3)
         ax.margins(x=0.15, y=0.2)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
-        left = [xi > middle and len(keep) > 1 for xi in xs]
-        for label, xi, yi, lift, is_left in zip(keep, xs, ys, _label_lifts(ax, keep, xs, ys, left), left):
-            ax.annotate(label, (xi, yi), xytext=(-6 if is_left else 6, 4 + lift), textcoords="offset points",
-                        ha="right" if is_left else "left", va="bottom", fontsize=9,
-                        color=system_colour(label, list(x).index(label)))  # fmt: skip
+        _place_labels(ax, keep, xs, ys, colours)
     return ax.figure
 
 
-def _label_lifts(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, left: list[bool]) -> list[float]:
-    """Vertical offsets (points) that keep point labels from overlapping: from the top point down, a label
-    whose box (about 5.5 points per character, 11 high) meets a placed one moves below it."""
-    to_points = 72.0 / ax.figure.dpi
-    xy = ax.transData.transform(np.column_stack([xs, ys])) * to_points
-    boxes: list[tuple[float, float, float, float]] = []  # x0, x1, y0, y1 in points
-    lifts = [0.0] * len(labels)
+#: Label places around a point, (dx, dy) points from it, with the alignment that puts the text there:
+#: beside it above and below, then straight above and below, then further up and down.
+_PLACES = [
+    (6, 3, "bottom"),
+    (6, -3, "top"),
+    (0, 8, "bottom"),
+    (0, -8, "top"),
+    (6, 16, "bottom"),
+    (6, -16, "top"),
+]
+
+
+def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, colours: list[Any]) -> None:
+    """Annotate each point with its label at the first free place of :data:`_PLACES`, top point first.
+
+    Free: inside the axes, overlapping no placed label and no marker (a 10-point square). The
+    figure is drawn once first, so that the layout and the text sizes are final; the labels are
+    left out of the layout, so placing them does not move the axes.
+    """
+    from matplotlib.transforms import Bbox
+
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    centres = ax.transData.transform(np.column_stack([xs, ys]))
+    half = 5 * fig.dpi / 72
+    taken = [Bbox.from_extents(cx - half, cy - half, cx + half, cy + half) for cx, cy in centres]
+    middle = (centres[:, 0].min() + centres[:, 0].max()) / 2
     for i in sorted(range(len(labels)), key=lambda k: -ys[k]):
-        width = 5.5 * len(labels[i])
-        x0 = xy[i, 0] - 6 - width if left[i] else xy[i, 0] + 6
-        lift = 0.0
-        for _ in range(len(labels)):
-            y0 = xy[i, 1] + 4 + lift
-            hit = [b for b in boxes if x0 < b[1] and b[0] < x0 + width and y0 < b[3] and b[2] < y0 + 11]
-            if not hit:
+        side = -1 if centres[i, 0] > middle and len(labels) > 1 else 1  # the side facing the middle first
+        places = [(side * dx, dy, va) for dx, dy, va in _PLACES] + [
+            (-side * dx, dy, va) for dx, dy, va in _PLACES
+        ]
+        best = None
+        for dx, dy, va in places:
+            ha = "center" if dx == 0 else ("left" if dx > 0 else "right")
+            note = ax.annotate(labels[i], (xs[i], ys[i]), xytext=(dx, dy), textcoords="offset points",
+                               ha=ha, va=va, fontsize=9, color=colours[i])  # fmt: skip
+            note.set_in_layout(False)
+            box = note.get_window_extent(renderer)
+            clear = _contains(frame, box) and not any(b.overlaps(box) for b in taken)
+            if clear or best is None:
+                if best is not None:
+                    best[0].remove()
+                best = (note, box)
+            else:
+                note.remove()
+            if clear:
                 break
-            lift = min(b[2] for b in hit) - 11 - 4 - xy[i, 1]
-        boxes.append((x0, x0 + width, xy[i, 1] + 4 + lift, xy[i, 1] + 15 + lift))
-        lifts[i] = lift
-    return lifts
+        taken.append(best[1])
+
+
+def _contains(outer: Any, inner: Any) -> bool:
+    return outer.x0 <= inner.x0 and inner.x1 <= outer.x1 and outer.y0 <= inner.y0 and inner.y1 <= outer.y1
 
 
 def plot_effects(
