@@ -6,18 +6,16 @@ the parameters and the generator's gradients of the last step to ``argv[1]``."""
 import sys
 
 import torch
+from ddp_model import camn_without_dropout
 
 from beatlite.train import TrainConfig, fit
 from beatlite.train.distributed import distributed_rank
-from beatlite.train.recipes import RECIPES, build_recipe_model, training_data
+from beatlite.train.recipes import RECIPES, training_data
 
 out, micro, windows = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 data = training_data()
 recipe = RECIPES["camn_tiny"]
-model = build_recipe_model("camn_tiny", data, seed=7)
-for module in model.modules():  # dropout 0: the processes draw no random masks
-    if isinstance(module, torch.nn.Dropout):
-        module.p = 0.0
+model = camn_without_dropout(data)
 config = TrainConfig(
     epochs=1, batch_size=16, lr=recipe.lr, seed=7, windows_per_epoch=windows, no_adv_epochs=0,
     micro_batches=micro, threads=1, progress=False,

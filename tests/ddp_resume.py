@@ -6,21 +6,14 @@ from the checkpoint; process 0 saves the final parameters and history to ``argv[
 import sys
 
 import torch
+from ddp_model import camn_without_dropout
 
 from beatlite.train import TrainConfig, fit, training
 from beatlite.train.distributed import distributed_rank
-from beatlite.train.recipes import RECIPES, build_recipe_model, training_data
+from beatlite.train.recipes import RECIPES, training_data
 
 path, mode = sys.argv[1], sys.argv[2]
 data = training_data()
-
-
-def model():
-    m = build_recipe_model("camn_tiny", data, seed=7)
-    for module in m.modules():
-        if isinstance(module, torch.nn.Dropout):
-            module.p = 0.0
-    return m
 
 
 def config(resume: bool) -> TrainConfig:
@@ -30,7 +23,7 @@ def config(resume: bool) -> TrainConfig:
     )  # fmt: skip
 
 
-net = model()
+net = camn_without_dropout(data)
 if mode == "kill":
     real_step, calls = training._Run.step, {"n": 0}
 
@@ -46,7 +39,7 @@ if mode == "kill":
     except KeyboardInterrupt:
         pass
     training._Run.step = real_step
-    net = model()
+    net = camn_without_dropout(data)
 history = fit(net, data.train, config(mode == "kill"), meta=data.meta).history
 if distributed_rank()[0] == 0:
     torch.save(

@@ -731,8 +731,9 @@ def test_score_scatter_labels_cover_no_marker_and_stay_inside():
     (a label written beside its point crossed the next marker before)."""
     from beatlite.viz import charts
 
-    x = {"CaMN": 2.97, "HA2G": 3.92, "S2G-style": 4.86, "Trimodal-style": 5.31, "A2G-style": 8.0, "Mean": 0.0}
-    y = {"CaMN": 0.727, "HA2G": 0.786, "S2G-style": 0.815, "Trimodal-style": 0.784, "A2G-style": 0.75, "Mean": 0.66}
+    names = ["CaMN", "HA2G", "S2G-style", "Trimodal-style", "A2G-style", "Mean"]
+    x = dict(zip(names, [2.97, 3.92, 4.86, 5.31, 8.0, 0.0], strict=True))
+    y = dict(zip(names, [0.727, 0.786, 0.815, 0.784, 0.75, 0.66], strict=True))
     fig = charts.plot_score_scatter(x, y, "FGD", "BC")
     fig.canvas.draw()
     ax = fig.axes[0]
@@ -741,6 +742,7 @@ def test_score_scatter_labels_cover_no_marker_and_stay_inside():
     assert len(labels) == len(x)
     for text, box in zip(ax.texts, labels, strict=True):
         assert _inside(box, ax.get_window_extent()), text.get_text()
-        assert not any(box.contains(px, py) for px, py in points), text.get_text()  # no marker centre under a label
-        assert sum(box.overlaps(other) for other in labels) == 1, text.get_text()  # itself only
+        # no marker centre under a label, and no other label overlapping it
+        assert not any(box.contains(px, py) for px, py in points), text.get_text()
+        assert sum(box.overlaps(other) for other in labels) == 1, text.get_text()
     plt.close("all")
