@@ -258,8 +258,8 @@ def plot_score_scatter(
     return ax.figure
 
 
-#: Label places around a point, (dx, dy) points from it, with the alignment that puts the text there:
-#: beside it above and below, then straight above and below, then further up and down.
+#: Label places around a point, (dx, dy) points from it, with the vertical alignment that puts the text
+#: there: beside it above and below, then straight above and below, then further up and down.
 _PLACES = [
     (6, 3, "bottom"),
     (6, -3, "top"),
@@ -273,9 +273,10 @@ _PLACES = [
 def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, colours: list[Any]) -> None:
     """Annotate each point with its label at the first free place of :data:`_PLACES`, top point first.
 
-    Free: inside the axes, overlapping no placed label and no marker (a 10-point square). The
-    figure is drawn once first, so that the layout and the text sizes are final; the labels are
-    left out of the layout, so placing them does not move the axes.
+    Free: inside the axes, overlapping no placed label and no marker (a 10-point square). The places
+    on the side facing the middle come first, then the mirrored ones; with none free, the first. The
+    figure is drawn once first, so that the layout and the text sizes are final; the labels are left
+    out of the layout, so placing them does not move the axes.
     """
     from matplotlib.transforms import Bbox
 
@@ -288,31 +289,20 @@ def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, co
     taken = [Bbox.from_extents(cx - half, cy - half, cx + half, cy + half) for cx, cy in centres]
     middle = (centres[:, 0].min() + centres[:, 0].max()) / 2
     for i in sorted(range(len(labels)), key=lambda k: -ys[k]):
-        side = -1 if centres[i, 0] > middle and len(labels) > 1 else 1  # the side facing the middle first
-        places = [(side * dx, dy, va) for dx, dy, va in _PLACES] + [
-            (-side * dx, dy, va) for dx, dy, va in _PLACES
-        ]
-        best = None
-        for dx, dy, va in places:
-            ha = "center" if dx == 0 else ("left" if dx > 0 else "right")
-            note = ax.annotate(labels[i], (xs[i], ys[i]), xytext=(dx, dy), textcoords="offset points",
-                               ha=ha, va=va, fontsize=9, color=colours[i])  # fmt: skip
-            note.set_in_layout(False)
+        side = -1 if centres[i, 0] > middle and len(labels) > 1 else 1
+        places = [(side * dx, dy, va) for dx, dy, va in _PLACES]
+        places += [(-dx, dy, va) for dx, dy, va in places if dx]  # the mirrored side
+        note = ax.annotate(labels[i], (xs[i], ys[i]), xytext=(0, 0), textcoords="offset points",
+                           fontsize=9, color=colours[i])  # fmt: skip
+        note.set_in_layout(False)
+        for dx, dy, va in [*places, places[0]]:  # the first again when none is free
+            note.xyann = (dx, dy)
+            note.set(ha="center" if dx == 0 else ("left" if dx > 0 else "right"), va=va)
             box = note.get_window_extent(renderer)
-            clear = _contains(frame, box) and not any(b.overlaps(box) for b in taken)
-            if clear or best is None:
-                if best is not None:
-                    best[0].remove()
-                best = (note, box)
-            else:
-                note.remove()
-            if clear:
+            inside = frame.contains(box.x0, box.y0) and frame.contains(box.x1, box.y1)
+            if inside and not any(b.overlaps(box) for b in taken):
                 break
-        taken.append(best[1])
-
-
-def _contains(outer: Any, inner: Any) -> bool:
-    return outer.x0 <= inner.x0 and inner.x1 <= outer.x1 and outer.y0 <= inner.y0 and inner.y1 <= outer.y1
+        taken.append(box)
 
 
 def plot_effects(
