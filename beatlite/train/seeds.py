@@ -128,9 +128,15 @@ def ship_median_seeds(
     return chosen
 
 
+def _existing_checkpoint(name: str, seed: int) -> Path | None:
+    """:func:`checkpoint_path` of ``(name, seed)`` when that file exists, else None."""
+    path = checkpoint_path(name, seed)
+    return path if path.is_file() else None
+
+
 def _seed_files(name: str, seeds: Sequence[int]) -> list[str]:
     """The checkpoint files of recipe ``name`` for those of ``seeds`` that have one (:func:`checkpoint_path`)."""
-    return [str(checkpoint_path(name, s)) for s in seeds if checkpoint_path(name, s).is_file()]
+    return [str(path) for s in seeds if (path := _existing_checkpoint(name, s)) is not None]
 
 
 def _current(name: str, seed: int, verbose: bool) -> bool:
@@ -493,10 +499,9 @@ def evaluate_seeds(
     values: dict[str, dict[str, list[float]]] = {}
     info: dict[str, Any] = {}
     for i, seed in enumerate(seeds):
-        present = [n for n in names if checkpoint_path(n, seed).is_file()]
-        paths = [str(checkpoint_path(n, seed)) for n in present]
+        present = {n: path for n in names if (path := _existing_checkpoint(n, seed)) is not None}
         res = evaluate_models(
-            paths,
+            [str(path) for path in present.values()],
             test=test,
             extractor=extractor,
             ground_truth=i == 0,
