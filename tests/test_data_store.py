@@ -300,3 +300,26 @@ def test_fit_reads_a_store_through_a_dataloader_like_the_windows_in_memory(
     for name in ("store", "store, 2 workers"):
         assert runs[name][0] == runs["memory"][0], name
         assert all(torch.equal(a, b) for a, b in zip(runs[name][1], runs["memory"][1], strict=True)), name
+
+
+def _build_in_child(root: str, folder: str) -> list[str]:
+    from test_data_windows import VOCAB as vocab
+
+    return [
+        t.stem for t in build_store(index_folder(root, cache=False), folder, vocab=vocab, workers=0).takes
+    ]
+
+
+def test_processes_building_one_store_at_once_take_turns(corpus: Path, tmp_path: Path) -> None:
+    """retrain-all --jobs 2 and torchrun start processes that build the same store: without the lock one
+    read a take's entry while the other rewrote it (FormatError: meta.json missing)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    folder = tmp_path / "shared_store"
+    with ProcessPoolExecutor(3, mp_context=get_context("spawn")) as pool:
+        stems = list(pool.map(_build_in_child, [str(corpus)] * 3, [str(folder)] * 3))
+    assert stems[0] == stems[1] == stems[2] and len(stems[0]) == len(TAKES)
+    ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
+    got = WindowStore.open(folder).windows("train", stats=ref.normalizers).batch()
+    assert np.array_equal(got["pose_raw"], ref["pose_raw"])

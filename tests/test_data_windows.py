@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from childproc import run_ok
 from test_data_fixtures import (
     SR,
     write_beat_bvh,
@@ -263,11 +264,10 @@ def test_torch_dataset(train: Windows) -> None:
 
 
 def test_import_does_not_load_torch() -> None:
-    import subprocess
     import sys
 
     code = "import sys, beatlite.data, beatlite.data.windows, beatlite.stats; print('torch' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    out = run_ok([sys.executable, "-c", code])
     assert out.stdout.strip() == "False"
 
 

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
-import subprocess
 import sys
 
 import numpy as np
 import pytest
+from childproc import run_ok
 from scipy import linalg
 
 from beatlite.data.windows import sliding_windows
@@ -34,7 +34,7 @@ from beatlite.metrics.recall import srgr_per_frame
 
 def test_import_does_not_import_torch():
     code = "import sys, beatlite.metrics; assert 'torch' not in sys.modules, 'torch imported'"
-    subprocess.run([sys.executable, "-c", code], check=True)
+    run_ok([sys.executable, "-c", code])
 
 
 # ----------------------------------------------------------------------------- FGD

@@ -153,12 +153,13 @@ def split_windows(data_samples):
 
 @pytest.mark.parametrize("space", ["dirvec", "pose"])
 def test_shipped_extractor_matches_the_corpus_and_ranks_broken_motion_worse(space, split_windows):
-    from beatlite.metrics.extractor import SPACES, load_extractor, windows_hash
+    from beatlite.metrics.extractor import SPACES, load_extractor
 
     train, val, test = split_windows
     key = SPACES[space][0]
     ex = load_extractor(space)
-    assert ex.meta["data_fingerprint"] == windows_hash(np.asarray(train[key])), (
+    # files (content) + parameters: the same on every machine (float bytes are not: other CPUs, builds)
+    assert ex.meta["data_fingerprint"] == train.fingerprint, (
         f"checkpoint is stale: retrain with `python -m beatlite.metrics.extractor train --space {space}`"
     )
     real, held_out = ex(np.asarray(test[key])), ex(np.asarray(val[key]))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from childproc import run_ok
 
 torch = pytest.importorskip("torch")
 
@@ -109,8 +110,7 @@ def test_registry_and_config_round_trip(batch):
 
 
 def test_import_models_does_not_import_torch():
-    import subprocess
     import sys
 
     code = "import sys, beatlite.models, beatlite.train; assert 'torch' not in sys.modules"
-    subprocess.run([sys.executable, "-c", code], check=True)
+    run_ok([sys.executable, "-c", code])

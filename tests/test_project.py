@@ -71,17 +71,19 @@ def test_environment_yml_matches_pyproject():
     assert pip_reqs["torch"] == "==2.13.0"
 
 
-def test_import_is_lazy_and_fast():
+#: Modules that make ``import beatlite`` slow (seconds each); the I/O and skeleton layers need none of them.
+HEAVY_MODULES = ("torch", "scipy", "librosa", "numba", "matplotlib", "sklearn", "soundfile", "pyvista")
+
+
+def test_import_is_lazy():
+    """What keeps the import fast, asserted without a clock (its time is in bench/bench_import.py)."""
     code = (
-        "import sys, time; t = time.perf_counter(); import beatlite, beatlite.io, beatlite.skeleton; "
-        "dt = time.perf_counter() - t; print(dt); assert 'torch' not in sys.modules, 'torch imported'"
+        "import sys, json; import beatlite, beatlite.io, beatlite.skeleton; "
+        f"print(json.dumps([m for m in {HEAVY_MODULES!r} if m in sys.modules]))"
     )
-    times = []
-    for _ in range(3):  # best of three: the first run may pay for cold disk caches
-        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
-        assert out.returncode == 0, out.stderr
-        times.append(float(out.stdout.strip().splitlines()[-1]))
-    assert min(times) < 0.5, f"import beatlite took {min(times):.2f} s"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [], "import beatlite loads heavy modules"
 
 
 def test_ci_runs_the_readme_test_command():

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import shutil
-import subprocess
 import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
+from childproc import run_ok
 
 from beatlite.io import parse_take_name, read_bvh, read_semantic, read_textgrid
 from beatlite.skeleton.beat import beat_skeleton
@@ -303,4 +303,4 @@ def test_full_rate_take_is_the_same_motion_at_120fps(tmp_path: Path) -> None:
 
 def test_import_does_not_load_torch() -> None:
     code = "import sys, beatlite.synth, beatlite.synth.corpus; assert 'torch' not in sys.modules"
-    subprocess.run([sys.executable, "-c", code], check=True)
+    run_ok([sys.executable, "-c", code])

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from childproc import run_ok
 
 torch = pytest.importorskip("torch")
 
@@ -37,9 +37,9 @@ def _one_and_two_processes(tmp_path: Path, micro: int, windows: int) -> tuple[di
     torchrun = _torchrun()
     one, two = tmp_path / "one.pt", tmp_path / "two.pt"
     args = [str(micro), str(windows)]
-    subprocess.run([sys.executable, str(SCRIPT), str(one), *args], check=True, env=_env(), timeout=900)
+    run_ok([sys.executable, str(SCRIPT), str(one), *args], env=_env(), timeout=900)
     cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(SCRIPT), str(two), *args]
-    subprocess.run(cmd, check=True, env=_env(), timeout=900)
+    run_ok(cmd, env=_env(), timeout=900)
     return torch.load(one, weights_only=False), torch.load(two, weights_only=False)
 
 
@@ -89,7 +89,7 @@ def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path)
     for mode in ("whole", "kill"):
         path = tmp_path / f"{mode}.pt"
         cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode]
-        subprocess.run(cmd, check=True, env=_env(), timeout=900)
+        run_ok(cmd, env=_env(), timeout=900)
         out[mode] = torch.load(str(path) + ".out", weights_only=False)
     whole, resumed = out["whole"], out["kill"]
     for name, p in whole["params"].items():
@@ -117,6 +117,6 @@ def test_the_process_group_is_destroyed_before_the_interpreter_exits(tmp_path):
     script = tmp_path / "exit_check.py"
     script.write_text(EXIT_CHECK)
     cmd = [_torchrun(), "--standalone", "--nproc_per_node=2", str(script)]
-    done = subprocess.run(cmd, check=True, env=_env(), timeout=300, capture_output=True, text=True)
+    done = run_ok(cmd, env=_env(), timeout=300)
     assert done.stdout.count("group alive at exit: False") == 2, done.stdout + done.stderr
     assert "rank 0 of 2" in done.stdout and "rank 1 of 2" in done.stdout

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from childproc import run_ok
 
 from beatlite.models import MODELS
 from beatlite.train.recipes import CAMN_ABLATIONS, HA2G_ABLATIONS, RECIPES, SEED, retrain, retrain_many
@@ -254,7 +255,6 @@ def test_train_seeds_keeps_current_checkpoints_and_retrains_stale_ones(tmp_path,
 @pytest.mark.slow
 def test_fit_command_writes_only_under_out(tmp_path):
     """``python -m beatlite.train fit`` on data_samples/: checkpoints and caches under --out, the repository untouched."""
-    import subprocess
     import sys
 
     from beatlite.paths import checkpoints_dir, repo_root
@@ -271,9 +271,7 @@ def test_fit_command_writes_only_under_out(tmp_path):
         str(repo_root() / "data_samples"),
     ]
     env = {k: v for k, v in __import__("os").environ.items() if k != "BEATLITE_BUILD"}
-    subprocess.run(
-        [*cmd, "--out", str(out), "--epochs", "1", "--device", "cpu"], check=True, env=env, timeout=600
-    )
+    run_ok([*cmd, "--out", str(out), "--epochs", "1", "--device", "cpu"], env=env, timeout=600)
     assert (out / "s2g_tiny.pt").is_file() and (out / "train" / "s2g_tiny.pt").is_file()
     assert list((out / "build" / "cache").rglob("*.npz"))  # window caches went under --out
     assert {p.name: p.stat().st_mtime_ns for p in checkpoints_dir().iterdir()} == before

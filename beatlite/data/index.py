@@ -595,8 +595,10 @@ def index_folder(
     recursive: bool = True,
     read_durations: bool = True,
     bvh_fps: Mapping[str, float] | None = None,
+    cache: bool = True,
+    workers: int | None = None,
 ) -> TakeIndex:
-    """Index every take under ``root``.
+    """Index every take under ``root``; takes whose files did not change come from the cache.
 
     Parameters
     ----------
@@ -612,6 +614,13 @@ def index_folder(
     bvh_fps : Mapping[str, float], optional
         Per-take overrides of the BVH row rate, stem -> fps (e.g. ``{"29_hanieh_1_4_4":
         120}``); stored in :attr:`TakeRecord.bvh_fps` and used by windows and statistics.
+    cache : bool
+        Reuse and update the index cache (:mod:`beatlite.data.index_cache`, under
+        ``cache_dir()/index/``): a take is read again only when one of its files or its override
+        changed (default True; only with ``read_durations``).
+    workers : int, optional
+        Processes that index the takes not in the cache (spawned; 0 or 1: this process). Default
+        :func:`default_workers` of their files.
 
     Returns
     -------
@@ -635,9 +644,77 @@ def index_folder(
     unknown = sorted(set(overrides) - set(found))
     if unknown:
         raise ValueError(f"index_folder: bvh_fps names takes that are not in {root}: {unknown[:5]}")
-    records = [
-        index_take(stem, files, read_durations=read_durations, bvh_fps=overrides.get(stem))
-        for stem, files in found.items()
-    ]
+    if not (cache and read_durations):
+        records = [
+            index_take(s, f, read_durations=read_durations, bvh_fps=overrides.get(s))
+            for s, f in found.items()
+        ]
+    else:
+        records = _index_with_cache(root, recursive, found, overrides, workers)
     records.sort(key=_sort_key)
     return TakeIndex(records, root)
+
+
+def _index_with_cache(
+    root: Path, recursive: bool, found: dict[str, dict[str, list[Path]]], overrides: dict, workers: int | None
+) -> list[TakeRecord]:
+    """Records of ``found``: cached ones whose key matches, the others indexed (in parallel) and cached."""
+    from beatlite.data import index_cache
+
+    path = index_cache.cache_path(root, recursive)
+    old = index_cache.load(path)
+    keys = {stem: index_cache.take_key(files, overrides.get(stem)) for stem, files in found.items()}
+    records = {stem: index_cache.cached_record(old.get(stem), keys[stem]) for stem in found}
+    todo = [stem for stem, record in records.items() if record is None]
+    for record in _index_many([(s, found[s], overrides.get(s)) for s in todo], workers):
+        records[record.stem] = record  # its files' digests were computed beside it, and remembered
+    new = {s: index_cache.entry(records[s], keys[s]) if s in todo else old[s] for s in found if keys[s]}
+    if todo or set(new) != set(old):
+        index_cache.save(path, new)
+    return list(records.values())
+
+
+#: Bytes of files to read above which ``index_folder`` and ``build_store`` use worker processes by default.
+PARALLEL_BYTES = 256 * 2**20
+
+
+def default_workers(paths: Iterable[Path]) -> int:
+    """Worker processes for reading ``paths``: ``os.cpu_count()`` when they exceed :data:`PARALLEL_BYTES`,
+    else 1 (spawning costs about a second per process, and a script that spawns needs an
+    ``if __name__ == "__main__":`` guard: small corpora such as ``data_samples/`` need neither)."""
+    size = sum(Path(p).stat().st_size for p in paths)
+    return (os.cpu_count() or 1) if size > PARALLEL_BYTES else 1
+
+
+def _index_many(
+    jobs: list[tuple[str, dict[str, list[Path]], float | None]], workers: int | None
+) -> list[TakeRecord]:
+    """:func:`index_take` of every (stem, files, bvh_fps) job and its files' digests (remembered by
+    :func:`beatlite.data.fingerprint.file_digest`), in ``workers`` spawned processes if > 1."""
+    from beatlite.data.fingerprint import file_key, remember_digest
+
+    if workers is None:
+        workers = default_workers(p for _, files, _ in jobs for paths in files.values() for p in paths)
+    if workers <= 1 or len(jobs) <= 1:
+        done = [_index_take_job(job) for job in jobs]
+    else:
+        from concurrent.futures import ProcessPoolExecutor
+        from multiprocessing import get_context
+
+        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=get_context("spawn")) as pool:
+            done = list(pool.map(_index_take_job, jobs, chunksize=4))
+    for record, digests in done:
+        for modality, digest in digests.items():
+            remember_digest(file_key(record.files[modality]), digest)
+    return [record for record, _ in done]
+
+
+def _index_take_job(
+    job: tuple[str, dict[str, list[Path]], float | None],
+) -> tuple[TakeRecord, dict[str, str]]:
+    """:func:`index_take` and the content digest of each file it uses (run in a worker process)."""
+    from beatlite.data.fingerprint import file_digest
+
+    stem, files, fps = job
+    record = index_take(stem, files, bvh_fps=fps)
+    return record, {m: file_digest(p) for m, p in record.files.items()}

@@ -47,6 +47,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -76,7 +77,7 @@ if TYPE_CHECKING:
     from beatlite.data.vocab import Vocab
 
 #: Bump when the layout or the content of the files changes (older entries are rebuilt).
-STORE_VERSION = 1
+STORE_VERSION = 2
 #: Streams of a take: file name -> dtype on disk.
 STREAMS = {
     "pose_raw": "<f8",
@@ -157,13 +158,11 @@ def quantize_audio(audio: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 def take_fingerprint(record: TakeRecord, params: Mapping[str, Any]) -> str:
-    """sha256 of the take's files (name, size, mtime_ns), the store parameters and :data:`STORE_VERSION`."""
-    h = hashlib.sha256(json.dumps({**params, "version": STORE_VERSION}, sort_keys=True).encode())
-    for modality in sorted(record.files):
-        p = Path(record.files[modality])
-        st = p.stat()
-        h.update(f"{record.stem}|{modality}|{p.name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
-    return h.hexdigest()
+    """:func:`beatlite.data.fingerprint.take_fingerprint` with :data:`STORE_VERSION`: the take's files
+    (content), its ``bvh_fps`` override and the store parameters."""
+    from beatlite.data.fingerprint import take_fingerprint as fingerprint
+
+    return fingerprint(record, {**params, "version": STORE_VERSION})
 
 
 def _moments(x: np.ndarray) -> dict[str, Any]:
@@ -572,16 +571,22 @@ class StoreWindows:
 
     @property
     def fingerprint(self) -> str:
-        """16 hex digits identifying these windows: the takes' fingerprints, the windows and the statistics
-        (what :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data)."""
-        import hashlib
+        """16 hex digits identifying these windows, the same on every machine and equal to the
+        :attr:`Windows.fingerprint <beatlite.data.windows.Windows.fingerprint>` of the same takes and
+        parameters (:func:`beatlite.data.fingerprint.windows_fingerprint`: the takes' files by content,
+        overrides, store parameters, split, length, stride, vocabulary). What
+        :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data.
+        The statistics are left out (their float bits vary across machines; they derive from the takes)."""
+        from beatlite.data.fingerprint import windows_fingerprint
 
-        h = hashlib.sha256(json.dumps({k: str(v) for k, v in self.params.items()}, sort_keys=True).encode())
-        for i in np.unique(self.take_ids):
-            h.update(self.store.takes[int(i)].meta["fingerprint"].encode())
-        for a in (self.take_ids, self.starts, *self.normalizers.to_meta().values()):
-            h.update(np.ascontiguousarray(a).tobytes())
-        return h.hexdigest()[:16]
+        takes = [self.store.takes[int(i)].meta["fingerprint"] for i in np.unique(self.take_ids)]
+        return windows_fingerprint(
+            takes,
+            split=self.params["split"],
+            length=self.length,
+            stride=self.params["stride"],
+            vocab=self.vocab.itos,
+        )
 
     # mapping-like access, as Windows -------------------------------------------
     def keys(self) -> list[str]:
@@ -731,12 +736,13 @@ def _is_current(folder: Path, record: TakeRecord, params: Mapping[str, Any]) -> 
 
 
 def _text_fingerprint(index: TakeIndex) -> str:
-    """sha256 over (stem, name, size, mtime_ns) of every TextGrid of the index (what ``build_vocab`` reads)."""
+    """sha256 over (stem, name, content) of every TextGrid of the index (what ``build_vocab`` reads)."""
+    from beatlite.data.fingerprint import file_digest
+
     h = hashlib.sha256()
     for r in index:
         if "text" in r.files:
-            st = Path(r.files["text"]).stat()
-            h.update(f"{r.stem}|{Path(r.files['text']).name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+            h.update(f"{r.stem}|{Path(r.files['text']).name}|{file_digest(r.files['text'])}\n".encode())
     return h.hexdigest()
 
 
@@ -760,9 +766,12 @@ def _run_builds(
     from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
     from multiprocessing import get_context
 
+    from beatlite.data.index import default_workers
     from beatlite.notebook import progress as progress_bar
 
-    n = min(len(todo), workers if workers is not None else (os.cpu_count() or 1))
+    if workers is None:
+        workers = default_workers(p for r in todo for p in r.files.values())
+    n = min(len(todo), workers)
     todo = sorted(todo, key=lambda r: -r.duration if r.duration else 0.0)  # long takes first: balance
     with progress_bar(total=len(todo), desc="store takes", unit="take", disable=not progress) as bar:
         if n <= 1:
@@ -831,7 +840,7 @@ def build_store(
 ) -> WindowStore:
     """Make or update the window store of every usable take of ``index``; returns it opened.
 
-    Takes whose entry is complete and whose fingerprint (files' name/size/mtime, parameters,
+    Takes whose entry is complete and whose fingerprint (files' content, ``bvh_fps`` override, parameters,
     :data:`STORE_VERSION`) matches are kept; the others are rebuilt; entries of takes no longer
     in the index are removed. Memory: one take per worker (plus O(number of takes) meta data).
 
@@ -850,7 +859,9 @@ def build_store(
     vocab : Vocab, optional
         Default :func:`beatlite.data.vocab.build_vocab` of the whole index (as ``build_windows``).
     workers : int, optional
-        Worker processes (spawned; default ``os.cpu_count()``; 0 or 1: in this process).
+        Worker processes (spawned; 0 or 1: in this process). Default
+        :func:`beatlite.data.index.default_workers` of the files to read: ``os.cpu_count()`` for a
+        real corpus (a script then needs an ``if __name__ == "__main__":`` guard), 1 for ``data_samples/``.
     progress : bool
         Show a tqdm bar over the takes being built.
 
@@ -872,11 +883,29 @@ def build_store(
     params = store_params(fps=fps, sr=sr, positions=positions, word_rule=word_rule)
     folder = Path(folder) if folder is not None else default_store_folder(index, params)
     (folder / "takes").mkdir(parents=True, exist_ok=True)
-    todo = [r for r in records if not _is_current(folder / "takes" / r.stem, r, params)]
-    _run_builds(todo, folder, params, workers, progress)
-    keep = {r.stem for r in records}
-    for stale in (folder / "takes").iterdir():
-        if stale.is_dir() and stale.name not in keep:
-            shutil.rmtree(stale)
-    _write_manifest(folder, index, records, params, vocab)
-    return WindowStore.open(folder)
+    with _exclusive(folder / ".build.lock"):  # other processes building this store wait, then find it current
+        todo = [r for r in records if not _is_current(folder / "takes" / r.stem, r, params)]
+        _run_builds(todo, folder, params, workers, progress)
+        keep = {r.stem for r in records}
+        for stale in (folder / "takes").iterdir():
+            if stale.is_dir() and stale.name not in keep:
+                shutil.rmtree(stale)
+        _write_manifest(folder, index, records, params, vocab)
+        return WindowStore.open(folder)
+
+
+@contextlib.contextmanager
+def _exclusive(path: Path) -> Iterator[None]:
+    """Hold an exclusive ``flock`` on ``path`` (POSIX; elsewhere no lock): one builder of a store at a time
+    (``retrain-all --jobs 2`` and ``torchrun`` start several processes that build the same store)."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: no advisory locks in the standard library
+        yield
+        return
+    with open(path, "a+b") as f:
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f.fileno(), fcntl.LOCK_UN)

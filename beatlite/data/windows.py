@@ -26,7 +26,7 @@ key            shape, dtype              content
 Normalisation statistics (pose mean/std, direction mean) are computed on the
 **train** split only and saved with the arrays. Results are cached as ``.npz``
 under :func:`beatlite.paths.cache_dir` keyed by a fingerprint of the source
-files (name, size, mtime) and every parameter.
+files (their content: :mod:`beatlite.data.fingerprint`), the per-take overrides and every parameter.
 
 With ``whole_takes=True`` there is one item per take, full length (the
 reference's test mode); per-frame keys are then lists of (T_i, ...) arrays.
@@ -78,7 +78,7 @@ WINDOW_KEYS = (
 MEL_SETTINGS = {"n_mels": 128, "n_fft": 1024, "hop_length": 512, "power": 2.0}
 POSE_SUBSET = "spine_neck_141"
 #: Bump when the content of the cache changes.
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 
 
 def window_starts(n_frames: int, length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE) -> np.ndarray:
@@ -383,12 +383,26 @@ class Windows:
                 out[k] = arr[i]
         return out
 
-    def batch(self, indices: Sequence[int] | np.ndarray | None = None) -> dict[str, np.ndarray]:
-        """Batch dict (the contract) of the given windows (default all); windowed mode only."""
+    def batch(
+        self, indices: Sequence[int] | np.ndarray | None = None, *, keys: Sequence[str] | None = None
+    ) -> dict[str, np.ndarray]:
+        """Batch dict (the contract) of the given windows (default all) and ``keys`` (default all);
+        windowed mode only (as :meth:`beatlite.data.store.StoreWindows.batch`)."""
         if self.whole_takes:
             raise ValueError("Windows.batch: whole-take items have different lengths; use item(i)")
+        missing = [k for k in keys or () if k not in self.keys()]
+        if missing:
+            raise KeyError(f"Windows.batch: keys {missing} not in these windows ({self.keys()})")
         idx = np.arange(len(self)) if indices is None else np.asarray(indices, dtype=np.int64)
-        return {k: self._arrays[k][idx] for k in self.keys()}
+        return {k: self._arrays[k][idx] for k in (self.keys() if keys is None else keys)}
+
+    @property
+    def fingerprint(self) -> str:
+        """16 hex digits identifying the source of these windows, the same on every machine: the takes'
+        files (content), per-take overrides, the parameters and the vocabulary
+        (:mod:`beatlite.data.fingerprint`). The statistics are left out (their float bits vary across
+        machines; they are derived from the train takes, or compared by :meth:`Normalizers.matches`)."""
+        return str(self.params.get("fingerprint", ""))
 
     def __repr__(self) -> str:
         mode = "whole takes" if self.whole_takes else f"windows of {self.params['length']} frames"
@@ -432,17 +446,10 @@ class Windows:
 
 # ---------------------------------------------------------------------- building
 def _fingerprint(records: Sequence[TakeRecord], payload: dict[str, Any]) -> str:
-    """sha256 over the files (name, size, mtime_ns) of ``records`` and the JSON of ``payload``."""
-    h = hashlib.sha256()
-    h.update(json.dumps({**payload, "version": CACHE_VERSION}, sort_keys=True, default=str).encode())
-    for r in sorted(records, key=lambda r: r.stem):
-        for modality in sorted(r.files):
-            p = r.files[modality]
-            st = p.stat()
-            h.update(f"{r.stem}|{modality}|{p.name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
-        if r.bvh_fps is not None:  # a per-take frame-rate override changes the windows
-            h.update(f"{r.stem}|bvh_fps|{r.bvh_fps!r}\n".encode())
-    return h.hexdigest()
+    """:func:`beatlite.data.fingerprint.takes_fingerprint` of ``records`` with ``payload`` and :data:`CACHE_VERSION`."""
+    from beatlite.data.fingerprint import takes_fingerprint
+
+    return takes_fingerprint(records, {**payload, "version": CACHE_VERSION})
 
 
 def _usable(index: TakeIndex, split: str | None) -> list[TakeRecord]:
@@ -592,12 +599,15 @@ def build_windows(
             return Windows.load(path)
         except ValueError:
             pass  # broken cache: rebuild
+    shown = records
     if progress:
         from beatlite.notebook import progress as progress_bar
 
-        records = progress_bar(records, desc=f"windows {split}")
-    features = (loaded.pop(r.stem, None) or take_features(r, **feature_args) for r in records)
-    windows = Windows(_cut(features, stats, params), normalizers=stats, params=params)
+        shown = progress_bar(records, desc=f"windows {split}")
+    features = (loaded.pop(r.stem, None) or take_features(r, **feature_args) for r in shown)
+    arrays = _cut(features, stats, params)
+    params["fingerprint"] = _windows_fingerprint(records, arrays, params, vocab)
+    windows = Windows(arrays, normalizers=stats, params=params)
     if path is not None:
         windows.save(path)
     return windows
@@ -631,6 +641,26 @@ def _train_normalizers(
     return _fit_stats([take_features(r, fps=fps, sr=sr, mel=False) for r in records], stats_path), {}
 
 
+def _windows_fingerprint(
+    records: Sequence[TakeRecord], arrays: dict[str, np.ndarray], params: dict[str, Any], vocab: Vocab
+) -> str:
+    """:func:`beatlite.data.fingerprint.windows_fingerprint` of the takes that have windows (as the store's)."""
+    from beatlite.data.fingerprint import windows_fingerprint
+    from beatlite.data.store import store_params, take_fingerprint
+
+    have = set(np.asarray(arrays["take"]).tolist())
+    store = store_params(
+        fps=params["fps"], sr=params["sr"], positions=params["positions"], word_rule=params["word_rule"]
+    )
+    takes = [take_fingerprint(r, store) for r in records if r.stem in have]
+    length, stride = (0, 0) if params["whole_takes"] else (params["length"], params["stride"])
+    return windows_fingerprint(takes, split=params["split"], length=length, stride=stride, vocab=vocab.itos)
+
+
+def _vocab_hash(vocab: Vocab) -> str:
+    return hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
+
+
 def _windows_cache_path(
     records: Sequence[TakeRecord],
     params: dict[str, Any],
@@ -641,7 +671,7 @@ def _windows_cache_path(
     folder = _cache_folder(cache)
     if folder is None:
         return None
-    vocab_hash = hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
+    vocab_hash = _vocab_hash(vocab)
     stats_hash = hashlib.sha256(
         b"".join(a.tobytes() for a in (stats.pose.mean, stats.pose.std, stats.dirvec.mean))
     ).hexdigest()

@@ -30,7 +30,6 @@ Taught in notebooks/04_metrics.ipynb, section 1.3 (FGD on motion: the features d
 from __future__ import annotations
 
 import argparse
-import hashlib
 import sys
 import time
 from collections.abc import Sequence
@@ -183,30 +182,72 @@ class FeatureExtractor:
 
 
 # ----------------------------------------------------------------------------- training
-def windows_hash(windows: np.ndarray) -> str:
-    """sha256 (first 16 hex digits) of the float32 training windows and their shape."""
-    w = np.ascontiguousarray(windows, dtype=np.float32)
-    h = hashlib.sha256(str(w.shape).encode())
-    h.update(w.tobytes())
-    return h.hexdigest()[:16]
+class WindowSource:
+    """The (N, 34, D) float32 training windows of an extractor, from an array or a window view.
+
+    A view (:class:`~beatlite.data.store.StoreWindows` or :class:`~beatlite.data.windows.Windows`)
+    is read ``key`` by ``key`` in batches (``view.batch(idx, keys=(key,))``), so training from the
+    window store holds one batch in memory, whatever the corpus size. An array is indexed directly.
+    """
+
+    def __init__(self, windows: Any, key: str | None = None) -> None:
+        self.view = None if key is None else windows
+        self.array = np.asarray(windows, dtype=np.float32) if key is None else None
+        self.key = key
+        n, shape = (
+            (len(windows), self.get(np.arange(min(1, len(windows))))[0].shape) if len(windows) else (0, ())
+        )
+        self.n, self.shape = n, shape
+
+    def __len__(self) -> int:
+        return self.n
+
+    def get(self, idx: np.ndarray) -> np.ndarray:
+        """Windows ``idx``: (len(idx), 34, D) float32."""
+        if self.view is None:
+            return self.array[idx]
+        return np.asarray(self.view.batch(np.asarray(idx), keys=(self.key,))[self.key], np.float32)
+
+    def moments(self, chunk: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+        """Per-channel mean and std (floored at 1e-3), (D,) float32: of the array as numpy computes
+        them; of a view accumulated in float64 over chunks of ``chunk`` windows."""
+        if self.view is None:
+            flat = self.array.reshape(-1, self.array.shape[2])
+            return flat.mean(axis=0), np.maximum(flat.std(axis=0), 1e-3).astype(np.float32)
+        total = total_sq = 0.0
+        for start in range(0, self.n, chunk):
+            flat = (
+                self.get(np.arange(start, min(self.n, start + chunk)))
+                .astype(np.float64)
+                .reshape(-1, self.shape[1])
+            )
+            total, total_sq = total + flat.sum(axis=0), total_sq + (flat**2).sum(axis=0)
+        count = self.n * self.shape[0]
+        mean = total / count
+        std = np.sqrt(np.maximum(total_sq / count - mean**2, 0.0))
+        return mean.astype(np.float32), np.maximum(std, 1e-3).astype(np.float32)
 
 
 def train_autoencoder(
-    windows: np.ndarray,
+    windows: Any,
     config: ExtractorConfig,
     *,
-    val_windows: np.ndarray | None = None,
+    val_windows: Any = None,
+    key: str | None = None,
     log: bool = True,
 ) -> tuple[MotionAutoencoder, dict[str, Any]]:
     """Train the autoencoder on (N, 34, D) windows, deterministically (one thread by default).
 
     Parameters
     ----------
-    windows : (N, 34, D) float
-        Training windows in the extractor's space.
+    windows : (N, 34, D) float array, or a window view with ``key``
+        Training windows in the extractor's space; a view (the window store's
+        ``store.windows("train")``) is read one batch at a time (:class:`WindowSource`).
     config : ExtractorConfig
-    val_windows : (M, 34, D) float, optional
+    val_windows : (M, 34, D) float array or a view with ``key``, optional
         Held-out windows whose loss is reported.
+    key : str, optional
+        The batch key of a view (``"dirvec"`` or ``"pose"``); None for arrays.
     log : bool
         Print one line per 10 epochs.
 
@@ -218,28 +259,26 @@ def train_autoencoder(
     """
     from beatlite.paths import n_threads
 
-    w = np.asarray(windows, dtype=np.float32)
-    if w.ndim != 3 or w.shape[1] != WINDOW or w.shape[2] != config.input_dim:
-        raise ValueError(f"windows must be (N, {WINDOW}, {config.input_dim}), got shape {w.shape}")
+    w = WindowSource(windows, key)
+    if len(w) and w.shape != (WINDOW, config.input_dim):
+        raise ValueError(f"windows must be (N, {WINDOW}, {config.input_dim}), got (N, *{w.shape})")
     if len(w) < 2:
         raise ValueError(f"need at least 2 training windows, got {len(w)}")
+    val = None if val_windows is None else WindowSource(val_windows, key)
     torch.set_num_threads(n_threads())
     torch.manual_seed(config.seed)
     was_deterministic = torch.are_deterministic_algorithms_enabled()
     torch.use_deterministic_algorithms(True)
     try:
-        return _train(w, config, val_windows, log)
+        return _train(w, config, val, log)
     finally:
         torch.use_deterministic_algorithms(was_deterministic)
 
 
 def _train(
-    w: np.ndarray, config: ExtractorConfig, val_windows: np.ndarray | None, log: bool
+    w: WindowSource, config: ExtractorConfig, val: WindowSource | None, log: bool
 ) -> tuple[MotionAutoencoder, dict[str, Any]]:
-    mean = w.reshape(-1, w.shape[2]).mean(axis=0)
-    std = np.maximum(w.reshape(-1, w.shape[2]).std(axis=0), 1e-3).astype(np.float32)
-    x = torch.from_numpy((w - mean) / std)
-    xv = None if val_windows is None else torch.from_numpy((np.asarray(val_windows, np.float32) - mean) / std)
+    mean, std = w.moments()
     model = MotionAutoencoder(config)
     opt = torch.optim.Adam(model.parameters(), lr=config.lr, betas=(0.5, 0.999))
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=config.epochs)
@@ -247,14 +286,10 @@ def _train(
     history = []
     t0 = time.perf_counter()
     for epoch in range(config.epochs):
-        row = {"epoch": epoch + 1, "train": _train_epoch(model, opt, x, config, gen)}
+        row = {"epoch": epoch + 1, "train": _train_epoch(model, opt, w, (mean, std), config, gen)}
         sched.step()
-        if xv is not None and len(xv) >= 1:
-            model.eval()
-            with torch.no_grad():
-                row["val"] = float(
-                    autoencoder_loss(model(xv), xv, config.velocity_weight, config.velocity_loss)
-                )
+        if val is not None and len(val) >= 1:
+            row["val"] = _val_loss(model, val, (mean, std), config)
         history.append(row)
         if log and ((epoch + 1) % 10 == 0 or epoch == 0):
             extra = f", val {row['val']:.4f}" if "val" in row else ""
@@ -263,22 +298,45 @@ def _train(
     return model, {"mean": mean, "std": std, "history": history, "seconds": time.perf_counter() - t0}
 
 
+def _normalised(w: WindowSource, idx: np.ndarray, moments: tuple[np.ndarray, np.ndarray]) -> torch.Tensor:
+    return torch.from_numpy((w.get(idx) - moments[0]) / moments[1])
+
+
+def _val_loss(
+    model: MotionAutoencoder,
+    val: WindowSource,
+    moments: tuple[np.ndarray, np.ndarray],
+    config: ExtractorConfig,
+) -> float:
+    """Mean validation loss, over chunks of 4096 windows weighted by their size (one chunk: as one batch)."""
+    model.eval()
+    total, chunk = 0.0, 4096
+    with torch.no_grad():
+        for start in range(0, len(val), chunk):
+            xv = _normalised(val, np.arange(start, min(len(val), start + chunk)), moments)
+            loss = autoencoder_loss(model(xv), xv, config.velocity_weight, config.velocity_loss)
+            total += float(loss) * len(xv)
+    return total / len(val)
+
+
 def _train_epoch(
     model: MotionAutoencoder,
     opt: torch.optim.Optimizer,
-    x: torch.Tensor,
+    w: WindowSource,
+    moments: tuple[np.ndarray, np.ndarray],
     config: ExtractorConfig,
     gen: torch.Generator,
 ) -> float:
-    """One pass over the (N, 34, D) windows ``x`` in shuffled mini-batches; the mean training loss."""
+    """One pass over the windows in shuffled mini-batches (read and normalised per batch); the mean loss."""
     model.train()
-    perm = torch.randperm(len(x), generator=gen)
+    perm = torch.randperm(len(w), generator=gen).numpy()
     total, n = 0.0, 0
-    for i in range(0, len(x), config.batch_size):
+    for i in range(0, len(w), config.batch_size):
         idx = perm[i : i + config.batch_size]
         if len(idx) < 2:  # BatchNorm needs 2 samples
             continue
-        loss = autoencoder_loss(model(x[idx]), x[idx], config.velocity_weight, config.velocity_loss)
+        x = _normalised(w, idx, moments)
+        loss = autoencoder_loss(model(x), x, config.velocity_weight, config.velocity_loss)
         opt.zero_grad()
         loss.backward()
         opt.step()
@@ -357,35 +415,30 @@ def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> Fea
 # ----------------------------------------------------------------------------- command line
 def _train_command(args: argparse.Namespace) -> int:
     from beatlite.data.index import index_folder
-    from beatlite.data.windows import build_windows
+    from beatlite.data.store import build_store
     from beatlite.paths import checkpoints_dir, data_dir
 
     key, fname = SPACES[args.space]
     root = Path(args.data) if args.data else data_dir()
-    index = index_folder(root)
-    train = build_windows(index, split="train", cache=not args.no_cache)
-    w = np.asarray(train[key], dtype=np.float32)
+    store = build_store(index_folder(root), args.store, progress=True)
+    train = store.windows("train", keys=(key,))  # read one batch at a time: memory flat in the corpus size
     try:
-        val = np.asarray(build_windows(index, split="val", stats=train.normalizers,
-                                       cache=not args.no_cache)[key], dtype=np.float32)  # fmt: skip
+        val = store.windows("val", keys=(key,), stats=train.normalizers)
     except ValueError:
         val = None
     config = ExtractorConfig(
-        input_dim=w.shape[2], latent_dim=args.latent, channels=args.channels, epochs=args.epochs,
-        batch_size=args.batch_size, lr=args.lr, seed=args.seed,
+        input_dim=WindowSource(train, key).shape[1], latent_dim=args.latent, channels=args.channels,
+        epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
         velocity_weight=VELOCITY_WEIGHT[args.space] if args.velocity_weight is None else args.velocity_weight,
         velocity_loss=args.velocity_loss,
     )  # fmt: skip
-    print(
-        f"training the {args.space} FGD autoencoder on {len(w)} windows {w.shape[1:]} from {root}", flush=True
-    )
-    model, info = train_autoencoder(w, config, val_windows=val)
-    takes = sorted({str(t) for t in np.asarray(train["take"]).tolist()})
+    print(f"training the {args.space} FGD autoencoder on {len(train)} windows from {root}", flush=True)
+    model, info = train_autoencoder(train, config, val_windows=val, key=key)
     meta = {
-        "data_fingerprint": windows_hash(w),
-        "n_windows": int(len(w)),
+        "data_fingerprint": train.fingerprint,  # files + parameters: the same on every machine
+        "n_windows": int(len(train)),
         "n_val_windows": 0 if val is None else int(len(val)),
-        "takes": takes,
+        "takes": sorted(store.takes[int(i)].stem for i in np.unique(train.take_ids)),
         "window_key": key,
         "seconds": round(float(info["seconds"]), 1),
         "torch": str(torch.__version__),
@@ -425,7 +478,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     t.add_argument("--velocity-weight", type=float, default=None, help="default: 10 for dirvec, 0.1 for pose")
     t.add_argument("--velocity-loss", choices=("mse", "l1"), default="mse")
     t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--no-cache", action="store_true", help="do not read/write the window cache")
+    t.add_argument("--store", help="window store folder (default: under build/cache/store, built or updated)")
     t.set_defaults(func=_train_command)
     i = sub.add_parser("info", help="describe a checkpoint")
     i.add_argument("--space", choices=sorted(SPACES), default="dirvec")

@@ -342,8 +342,10 @@ def directions_to_ted_positions(directions: np.ndarray, lengths: np.ndarray | No
     return directions_to_positions(directions, np.asarray(TED_BONES), lengths, np.zeros(3))
 
 
-def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) -> EvaluationSet:
-    """Load the whole takes of ``split`` with train-split normalisation (window caches in ``build/``).
+def load_test_set(
+    index: Any = None, *, split: str = "test", vocab: Any = None, store: Any = None
+) -> EvaluationSet:
+    """Load the whole takes of ``split`` from the window store, with train-split normalisation.
 
     Parameters
     ----------
@@ -353,50 +355,72 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         Takes to evaluate on.
     vocab : Vocab, optional
         Default :func:`beatlite.data.vocab.build_vocab` of ``index`` (what ``retrain-all`` uses).
+    store : WindowStore, optional
+        Default :func:`beatlite.data.store.build_store` of ``index`` (built once, then only takes
+        whose files changed are rebuilt). The statistics are the store's train statistics
+        (:meth:`~beatlite.data.store.WindowStore.statistics`); the train windows are never held in memory.
 
     Returns
     -------
     EvaluationSet
     """
     from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
     from beatlite.data.vocab import build_vocab
-    from beatlite.data.windows import build_windows
     from beatlite.paths import data_dir
-    from beatlite.train.training import data_fingerprint
 
     index = index_folder(data_dir()) if index is None else index
     vocab = build_vocab(index) if vocab is None else vocab
-    train = build_windows(index, split="train", vocab=vocab)
-    whole = build_windows(index, split=split, vocab=vocab, stats=train.normalizers, whole_takes=True)
-    items = [whole.item(i) for i in range(len(whole))]
+    store = build_store(index, vocab=vocab) if store is None else store
+    train = store.windows("train", vocab=vocab)  # an index of (take, start): read in batches below
+    norms = train.normalizers
+    stems = [t.stem for t in store.takes if t.meta["split"] == split]
+    if not stems:
+        raise ValueError(f"load_test_set: no usable take of split {split!r} in {store.folder}")
+    items = [store.whole_take(stem, stats=norms, vocab=vocab) for stem in stems]
     keys = ("pose", "dirvec", "audio", "mel", "face", "word", "emotion", "semantic")
     test = EvaluationSet(
-        takes=[str(item["take"]) for item in items],
+        takes=stems,
         streams=[{**{k: item[k] for k in keys}, "speaker": int(item["speaker"])} for item in items],
-        gt_directions=[train.normalizers.inverse_transform(item["dirvec"], "dirvec126") for item in items],
+        gt_directions=[norms.inverse_transform(item["dirvec"], "dirvec126") for item in items],
         gt_directions_141=[euler_to_directions(item["pose_raw"]) for item in items],
         gt_euler=[np.asarray(item["pose_raw"], np.float64) for item in items],
         semantic=[np.asarray(item["semantic"], np.float64) for item in items],
         audio=[np.asarray(item["audio"], np.float32) for item in items],
-        normalizers=train.normalizers,
+        normalizers=norms,
         change_angle=train_change_angle(train),
         vocab=tuple(vocab.itos),
         split=split,
-        fingerprint=data_fingerprint(train),
-        train_speakers=tuple(int(s) for s in np.unique(train["speaker"])),
+        fingerprint=train.fingerprint,
+        train_speakers=tuple(
+            sorted({int(store.takes[i].meta["speaker"]) for i in np.unique(train.take_ids)})
+        ),
     )
     test.beats()
     return test
 
 
-def train_change_angle(train: Any) -> np.ndarray:
-    """(41,) MAAC per HA2G angle pair over the train windows (beat consistency's normaliser, HA2G eq. 10)."""
+def train_change_angle(train: Any, batch_size: int = 1024) -> np.ndarray:
+    """(41,) MAAC per HA2G angle pair over the train windows (beat consistency's normaliser, HA2G eq. 10).
+
+    ``train`` is a :class:`~beatlite.data.windows.Windows` or a store's
+    :class:`~beatlite.data.store.StoreWindows`; its ``dirvec`` is read ``batch_size`` windows at a
+    time (memory flat) and the per-window sums of :func:`beatlite.metrics.beats.mean_angle_change`
+    are pooled (every window has ``length - 1`` frame steps, so the pooled mean is the batch means'
+    average weighted by their window counts).
+    """
     from beatlite.metrics.beats import mean_angle_change
     from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
-    # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
-    dirs = train.normalizers.dirvec.inverse_transform(np.asarray(train["dirvec"], np.float64))
-    return mean_angle_change([prepare_directions(w) for w in dirs], default_angle_pairs())
+    pairs, n = default_angle_pairs(), len(train)
+    total = np.zeros(len(pairs))
+    for start in range(0, n, batch_size):
+        idx = np.arange(start, min(n, start + batch_size))
+        batch = train.batch(idx, keys=("dirvec",))
+        # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
+        dirs = train.normalizers.dirvec.inverse_transform(np.asarray(batch["dirvec"], np.float64))
+        total += mean_angle_change([prepare_directions(w) for w in dirs], pairs) * len(idx)
+    return total / n
 
 
 # ------------------------------------------------------------------------------------ generation

@@ -1,0 +1,95 @@
+"""The cache of :func:`beatlite.data.index.index_folder`: a take's files are read again only when they changed.
+
+Indexing reads every file of every take (about 32 CPU-s per hour of BEAT-rate corpus), so
+``index_folder`` keeps, per corpus folder, one JSON file under ``cache_dir()/index/`` holding each
+take's :class:`~beatlite.data.index.TakeRecord` with the key it was computed from: the take's
+candidate files (path, size, mtime_ns), its ``bvh_fps`` override and :data:`INDEX_VERSION`, plus
+the sha256 of each file's content (so :func:`beatlite.data.fingerprint.file_digest` does not read it
+again). A take is re-indexed when any part of its key differs. Files modified in the last
+:data:`~beatlite.data.fingerprint.SETTLE_S` seconds are never cached (their size and mtime could
+stay the same through a quick rewrite). The cache is written atomically; a broken or foreign
+cache file is ignored (rebuilt), never an error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from beatlite.data.fingerprint import file_digest, file_key, remember_digest, settled
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeRecord
+
+#: Bump when what indexing records changes (every cached record is then recomputed).
+INDEX_VERSION = 1
+
+
+def cache_path(root: Path, recursive: bool) -> Path:
+    """``cache_dir()/index/{hash of the resolved folder and recursive}.json``."""
+    from beatlite.paths import cache_dir
+
+    key = json.dumps({"root": str(Path(root).resolve()), "recursive": bool(recursive)})
+    return cache_dir() / "index" / f"{hashlib.sha256(key.encode()).hexdigest()[:16]}.json"
+
+
+def take_key(files: dict[str, list[Path]], bvh_fps: float | None) -> list[Any] | None:
+    """The JSON key a take's cached record must match, or None when a file is too fresh to cache."""
+    keys = sorted([modality, *file_key(p)] for modality, paths in files.items() for p in paths)
+    if not all(settled((k[1], k[2], k[3])) for k in keys):
+        return None
+    return [INDEX_VERSION, None if bvh_fps is None else float(bvh_fps), keys]
+
+
+def load(path: Path) -> dict[str, Any]:
+    """``{stem: {"key": ..., "record": ..., "digests": ...}}`` of a cache file ({} if absent or unreadable)."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return {}
+    if (
+        not isinstance(data, dict)
+        or data.get("version") != INDEX_VERSION
+        or not isinstance(data.get("takes"), dict)
+    ):
+        return {}
+    return data["takes"]
+
+
+def cached_record(entry: Any, key: list[Any] | None) -> TakeRecord | None:
+    """The record of a cache ``entry`` if it was computed from ``key`` (its digests primed), else None."""
+    from beatlite.data.index import TakeRecord
+
+    if key is None or not isinstance(entry, dict) or entry.get("key") != key:
+        return None
+    try:
+        fields = dict(entry["record"])
+        fields["files"] = {m: Path(p) for m, p in fields["files"].items()}
+        record = TakeRecord(**fields)
+        for modality, digest in entry["digests"].items():
+            remember_digest(file_key(record.files[modality]), digest)
+    except (KeyError, TypeError, ValueError, OSError):
+        return None
+    return record
+
+
+def entry(record: TakeRecord, key: list[Any]) -> dict[str, Any]:
+    """The cache entry of a freshly indexed record (its files hashed now, with :func:`file_digest`)."""
+    fields = dataclasses.asdict(record)
+    fields["files"] = {m: str(p) for m, p in record.files.items()}
+    return {"key": key, "record": fields, "digests": {m: file_digest(p) for m, p in record.files.items()}}
+
+
+def save(path: Path, takes: dict[str, Any]) -> None:
+    """Write the cache atomically (a failure to write, e.g. a read-only build folder, is ignored)."""
+    from beatlite.io.atomic import atomic_write
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_write(path) as f:
+            json.dump({"version": INDEX_VERSION, "takes": takes}, f)
+    except OSError:
+        pass
