@@ -15,7 +15,7 @@ export PYTHONHASHSEED ?= 0
 # Training processes at once for `make checkpoints` / `make seeds` (1 torch thread each; 2 on an idle 2-core machine).
 JOBS ?= 1
 
-.PHONY: run test lint lab venv system-deps data checkpoints results seeds bench clean
+.PHONY: run test test-fast lint lab venv system-deps data checkpoints results seeds bench clean
 
 venv: $(STAMP)
 
@@ -54,6 +54,12 @@ lab: $(INTERACTIVE) system-deps
 test: $(STAMP) system-deps lint
 	BEATLITE_INTERACTIVE=off $(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
 	BEATLITE_INTERACTIVE=off $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
+
+## The quick loop while editing (about 2 minutes on 2 cores): lint, the unit tests not marked `slow` (no
+## torchrun, no whole-recipe training, no notebooks), the doctests. `make test` (CI) runs everything.
+test-fast: $(STAMP) system-deps lint
+	BEATLITE_INTERACTIVE=off $(VPY) -m pytest tests -m "not slow" -p no:cacheprovider -q
+	BEATLITE_INTERACTIVE=off $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider -q
 
 lint: $(STAMP)
 	$(VPY) -m ruff check beatlite tests bench scripts

@@ -275,7 +275,6 @@ def test_whole_take_equals_build_windows_whole_takes(corpus: Path, store: Window
     assert store.whole_take("2_scott_0_9_9", keys=("mel",))["mel"].shape == (207, 128)
 
 
-@pytest.mark.slow
 def test_fit_reads_a_store_through_a_dataloader_like_the_windows_in_memory(
     corpus: Path, store: WindowStore
 ) -> None:

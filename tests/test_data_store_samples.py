@@ -14,6 +14,7 @@ from beatlite.data.windows import build_windows
 pytestmark = pytest.mark.slow
 
 
+@pytest.mark.slow
 def test_store_equals_build_windows_on_data_samples(data_samples: Path, tmp_path: Path) -> None:
     idx = index_folder(data_samples)
     store = build_store(idx, tmp_path / "store", workers=2)

@@ -462,7 +462,6 @@ def test_bad_inputs_raise_clear_errors() -> None:
 
 
 # ----------------------------------------------------------------------------- training
-@pytest.mark.slow
 def test_two_short_runs_with_one_seed_give_identical_losses() -> None:
     from beatlite.train import TrainConfig, fit
 
@@ -478,7 +477,6 @@ def test_two_short_runs_with_one_seed_give_identical_losses() -> None:
     assert all(np.isfinite(v) for e in histories[0] for v in e["train"].values())
 
 
-@pytest.mark.slow
 def test_paper_preset_builds_and_runs_one_forward() -> None:
     torch.manual_seed(0)
     model = build_model("ha2g", preset="paper")

@@ -45,7 +45,6 @@ class SeedMean(GestureModel):
 '''
 
 
-@pytest.mark.slow
 def test_a_new_model_trains_evaluates_and_appears_in_the_table(tmp_path, monkeypatch):
     from beatlite import models
     from beatlite.train import recipes

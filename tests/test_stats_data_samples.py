@@ -72,6 +72,7 @@ def test_emotion_classifier_beats_chance_on_test_takes(takes: list) -> None:
     assert acc["overall"] >= majority, acc
 
 
+@pytest.mark.slow
 def test_take_analyses_stream_in_one_pass(index: TakeIndex, takes: list) -> None:
     """Each take analysis reads its takes once: given the one-shot iterator iter_corpus, the same numbers as
     on the loaded list (so a corpus of any size streams, holding one take at a time)."""

@@ -111,6 +111,7 @@ print(f"rank {rank} of {world}", flush=True)
 """
 
 
+@pytest.mark.slow
 def test_the_process_group_is_destroyed_before_the_interpreter_exits(tmp_path):
     """A process group left alive at exit can abort a process in gloo's threads (it did once in CI):
     the group distributed_rank initialises is gone by the time later exit handlers run."""

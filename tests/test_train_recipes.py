@@ -55,6 +55,7 @@ def test_ha2g_ablations_really_switch_something():
             assert getattr(tiny, field) != value, (name, field)
 
 
+@pytest.mark.slow
 def test_every_generator_parameter_gets_a_gradient_in_every_recipe():
     """The contract DistributedDataParallel relies on (beatlite.train.distributed): one step's generator
     loss reaches every generator parameter, before and after the adversarial epochs start."""
