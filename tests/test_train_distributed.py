@@ -121,3 +121,31 @@ def test_the_process_group_is_destroyed_before_the_interpreter_exits(tmp_path):
     done = run_ok(cmd, env=_env(), timeout=300)
     assert done.stdout.count("group alive at exit: False") == 2, done.stdout + done.stderr
     assert "rank 0 of 2" in done.stdout and "rank 1 of 2" in done.stdout
+
+
+SUM_ORDER = """
+import json, sys
+from beatlite.train.distributed import distributed_rank, sum_over_processes
+
+rank, world = distributed_rank()
+sums = {"rec": 1.0 + rank, "adv": 10.0, "D_real": 0.5}  # the model's insertion order: rec first
+with open(f"{sys.argv[1]}/{rank}.json", "w") as f:  # one file per process: stdout lines interleave
+    json.dump(list(sum_over_processes(sums, world).items()), f)
+"""
+
+
+@pytest.mark.slow
+def test_summed_losses_keep_the_models_order(tmp_path):
+    """Under torchrun the progress bar showed ``adv=0``: the reduced sums came back in sorted-key order and
+    the bar shows the first key. They are summed over the processes and come back in the model's order."""
+    import json
+
+    script = tmp_path / "sum_order.py"
+    script.write_text(SUM_ORDER)
+    run_ok(
+        [_torchrun(), "--standalone", "--nproc_per_node=2", str(script), str(tmp_path)],
+        env=_env(),
+        timeout=300,
+    )
+    rows = [json.loads((tmp_path / f"{rank}.json").read_text()) for rank in (0, 1)]
+    assert rows == [[["rec", 3.0], ["adv", 20.0], ["D_real", 1.0]]] * 2

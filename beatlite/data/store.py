@@ -47,7 +47,6 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import os
@@ -883,7 +882,11 @@ def build_store(
     params = store_params(fps=fps, sr=sr, positions=positions, word_rule=word_rule)
     folder = Path(folder) if folder is not None else default_store_folder(index, params)
     (folder / "takes").mkdir(parents=True, exist_ok=True)
-    with _exclusive(folder / ".build.lock"):  # other processes building this store wait, then find it current
+    from beatlite.io.atomic import exclusive_lock
+
+    with exclusive_lock(
+        folder / ".build.lock"
+    ):  # other processes building this store wait, then find it current
         todo = [r for r in records if not _is_current(folder / "takes" / r.stem, r, params)]
         _run_builds(todo, folder, params, workers, progress)
         keep = {r.stem for r in records}
@@ -892,20 +895,3 @@ def build_store(
                 shutil.rmtree(stale)
         _write_manifest(folder, index, records, params, vocab)
         return WindowStore.open(folder)
-
-
-@contextlib.contextmanager
-def _exclusive(path: Path) -> Iterator[None]:
-    """Hold an exclusive ``flock`` on ``path`` (POSIX; elsewhere no lock): one builder of a store at a time
-    (``retrain-all --jobs 2`` and ``torchrun`` start several processes that build the same store)."""
-    try:
-        import fcntl
-    except ImportError:  # Windows: no advisory locks in the standard library
-        yield
-        return
-    with open(path, "a+b") as f:
-        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(f.fileno(), fcntl.LOCK_UN)

@@ -170,3 +170,27 @@ def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
                     cand.unlink()
                     removed.append(cand)
     return removed
+
+
+@contextlib.contextmanager
+def exclusive_lock(path: str | os.PathLike[str]) -> Iterator[None]:
+    """Hold an exclusive advisory lock (``flock``) on ``path`` (created if needed) for the ``with`` block.
+
+    Processes that prepare the same thing (``retrain-all --jobs 2`` and ``torchrun`` start several,
+    each building the same window store or FGD extractor) take turns: the first does the work, the
+    others wait, then find it done. Waiting has no time limit and happens outside any collective of
+    ``torch.distributed`` (whose barriers time out after 30 minutes). The lock is released when the
+    block ends or the process dies. POSIX only; elsewhere (Windows) the block runs unlocked.
+    """
+    try:
+        import fcntl
+    except ImportError:  # Windows: no advisory locks in the standard library
+        yield
+        return
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "a+b") as f:
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f.fileno(), fcntl.LOCK_UN)

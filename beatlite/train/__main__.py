@@ -73,6 +73,12 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
     f.add_argument("--checkpoint-every", type=int, help="also checkpoint every N steps inside an epoch")
+    f.add_argument(
+        "--extractor-epochs",
+        type=int,
+        default=100,
+        help="epochs of the FGD extractor trained for new data (once)",
+    )
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
     p.add_argument("--seed", type=int, help="default: each recipe's shipped seed in the recorded seed table")
     p.add_argument("--epochs", type=int, help="override every recipe's epochs (for quick checks)")
@@ -150,31 +156,38 @@ def _retrain_all_command(args: argparse.Namespace) -> int:
 
 
 def _fit_command(args: argparse.Namespace) -> int:
-    """``fit``: one recipe on ``--data``, every file under ``--out``."""
+    """``fit``: one recipe on ``--data``, every file under ``--out``.
+
+    The data are prepared before any process group exists: the window store (built once, then only
+    changed takes) and, for data other than ``data_samples/``, the FGD extractor (trained once). Under
+    ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
+    the first builds, the others wait (no time limit, no collective) and find it done.
+    """
     from pathlib import Path
 
+    from beatlite.io.atomic import exclusive_lock
     from beatlite.paths import repo_root
-    from beatlite.train.distributed import distributed_rank, wait_for_all
     from beatlite.train.recipes import retrain, training_data
 
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
-    os.environ.setdefault("BEATLITE_BUILD", str(out / "build"))  # window caches under --out too
+    os.environ.setdefault(
+        "BEATLITE_BUILD", str(out / "build")
+    )  # the index, the store and caches under --out too
+    rank = int(os.environ.get("RANK", "0"))
+    data = training_data(data_dir)
     extractor = None
-    rank, world = distributed_rank()  # under torchrun: process 0 trains the extractor, the others wait
     if data_dir != (repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
-        if not extractor.is_file() and rank == 0:
-            print(f"training the FGD extractor on {data_dir} -> {extractor}", flush=True)
-            cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", "dirvec"]
-            subprocess.run([*cmd, "--data", str(data_dir), "--out", str(extractor)], check=True)
-    wait_for_all(world)
+        with exclusive_lock(out / ".fgd_dirvec.lock"):
+            if not extractor.is_file():
+                _train_extractor(data_dir, extractor, args.extractor_epochs)
     seconds = retrain(
         args.recipe,
         seed=args.seed,
         epochs=args.epochs,
         out_dir=out,
-        data=training_data(data_dir),
+        data=data,
         resume=args.resume,
         device=args.device,
         extractor=extractor,
@@ -183,6 +196,26 @@ def _fit_command(args: argparse.Namespace) -> int:
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
     return 0
+
+
+def _train_extractor(data_dir: object, path: object, epochs: int) -> None:
+    """Train the dirvec FGD extractor of ``data_dir`` into ``path`` (its command, in a child process, on
+    the window store the parent built: ``BEATLITE_BUILD`` is inherited)."""
+    print(
+        f"training the FGD extractor on {data_dir} -> {path} ({epochs} epochs on the train windows)",
+        flush=True,
+    )
+    cmd = [
+        sys.executable,
+        "-m",
+        "beatlite.metrics.extractor",
+        "train",
+        "--space",
+        "dirvec",
+        "--epochs",
+        str(epochs),
+    ]
+    subprocess.run([*cmd, "--data", str(data_dir), "--out", str(path)], check=True)
 
 
 if __name__ == "__main__":

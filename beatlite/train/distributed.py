@@ -143,7 +143,8 @@ def wait_for_all(world: int) -> None:
 
 
 def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
-    """The loss sums of all processes (every process has the same keys)."""
+    """The loss sums of all processes (every process has the same keys), in the order of ``sums``
+    (reduced in sorted-key order; the model's first loss stays first, as the progress bar shows it)."""
     if world < 2:
         return sums
     import torch.distributed as dist
@@ -152,4 +153,5 @@ def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
     device = torch.device("cuda", torch.cuda.current_device()) if torch.cuda.is_available() else None
     values = torch.tensor([sums[k] for k in keys], dtype=torch.float64, device=device)
     dist.all_reduce(values, op=dist.ReduceOp.SUM)
-    return dict(zip(keys, values.cpu().tolist(), strict=True))
+    reduced = dict(zip(keys, values.cpu().tolist(), strict=True))
+    return {k: reduced[k] for k in sums}
