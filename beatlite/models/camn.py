@@ -358,15 +358,19 @@ class CaMN(GestureModel):
                 keys.append(key)
         return tuple(keys)
 
+    @classmethod
+    def batch_keys(cls, config: CaMNConfig) -> tuple[str, ...]:
+        """:meth:`keys_for` plus ``semantic`` when the loss is semantic-weighted."""
+        return (*cls.keys_for(config), *(("semantic",) if config.semantic_weighting else ()))
+
     @property
     def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
         """Batch keys the forward pass reads (:meth:`keys_for` of its config)."""
         return self.keys_for(self.config)
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim); no-op without text."""
-        if self.text_encoder is not None:
-            self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The text encoder's embedding (none without text)."""
+        return [] if self.text_encoder is None else [self.text_encoder.embedding]
 
     def encode(self, batch: Batch) -> dict[str, torch.Tensor]:
         """Per-modality features, each (B, T, C): keys ``text, speaker, emotion, audio, face`` (those on)."""

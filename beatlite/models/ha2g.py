@@ -55,7 +55,7 @@ Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -64,7 +64,7 @@ from torch import nn
 
 from beatlite.data.normalize import Normalizers
 from beatlite.metrics.consistency import default_angle_pairs
-from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch, window_chunks
 from beatlite.models.ha2g_ablations import ABLATIONS
 from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
 from beatlite.models.ha2g_losses import (
@@ -470,14 +470,16 @@ class HA2G(GestureModel):
         self.register_buffer("statistics_ready", torch.zeros((), dtype=torch.bool))
 
     # ------------------------------------------------------------------ data statistics
-    def set_statistics(self, mean_dirvec: np.ndarray, dirvec_windows: np.ndarray | None = None) -> None:
+    def set_statistics(
+        self, mean_dirvec: np.ndarray, dirvec_windows: np.ndarray | Iterable[np.ndarray] | None = None
+    ) -> None:
         """Store the mean direction vector and (when ``use_physical``) the angle statistics.
 
         Parameters
         ----------
         mean_dirvec : (126,) float
             The training mean subtracted from the unit direction vectors.
-        dirvec_windows : (N, T, 126) float, optional
+        dirvec_windows : (N, T, 126) float or an iterable of (N_i, T, 126) chunks, optional
             Training windows (``windows["dirvec"]``); required when ``use_physical``.
         """
         m = np.asarray(mean_dirvec, dtype=np.float64)
@@ -496,31 +498,29 @@ class HA2G(GestureModel):
                 self.angle_change.copy_(torch.as_tensor(stats.change))
             self.statistics_ready.fill_(True)
 
-    def prepare(
-        self, train_windows: Mapping[str, np.ndarray], normalizers: Normalizers | None = None
-    ) -> None:
-        """Compute the data statistics from the numpy training windows (called by ``fit``).
+    def prepare(self, train_windows: Any, normalizers: Normalizers | None = None) -> None:
+        """Compute the data statistics from the training windows (called by ``fit``).
 
-        The mean direction vector the windows were centred with is ``normalizers.dirvec.mean``
-        (the train split's :class:`~beatlite.data.normalize.Normalizers`, which ``fit`` passes).
+        ``train_windows`` is a numpy window dict or a window store view (``StoreWindows``, whose
+        ``dirvec`` is read in chunks, so memory stays flat). The mean direction vector the windows
+        were centred with is ``normalizers.dirvec.mean`` (the train split's
+        :class:`~beatlite.data.normalize.Normalizers`, which ``fit`` passes).
         """
         if "dirvec" not in train_windows:
-            raise KeyError(f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows)})")
+            raise KeyError(
+                f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows.keys())})"
+            )
         if normalizers is None:
             raise ValueError(
                 "HA2G.prepare needs the train split's Normalizers (fit passes Windows.normalizers, or "
                 "meta=normalizers.to_meta()): it adds the mean direction back for its angle statistics"
             )
-        self.set_statistics(normalizers.dirvec.mean, np.asarray(train_windows["dirvec"]))
+        self.set_statistics(normalizers.dirvec.mean, window_chunks(train_windows, "dirvec"))
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into every text encoder's embedding."""
-        encoders = [
-            *self.text_encoders,
-            *([self.contrastive_text] if self.contrastive_text is not None else []),
-        ]
-        for enc in encoders:
-            enc.set_word_vectors(torch.as_tensor(np.asarray(vectors), dtype=torch.float32))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The embedding of every text encoder (the generators' and the contrastive loss's)."""
+        extra = [] if self.contrastive_text is None else [self.contrastive_text]
+        return [enc.embedding for enc in (*self.text_encoders, *extra)]
 
     # ------------------------------------------------------------------ forward
     def _check_inputs(self, batch: Batch) -> None:
@@ -624,7 +624,8 @@ class HA2G(GestureModel):
             rest = dirvec.new_zeros(b, t - n_pre, d + 1)
             if k:
                 dst, src = getattr(self, f"_dst{k}"), getattr(self, f"_src{k}")
-                rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src])
+                # under autocast the prediction may be bfloat16: index_copy needs one dtype (CUDA)
+                rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src].to(rest.dtype))
             pre_seq = torch.cat([seed, rest], dim=1)
             text = (texts[k] if len(texts) > 1 else texts[0]) if texts else no_text
             preds.append(gen(pre_seq, level_audio[:, k], text, levels[:, k]))
@@ -664,7 +665,7 @@ class HA2G(GestureModel):
             preds, weights = self._decode(dirvec, audio, texts, style["coord"], style["levels"])
             other = {}
         pose = dirvec.new_zeros(dirvec.shape).index_copy(
-            -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1]
+            -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1].to(dirvec.dtype)
         )
         out: dict[str, torch.Tensor] = {
             "pose": pose,

@@ -39,7 +39,6 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-import numpy as np
 import torch
 from torch import nn
 
@@ -119,9 +118,9 @@ class JointEmbedding(GestureModel):
         )
         self.head = mlp((cfg.hidden, cfg.hidden // 2, POSE_DIM), cfg.slope, last_act=False)
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim)."""
-        self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The text encoder's embedding."""
+        return [self.text_encoder.embedding]
 
     def embed_text(self, words: torch.Tensor) -> torch.Tensor:
         """(B, T) word ids -> (B, embed_dim)."""
