@@ -346,7 +346,9 @@ class _Data:
         """For every step, its micro-batches as (tensor dict, windows) on ``device``.
 
         A window store is read by a ``torch.utils.data.DataLoader`` (``workers`` processes, pinned
-        memory on CUDA) in exactly this order; in-memory arrays are indexed here.
+        memory on CUDA) in exactly this order; in-memory arrays are indexed here. The loader draws its
+        workers' base seed from its own generator, not torch's global one, which the models' dropout and
+        sampling use: both routes then take the same steps.
         """
         if self.store is None:
             for step in steps:
@@ -359,7 +361,7 @@ class _Data:
         flat = [m for step in steps for m in step]
         pin = getattr(device, "type", "cpu") == "cuda"
         loader = DataLoader(WindowDataset(self.store, self.keys), batch_size=None, sampler=flat,
-                            num_workers=workers, pin_memory=pin)  # fmt: skip
+                            num_workers=workers, pin_memory=pin, generator=torch.Generator())  # fmt: skip
         batches = iter(loader)
         for step in steps:
             yield [
