@@ -184,7 +184,8 @@ def _finite(values: Mapping[str, Any]) -> list[str]:
 
 def check_shapes(case: ModelCase) -> None:
     """``batch_keys`` covers ``keys_for`` and the target; on a batch of exactly those keys ``forward`` and
-    ``generate`` give a finite (B, T, D) pose, and ``generate`` reads only the ``n_pre`` seed frames."""
+    ``generate`` give a finite (B, T, D) pose, and ``generate`` reads only the ``n_pre`` seed frames (and
+    leaves a model in training mode there)."""
     model = _prepared(case, case.build())
     keys = set(type(model).batch_keys(model.config))
     missing = (set(type(model).keys_for(model.config)) | {model.target_key}) - keys
@@ -200,11 +201,12 @@ def check_shapes(case: ModelCase) -> None:
     later[model.target_key] = batch[model.target_key].clone()
     later[model.target_key][:, model.n_pre :] += 1.0
     _expect(torch.equal(_reset(model).generate(later), seeded), case, "generate reads frames after the seed")
+    _expect(model.training, case, "generate did not restore training mode")
 
 
 def check_gradients(case: ModelCase) -> None:
-    """A finite scalar ``"total"`` whose backward reaches every generator parameter (adversarial terms on),
-    and a discriminator loss that reaches every discriminator parameter."""
+    """A finite scalar ``"total"`` whose backward gives every generator parameter a finite, non-zero
+    gradient (adversarial terms on), and a discriminator loss that does the same for the discriminator."""
     model = _prepared(case, case.build())
     batch = case.batch(model)
     losses = _train_losses(model, batch)
@@ -213,7 +215,7 @@ def check_gradients(case: ModelCase) -> None:
     names = {id(p): n for n, p in model.named_parameters()}
     if model.trainable:
         losses["total"].backward()
-        dead = [names[id(p)] for p in model.generator_parameters() if p.grad is None]
+        dead = [names[id(p)] for p in model.generator_parameters() if p.grad is None or not p.grad.any()]
         bad = [
             names[id(p)]
             for p in model.generator_parameters()
@@ -225,7 +227,7 @@ def check_gradients(case: ModelCase) -> None:
         d = model.discriminator_losses(batch, model(batch))["total"]
         _expect(d.ndim == 0 and torch.isfinite(d), case, "discriminator loss is not a finite scalar")
         d.backward()
-        dead = [names[id(p)] for p in model.discriminator.parameters() if p.grad is None]
+        dead = [names[id(p)] for p in model.discriminator.parameters() if p.grad is None or not p.grad.any()]
         _expect(not dead, case, f"discriminator parameters without gradient: {dead[:5]}")
 
 
