@@ -37,3 +37,18 @@ def test_window_helpers_read_a_store_as_the_windows_in_memory(small_store_window
     chunks = list(window_chunks(train, "dirvec", max_bytes=3 * 34 * 126 * 4))  # 3 windows per chunk
     assert len(chunks) == -(-n // 3) and np.array_equal(np.concatenate(chunks), reference["dirvec"])
     assert len(list(window_chunks(reference, "dirvec"))) == 1
+
+
+def test_a_store_view_without_a_key_the_losses_read_is_refused_by_name(small_store_windows: tuple) -> None:
+    """CaMN's loss reads ``semantic``, which its forward pass (``keys_for``) does not: ``batch_keys`` has it,
+    and a view of ``keys_for`` alone is refused before any step, naming the key."""
+    from beatlite.models import build_model
+    from beatlite.models.camn import CaMN
+    from beatlite.train import TrainConfig, fit
+
+    train, _ = small_store_windows
+    model = build_model("camn", preset="tiny", vocab_size=len(train.vocab))
+    assert "semantic" in CaMN.batch_keys(model.config) and "semantic" not in CaMN.keys_for(model.config)
+    view = train.store.windows("train", keys=CaMN.keys_for(model.config), stats=train.normalizers)
+    with pytest.raises(KeyError, match="semantic"):
+        fit(model, view, TrainConfig(epochs=1, batch_size=4, progress=False))
