@@ -63,7 +63,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from beatlite.constants import N_PRE
+from beatlite.constants import N_PRE, WINDOW_LENGTH
 
 Batch = dict[str, torch.Tensor]
 
@@ -82,6 +82,54 @@ class ModelConfig:
     """
 
     preset: str = "tiny"
+
+
+@dataclasses.dataclass
+class TextConfig(ModelConfig):
+    """Fields of a model reading word ids through a :class:`~beatlite.models.layers.TextEncoderTCN`.
+
+    Attributes
+    ----------
+    vocab_size, word_dim : int
+        Embedding table (id 0 = PAD; the recipes set ``vocab_size`` to the corpus vocabulary and load
+        pretrained vectors with :meth:`GestureModel.set_word_vectors`).
+    text_hidden, text_layers : int
+        Width and depth (levels) of the TCN.
+    text_features : int
+        Text features per frame.
+    """
+
+    vocab_size: int = 5793
+    word_dim: int = 300
+    text_hidden: int = 300
+    text_layers: int = 4
+    text_features: int = 32
+
+
+@dataclasses.dataclass
+class AdversarialConfig(ModelConfig):
+    """Fields of a model trained with a :class:`~beatlite.models.layers.ConvDiscriminator`-style critic.
+
+    Attributes
+    ----------
+    adversarial : bool
+        Build the discriminator and train adversarially.
+    adv_weight : float
+        Weight of the generator's adversarial term.
+    no_adv_epochs : int
+        0-based epoch from which the adversarial term is on (:meth:`GestureModel.adversarial_active`).
+    d_hidden, d_layers : int
+        Width and recurrent layers of the discriminator.
+    n_frames : int
+        Frames T per window (the discriminator's time head is sized for it).
+    """
+
+    adversarial: bool = True
+    adv_weight: float = 0.5
+    no_adv_epochs: int = 10
+    d_hidden: int = 64
+    d_layers: int = 4
+    n_frames: int = WINDOW_LENGTH
 
 
 def config_from_preset(

@@ -28,9 +28,11 @@ import torch
 from torch import nn
 
 from beatlite.models.base import (
+    AdversarialConfig,
     Batch,
     GestureModel,
     ModelConfig,
+    TextConfig,
     check_batch,
     huber,
     seed_input,
@@ -210,20 +212,14 @@ class _Adversarial(GestureModel):
 
 
 @dataclasses.dataclass
-class S2GConfig(ModelConfig):
+class S2GConfig(AdversarialConfig):
     """Speech2Gesture-style model: ``channels`` wide convolutions over 128-bin log-mel frames."""
 
     preset: str = "paper"
     n_mels: int = 128
     channels: int = 256
-    n_frames: int = 34
     slope: float = 0.2
     rec_weight: float = 500.0
-    adversarial: bool = True
-    adv_weight: float = 0.5
-    no_adv_epochs: int = 10
-    d_hidden: int = 64
-    d_layers: int = 4
 
 
 def _conv_block(a: int, b: int, k: int, stride: int, pad: int, slope: float) -> nn.Sequential:
@@ -286,15 +282,10 @@ class S2G(_Adversarial):
 
 
 @dataclasses.dataclass
-class TrimodalConfig(ModelConfig):
+class TrimodalConfig(TextConfig, AdversarialConfig):
     """Trimodal / MultiContext-style hyper-parameters (defaults = ``paper``: docs/reference_code.md#trimodal, hidden 300, 4 layers)."""
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     audio_channels: tuple[int, ...] = (16, 32, 64, 32)
     n_speakers: int = 30
     speaker_z: int = 16
@@ -304,12 +295,6 @@ class TrimodalConfig(ModelConfig):
     slope: float = 0.1
     rec_weight: float = 500.0
     kld_weight: float = 0.1
-    adversarial: bool = True
-    adv_weight: float = 0.5
-    no_adv_epochs: int = 10
-    d_hidden: int = 64
-    d_layers: int = 4
-    n_frames: int = 34
 
     def __post_init__(self) -> None:
         self.audio_channels = tuple(int(c) for c in self.audio_channels)

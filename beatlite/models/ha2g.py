@@ -64,7 +64,15 @@ from torch import nn
 
 from beatlite.data.normalize import Normalizers
 from beatlite.metrics.consistency import default_angle_pairs
-from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch, window_chunks
+from beatlite.models.base import (
+    N_PRE,
+    AdversarialConfig,
+    Batch,
+    GestureModel,
+    TextConfig,
+    check_batch,
+    window_chunks,
+)
 from beatlite.models.ha2g_ablations import ABLATIONS
 from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
 from beatlite.models.ha2g_losses import (
@@ -96,7 +104,7 @@ is :attr:`beatlite.train.TrainConfig.d_lr_weight`)."""
 
 
 @dataclasses.dataclass
-class HA2GConfig(ModelConfig):
+class HA2GConfig(TextConfig, AdversarialConfig):
     """HA2G hyper-parameters (defaults + the ``paper`` preset = HA2G's code, docs/reference_code.md#ha2g-hyperparameters).
 
     ``style``: ``"reference"`` (separate coordinator embedding, per-level style codes) or
@@ -116,11 +124,6 @@ class HA2GConfig(ModelConfig):
     """
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     text_per_level: bool = True
     n_speakers: int = 30
     z_dim: int = 16
@@ -144,7 +147,6 @@ class HA2GConfig(ModelConfig):
     use_contrastive: bool = True
     contrastive_high_negatives: bool = True
     use_physical: bool = True
-    adversarial: bool = True
     use_style_loss: bool = True
     huber_weight: float = 250.0
     huber_beta: float = 0.1
@@ -159,9 +161,6 @@ class HA2GConfig(ModelConfig):
     contrastive_min_distance: float = 1e-2
     physical_weight: float = 0.01
     angle_var_floor: float = 1e-4
-    d_hidden: int = 64
-    d_layers: int = 4
-    n_frames: int = 34
 
     def __post_init__(self) -> None:
         self.audio_channels = tuple(int(c) for c in self.audio_channels)

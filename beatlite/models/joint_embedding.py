@@ -42,20 +42,20 @@ from typing import Any
 import torch
 from torch import nn
 
-from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.base import N_PRE, Batch, GestureModel, TextConfig, check_batch
 from beatlite.models.layers import TextEncoderTCN, mlp, sum_directions
 
 POSE_DIM = 141
 
 
 @dataclasses.dataclass
-class JointEmbeddingConfig(ModelConfig):
+class JointEmbeddingConfig(TextConfig):
     """Joint Embedding hyper-parameters (defaults = ``paper``: the sizes of Yoon et al. 2020's baseline).
 
     Attributes
     ----------
     vocab_size, word_dim, text_hidden, text_layers, text_features : int
-        :class:`~beatlite.models.layers.TextEncoderTCN` sizes.
+        :class:`~beatlite.models.layers.TextEncoderTCN` sizes (:class:`~beatlite.models.base.TextConfig`).
     hidden : int
         Width of the two encoder GRUs and of the decoder GRU.
     dec_layers : int
@@ -71,11 +71,6 @@ class JointEmbeddingConfig(ModelConfig):
     """
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     hidden: int = 300
     dec_layers: int = 4
     embed_dim: int = 32
