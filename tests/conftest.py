@@ -26,3 +26,21 @@ def data_samples() -> Path:
     if not any(path.glob("*.wav")):
         pytest.fail("data_samples/ holds no takes: run `python -m beatlite.synth --out data_samples`")
     return path
+
+
+#: Three train takes of data_samples/ (three speakers): the small corpus of the model contract suite.
+SMALL_TAKES = ("2_scott_0_9_9", "4_lawrence_0_11_11", "6_carla_0_13_13")
+
+
+@pytest.fixture(scope="session")
+def small_store_windows(data_samples: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple:
+    """A window store of :data:`SMALL_TAKES` (built once per session) and its train windows:
+    ``(store view of every key, the same windows from build_windows)``, one statistics and vocabulary."""
+    from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
+    from beatlite.data.windows import build_windows
+
+    index = index_folder(data_samples).where(stem=list(SMALL_TAKES))
+    store = build_store(index, tmp_path_factory.mktemp("small_store"), workers=0)
+    reference = build_windows(index, split="train", vocab=store.vocab, cache=False)
+    return store.windows("train", stats=reference.normalizers), reference

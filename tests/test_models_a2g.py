@@ -11,7 +11,6 @@ torch = pytest.importorskip("torch")
 
 from beatlite.models import build_model  # noqa: E402
 from beatlite.models.a2g import kl_standard_normal, reparameterize  # noqa: E402
-from beatlite.models.base import GestureModel  # noqa: E402
 from beatlite.models.testing import fake_batch  # noqa: E402
 
 
@@ -100,13 +99,6 @@ def test_loss_terms_on_hand_cases(batch):
     assert float(model.losses(batch, within, epoch=0)["relaxed"]) == 0.0
 
 
-def test_gradient_reaches_every_parameter(batch):
-    model = _model()
-    model.losses(batch, model(batch), epoch=0)["total"].backward()
-    for name, p in model.named_parameters():
-        assert p.grad is not None and float(p.grad.abs().sum()) > 0, name
-
-
 def test_bicycle_and_kl_train_the_right_parts(batch):
     model = _model()
     out = model(batch)
@@ -151,11 +143,8 @@ def test_sampled_generation_is_seeded(batch):
     assert not torch.equal(mean.generate(batch), first)
 
 
-def test_config_round_trip_and_validation(batch):
+def test_config_validation_and_missing_audio(batch):
     model = _model().eval()
-    clone = GestureModel.from_config(model.to_config())
-    clone.load_state_dict(model.state_dict())
-    assert torch.equal(clone.eval()(batch)["pose"], model(batch)["pose"])
     with pytest.raises(ValueError, match="eval_z"):
         _model(eval_z="median")
     with pytest.raises(KeyError, match="audio"):

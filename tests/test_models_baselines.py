@@ -8,8 +8,7 @@ from childproc import run_ok
 
 torch = pytest.importorskip("torch")
 
-from beatlite.models import MODELS, build_model, model_class  # noqa: E402
-from beatlite.models.base import GestureModel  # noqa: E402
+from beatlite.models import MODELS, build_model  # noqa: E402
 from beatlite.models.testing import fake_batch, fake_windows  # noqa: E402
 
 V = 50
@@ -72,16 +71,11 @@ def test_trimodal_shapes_kld_and_eval_determinism(batch):
 
 
 @pytest.mark.parametrize("name", ["s2g", "trimodal"])
-def test_learned_baselines_get_gradient_everywhere(batch, name):
+def test_learned_baselines_reconstruction_is_zero_on_the_target(batch, name):
     torch.manual_seed(0)
     kw = {"vocab_size": V} if name == "trimodal" else {}
     model = build_model(name, preset="tiny", no_adv_epochs=0, **kw)
     out = model(batch)
-    model.losses(batch, out, epoch=0)["total"].backward()
-    d_ids = {id(p) for p in model.discriminator.parameters()}
-    for pname, p in model.named_parameters():
-        if id(p) not in d_ids:
-            assert p.grad is not None and float(p.grad.abs().sum()) > 0, pname
     assert float(model.losses(batch, {**out, "pose": batch["pose"]}, epoch=-1)["rec"]) == 0.0
 
 
@@ -93,7 +87,7 @@ def test_paper_presets_build_and_run(batch, name):
     assert model(batch)["pose"].shape == (3, 34, 141)
 
 
-def test_registry_and_config_round_trip(batch):
+def test_registry_names_presets_and_options_are_checked():
     assert {"camn", "ha2g", "s2g", "trimodal", "mean_pose", "random_clip"} <= set(MODELS)
     with pytest.raises(ValueError, match="model name"):
         build_model("nope")
@@ -101,12 +95,6 @@ def test_registry_and_config_round_trip(batch):
         build_model("s2g", preset="tiny", widht=3)
     with pytest.raises(ValueError, match="preset"):
         build_model("s2g", preset="huge")
-    torch.manual_seed(0)
-    model = build_model("trimodal", preset="tiny", vocab_size=V).eval()
-    clone = GestureModel.from_config(model.to_config())
-    assert type(clone) is model_class("trimodal")
-    clone.load_state_dict(model.state_dict())
-    assert torch.equal(clone.eval()(batch)["pose"], model(batch)["pose"])
 
 
 def test_import_models_does_not_import_torch():

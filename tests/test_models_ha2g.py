@@ -166,18 +166,6 @@ def test_coarse_to_fine_level_k_reads_level_k_minus_1() -> None:
     torch.testing.assert_close(model(future)["pose"], after["pose"])
 
 
-def test_generate_uses_only_the_seed_frames() -> None:
-    model = _model()
-    batch = fake_batch(2)
-    other = dict(batch)
-    other["dirvec"] = batch["dirvec"].clone()
-    other["dirvec"][:, 4:] = torch.randn(2, 30, 126)
-    a, b = model.generate(batch), model.generate(other)
-    assert tuple(a.shape) == (2, 34, 126)
-    torch.testing.assert_close(a, b)
-    assert model.training  # generate restores the mode
-
-
 def test_discriminator_shape_and_losses() -> None:
     d = HA2GDiscriminator(126, 16, 2, 34, 0.1)
     assert tuple(d(torch.randn(3, 34, 126)).shape) == (3, 1)

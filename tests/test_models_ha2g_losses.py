@@ -156,6 +156,20 @@ def test_angle_statistics_of_a_known_distribution() -> None:
     np.testing.assert_allclose(stats.change, [0.5, 0.0], atol=1e-9)
 
 
+def test_angle_statistics_of_chunks_pool_to_those_of_the_whole_array() -> None:
+    # A window store is read in chunks: Chan's pooled mean / variance and the pooled change agree with
+    # one pass over the whole array to float64 rounding (sums of ~1e3 terms of size <= 1: 1e-12 relative).
+    rng = np.random.default_rng(7)
+    d = 0.3 * rng.standard_normal((13, 6, 126))
+    mean = rng.standard_normal(126)
+    whole = angle_statistics(d, mean)
+    pooled = angle_statistics((d[a:b] for a, b in ((0, 1), (1, 6), (6, 13))), mean)
+    for field in ("mean", "var", "change"):
+        np.testing.assert_allclose(getattr(pooled, field), getattr(whole, field), rtol=1e-12, atol=1e-15)
+    once = angle_statistics(iter([d]), mean)  # one chunk: the very same numbers
+    assert all(np.array_equal(getattr(once, f), getattr(whole, f)) for f in ("mean", "var", "change"))
+
+
 def test_physical_constraint_minimal_at_the_mean_angles() -> None:
     rng = np.random.default_rng(4)
     pose = _random_unit_dirs(rng, (1,))

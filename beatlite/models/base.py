@@ -35,9 +35,14 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
   of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
 - ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
 - optional ``prepare(train_windows, normalizers=None)``: called once by ``fit`` before training with the
-  numpy window dict and the train split's ``Normalizers`` (used by the untrained baselines to store a
-  mean pose / clip bank, and by HA2G for its angle statistics);
-- optional classmethod ``keys_for(config)`` when config switches change ``input_keys``.
+  training window set (a numpy window dict or a :class:`~beatlite.data.store.StoreWindows`; read it
+  with :func:`window_count`, :func:`window_rows` and :func:`window_chunks`, which serve both) and the
+  train split's ``Normalizers`` (used by the untrained baselines to store a mean pose / clip bank, and
+  by HA2G for its angle statistics);
+- optional classmethod ``keys_for(config)`` when config switches change ``input_keys``;
+- classmethod ``batch_keys(config)``: every batch key read in training and evaluation (``keys_for``,
+  the target and what the losses read; override it when the losses read more, as CaMN's
+  ``semantic``). ``fit`` gives the model exactly these keys and a window store reads only these.
 
 Adding a model: write the class in its own module, then ``beatlite.models.register_model(name,
 "module:Class")`` and ``beatlite.train.recipes.register_recipe(checkpoint, Recipe(name, label, ...))``;
@@ -51,14 +56,14 @@ Taught in notebooks/05_camn.ipynb, sections 2 (the seed input) and 3 (the semant
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
 import torch
 from torch import nn
 
-from beatlite.constants import N_PRE
+from beatlite.constants import N_PRE, WINDOW_LENGTH
 
 Batch = dict[str, torch.Tensor]
 
@@ -77,6 +82,54 @@ class ModelConfig:
     """
 
     preset: str = "tiny"
+
+
+@dataclasses.dataclass
+class TextConfig(ModelConfig):
+    """Fields of a model reading word ids through a :class:`~beatlite.models.layers.TextEncoderTCN`.
+
+    Attributes
+    ----------
+    vocab_size, word_dim : int
+        Embedding table (id 0 = PAD; the recipes set ``vocab_size`` to the corpus vocabulary and load
+        pretrained vectors with :meth:`GestureModel.set_word_vectors`).
+    text_hidden, text_layers : int
+        Width and depth (levels) of the TCN.
+    text_features : int
+        Text features per frame.
+    """
+
+    vocab_size: int = 5793
+    word_dim: int = 300
+    text_hidden: int = 300
+    text_layers: int = 4
+    text_features: int = 32
+
+
+@dataclasses.dataclass
+class AdversarialConfig(ModelConfig):
+    """Fields of a model trained with a :class:`~beatlite.models.layers.ConvDiscriminator`-style critic.
+
+    Attributes
+    ----------
+    adversarial : bool
+        Build the discriminator and train adversarially.
+    adv_weight : float
+        Weight of the generator's adversarial term.
+    no_adv_epochs : int
+        0-based epoch from which the adversarial term is on (:meth:`GestureModel.adversarial_active`).
+    d_hidden, d_layers : int
+        Width and recurrent layers of the discriminator.
+    n_frames : int
+        Frames T per window (the discriminator's time head is sized for it).
+    """
+
+    adversarial: bool = True
+    adv_weight: float = 0.5
+    no_adv_epochs: int = 10
+    d_hidden: int = 64
+    d_layers: int = 4
+    n_frames: int = WINDOW_LENGTH
 
 
 def config_from_preset(
@@ -146,6 +199,49 @@ def check_batch(batch: Mapping[str, Any], keys: tuple[str, ...], who: str) -> No
             raise TypeError(f"{who}: batch[{key!r}] must be a torch.Tensor, got {type(batch[key]).__name__}")
 
 
+def _reads_by_batch(windows: Any) -> bool:
+    """Whether ``windows`` is a store view read with ``batch(indices, keys=)`` (a ``StoreWindows``)."""
+    return hasattr(windows, "store") and callable(getattr(windows, "batch", None))
+
+
+def window_count(windows: Any, key: str) -> int:
+    """Number of windows N of a window set (a numpy window dict, ``Windows`` or ``StoreWindows``)."""
+    if key not in windows:
+        raise KeyError(f"the windows have no {key!r} (keys: {sorted(windows.keys())})")
+    return len(windows) if _reads_by_batch(windows) else int(np.shape(windows[key])[0])
+
+
+def window_rows(windows: Any, key: str, indices: Sequence[int] | np.ndarray) -> np.ndarray:
+    """``windows[key][indices]`` of a window set, reading only those rows from a window store.
+
+    Returns
+    -------
+    (len(indices), ...) ndarray
+        In the order of ``indices`` (repeats allowed).
+    """
+    idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+    if _reads_by_batch(windows):
+        return windows.batch(idx, keys=[key])[key]
+    return np.asarray(windows[key])[idx]
+
+
+def window_chunks(windows: Any, key: str, *, max_bytes: int = 2**28) -> Iterator[np.ndarray]:
+    """``windows[key]`` for every window in order, in chunks of at most ``max_bytes`` (one chunk in RAM).
+
+    A numpy window dict (or ``Windows``) gives its whole array as one chunk; a window store is read
+    chunk by chunk, so statistics over a corpus larger than memory stream (one chunk when it fits in
+    ``max_bytes``: then a statistic equals the in-memory one bit for bit).
+    """
+    if not _reads_by_batch(windows):
+        yield np.asarray(windows[key])
+        return
+    n = window_count(windows, key)
+    first = window_rows(windows, key, [0])
+    per = max(1, int(max_bytes // max(1, first.nbytes)))
+    for start in range(0, n, per):
+        yield window_rows(windows, key, np.arange(start, min(n, start + per)))
+
+
 class GestureModel(nn.Module):
     """Base class of every gesture model (see the module docstring for the contract).
 
@@ -188,6 +284,17 @@ class GestureModel(nn.Module):
             raise TypeError(f"{cls.__name__}: input_keys depends on the config: define keys_for(config) too")
         return tuple(keys)
 
+    @classmethod
+    def batch_keys(cls, config: ModelConfig) -> tuple[str, ...]:
+        """Every batch key a model built from ``config`` reads in training and evaluation.
+
+        :meth:`keys_for` plus the target key (default). Override it when the losses read a key the
+        forward pass does not (CaMN's ``semantic``). ``fit`` gives the model exactly these keys, and a
+        window store (``store.windows(split, keys=cls.batch_keys(config))``) reads only these.
+        """
+        target = REPRESENTATIONS[cls.representation][0]
+        return tuple(dict.fromkeys((*cls.keys_for(config), target)))
+
     # ---------------------------------------------------------------- representation
     @property
     def target_key(self) -> str:
@@ -225,9 +332,35 @@ class GestureModel(nn.Module):
         d_ids = set() if self.discriminator is None else {id(p) for p in self.discriminator.parameters()}
         return [p for p in self.parameters() if p.requires_grad and id(p) not in d_ids]
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
-        """Hook called once by ``fit`` with the numpy training windows and the train split's
-        :class:`~beatlite.data.normalize.Normalizers` (None when unknown) (default: nothing)."""
+    def prepare(self, train_windows: Any, normalizers: Any = None) -> None:
+        """Hook called once by ``fit`` with the training window set and the train split's
+        :class:`~beatlite.data.normalize.Normalizers` (None when unknown) (default: nothing).
+
+        ``train_windows`` is a numpy window dict or a ``StoreWindows``: read it with
+        :func:`window_count`, :func:`window_rows` and :func:`window_chunks`.
+        """
+
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The word-embedding tables that pretrained vectors initialise (default: none; text models list theirs)."""
+        return []
+
+    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
+        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into every table of
+        :meth:`word_embeddings` (they stay trainable); a no-op for a model without text.
+
+        Raises
+        ------
+        ValueError
+            ``vectors`` does not have a table's shape.
+        """
+        for table in self.word_embeddings():
+            values = torch.as_tensor(np.asarray(vectors), dtype=table.weight.dtype)
+            if tuple(values.shape) != tuple(table.weight.shape):
+                raise ValueError(
+                    f"vectors must be {tuple(table.weight.shape)} (vocab_size, word_dim), got {tuple(values.shape)}"
+                )
+            with torch.no_grad():
+                table.weight.copy_(values)
 
     @property
     def trainable(self) -> bool:

@@ -21,14 +21,25 @@ Taught in notebooks/07_benchmark.ipynb, section 1 (one evaluation, one common sp
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 import torch
 from torch import nn
 
-from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch, huber, seed_input
+from beatlite.models.base import (
+    AdversarialConfig,
+    Batch,
+    GestureModel,
+    ModelConfig,
+    TextConfig,
+    check_batch,
+    huber,
+    seed_input,
+    window_chunks,
+    window_count,
+    window_rows,
+)
 from beatlite.models.layers import (
     ConvDiscriminator,
     PlainWavEncoder,
@@ -50,15 +61,21 @@ def _check_pose(batch: Batch, who: str) -> torch.Tensor:
     return pose
 
 
-def _train_poses(train_windows: Mapping[str, np.ndarray], who: str) -> np.ndarray:
-    if "pose" not in train_windows:
-        raise KeyError(f"{who}.prepare: train_windows has no 'pose' (keys: {sorted(train_windows)})")
-    pose = np.asarray(train_windows["pose"], dtype=np.float32)
+def _checked_poses(pose: np.ndarray, who: str) -> np.ndarray:
+    """``pose`` as float32 after checking it is (N > 0, T, 141)."""
+    pose = np.asarray(pose, dtype=np.float32)
     if pose.ndim != 3 or pose.shape[-1] != POSE_DIM or pose.shape[0] == 0:
         raise ValueError(
             f"{who}.prepare: train_windows['pose'] must be (N>0, T, {POSE_DIM}), got {pose.shape}"
         )
     return pose
+
+
+def _n_train_windows(train_windows: Any, who: str) -> int:
+    """N of the training windows' ``pose`` (KeyError naming ``who`` without it)."""
+    if "pose" not in train_windows:
+        raise KeyError(f"{who}.prepare: train_windows has no 'pose' (keys: {sorted(train_windows.keys())})")
+    return window_count(train_windows, "pose")
 
 
 # ------------------------------------------------------------------------------------ untrained rows
@@ -101,11 +118,15 @@ class MeanPose(_Untrained):
         super().__init__(config)
         self.register_buffer("mean", torch.zeros(POSE_DIM))
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
-        pose = _train_poses(train_windows, "MeanPose")
-        self.mean.copy_(
-            torch.from_numpy(pose.reshape(-1, POSE_DIM).mean(axis=0, dtype=np.float64).astype(np.float32))
-        )
+    def prepare(self, train_windows: Any, normalizers: Any = None) -> None:
+        """Store the mean over windows and frames of ``train_windows["pose"]`` (a window dict or a store view,
+        read in chunks; float64 sums)."""
+        _n_train_windows(train_windows, "MeanPose")
+        total, count = np.zeros(POSE_DIM), 0
+        for chunk in window_chunks(train_windows, "pose"):
+            rows = _checked_poses(chunk, "MeanPose").reshape(-1, POSE_DIM)
+            total, count = total + rows.sum(axis=0, dtype=np.float64), count + len(rows)
+        self.mean.copy_(torch.from_numpy((total / count).astype(np.float32)))
 
     def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
         """``{"pose": (B, T, 141)}``, every frame = the stored mean."""
@@ -138,16 +159,18 @@ class RandomClip(_Untrained):
         """Restart the sequence of draws."""
         self._calls = 0
 
-    def prepare(self, train_windows: Mapping[str, np.ndarray], normalizers: Any = None) -> None:
-        pose = _train_poses(train_windows, "RandomClip")
+    def prepare(self, train_windows: Any, normalizers: Any = None) -> None:
+        """Keep ``n_clips`` training windows drawn with ``seed`` (a window dict or a store view: only they are read)."""
+        n = _n_train_windows(train_windows, "RandomClip")
         cfg = self.config
+        rng = np.random.default_rng(cfg.seed)
+        idx = rng.choice(n, size=cfg.n_clips, replace=n < cfg.n_clips)
+        pose = _checked_poses(window_rows(train_windows, "pose", idx), "RandomClip")
         if pose.shape[1] < cfg.n_frames:
             raise ValueError(
                 f"RandomClip.prepare: windows have {pose.shape[1]} frames < n_frames={cfg.n_frames}"
             )
-        rng = np.random.default_rng(cfg.seed)
-        idx = rng.choice(pose.shape[0], size=cfg.n_clips, replace=pose.shape[0] < cfg.n_clips)
-        self.bank.copy_(torch.from_numpy(pose[idx, : cfg.n_frames]))
+        self.bank.copy_(torch.from_numpy(pose[:, : cfg.n_frames]))
 
     def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
         """``{"pose": (B, T, 141)}`` of random bank clips (not depending on any input)."""
@@ -189,20 +212,14 @@ class _Adversarial(GestureModel):
 
 
 @dataclasses.dataclass
-class S2GConfig(ModelConfig):
+class S2GConfig(AdversarialConfig):
     """Speech2Gesture-style model: ``channels`` wide convolutions over 128-bin log-mel frames."""
 
     preset: str = "paper"
     n_mels: int = 128
     channels: int = 256
-    n_frames: int = 34
     slope: float = 0.2
     rec_weight: float = 500.0
-    adversarial: bool = True
-    adv_weight: float = 0.5
-    no_adv_epochs: int = 10
-    d_hidden: int = 64
-    d_layers: int = 4
 
 
 def _conv_block(a: int, b: int, k: int, stride: int, pad: int, slope: float) -> nn.Sequential:
@@ -265,15 +282,10 @@ class S2G(_Adversarial):
 
 
 @dataclasses.dataclass
-class TrimodalConfig(ModelConfig):
+class TrimodalConfig(TextConfig, AdversarialConfig):
     """Trimodal / MultiContext-style hyper-parameters (defaults = ``paper``: docs/reference_code.md#trimodal, hidden 300, 4 layers)."""
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     audio_channels: tuple[int, ...] = (16, 32, 64, 32)
     n_speakers: int = 30
     speaker_z: int = 16
@@ -283,12 +295,6 @@ class TrimodalConfig(ModelConfig):
     slope: float = 0.1
     rec_weight: float = 500.0
     kld_weight: float = 0.1
-    adversarial: bool = True
-    adv_weight: float = 0.5
-    no_adv_epochs: int = 10
-    d_hidden: int = 64
-    d_layers: int = 4
-    n_frames: int = 34
 
     def __post_init__(self) -> None:
         self.audio_channels = tuple(int(c) for c in self.audio_channels)
@@ -338,9 +344,9 @@ class Trimodal(_Adversarial):
         )
         self._build_discriminator()
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim)."""
-        self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The text encoder's embedding."""
+        return [self.text_encoder.embedding]
 
     def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
         """``{"pose": (B,T,141), "z_mu", "z_logvar"}``."""

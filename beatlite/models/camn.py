@@ -39,7 +39,15 @@ import numpy as np
 import torch
 from torch import nn
 
-from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch, huber, seed_input
+from beatlite.models.base import (
+    AdversarialConfig,
+    Batch,
+    GestureModel,
+    TextConfig,
+    check_batch,
+    huber,
+    seed_input,
+)
 from beatlite.models.layers import (
     BasicBlock1d,
     ConvDiscriminator,
@@ -58,18 +66,17 @@ POSE_DIM = 141
 
 
 @dataclasses.dataclass
-class CaMNConfig(ModelConfig):
+class CaMNConfig(TextConfig, AdversarialConfig):
     """CaMN hyper-parameters (defaults = the ``paper`` preset, BEAT §4, docs/reference_code.md#camn).
 
     Sizes are feature channels per frame; ``hidden``/``n_layers`` are the decoder LSTMs'.
-    ``no_adv_epochs`` is the 0-based epoch from which the adversarial term is on.
+    ``no_adv_epochs`` is the 0-based epoch from which the adversarial term is on. The text and
+    discriminator fields are :class:`~beatlite.models.base.TextConfig`'s and
+    :class:`~beatlite.models.base.AdversarialConfig`'s (CaMN's own defaults redeclared here).
     """
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
     text_hidden: int = 256
-    text_layers: int = 4
     text_features: int = 128
     n_speakers: int = 30
     speaker_features: int = 8
@@ -92,13 +99,8 @@ class CaMNConfig(ModelConfig):
     cascade: bool = True
     semantic_weighting: bool = True
     rec_weight: float = 500.0
-    adversarial: bool = True
-    adv_weight: float = 0.5
     no_adv_epochs: int = 40
     squared_adv_loss: bool = False
-    d_hidden: int = 64
-    d_layers: int = 4
-    n_frames: int = 34
 
     def __post_init__(self) -> None:
         self.audio_channels = tuple(int(c) for c in self.audio_channels)
@@ -358,15 +360,19 @@ class CaMN(GestureModel):
                 keys.append(key)
         return tuple(keys)
 
+    @classmethod
+    def batch_keys(cls, config: CaMNConfig) -> tuple[str, ...]:
+        """:meth:`keys_for` plus ``semantic`` when the loss is semantic-weighted."""
+        return (*cls.keys_for(config), *(("semantic",) if config.semantic_weighting else ()))
+
     @property
     def input_keys(self) -> tuple[str, ...]:  # type: ignore[override]
         """Batch keys the forward pass reads (:meth:`keys_for` of its config)."""
         return self.keys_for(self.config)
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim); no-op without text."""
-        if self.text_encoder is not None:
-            self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The text encoder's embedding (none without text)."""
+        return [] if self.text_encoder is None else [self.text_encoder.embedding]
 
     def encode(self, batch: Batch) -> dict[str, torch.Tensor]:
         """Per-modality features, each (B, T, C): keys ``text, speaker, emotion, audio, face`` (those on)."""

@@ -55,7 +55,7 @@ Taught in notebooks/06_ha2g.ipynb, sections 2 (the coarse-to-fine body hierarchy
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -64,7 +64,15 @@ from torch import nn
 
 from beatlite.data.normalize import Normalizers
 from beatlite.metrics.consistency import default_angle_pairs
-from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.base import (
+    N_PRE,
+    AdversarialConfig,
+    Batch,
+    GestureModel,
+    TextConfig,
+    check_batch,
+    window_chunks,
+)
 from beatlite.models.ha2g_ablations import ABLATIONS
 from beatlite.models.ha2g_audio import AUDIO_LEVELS, HierarchicalAudioEncoder, StyleCoordinator, blend_audio
 from beatlite.models.ha2g_losses import (
@@ -96,7 +104,7 @@ is :attr:`beatlite.train.TrainConfig.d_lr_weight`)."""
 
 
 @dataclasses.dataclass
-class HA2GConfig(ModelConfig):
+class HA2GConfig(TextConfig, AdversarialConfig):
     """HA2G hyper-parameters (defaults + the ``paper`` preset = HA2G's code, docs/reference_code.md#ha2g-hyperparameters).
 
     ``style``: ``"reference"`` (separate coordinator embedding, per-level style codes) or
@@ -116,11 +124,6 @@ class HA2GConfig(ModelConfig):
     """
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     text_per_level: bool = True
     n_speakers: int = 30
     z_dim: int = 16
@@ -144,7 +147,6 @@ class HA2GConfig(ModelConfig):
     use_contrastive: bool = True
     contrastive_high_negatives: bool = True
     use_physical: bool = True
-    adversarial: bool = True
     use_style_loss: bool = True
     huber_weight: float = 250.0
     huber_beta: float = 0.1
@@ -159,9 +161,6 @@ class HA2GConfig(ModelConfig):
     contrastive_min_distance: float = 1e-2
     physical_weight: float = 0.01
     angle_var_floor: float = 1e-4
-    d_hidden: int = 64
-    d_layers: int = 4
-    n_frames: int = 34
 
     def __post_init__(self) -> None:
         self.audio_channels = tuple(int(c) for c in self.audio_channels)
@@ -470,14 +469,16 @@ class HA2G(GestureModel):
         self.register_buffer("statistics_ready", torch.zeros((), dtype=torch.bool))
 
     # ------------------------------------------------------------------ data statistics
-    def set_statistics(self, mean_dirvec: np.ndarray, dirvec_windows: np.ndarray | None = None) -> None:
+    def set_statistics(
+        self, mean_dirvec: np.ndarray, dirvec_windows: np.ndarray | Iterable[np.ndarray] | None = None
+    ) -> None:
         """Store the mean direction vector and (when ``use_physical``) the angle statistics.
 
         Parameters
         ----------
         mean_dirvec : (126,) float
             The training mean subtracted from the unit direction vectors.
-        dirvec_windows : (N, T, 126) float, optional
+        dirvec_windows : (N, T, 126) float or an iterable of (N_i, T, 126) chunks, optional
             Training windows (``windows["dirvec"]``); required when ``use_physical``.
         """
         m = np.asarray(mean_dirvec, dtype=np.float64)
@@ -496,31 +497,29 @@ class HA2G(GestureModel):
                 self.angle_change.copy_(torch.as_tensor(stats.change))
             self.statistics_ready.fill_(True)
 
-    def prepare(
-        self, train_windows: Mapping[str, np.ndarray], normalizers: Normalizers | None = None
-    ) -> None:
-        """Compute the data statistics from the numpy training windows (called by ``fit``).
+    def prepare(self, train_windows: Any, normalizers: Normalizers | None = None) -> None:
+        """Compute the data statistics from the training windows (called by ``fit``).
 
-        The mean direction vector the windows were centred with is ``normalizers.dirvec.mean``
-        (the train split's :class:`~beatlite.data.normalize.Normalizers`, which ``fit`` passes).
+        ``train_windows`` is a numpy window dict or a window store view (``StoreWindows``, whose
+        ``dirvec`` is read in chunks, so memory stays flat). The mean direction vector the windows
+        were centred with is ``normalizers.dirvec.mean`` (the train split's
+        :class:`~beatlite.data.normalize.Normalizers`, which ``fit`` passes).
         """
         if "dirvec" not in train_windows:
-            raise KeyError(f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows)})")
+            raise KeyError(
+                f"HA2G.prepare: train_windows has no 'dirvec' (keys: {sorted(train_windows.keys())})"
+            )
         if normalizers is None:
             raise ValueError(
                 "HA2G.prepare needs the train split's Normalizers (fit passes Windows.normalizers, or "
                 "meta=normalizers.to_meta()): it adds the mean direction back for its angle statistics"
             )
-        self.set_statistics(normalizers.dirvec.mean, np.asarray(train_windows["dirvec"]))
+        self.set_statistics(normalizers.dirvec.mean, window_chunks(train_windows, "dirvec"))
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into every text encoder's embedding."""
-        encoders = [
-            *self.text_encoders,
-            *([self.contrastive_text] if self.contrastive_text is not None else []),
-        ]
-        for enc in encoders:
-            enc.set_word_vectors(torch.as_tensor(np.asarray(vectors), dtype=torch.float32))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The embedding of every text encoder (the generators' and the contrastive loss's)."""
+        extra = [] if self.contrastive_text is None else [self.contrastive_text]
+        return [enc.embedding for enc in (*self.text_encoders, *extra)]
 
     # ------------------------------------------------------------------ forward
     def _check_inputs(self, batch: Batch) -> None:
@@ -624,7 +623,8 @@ class HA2G(GestureModel):
             rest = dirvec.new_zeros(b, t - n_pre, d + 1)
             if k:
                 dst, src = getattr(self, f"_dst{k}"), getattr(self, f"_src{k}")
-                rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src])
+                # under autocast the prediction may be bfloat16: index_copy needs one dtype (CUDA)
+                rest = rest.index_copy(-1, dst, preds[-1][:, n_pre:, src].to(rest.dtype))
             pre_seq = torch.cat([seed, rest], dim=1)
             text = (texts[k] if len(texts) > 1 else texts[0]) if texts else no_text
             preds.append(gen(pre_seq, level_audio[:, k], text, levels[:, k]))
@@ -664,7 +664,7 @@ class HA2G(GestureModel):
             preds, weights = self._decode(dirvec, audio, texts, style["coord"], style["levels"])
             other = {}
         pose = dirvec.new_zeros(dirvec.shape).index_copy(
-            -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1]
+            -1, getattr(self, f"_cols{self.n_levels - 1}"), preds[-1].to(dirvec.dtype)
         )
         out: dict[str, torch.Tensor] = {
             "pose": pose,

@@ -12,7 +12,7 @@ Taught in notebooks/06_ha2g.ipynb, sections 4 (the multi-level contrastive loss)
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -288,8 +288,24 @@ class AngleStatistics:
     change: np.ndarray
 
 
+def _window_angles(d: np.ndarray, m: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """(N, T, 126) mean-subtracted directions and their mean -> (N, T, P) bone angles (units of pi)."""
+    from beatlite.metrics.beats import append_palm_normals, included_angles
+
+    d = np.asarray(d, dtype=np.float64)
+    if d.ndim != 3 or d.shape[2] != 3 * N_BONES or d.shape[0] < 1 or d.shape[1] < 2:
+        raise ValueError(f"dirvec_windows must be (N >= 1, T >= 2, 126), got shape {d.shape}")
+    if not np.all(np.isfinite(d)):
+        raise ValueError("dirvec_windows and mean_dirvec must be finite")
+    n, t, _ = d.shape
+    v = (d + m).reshape(n * t, N_BONES, 3)
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    v = np.divide(v, norm, out=np.zeros_like(v), where=norm > 1e-12)
+    return included_angles(append_palm_normals(v), pairs).reshape(n, t, -1)
+
+
 def angle_statistics(
-    dirvec_windows: np.ndarray,
+    dirvec_windows: np.ndarray | Iterable[np.ndarray],
     mean_dirvec: np.ndarray,
     *,
     pairs: np.ndarray | None = None,
@@ -302,8 +318,10 @@ def angle_statistics(
 
     Parameters
     ----------
-    dirvec_windows : (N, T, 126) float
-        Mean-subtracted unit direction vectors (``windows["dirvec"]``).
+    dirvec_windows : (N, T, 126) float, or an iterable of (N_i, T, 126) chunks
+        Mean-subtracted unit direction vectors (``windows["dirvec"]``); chunks (a window store read
+        piece by piece) are pooled with Chan et al.'s update: one chunk gives exactly the statistics
+        of the whole array, several agree with it up to float64 rounding.
     mean_dirvec : (126,) float
         The mean that was subtracted.
     pairs : (P, 2) int, optional
@@ -315,24 +333,28 @@ def angle_statistics(
     -------
     AngleStatistics
     """
-    from beatlite.metrics.beats import append_palm_normals, included_angles
-
-    d = np.asarray(dirvec_windows, dtype=np.float64)
-    if d.ndim != 3 or d.shape[2] != 3 * N_BONES or d.shape[0] < 1 or d.shape[1] < 2:
-        raise ValueError(f"dirvec_windows must be (N >= 1, T >= 2, 126), got shape {d.shape}")
     m = np.asarray(mean_dirvec, dtype=np.float64)
     if m.shape != (3 * N_BONES,):
         raise ValueError(f"mean_dirvec must be (126,), got shape {m.shape}")
-    if not (np.all(np.isfinite(d)) and np.all(np.isfinite(m))):
+    if not np.all(np.isfinite(m)):
         raise ValueError("dirvec_windows and mean_dirvec must be finite")
     from beatlite.metrics.consistency import default_angle_pairs
 
     pr = default_angle_pairs() if pairs is None else np.asarray(pairs, dtype=np.int64)
-    n, t, _ = d.shape
-    v = (d + m).reshape(n * t, N_BONES, 3)
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
-    v = np.divide(v, norm, out=np.zeros_like(v), where=norm > 1e-12)
-    theta = included_angles(append_palm_normals(v), pr).reshape(n, t, -1)
-    flat = theta.reshape(n * t, -1)
-    change = np.abs(np.diff(theta, axis=1)).mean(axis=(0, 1))
-    return AngleStatistics(mean=flat.mean(axis=0), var=np.maximum(flat.var(axis=0), var_floor), change=change)
+    chunks = [dirvec_windows] if isinstance(dirvec_windows, np.ndarray) else dirvec_windows
+    count, mean, m2, change_sum, change_count = 0, 0.0, 0.0, 0.0, 0
+    for chunk in chunks:
+        theta = _window_angles(chunk, m, pr)
+        flat = theta.reshape(-1, theta.shape[-1])
+        c_mean = flat.sum(axis=0) / len(flat)
+        c_m2 = ((flat - c_mean) ** 2).sum(axis=0)
+        total = count + len(flat)
+        delta = c_mean - mean
+        mean = mean + delta * (len(flat) / total) if count else c_mean
+        m2 = m2 + c_m2 + delta**2 * (count * len(flat) / total) if count else c_m2
+        count = total
+        change_sum = change_sum + np.abs(np.diff(theta, axis=1)).sum(axis=(0, 1))
+        change_count += theta.shape[0] * (theta.shape[1] - 1)
+    if not count:
+        raise ValueError("dirvec_windows must be (N >= 1, T >= 2, 126), got no windows")
+    return AngleStatistics(mean=mean, var=np.maximum(m2 / count, var_floor), change=change_sum / change_count)

@@ -39,24 +39,23 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-import numpy as np
 import torch
 from torch import nn
 
-from beatlite.models.base import N_PRE, Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.base import N_PRE, Batch, GestureModel, TextConfig, check_batch
 from beatlite.models.layers import TextEncoderTCN, mlp, sum_directions
 
 POSE_DIM = 141
 
 
 @dataclasses.dataclass
-class JointEmbeddingConfig(ModelConfig):
+class JointEmbeddingConfig(TextConfig):
     """Joint Embedding hyper-parameters (defaults = ``paper``: the sizes of Yoon et al. 2020's baseline).
 
     Attributes
     ----------
     vocab_size, word_dim, text_hidden, text_layers, text_features : int
-        :class:`~beatlite.models.layers.TextEncoderTCN` sizes.
+        :class:`~beatlite.models.layers.TextEncoderTCN` sizes (:class:`~beatlite.models.base.TextConfig`).
     hidden : int
         Width of the two encoder GRUs and of the decoder GRU.
     dec_layers : int
@@ -72,11 +71,6 @@ class JointEmbeddingConfig(ModelConfig):
     """
 
     preset: str = "paper"
-    vocab_size: int = 5793
-    word_dim: int = 300
-    text_hidden: int = 300
-    text_layers: int = 4
-    text_features: int = 32
     hidden: int = 300
     dec_layers: int = 4
     embed_dim: int = 32
@@ -119,9 +113,9 @@ class JointEmbedding(GestureModel):
         )
         self.head = mlp((cfg.hidden, cfg.hidden // 2, POSE_DIM), cfg.slope, last_act=False)
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Initialise the text embedding with pretrained vectors (vocab_size, word_dim)."""
-        self.text_encoder.set_word_vectors(torch.as_tensor(np.asarray(vectors)))
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The text encoder's embedding."""
+        return [self.text_encoder.embedding]
 
     def embed_text(self, words: torch.Tensor) -> torch.Tensor:
         """(B, T) word ids -> (B, embed_dim)."""

@@ -195,7 +195,7 @@ class TextEncoderTCN(nn.Module):
     Parameters
     ----------
     vocab_size, word_dim : int
-        Embedding table size (id 0 = PAD). Load pretrained vectors with :meth:`set_word_vectors`.
+        Embedding table size (id 0 = PAD). Load pretrained vectors with :meth:`beatlite.models.base.GestureModel.set_word_vectors`.
     hidden, n_layers : int
         TCN width and depth.
     out_features : int
@@ -220,17 +220,6 @@ class TextEncoderTCN(nn.Module):
         self.tcn = nn.Sequential(*layers)
         self.proj = nn.Linear(hidden, out_features)
         self.out_features = out_features
-
-    def set_word_vectors(self, vectors: torch.Tensor) -> None:
-        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into the embedding (stays trainable)."""
-        vectors = torch.as_tensor(vectors, dtype=self.embedding.weight.dtype)
-        if tuple(vectors.shape) != tuple(self.embedding.weight.shape):
-            raise ValueError(
-                f"vectors must be {tuple(self.embedding.weight.shape)} (vocab_size, word_dim), "
-                f"got {tuple(vectors.shape)}"
-            )
-        with torch.no_grad():
-            self.embedding.weight.copy_(vectors)
 
     def forward(self, words: torch.Tensor) -> torch.Tensor:
         if words.ndim != 2:

@@ -42,7 +42,6 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-import numpy as np
 import torch
 from torch import nn
 
@@ -130,16 +129,9 @@ class Seq2Seq(GestureModel):
         self.decoder = nn.GRU(cfg.hidden, cfg.hidden, cfg.n_layers, batch_first=True, dropout=drop)
         self.out = nn.Linear(cfg.hidden, POSE_DIM)
 
-    def set_word_vectors(self, vectors: np.ndarray | torch.Tensor) -> None:
-        """Copy pretrained word vectors ``(vocab_size, word_dim)`` into the embedding (stays trainable)."""
-        vectors = torch.as_tensor(np.asarray(vectors), dtype=self.embedding.weight.dtype)
-        if tuple(vectors.shape) != tuple(self.embedding.weight.shape):
-            raise ValueError(
-                f"vectors must be {tuple(self.embedding.weight.shape)} (vocab_size, word_dim), "
-                f"got {tuple(vectors.shape)}"
-            )
-        with torch.no_grad():
-            self.embedding.weight.copy_(vectors)
+    def word_embeddings(self) -> list[nn.Embedding]:
+        """The encoder's word embedding."""
+        return [self.embedding]
 
     def _check(self, batch: Batch) -> tuple[torch.Tensor, torch.Tensor]:
         check_batch(batch, self.input_keys, "Seq2Seq")

@@ -1,12 +1,25 @@
-"""Random window batches with the shapes of :func:`beatlite.data.windows.build_windows`, for tests.
+"""Fake window batches and the model contract suite (:func:`check_model`), for tests.
 
-The values are random (seeded) but respect each key's type and range, so a
-model's forward/backward pass can be unit-tested without the data pipeline.
+:func:`fake_windows` / :func:`fake_batch`: random (seeded) windows with the shapes of
+:func:`beatlite.data.windows.build_windows`, each key in its type and range, so a model's
+forward/backward pass can be unit-tested without the data pipeline.
 
-Not taught in a notebook: fake windows and batches for the tests.
+:func:`check_model` runs every rule of the :class:`~beatlite.models.base.GestureModel` contract on a
+model (in the spirit of scikit-learn's ``check_estimator``): shapes and seed-only generation on a batch of
+exactly its ``batch_keys``, finite losses whose backward reaches every parameter, determinism under a
+seed, the checkpoint round trip, and (given a small window store) two training steps from the store that
+equal the in-memory route bit for bit, and two under bfloat16 autocast with CUDA's dtype rules.
+``tests/test_models_contract.py`` runs it over the whole registry.
+
+Not taught in a notebook: fake windows and batches and the contract checks for the tests.
 """
 
 from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
@@ -73,3 +86,309 @@ def fake_windows(
 def fake_batch(b: int = 2, *, seed: int = 0, **kwargs: int) -> dict[str, torch.Tensor]:
     """:func:`fake_windows` as a dict of torch tensors (float32 / int64), batch size ``b``."""
     return {k: torch.from_numpy(v) for k, v in fake_windows(b, seed=seed, **kwargs).items()}
+
+
+# ---------------------------------------------------------------------------- the model contract suite
+#: Epoch given to ``losses`` in the checks: late enough that every adversarial term is on.
+LATE_EPOCH = 1000
+
+
+@dataclasses.dataclass
+class ModelCase:
+    """What every contract check receives: the model class, how to build it, and where to write.
+
+    Attributes
+    ----------
+    cls : GestureModel subclass
+    preset : str
+        Preset to build (``"tiny"``: the checks run in seconds on one core).
+    overrides : dict
+        Config overrides (e.g. ``vocab_size`` of the store's vocabulary).
+    folder : Path
+        A scratch folder for checkpoints.
+    train : StoreWindows, optional
+        A small window store's train view (the store checks need it).
+    reference : Windows or dict of ndarray, optional
+        The same windows in memory (``build_windows`` with the store view's statistics and vocabulary).
+    """
+
+    cls: type
+    preset: str
+    overrides: dict[str, Any]
+    folder: Path
+    train: Any = None
+    reference: Any = None
+
+    def build(self, seed: int = 0) -> Any:
+        """A freshly initialised model (torch seeded with ``seed``), in training mode."""
+        from beatlite.models.base import config_from_preset
+
+        torch.manual_seed(seed)
+        presets = self.cls.presets if self.cls.presets is not None else _module_presets(self.cls)
+        return self.cls(config_from_preset(self.cls.config_class, presets, self.preset, **self.overrides))
+
+    def batch(self, model: Any, b: int = 2, seed: int = 0) -> dict[str, torch.Tensor]:
+        """A fake batch of ``b`` windows holding exactly the model's :meth:`batch_keys` (ids in its ranges)."""
+        cfg = model.config
+        full = fake_batch(
+            b, seed=seed, vocab_size=int(getattr(cfg, "vocab_size", 100)),
+            n_speakers=min(4, int(getattr(cfg, "n_speakers", 4))),
+        )  # fmt: skip
+        return {k: full[k] for k in type(model).batch_keys(cfg)}
+
+
+def _module_presets(cls: type) -> Mapping[str, Any]:
+    import importlib
+
+    return importlib.import_module(cls.__module__).PRESETS
+
+
+def _prepared(case: ModelCase, model: Any) -> Any:
+    """``model`` after ``prepare`` on 8 fake windows with their own normalisers (statistics buffers set)."""
+    from beatlite.data.normalize import Normalizer, Normalizers
+
+    windows = fake_windows(8, seed=1)
+    pose, dirvec = windows["pose"].reshape(-1, 141), windows["dirvec"].reshape(-1, 126)
+    norms = Normalizers(Normalizer(pose.mean(0), pose.std(0)), Normalizer(dirvec.mean(0), np.ones(126)))
+    model.prepare(windows, norms)
+    return model
+
+
+def _reset(model: Any) -> Any:
+    """Restart a model's counted draws (``reset()`` of RandomClip, A2G) so two calls can be compared."""
+    if callable(getattr(model, "reset", None)):
+        model.reset()
+    return model
+
+
+def _train_losses(model: Any, batch: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    """One training-mode forward pass and the generator losses at :data:`LATE_EPOCH`."""
+    model.train()
+    return model.losses(batch, model(batch), epoch=LATE_EPOCH)
+
+
+def _expect(ok: Any, case: ModelCase, message: str) -> None:
+    """Raise ``AssertionError`` naming the model when ``ok`` is false (kept under ``python -O``)."""
+    if not bool(ok):
+        raise AssertionError(f"{case.cls.__name__} ({case.preset}): {message}")
+
+
+def _finite(values: Mapping[str, Any]) -> list[str]:
+    """Names of the non-finite values of a loss dict (tensors or floats)."""
+    return [
+        k
+        for k, v in values.items()
+        if not bool(torch.isfinite(torch.as_tensor(v, dtype=torch.float64)).all())
+    ]
+
+
+def check_shapes(case: ModelCase) -> None:
+    """``batch_keys`` covers ``keys_for`` and the target; on a batch of exactly those keys ``forward`` and
+    ``generate`` give a finite (B, T, D) pose, and ``generate`` reads only the ``n_pre`` seed frames (and
+    leaves a model in training mode there)."""
+    model = _prepared(case, case.build())
+    keys = set(type(model).batch_keys(model.config))
+    missing = (set(type(model).keys_for(model.config)) | {model.target_key}) - keys
+    _expect(not missing, case, f"batch_keys lacks {sorted(missing)}")
+    batch = case.batch(model)
+    b, t = batch[model.target_key].shape[:2]
+    pose = model(batch)["pose"]
+    _expect(tuple(pose.shape) == (b, t, model.pose_dim), case, f"forward pose has shape {tuple(pose.shape)}")
+    _expect(torch.isfinite(pose).all(), case, "forward pose is not finite")
+    seeded = _reset(model).generate(batch)
+    _expect(tuple(seeded.shape) == (b, t, model.pose_dim), case, f"generate gave shape {tuple(seeded.shape)}")
+    later = dict(batch)
+    later[model.target_key] = batch[model.target_key].clone()
+    later[model.target_key][:, model.n_pre :] += 1.0
+    _expect(torch.equal(_reset(model).generate(later), seeded), case, "generate reads frames after the seed")
+    _expect(model.training, case, "generate did not restore training mode")
+
+
+def check_gradients(case: ModelCase) -> None:
+    """A finite scalar ``"total"`` whose backward gives every generator parameter a finite, non-zero
+    gradient (adversarial terms on), and a discriminator loss that does the same for the discriminator."""
+    model = _prepared(case, case.build())
+    batch = case.batch(model)
+    losses = _train_losses(model, batch)
+    _expect(losses["total"].ndim == 0, case, "losses['total'] is not a scalar")
+    _expect(not _finite(losses), case, f"non-finite losses {_finite(losses)}")
+    names = {id(p): n for n, p in model.named_parameters()}
+    if model.trainable:
+        losses["total"].backward()
+        dead = [names[id(p)] for p in model.generator_parameters() if p.grad is None or not p.grad.any()]
+        bad = [
+            names[id(p)]
+            for p in model.generator_parameters()
+            if p.grad is not None and not p.grad.isfinite().all()
+        ]
+        _expect(not dead and not bad, case, f"no gradient: {dead[:5]}; non-finite gradient: {bad[:5]}")
+    if model.discriminator is not None:
+        model.zero_grad(set_to_none=True)
+        d = model.discriminator_losses(batch, model(batch))["total"]
+        _expect(d.ndim == 0 and torch.isfinite(d), case, "discriminator loss is not a finite scalar")
+        d.backward()
+        dead = [names[id(p)] for p in model.discriminator.parameters() if p.grad is None or not p.grad.any()]
+        _expect(not dead, case, f"discriminator parameters without gradient: {dead[:5]}")
+
+
+def check_determinism(case: ModelCase) -> None:
+    """One seed, two models: identical weights, and identical training-mode outputs and losses under one seed."""
+    runs = []
+    for _ in range(2):
+        model = _prepared(case, case.build(seed=0))
+        batch = case.batch(model)
+        torch.manual_seed(1)
+        out = model(batch)
+        losses = model.losses(batch, out, epoch=LATE_EPOCH)
+        runs.append((model.state_dict(), out["pose"].detach(), {k: v.detach() for k, v in losses.items()}))
+    (s1, p1, l1), (s2, p2, l2) = runs
+    _expect(all(torch.equal(s1[k], s2[k]) for k in s1), case, "two models built with one seed differ")
+    _expect(torch.equal(p1, p2), case, "two forward passes with one seed differ")
+    _expect(all(torch.equal(l1[k], l2[k]) for k in l1), case, "two loss evaluations with one seed differ")
+
+
+def check_checkpoint(case: ModelCase) -> None:
+    """save_checkpoint -> export_checkpoint (float32) -> ``torch.load(weights_only=True)`` ->
+    model_from_checkpoint generates exactly what the model generates."""
+    from beatlite.train.checkpoint import FORMAT, export_checkpoint, model_from_checkpoint, save_checkpoint
+
+    model = _prepared(case, case.build()).eval()
+    state = {k: v.detach().cpu() for k, v in model.state_dict().items()}
+    payload = {"format": FORMAT, "model": model.to_config(), "state": state, "epoch": 0, "history": []}
+    src = save_checkpoint(case.folder / f"{model.name}_train.pt", payload)
+    dst = export_checkpoint(src, case.folder / f"{model.name}.pt", half=False)
+    loaded = model_from_checkpoint(torch.load(dst, map_location="cpu", weights_only=True))
+    batch = case.batch(model)
+    _expect(loaded.to_config() == model.to_config(), case, "the checkpoint's config differs")
+    want, got = _reset(model).generate(batch), _reset(loaded).generate(batch)
+    _expect(torch.equal(want, got), case, "the loaded checkpoint generates something else")
+
+
+class CudaAutocastRules(torch.overrides.TorchFunctionMode):
+    """Raise where CUDA's autocast would while running under the CPU's.
+
+    CPU autocast promotes ``index_copy`` to the widest input dtype; CUDA autocast does not, so a float32
+    destination and a bfloat16 source fail on the GPU only (``index_copy_(): self and source expected to
+    have the same dtype``). Inside this mode they fail on the CPU too, so a CPU test covers the GPU rule.
+    """
+
+    OPS = (torch.Tensor.index_copy, torch.Tensor.index_copy_, torch.index_copy)
+
+    def __torch_function__(self, func: Any, types: Any, args: tuple = (), kwargs: dict | None = None) -> Any:
+        kwargs = kwargs or {}
+        if func in self.OPS:
+            dest, source = args[0], (args[3] if len(args) > 3 else kwargs["source"])
+            if dest.dtype != source.dtype:
+                raise RuntimeError(
+                    f"index_copy: self and source expected to have the same dtype (CUDA autocast), "
+                    f"got {dest.dtype} and {source.dtype}"
+                )
+        return func(*args, **kwargs)
+
+
+def _store_view(case: ModelCase, keys: tuple[str, ...]) -> Any:
+    """The case's train windows read through a store view of exactly ``keys``."""
+    train = case.train
+    return train.store.windows(
+        train.params["split"], length=train.length, stride=train.params["stride"], keys=keys,
+        stats=train.normalizers, vocab=train.vocab,
+    )  # fmt: skip
+
+
+def _fit_two_steps(case: ModelCase, windows: Any, *, amp: bool) -> tuple[Any, list[dict[str, Any]]]:
+    """A fresh model trained for two steps of 4 windows on ``windows`` (adversarial from the start)."""
+    from beatlite.train import TrainConfig, fit
+
+    model = case.build()
+    config = TrainConfig(
+        epochs=1, batch_size=4, windows_per_epoch=8, seed=1, no_adv_epochs=0, progress=False, amp=amp
+    )
+    with CudaAutocastRules():
+        history = fit(model, windows, config).history
+    return model, history
+
+
+def check_store_training(case: ModelCase) -> None:
+    """Two steps from a store view of exactly ``batch_keys`` equal two steps from the same windows in memory
+    (same losses, weights and buffers, bit for bit), with finite losses."""
+    model = case.build()
+    view = _store_view(case, type(model).batch_keys(model.config))
+    stored, history = _fit_two_steps(case, view, amp=False)
+    memory, reference = _fit_two_steps(case, case.reference, amp=False)
+    _expect(len(history) == (1 if stored.trainable else 0), case, f"history has {len(history)} epochs")
+    _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite losses {history}")
+    _expect(history == reference, case, f"store route {history} != in-memory route {reference}")
+    a, b = stored.state_dict(), memory.state_dict()
+    _expect(
+        all(torch.equal(a[k], b[k]) for k in a), case, "store and in-memory training end with other weights"
+    )
+    pose = _reset(stored).generate(case.batch(stored))
+    _expect(torch.isfinite(pose).all(), case, "the model prepared from the store generates non-finite values")
+
+
+def check_bf16_training(case: ModelCase) -> None:
+    """Two steps from the store under bfloat16 autocast (CPU; CUDA's dtype rules enforced): finite losses."""
+    model = case.build()
+    _, history = _fit_two_steps(case, _store_view(case, type(model).batch_keys(model.config)), amp=True)
+    _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite bf16 losses {history}")
+
+
+#: Contract checks on fake batches: name -> check(case).
+CHECKS = {
+    "shapes": check_shapes,
+    "gradients": check_gradients,
+    "determinism": check_determinism,
+    "checkpoint": check_checkpoint,
+}
+#: Contract checks that train from a window store (they need ``ModelCase.train`` and ``.reference``).
+STORE_CHECKS = {"store_training": check_store_training, "bf16_training": check_bf16_training}
+
+
+def model_case(model: str | type, folder: str | Path, *, preset: str = "tiny", train: Any = None,
+               reference: Any = None, **overrides: Any) -> ModelCase:  # fmt: skip
+    """The :class:`ModelCase` of a registry name or model class (``vocab_size`` from ``train``'s vocabulary)."""
+    from beatlite.models import model_class
+
+    cls = model_class(model) if isinstance(model, str) else model
+    fields = {f.name for f in dataclasses.fields(cls.config_class)}
+    if train is not None and "vocab_size" in fields:
+        overrides = {"vocab_size": len(train.vocab), **overrides}
+    return ModelCase(cls, preset, dict(overrides), Path(folder), train, reference)
+
+
+def check_model(model: str | type, folder: str | Path, *, train: Any = None, reference: Any = None,
+                preset: str = "tiny", **overrides: Any) -> list[str]:  # fmt: skip
+    """Run the model contract suite on a registered model (by name) or a model class.
+
+    In the spirit of scikit-learn's ``check_estimator``: every check builds a fresh model and raises
+    ``AssertionError`` naming the model and the broken rule.
+
+    Parameters
+    ----------
+    model : str or GestureModel subclass
+    folder : str or Path
+        Scratch folder for the checkpoint files.
+    train : StoreWindows, optional
+        A (small) train split of a window store: also runs :data:`STORE_CHECKS`.
+    reference : Windows or dict of ndarray, optional
+        The same windows in memory (``build_windows`` with ``train``'s statistics and vocabulary);
+        required with ``train``.
+    preset : str
+        Preset to build (``"tiny"``).
+    **overrides
+        Config overrides.
+
+    Returns
+    -------
+    list of str
+        The names of the checks run (all passed).
+    """
+    if (train is None) != (reference is None):
+        raise ValueError(
+            "check_model: give both train (a store view) and reference (the same windows in memory)"
+        )
+    case = model_case(model, folder, preset=preset, train=train, reference=reference, **overrides)
+    checks = {**CHECKS, **(STORE_CHECKS if train is not None else {})}
+    for check in checks.values():
+        check(case)
+    return list(checks)

@@ -56,8 +56,9 @@ class TrainConfig:
         Where the model trains (``"auto"``: CUDA when available, else the CPU). Checkpoints are
         always written and read on the CPU, so they load on any device.
     amp : bool
-        Mixed precision (bfloat16 autocast) for the forward pass and losses on CUDA; ignored on the
-        CPU, where training stays float32 and bitwise deterministic.
+        Mixed precision: bfloat16 autocast of the forward pass and losses on the training device (CUDA,
+        or the CPU, where torch autocasts to bfloat16 too; weights, optimiser and gradients stay
+        float32). Off by default: float32 training on the CPU is bitwise deterministic.
     checkpoint_every : int or None
         Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
         BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as

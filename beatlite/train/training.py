@@ -116,8 +116,13 @@ def _n_windows(arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], who: str
     return n
 
 
+def _is_store_view(windows: Any) -> bool:
+    """Whether ``windows`` is a window store view (a ``StoreWindows``: read with ``batch(indices, keys=)``)."""
+    return hasattr(windows, "store") and callable(getattr(windows, "batch", None))
+
+
 def _batch(
-    arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], idx: np.ndarray, device: Any = None
+    arrays: Mapping[str, np.ndarray], keys: tuple[str, ...], idx: np.ndarray | slice, device: Any = None
 ) -> dict[str, torch.Tensor]:
     out = {}
     for k in keys:
@@ -134,14 +139,22 @@ def model_device(model: torch.nn.Module) -> torch.device:
     return torch.device("cpu")
 
 
-def _needed_keys(model: GestureModel, arrays: Mapping[str, np.ndarray], who: str) -> tuple[str, ...]:
-    needed = set(model.input_keys) | {model.target_key}
-    missing = sorted(needed - set(arrays))
+def model_keys(model: GestureModel) -> tuple[str, ...]:
+    """The batch keys ``model`` reads in training and evaluation (its ``batch_keys``), in contract order."""
+    needed = set(type(model).batch_keys(model.config))
+    return tuple(k for k in TENSOR_KEYS if k in needed)
+
+
+def _needed_keys(model: GestureModel, windows: Any, who: str) -> tuple[str, ...]:
+    """:func:`model_keys`, after checking ``windows`` has them all (``KeyError`` naming the missing ones)."""
+    keys = model_keys(model)
+    have = set(windows.keys())
+    missing = sorted(set(keys) - have)
     if missing:
         raise KeyError(
-            f"{who}: windows lack {missing} needed by {type(model).__name__} (have {sorted(arrays)})"
+            f"{who}: windows lack {missing} needed by {type(model).__name__} (have {sorted(have)})"
         )
-    return tuple(k for k in TENSOR_KEYS if k in arrays)
+    return keys
 
 
 def configure_torch(seed: int, threads: int | None) -> None:
@@ -172,10 +185,14 @@ def _accumulate(
 def evaluate_losses(
     model: GestureModel, windows: Any, *, epoch: int, batch_size: int = 64
 ) -> dict[str, float]:
-    """Mean of ``model.losses`` over ``windows`` in eval mode (weighted by batch size)."""
-    arrays = as_arrays(windows)
-    keys = _needed_keys(model, arrays, "evaluate_losses")
-    n = _n_windows(arrays, keys, "evaluate_losses")
+    """Mean of ``model.losses`` over ``windows`` in eval mode (weighted by batch size).
+
+    ``windows``: in-memory windows, or a window store view read batch by batch (only the model's keys).
+    """
+    store = windows if _is_store_view(windows) else None
+    arrays = None if store is not None else as_arrays(windows)
+    keys = _needed_keys(model, windows if store is not None else arrays, "evaluate_losses")
+    n = len(store) if store is not None else _n_windows(arrays, keys, "evaluate_losses")
     was_training = model.training
     model.eval()
     sums: dict[str, float] = {}
@@ -183,7 +200,8 @@ def evaluate_losses(
     try:
         for start in range(0, n, batch_size):
             idx = np.arange(start, min(n, start + batch_size))
-            batch = _batch(arrays, keys, idx, device)
+            source = arrays if store is None else store.batch(idx, keys=keys)
+            batch = _batch(source, keys, idx if store is None else slice(None), device)
             _accumulate(sums, model.losses(batch, model(batch), epoch=epoch), len(idx))
     finally:
         model.train(was_training)
@@ -206,9 +224,11 @@ def fit(
     model : GestureModel
         Any model of :mod:`beatlite.models`. Untrained baselines (no generator
         parameters) only get :meth:`~GestureModel.prepare` and a checkpoint.
-    train_windows : dict of str -> ndarray (or an object with ``.arrays``)
-        Window arrays as :func:`beatlite.data.windows.build_windows` makes them
-        (N windows each); only the keys in :data:`TENSOR_KEYS` are used.
+    train_windows : dict of str -> ndarray, ``Windows`` or ``StoreWindows``
+        Window arrays as :func:`beatlite.data.windows.build_windows` makes them (N windows each), or a
+        window store view (:meth:`beatlite.data.store.WindowStore.windows`) read at batch time; only the
+        model's :meth:`~beatlite.models.base.GestureModel.batch_keys` are read (a ``KeyError`` names
+        the missing ones). :meth:`~beatlite.models.base.GestureModel.prepare` gets the same window set.
     config : TrainConfig
         Epochs, batch size, learning rates, seed, threads, checkpoint path, resume.
     val_windows : same type as ``train_windows``, optional
@@ -246,7 +266,7 @@ def fit(
     configure_torch(config.seed, config.threads)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
-    model.prepare(data.arrays, _normalizers_of(train_windows, meta))
+    model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
     if config.resume:
         wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
@@ -315,11 +335,8 @@ class _Data:
 
     @classmethod
     def of(cls, model: GestureModel, windows: Any) -> _Data:
-        if hasattr(windows, "store") and callable(getattr(windows, "batch", None)):  # a StoreWindows
-            missing = sorted((set(model.input_keys) | {model.target_key}) - set(windows.keys()))
-            if missing:
-                raise KeyError(f"fit: windows lack {missing} needed by {type(model).__name__}")
-            keys = tuple(k for k in TENSOR_KEYS if k in windows.keys())
+        if _is_store_view(windows):  # read at batch time: only the model's keys
+            keys = _needed_keys(model, windows, "fit")
             return cls(None, keys, len(windows), data_fingerprint(windows), windows)
         arrays = as_arrays(windows)
         keys = _needed_keys(model, arrays, "fit")
@@ -329,7 +346,9 @@ class _Data:
         """For every step, its micro-batches as (tensor dict, windows) on ``device``.
 
         A window store is read by a ``torch.utils.data.DataLoader`` (``workers`` processes, pinned
-        memory on CUDA) in exactly this order; in-memory arrays are indexed here.
+        memory on CUDA) in exactly this order; in-memory arrays are indexed here. The loader draws its
+        workers' base seed from its own generator, not torch's global one, which the models' dropout and
+        sampling use: both routes then take the same steps.
         """
         if self.store is None:
             for step in steps:
@@ -342,7 +361,7 @@ class _Data:
         flat = [m for step in steps for m in step]
         pin = getattr(device, "type", "cpu") == "cuda"
         loader = DataLoader(WindowDataset(self.store, self.keys), batch_size=None, sampler=flat,
-                            num_workers=workers, pin_memory=pin)  # fmt: skip
+                            num_workers=workers, pin_memory=pin, generator=torch.Generator())  # fmt: skip
         batches = iter(loader)
         for step in steps:
             yield [
@@ -360,7 +379,7 @@ class _Run:
         self.rank, self.world = distributed_rank()
         self.device = local_device(config.torch_device())
         model.to(self.device)
-        self.amp = config.amp and self.device.type == "cuda"
+        self.amp = bool(config.amp)
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
         self.g_opt = (
@@ -487,7 +506,7 @@ class _Run:
         self.g_opt.step()
 
     def _autocast(self) -> Any:
-        """bfloat16 autocast on CUDA when ``config.amp`` (a no-op otherwise)."""
+        """bfloat16 autocast on the training device (CUDA or CPU) when ``config.amp`` (a no-op otherwise)."""
         return torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp)
 
     def score(self, epoch: int, val_score: Callable[[GestureModel], float], entry: dict[str, Any]) -> None:

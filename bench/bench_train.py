@@ -1,0 +1,353 @@
+"""Training speed per model x preset x device x precision x batch size: windows/s, peak memory, FLOPs.
+
+Run: ``BEATLITE_THREADS=1 .venv/bin/python bench/bench_train.py --quick [--json build/bench_train.json]``
+(``--quick``: CaMN and HA2G tiny, batch 16, fp32 and bf16, on a 3-take store; under a minute on one CPU
+core). Without ``--quick`` every trainable registered model's ``tiny`` preset (and on CUDA CaMN's and HA2G's
+``paper`` preset) runs at batch 16 and 64 on the ``data_samples/`` train split (``--models``, ``--presets``,
+``--batch-sizes``, ``--devices``, ``--precisions`` choose; a paper preset on one CPU thread takes minutes per row).
+
+Per row:
+
+- **step windows/s** (and ms/step): the model's own training step, as ``fit`` takes it
+  (``beatlite.train.training._Run.step``: forward, losses, discriminator step, backward, Adam, gradient
+  clipping; adversarial epoch) on one batch already on the device: no data path.
+- **fit windows/s**: ``fit`` itself on a window store (``store.windows("train", keys=batch_keys)``), one
+  epoch of ``--fit-steps`` steps: the data path included. ``fit/step`` is their ratio (the named
+  alternative measured in the same run: what the data path costs).
+- **GFLOP/window**: FLOPs of one training step divided by the batch size, counted with
+  ``torch.utils.flop_counter.FlopCounterMode`` (matrix products and convolutions; the fused recurrent kernels
+  that it does not know, oneDNN's ``mkldnn_rnn_layer`` and cuDNN's ``_cudnn_rnn``, are counted here as
+  ``2 x frames x windows x`` the size of their weight matrices forward and twice that backward; elementwise
+  work is not counted).
+- **% of peak**: achieved FLOP/s (GFLOP/window x step windows/s) over the rate of a large matrix product
+  of the same precision measured in the same run on the same device (``peak`` line; 1024^2 on the CPU, 8192^2
+  on CUDA), i.e. of what this device reaches on dense GEMMs, not of its datasheet.
+- **peak MiB**: on CUDA ``torch.cuda.max_memory_allocated`` during the timed steps; on the CPU the peak
+  resident set above its level before the steps (``VmHWM`` after resetting it through
+  ``/proc/self/clear_refs``).
+
+Devices that are not present print ``unmeasured``. Timings on a shared machine are noisy: compare rows of
+one run, on one machine. Issue 28's targets (benchmark, not tests): CaMN paper >= 10,000 windows/s in bf16
+and HA2G paper >= 3,000 on one H100/H200; tiny models on one CPU thread no slower than before (CaMN tiny
+about 150 windows/s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch.utils.flop_counter import FlopCounterMode
+
+from beatlite.models import MODELS, build_model, model_class
+from beatlite.paths import data_dir, n_threads
+from beatlite.train import TrainConfig, fit
+from beatlite.train.training import _Run, model_keys
+
+QUICK_TAKES = ("2_scott_0_9_9", "4_lawrence_0_11_11", "6_carla_0_13_13")
+"""The 3 train takes of ``--quick`` (those of the model contract suite)."""
+UNMEASURED = "unmeasured"
+
+
+# ---------------------------------------------------------------------------- FLOPs
+def _rnn_flops(weights: list[Any], input_shape: Any) -> int:
+    """2 x (rows x cols of every 2-D weight) per frame and window of a fused recurrent kernel (forward)."""
+    steps = math.prod(input_shape[:-1])
+    return 2 * steps * sum(math.prod(w) for w in weights if w is not None and len(w) == 2)
+
+
+def _mkldnn_rnn(input, w0, w1, *args: Any, out_shape: Any = None, **kwargs: Any) -> int:  # noqa: A002, ANN001
+    return _rnn_flops([w0, w1], input)
+
+
+def _mkldnn_rnn_backward(input, w0, w1, *args: Any, out_shape: Any = None, **kwargs: Any) -> int:  # noqa: A002, ANN001
+    return 2 * _rnn_flops([w0, w1], input)
+
+
+def _cudnn_rnn(input, weights, *args: Any, out_shape: Any = None, **kwargs: Any) -> int:  # noqa: A002, ANN001
+    return _rnn_flops(list(weights), input)
+
+
+def _cudnn_rnn_backward(input, weights, *args: Any, out_shape: Any = None, **kwargs: Any) -> int:  # noqa: A002, ANN001
+    return 2 * _rnn_flops(list(weights), input)
+
+
+def _flop_counter() -> FlopCounterMode:
+    """``FlopCounterMode`` that also counts the fused recurrent kernels (module docstring)."""
+    aten = torch.ops.aten
+    mapping = {aten.mkldnn_rnn_layer: _mkldnn_rnn, aten.mkldnn_rnn_layer_backward: _mkldnn_rnn_backward}
+    if hasattr(aten, "_cudnn_rnn"):
+        mapping.update({aten._cudnn_rnn: _cudnn_rnn, aten._cudnn_rnn_backward: _cudnn_rnn_backward})
+    return FlopCounterMode(display=False, custom_mapping=mapping)
+
+
+def gemm_peak(device: torch.device, dtype: torch.dtype) -> float:
+    """FLOP/s of the best of 3 timed large square matrix products (1024 on the CPU, 8192 on CUDA)."""
+    n = 8192 if device.type == "cuda" else 1024
+    a, b = (torch.randn(n, n, device=device, dtype=dtype) for _ in range(2))
+    best = math.inf
+    for _ in range(4):
+        _sync(device)
+        start = time.perf_counter()
+        a @ b
+        _sync(device)
+        best = min(best, time.perf_counter() - start)
+    return 2 * n**3 / best
+
+
+def _sync(device: torch.device) -> None:
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
+
+
+# ---------------------------------------------------------------------------- memory
+def _status_kib(field: str) -> int:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(field + ":"):
+            return int(line.split()[1])
+    return 0
+
+
+class _PeakMemory:
+    """Peak memory (MiB) of the block: CUDA's allocator peak, or the CPU resident set's rise."""
+
+    def __init__(self, device: torch.device) -> None:
+        self.device, self.mib = device, float("nan")
+
+    def __enter__(self) -> _PeakMemory:
+        if self.device.type == "cuda":
+            torch.cuda.reset_peak_memory_stats(self.device)
+        else:
+            try:
+                Path("/proc/self/clear_refs").write_text("5")  # VmHWM := VmRSS
+            except OSError:
+                pass
+            self.start = _status_kib("VmRSS")
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.device.type == "cuda":
+            self.mib = torch.cuda.max_memory_allocated(self.device) / 2**20
+        elif Path("/proc/self/status").is_file():
+            self.mib = (_status_kib("VmHWM") - self.start) / 1024
+
+
+# ---------------------------------------------------------------------------- one row
+@dataclasses.dataclass
+class Row:
+    """One measured (or unmeasured) configuration."""
+
+    model: str
+    preset: str
+    device: str
+    precision: str
+    batch: int
+    params: int | None = None
+    gflop_per_window: float | None = None
+    step_wps: float | None = None
+    step_ms: float | None = None
+    fit_wps: float | None = None
+    peak_mib: float | None = None
+    peak_fraction: float | None = None
+    note: str = ""
+
+
+def _model(name: str, preset: str, train: Any, *, prepare: bool = True) -> Any:
+    """Model ``name`` at ``preset`` (seed 0) sized for the store's vocabulary, prepared on its windows."""
+    fields = {f.name for f in dataclasses.fields(model_class(name).config_class)}
+    torch.manual_seed(0)
+    model = build_model(
+        name, preset=preset, **({"vocab_size": len(train.vocab)} if "vocab_size" in fields else {})
+    )
+    if prepare:
+        model.prepare(train, train.normalizers)
+    return model
+
+
+def _config(device: str, precision: str, batch: int, **kw: Any) -> TrainConfig:
+    return TrainConfig(
+        batch_size=batch, device=device, amp=precision == "bf16", progress=False, no_adv_epochs=0, **kw
+    )
+
+
+def measure_step(
+    name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int
+) -> Row:
+    """The step columns of one row: FLOPs, windows/s and peak memory of ``fit``'s training step."""
+    model = _model(name, preset, train)
+    run = _Run(model, _config(device, precision, batch, epochs=1), "bench", {})
+    keys = model_keys(model)
+    data = train.batch(np.arange(batch) % len(train), keys=keys)
+    tensors = {k: torch.from_numpy(np.ascontiguousarray(v)).to(run.device) for k, v in data.items()}
+    tensors = {
+        k: v.long() if v.dtype in (torch.int32, torch.int16, torch.int8) else v for k, v in tensors.items()
+    }
+    step = [(tensors, batch)]
+    model.train()
+    with _flop_counter() as counter:
+        run.step(step, 1, 0, {})
+    run.step(step, 1, 0, {})  # warm-up (allocator, oneDNN primitives, cuDNN plans)
+    _sync(run.device)
+    with _PeakMemory(run.device) as memory:
+        start = time.perf_counter()
+        for _ in range(steps):
+            run.step(step, 1, 0, {})
+        _sync(run.device)
+        seconds = (time.perf_counter() - start) / steps
+    dtype = torch.bfloat16 if precision == "bf16" else torch.float32
+    gflop = counter.get_total_flops() / batch / 1e9
+    row = Row(
+        name, preset, device, precision, batch, model.n_parameters(), gflop, batch / seconds, 1e3 * seconds
+    )
+    row.peak_mib = memory.mib
+    row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
+    return row
+
+
+_PEAKS: dict[tuple[str, torch.dtype], float] = {}
+
+
+def _peak(device: torch.device, dtype: torch.dtype) -> float:
+    key = (str(device), dtype)
+    if key not in _PEAKS:
+        _PEAKS[key] = gemm_peak(device, dtype)
+    return _PEAKS[key]
+
+
+def measure_fit(row: Row, store_train: Any, steps: int) -> None:
+    """``fit``'s windows/s on the store view of the model's keys (one epoch of ``steps`` steps)."""
+    model = _model(row.model, row.preset, store_train, prepare=False)  # fit prepares it (timed)
+    keys = type(model).batch_keys(model.config)
+    view = store_train.store.windows("train", keys=keys, stats=store_train.normalizers)
+    n = min(len(view), steps * row.batch)
+    config = _config(row.device, row.precision, row.batch, epochs=1, windows_per_epoch=n)
+    start = time.perf_counter()
+    fit(model, view, config)
+    row.fit_wps = n / (time.perf_counter() - start)
+
+
+# ---------------------------------------------------------------------------- table and command line
+COLUMNS = (
+    ("model", "model"), ("preset", "preset"), ("device", "device"), ("precision", "precision"),
+    ("batch", "batch"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
+    ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s"),
+    ("fit_ratio", "fit/step"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
+)  # fmt: skip
+
+
+def _cell(row: Row, field: str) -> str:
+    if row.note and field not in ("model", "preset", "device", "precision", "batch"):
+        return row.note
+    value = (
+        (row.fit_wps / row.step_wps if row.fit_wps and row.step_wps else None)
+        if field == "fit_ratio"
+        else getattr(row, field)
+    )
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if field == "params":
+        return f"{value / 1e6:.2f}"
+    if field == "peak_fraction":
+        return f"{100 * value:.1f}"
+    if field in ("gflop_per_window", "fit_ratio"):
+        return f"{value:.3g}"
+    return f"{value:,.0f}" if isinstance(value, float) else str(value)
+
+
+def markdown(rows: list[Row]) -> str:
+    """The rows as a Markdown table."""
+    lines = ["| " + " | ".join(h for _, h in COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(_cell(r, f) for f, _ in COLUMNS) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def _store_train(quick: bool, folder: Path) -> Any:
+    """The train split of a window store: 3 takes of ``data_samples/`` (quick, in ``folder``) or all its takes
+    (the default store folder, built once and kept)."""
+    from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
+
+    index = index_folder(data_dir())
+    if quick:
+        return build_store(index.where(stem=list(QUICK_TAKES)), folder, workers=0).windows("train")
+    return build_store(index, workers=n_threads()).windows("train")
+
+
+def _parse() -> argparse.Namespace:
+    trainable = [n for n in MODELS if n not in ("mean_pose", "random_clip")]
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument(
+        "--quick", action="store_true", help="CaMN and HA2G tiny, batch 16, 3 takes (< 1 min on a CPU)"
+    )
+    p.add_argument(
+        "--models", nargs="+", default=None, help=f"default: {' '.join(trainable)} (quick: camn ha2g)"
+    )
+    p.add_argument(
+        "--presets", nargs="+", default=None, help="default: tiny, and paper for camn/ha2g on CUDA"
+    )
+    p.add_argument("--devices", nargs="+", default=["cpu", "cuda"])
+    p.add_argument("--precisions", nargs="+", default=["fp32", "bf16"], choices=["fp32", "bf16"])
+    p.add_argument("--batch-sizes", nargs="+", type=int, default=None, help="default 16 64 (quick: 16)")
+    p.add_argument("--steps", type=int, default=None, help="timed steps per row (default 10, quick 3)")
+    p.add_argument(
+        "--fit-steps", type=int, default=None, help="steps of the timed fit epoch (default 10, quick 2)"
+    )
+    p.add_argument("--json", type=Path, default=None, help="also write the rows as JSON here")
+    args = p.parse_args()
+    args.models = args.models or (["camn", "ha2g"] if args.quick else trainable)
+    args.batch_sizes = args.batch_sizes or ([16] if args.quick else [16, 64])
+    args.steps = args.steps or (3 if args.quick else 10)
+    args.fit_steps = args.fit_steps or (2 if args.quick else 10)
+    return args
+
+
+def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int]]:
+    """(model, preset, device, precision, batch) of every row; by default the paper presets on CUDA only."""
+    grid = []
+    for name in args.models:
+        for device in args.devices:
+            paper = name in ("camn", "ha2g") and device == "cuda" and not args.quick
+            for preset in args.presets or (["tiny", "paper"] if paper else ["tiny"]):
+                for precision in args.precisions:
+                    grid += [(name, preset, device, precision, b) for b in args.batch_sizes]
+    return grid
+
+
+def main() -> None:
+    args = _parse()
+    torch.set_num_threads(n_threads())
+    with tempfile.TemporaryDirectory() as tmp:
+        train = _store_train(args.quick, Path(tmp) / "store")
+        print(f"threads={torch.get_num_threads()}  torch {torch.__version__}  {len(train)} train windows")
+        rows = []
+        for name, preset, device, precision, batch in _grid(args):
+            if device == "cuda" and not torch.cuda.is_available():
+                rows.append(Row(name, preset, device, precision, batch, note=UNMEASURED))
+                continue
+            row = measure_step(name, preset, device, precision, batch, train, args.steps)
+            measure_fit(row, train, args.fit_steps)
+            rows.append(row)
+            print(
+                f"  {name} {preset} {device} {precision} b{batch}: {row.step_wps:,.0f} windows/s", flush=True
+            )
+    for (device, dtype), flops in sorted(_PEAKS.items(), key=str):
+        print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")
+    print(markdown(rows))
+    if args.json is not None:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
+        args.json.write_text(
+            json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1)
+        )
+
+
+if __name__ == "__main__":
+    main()
