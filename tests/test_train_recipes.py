@@ -60,19 +60,18 @@ def test_every_generator_parameter_gets_a_gradient_in_every_recipe():
     """The contract DistributedDataParallel relies on (beatlite.train.distributed): one step's generator
     loss reaches every generator parameter, before and after the adversarial epochs start."""
     torch = pytest.importorskip("torch")
+    from beatlite.data.torch_dataset import WindowDataset
     from beatlite.train.recipes import build_recipe_model, training_data
-    from beatlite.train.training import _batch, _Data
 
     torch.set_num_threads(1)
-    data = training_data()
+    data = training_data()  # the window store's train windows, as fit reads them
     for name in RECIPES:
         model = build_recipe_model(name, data, seed=1)
         generator = model.generator_parameters()
         if not generator:  # the untrained baselines
             continue
-        windows = _Data.of(model, data.train)
-        model.prepare(windows.arrays, data.train.normalizers)
-        batch = _batch(windows.arrays, windows.keys, np.arange(4), torch.device("cpu"))
+        model.prepare(data.train, data.train.normalizers)
+        batch = WindowDataset(data.train, model.batch_keys(model.config))[list(range(4))]
         for epoch in (0, 1000):
             model.zero_grad(set_to_none=True)
             model.losses(batch, model(batch), epoch=epoch)["total"].backward()
@@ -274,7 +273,8 @@ def test_fit_command_writes_only_under_out(tmp_path):
     env = {k: v for k, v in __import__("os").environ.items() if k != "BEATLITE_BUILD"}
     run_ok([*cmd, "--out", str(out), "--epochs", "1", "--device", "cpu"], env=env, timeout=600)
     assert (out / "s2g_tiny.pt").is_file() and (out / "train" / "s2g_tiny.pt").is_file()
-    assert list((out / "build" / "cache").rglob("*.npz"))  # window caches went under --out
+    assert list((out / "build" / "cache" / "store").rglob("meta.json"))  # the window store went under --out
+    assert list((out / "build" / "cache" / "index").glob("*.json"))  # and the index cache
     assert {p.name: p.stat().st_mtime_ns for p in checkpoints_dir().iterdir()} == before
     from beatlite.train.checkpoint import load_checkpoint
 
@@ -363,3 +363,58 @@ def test_retrain_all_uses_the_recorded_shipped_seed(tmp_path):
     assert recorded_shipped_seed("s2g_tiny", path) == 2022
     assert recorded_shipped_seed("camn_tiny", path) == SEED  # a row the record does not name
     assert recorded_shipped_seed("camn_tiny", tmp_path / "none.json") == SEED
+
+
+#: Other speakers for the copies of data_samples' speakers 2, 4, 6, 8 (a BEAT name must parse).
+OTHER_SPEAKERS = [{2: "1_wayne", 4: "3_solomon", 6: "5_stewart", 8: "7_sophie"},
+                  {2: "9_miranda", 4: "11_nidal", 6: "13_lu", 8: "15_carlos"},
+                  {2: "17_jorge", 4: "19_jaime", 6: "21_ayana", 8: "23_hailing"}]  # fmt: skip
+
+
+def symlinked_corpus(root, copies: int):
+    """data_samples/ ``copies`` times over (copy 0 as it is, the others under other speakers), as symlinks."""
+    from beatlite.paths import repo_root
+
+    root.mkdir()
+    for src in (repo_root() / "data_samples").iterdir():
+        sid, _, rest = src.name.partition("_")
+        if not sid.isdigit():
+            continue
+        for k in range(copies):
+            name = src.name if k == 0 else f"{OTHER_SPEAKERS[k - 1][int(sid)]}_{rest.partition('_')[2]}"
+            (root / name).symlink_to(src)
+    return root
+
+
+PEAK_RSS = """
+import resource, subprocess, sys
+done = subprocess.run(sys.argv[1:], capture_output=True, text=True)
+sys.stderr.write(done.stderr[-6000:])
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)  # KiB: the largest process of the command
+sys.exit(done.returncode)
+"""
+
+
+@pytest.mark.slow
+def test_fit_command_memory_does_not_grow_with_the_corpus(tmp_path):
+    """``fit`` reads windows from the store: on 4x the corpus its peak RSS stays within 150 MB of 1x
+    (the in-memory windows it built before would add about 3 x 190 MB: 658 train + 153 val windows of
+    about 244 KB per copy)."""
+    import os
+    import sys
+
+    peaks = {}
+    for copies in (1, 4):
+        corpus = symlinked_corpus(tmp_path / f"corpus{copies}", copies)
+        out = tmp_path / f"run{copies}"
+        cmd = [sys.executable, "-m", "beatlite.train", "fit", "s2g_tiny", "--data", str(corpus), "--out", str(out),
+               "--epochs", "1", "--device", "cpu", "--extractor-epochs", "1"]  # fmt: skip
+        env = {k: v for k, v in os.environ.items() if k != "BEATLITE_BUILD"}
+        done = run_ok([sys.executable, "-c", PEAK_RSS, *cmd], env=env, timeout=1200)
+        peaks[copies] = int(done.stdout.strip().splitlines()[-1]) / 1024  # MiB
+        assert (out / "s2g_tiny.pt").is_file() and (out / "fgd_dirvec.pt").is_file()
+    from beatlite.data.store import WindowStore
+
+    stores = list((tmp_path / "run4" / "build" / "cache" / "store").iterdir())
+    assert len(WindowStore.open(stores[0]).takes) == 4 * 44
+    assert peaks[4] < peaks[1] + 150, peaks

@@ -175,7 +175,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
     rank = int(os.environ.get("RANK", "0"))
-    data = training_data(data_dir)
+    data = training_data(data_dir, progress=rank == 0)
     extractor = None
     if data_dir != (repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"

@@ -188,7 +188,8 @@ def label_of(name: str) -> str:
 
 @dataclasses.dataclass
 class TrainingData:
-    """What every recipe trains on (built once by :func:`training_data`)."""
+    """What every recipe trains on (built once by :func:`training_data`): the window store's train and
+    validation windows (an index read batch by batch: memory flat in the corpus size)."""
 
     index: Any
     vocab: Any
@@ -196,6 +197,7 @@ class TrainingData:
     val: Any
     sentences: Any
     meta: dict[str, Any]
+    store: Any = None
 
     @functools.cached_property
     def val_takes(self) -> Any:
@@ -203,27 +205,32 @@ class TrainingData:
         (an :class:`~beatlite.train.evaluation.EvaluationSet`, prepared on first use, then shared)."""
         from beatlite.train.evaluation import load_test_set
 
-        return load_test_set(self.index, split="val", vocab=self.vocab)
+        return load_test_set(self.index, split="val", vocab=self.vocab, store=self.store)
 
 
-def training_data(data: str | Path | None = None) -> TrainingData:
-    """Index ``data`` (default ``$BEATLITE_DATA``) and build its train/val windows and vocabulary."""
+def training_data(data: str | Path | None = None, *, progress: bool = False) -> TrainingData:
+    """Index ``data`` (default ``$BEATLITE_DATA``; cached), build or update its window store
+    (:func:`beatlite.data.store.build_store`, only changed takes) and open its train/val windows.
+
+    ``progress`` shows the store's tqdm bar over the takes it builds.
+    """
     from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
     from beatlite.data.vocab import build_vocab, take_sentences
-    from beatlite.data.windows import build_windows
     from beatlite.paths import data_dir
 
     root = Path(data) if data is not None else data_dir()
     index = index_folder(root)
     vocab = build_vocab(index)
-    train = build_windows(index, split="train", vocab=vocab)
-    val = build_windows(index, split="val", vocab=vocab, stats=train.normalizers)
+    store = build_store(index, vocab=vocab, progress=progress)
+    train = store.windows("train", vocab=vocab)
+    val = store.windows("val", vocab=vocab, stats=train.normalizers)
     meta = {
         **train.normalizers.to_meta(),
         "vocab": list(vocab.itos),
         "data": str(root),
     }
-    return TrainingData(index, vocab, train, val, take_sentences(index), meta)
+    return TrainingData(index, vocab, train, val, take_sentences(index), meta, store)
 
 
 def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> Any:
