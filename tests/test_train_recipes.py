@@ -415,6 +415,8 @@ def test_fit_command_memory_does_not_grow_with_the_corpus(tmp_path):
         assert (out / "s2g_tiny.pt").is_file() and (out / "fgd_dirvec.pt").is_file()
     from beatlite.data.store import WindowStore
 
-    stores = list((tmp_path / "run4" / "build" / "cache" / "store").iterdir())
-    assert len(WindowStore.open(stores[0]).takes) == 4 * 44
+    train = [WindowStore.open(next((tmp_path / f"run{c}" / "build" / "cache" / "store").iterdir())).n_frames("train")
+             for c in (1, 4)]  # fmt: skip
+    assert train[1] >= 3 * train[0], train  # (the 1-hour speakers' split rule leaves a few copied takes out)
+    print(f"peak RSS: 1x {peaks[1]:.0f} MiB, 4x {peaks[4]:.0f} MiB")
     assert peaks[4] < peaks[1] + 150, peaks
