@@ -130,7 +130,11 @@ def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
     -------
     (T, 228) float64
         :func:`beatlite.skeleton.beat.beat_skeleton` channel rows (degrees, ``Xrotation Yrotation
-        Zrotation``; root position in cm; joints the file lacks at 0 = rest).
+        Zrotation``; root position in cm; joints the file lacks at 0 = rest). A joint in another Euler order
+        is converted through its rotation matrices; of the two equivalent angle triples the one continuous
+        with the previous frame is kept from the first frame's ``|Y| <= 90°`` on
+        (:func:`beatlite.synth.motion.continuous_euler`), so the Euler-space metrics see continuous tracks;
+        a file whose first frame lies on the other branch gives other (equivalent) Euler values.
 
     Raises
     ------
@@ -141,6 +145,7 @@ def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
     from beatlite.io import FormatError
     from beatlite.skeleton.beat import JOINT_SUBSETS, beat_skeleton
     from beatlite.skeleton.rotations import euler_to_matrix, matrix_to_euler
+    from beatlite.synth.motion import continuous_euler
 
     beat, src = beat_skeleton(), motion.skeleton
     if src.same_topology(beat):
@@ -166,8 +171,8 @@ def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
                 path, f"joint {name} has {len(order)} rotation channels, not 3", field="CHANNELS"
             )
         angles = motion.channels[:, src.rotation_channel_indices(k)]
-        if order != want:
-            angles = matrix_to_euler(euler_to_matrix(angles, order), want)
+        if order != want:  # the branch of the middle angle kept continuous over time (BEAT's tracks are)
+            angles = continuous_euler(matrix_to_euler(euler_to_matrix(angles, order), want))
         out[:, beat.rotation_channel_indices(j)] = angles
     root = src.position_channel_indices(src.index("Hips")) if "Hips" in names else []
     if len(root):
