@@ -732,6 +732,7 @@ def bootstrap_intervals(
         draw_truth = dataclasses.replace(
             truth, takes=_draw(truth.takes, idx, bounds), semantic=_pick(truth.semantic, idx),
             audio=_pick(truth.audio, idx), audio_beats=_pick(beats, idx),
+            onsets={key: _pick(v, idx) for key, v in truth.onsets.items()},
         )  # fmt: skip
         scores = evaluate(_draw(generated, idx, bounds), draw_truth, metrics=metrics, seed=seed).values()
         for key in metrics:

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -79,6 +80,9 @@ class GroundTruth:
     change_angle : (P,) float, optional
         MAAC of the training directions per angle pair (beat consistency).
     fps, sr : float, int
+    onsets : dict of str -> list
+        Per-take onsets of the variants that detect their own (``"BeatAlign (reference)"``: one array per
+        take; ``"BC (ha2g)"``: per take one array per 34-frame clip), filled on first use.
     """
 
     takes: Takes
@@ -88,6 +92,14 @@ class GroundTruth:
     change_angle: np.ndarray | None = None
     fps: float = FPS
     sr: int = SR
+    onsets: dict[str, list[Any]] = field(default_factory=dict)
+
+    def variant_onsets(self, key: str, detect: Callable[[], list[Any]]) -> list[Any]:
+        """Per-take audio onsets of one metric variant (``detect()``), computed on first use and kept in
+        :attr:`onsets` ``[key]`` (bootstrap resamples pick the takes' entries instead of detecting again)."""
+        if key not in self.onsets:
+            self.onsets[key] = detect()
+        return self.onsets[key]
 
     def beats(self) -> list[np.ndarray] | None:
         """:attr:`audio_beats`, detected from :attr:`audio` now if needed (None without audio)."""
@@ -262,21 +274,30 @@ def _beat_align(g: Takes, t: GroundTruth, seed: int) -> float:
 
 
 def _beat_align_reference(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.alignment import beat_align
+    from beatlite.metrics.alignment import VARIANTS, beat_align
 
-    return beat_align(t.audio, t.sr, g.euler, t.fps, variant="reference")
+    detect = VARIANTS["reference"].audio_beats
+    beats = t.variant_onsets("BeatAlign (reference)", lambda: [detect(y, t.sr) for y in t.audio])
+    return beat_align(None, t.sr, g.euler, t.fps, variant="reference", audio_beats=beats)
 
 
 def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
-    from beatlite.metrics.consistency import beat_consistency
+    from beatlite.metrics.consistency import beat_consistency, clip_audio_beats
 
     def compute(g: Takes, t: GroundTruth, seed: int) -> float:
         if variant == "beatlite":
             return beat_consistency(
                 None, t.sr, g.directions, t.fps, change_angle=t.change_angle, audio_beats=t.beats()
             )
+        beats = t.variant_onsets(
+            f"BC ({variant})",
+            lambda: [
+                clip_audio_beats(y, t.sr, len(d), t.fps, variant=variant)
+                for y, d in zip(t.audio, t.takes.positions, strict=True)
+            ],
+        )
         return beat_consistency(
-            t.audio, t.sr, g.directions, t.fps, change_angle=t.change_angle, variant=variant
+            None, t.sr, g.directions, t.fps, change_angle=t.change_angle, variant=variant, audio_beats=beats
         )
 
     return compute
