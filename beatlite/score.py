@@ -412,7 +412,13 @@ class ScoreResult:
             f"Predictions `{i['pred']}` ({len(i['files'])} takes) vs the `{i['split']}` split of `{i['data']}` "
             f"({len(i['takes'])} takes, {i['frames']} frames at {i['fps']:g} fps; ground truth sha256 "
             f"{i['truth_sha256']}, train-split fingerprint {i['data_fingerprint'] or 'unknown'}).",
-            f"FGD extractor `{i['extractor']}` (sha256 {i['extractor_sha256']}); beatlite {i['beatlite_version']}.",
+            f"FGD extractor `{i['extractor']}` (sha256 {i['extractor_sha256']})"
+            + (
+                f", Euler autoencoder sha256 {i['euler_extractor_sha256']}"
+                if i.get("euler_extractor_sha256")
+                else ""
+            )
+            + f"; beatlite {i['beatlite_version']}.",
         ]
         if i.get("bootstrap"):
             lines.append(
@@ -644,7 +650,7 @@ def _score(
     if unknown:
         raise ScoreInputError([f"unknown metric {k!r}; known: {', '.join(METRICS)}" for k in unknown])
     torch.set_num_threads(n_threads())
-    extractor = load_extractor("dirvec", extractor_path)
+    extractor = _extractor(extractor_path)
     euler_ae = load_extractor("pose") if "FGD (BEAT AE)" in keys else None
     truth = test.ground_truth(extractor, euler_ae)
     generated = directions_takes(directions, test, extractor, euler=euler, euler_extractor=euler_ae)
@@ -669,6 +675,27 @@ def _score(
         "seed": int(seed),
     }
     return ScoreResult(evaluation, own, intervals, info)
+
+
+def _extractor(path: str | Path | None) -> Any:
+    """The FGD extractor of the ``dirvec`` space: the shipped one, or the checkpoint at ``path``."""
+    from beatlite.metrics.extractor import load_extractor
+
+    if path is None:
+        return load_extractor("dirvec")
+    try:
+        extractor = load_extractor("dirvec", path)
+    except FileNotFoundError:
+        raise ScoreInputError([f"{path}: no such FGD extractor checkpoint"]) from None
+    except Exception as exc:  # torch.load(weights_only=True) raises several types on a foreign file
+        raise ScoreInputError(
+            [f"{path}: not a beatlite FGD extractor checkpoint ({type(exc).__name__})"]
+        ) from None
+    if extractor.space != "dirvec":
+        raise ScoreInputError(
+            [f"{path}: an extractor of the {extractor.space!r} space; FGD here needs 'dirvec' (126-d)"]
+        )
+    return extractor
 
 
 # ------------------------------------------------------------------------------------ intervals

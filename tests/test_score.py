@@ -322,3 +322,11 @@ def test_bootstrap_intervals_are_seeded_and_contain_the_estimate(test_set, tmp_p
     for key in keys:
         low, high = a.intervals[key]
         assert low <= a.evaluation.get(key).value <= high, (key, low, a.evaluation.get(key).value, high)
+
+
+def test_an_extractor_of_another_space_is_refused(truth_files, test_set):
+    path = checkpoints_dir() / "fgd_euler141.pt"
+    if not path.is_file():
+        pytest.skip("no shipped Euler extractor")
+    with pytest.raises(ScoreInputError, match="'pose' space"):
+        score_folder(truth_files, test=test_set, metrics=["FGD"], extractor=path)
