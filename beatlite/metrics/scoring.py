@@ -26,6 +26,7 @@ Taught in ``notebooks/04_metrics.ipynb`` (the metrics) and ``notebooks/07_benchm
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -80,6 +81,8 @@ class GroundTruth:
     change_angle : (P,) float, optional
         MAAC of the training directions per angle pair (beat consistency).
     fps, sr : float, int
+    mean_direction : (126,) or (42, 3) float, optional
+        The train split's mean bone direction (HA2G's ``mean_dir_vec``; ``"BC (ha2g published)"``).
     onsets : dict of str -> list
         Per-take onsets of the variants that detect their own (``"BeatAlign (reference)"``: one array per
         take; ``"BC (ha2g)"``: per take one array per 34-frame clip), filled on first use.
@@ -92,6 +95,7 @@ class GroundTruth:
     change_angle: np.ndarray | None = None
     fps: float = FPS
     sr: int = SR
+    mean_direction: np.ndarray | None = None
     onsets: dict[str, list[Any]] = field(default_factory=dict)
 
     def variant_onsets(self, key: str, detect: Callable[[], list[Any]]) -> list[Any]:
@@ -124,7 +128,7 @@ class Metric:
         None for descriptive statistics.
     needs : tuple of str
         Inputs it reads: ``"positions"``, ``"directions"``, ``"euler"``, ``"features"``,
-        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``.
+        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``.
     compute : callable
         ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float``.
     describe : str
@@ -303,6 +307,31 @@ def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
     return compute
 
 
+def _bc_published(g: Takes, t: GroundTruth, seed: int) -> float:
+    """HA2G's clip BC as published before the 2023 fix of its README: the train mean direction is not added
+    back, so angles are measured between the mean-subtracted vectors (renormalised) the model outputs."""
+    mean = np.asarray(t.mean_direction, np.float64).reshape(-1, 3)
+    residuals = dataclasses.replace(
+        g, directions=[np.asarray(d).reshape(len(d), -1, 3) - mean for d in g.directions]
+    )
+    return _bc("ha2g")(residuals, t, seed)
+
+
+def _kinematic(stat: Callable[..., dict[str, float]]) -> Callable[[Takes, GroundTruth, int], float]:
+    """GENEA's average acceleration / jerk: per take the mean over frames and moving joints (the fixed root
+    of the common space left out, as GENEA leaves out the fixed hips), then the mean over takes."""
+    return lambda g, t, seed: float(np.mean([stat(p[:, 1:], t.fps)["mean"] for p in g.positions]))
+
+
+def _speed_hellinger(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.extras import hellinger_distance, speed_histogram
+
+    def hist(takes: Takes) -> np.ndarray:
+        return speed_histogram([p[:, 1:] for p in takes.positions], t.fps)
+
+    return hellinger_distance(hist(g), hist(t.takes))
+
+
 def _diversity(g: Takes, t: GroundTruth, seed: int) -> float:
     from beatlite.metrics.variation import diversity
 
@@ -327,7 +356,7 @@ def _frame_weighted(fn: Callable[..., float]) -> Callable[[Takes, GroundTruth, i
 
 
 def _metrics() -> dict[str, Metric]:
-    from beatlite.metrics.extras import mpjpe, pck
+    from beatlite.metrics.extras import acceleration_stats, jerk_stats, mpjpe, pck
 
     win = f"{WINDOW_LENGTH}-frame windows, stride {WINDOW_STRIDE}"
     return {
@@ -351,6 +380,10 @@ def _metrics() -> dict[str, Metric]:
                      "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows, rigid angle pairs left out"),
         "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),
                             "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s"),
+        "BC (ha2g published)": Metric("BC", "ha2g_published", True, ("directions", "audio", "change_angle", "mean_direction"),
+                                      _bc_published,
+                                      "HA2G's code as published (before its 2023 README fix): BC (ha2g) on the "
+                                      "mean-subtracted directions, the train mean direction not added back"),
         "Diversity": Metric("Diversity", "ha2g", True, ("features",), _diversity,
                             "mean L1 distance of extractor features of 500 random window pairs"),
         "L1div": Metric("L1div", "beatlite", True, ("positions",), _l1div(False),
@@ -361,6 +394,14 @@ def _metrics() -> dict[str, Metric]:
                       "fraction of joints within 10 cm, frame-weighted over takes"),
         "MPJPE": Metric("MPJPE", "positions", False, ("positions",), _frame_weighted(mpjpe),
                         "mean per-joint position error, cm, frame-weighted over takes"),
+        "Acceleration (GENEA)": Metric("Acceleration", "genea", None, ("positions",), _kinematic(acceleration_stats),
+                                       "GENEA's average acceleration: |Δ²p|·fps² (cm/s²), mean over frames and "
+                                       "moving joints per take, then over takes (compare with the ground truth's)"),
+        "Jerk (GENEA)": Metric("Jerk", "genea", None, ("positions",), _kinematic(jerk_stats),
+                               "GENEA's average jerk: |Δ³p|·fps³ (cm/s³), averaged as Acceleration (GENEA)"),
+        "Speed Hellinger (GENEA)": Metric("Speed Hellinger", "genea", False, ("positions",), _speed_hellinger,
+                                          "GENEA's Hellinger distance of joint-speed histograms (1 cm/s bins, "
+                                          "0-49 cm/s, moving joints of all takes pooled) vs the ground truth's"),
     }  # fmt: skip
 
 

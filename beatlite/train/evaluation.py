@@ -283,6 +283,7 @@ class EvaluationSet:
             audio=self.audio,
             audio_beats=self.beats(),
             change_angle=self.change_angle,
+            mean_direction=self.normalizers.dirvec.mean,
         )
 
     @property
