@@ -412,3 +412,27 @@ def test_published_ha2g_bc_measures_angles_between_the_mean_subtracted_vectors()
     # the fixed code measures the 3-D bones, whose angles change half as much: no drop reaches 0.03, no beat
     fixed = evaluate(Takes(positions=pos, directions=[bones]), truth, metrics=["BC (ha2g)"]).values()
     assert np.isnan(fixed["BC (ha2g)"])
+
+
+def test_emage_bc_of_a_drifting_sinusoid():
+    """8 s at 15 fps; only the neck (TED joint 1) moves: x = sin(w t) / w + 2 t (speed 2 + cos(w t), period 1.6 s,
+    always above 0.3 x the mean speed 1), minima at t = 0.8 + 1.6 k. EMAGE leaves out 2 s (30 frames) at both ends:
+    beats at 0.4, 2.0 and 3.6 s after the cut (order 7 at 30 fps = 4 frames here). Audio beats 0.5, 2.0, 3.3 s:
+    the neck scores mean(exp(-0.1^2/0.18), 1, exp(-0.3^2/0.18)); the 7 other EMAGE joints never move (no beat,
+    0 each), so BC = that / 8."""
+    fps, n = 15.0, 120
+    t = np.arange(n) / fps
+    w = 2 * np.pi / 1.6
+    pos = np.zeros((n, 43, 3))
+    pos[:, 1, 0] = np.sin(w * t) / w + 2.0 * t
+    onsets = np.array([0.5, 2.0, 3.3])
+    truth = GroundTruth(
+        Takes(positions=[pos]),
+        audio=[np.zeros(8 * 16000, np.float32)],
+        mean_speed=np.ones(43),
+        fps=fps,
+        onsets={"BC (emage)": [onsets]},  # the onsets EMAGE's librosa call would give, set by hand
+    )
+    neck = (math.exp(-(0.1**2) / 0.18) + 1.0 + math.exp(-(0.3**2) / 0.18)) / 3
+    value = evaluate(Takes(positions=[pos]), truth, metrics=["BC (emage)"]).get("BC (emage)").value
+    assert value == pytest.approx(neck / 8, rel=1e-9)

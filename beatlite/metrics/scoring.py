@@ -83,6 +83,8 @@ class GroundTruth:
     fps, sr : float, int
     mean_direction : (126,) or (42, 3) float, optional
         The train split's mean bone direction (HA2G's ``mean_dir_vec``; ``"BC (ha2g published)"``).
+    mean_speed : (J,) float, cm/s, optional
+        The train split's mean speed of each joint of ``takes.positions`` (EMAGE's ``avg_vel``; ``"BC (emage)"``).
     onsets : dict of str -> list
         Per-take onsets of the variants that detect their own (``"BeatAlign (reference)"``: one array per
         take; ``"BC (ha2g)"``: per take one array per 34-frame clip), filled on first use.
@@ -96,6 +98,7 @@ class GroundTruth:
     fps: float = FPS
     sr: int = SR
     mean_direction: np.ndarray | None = None
+    mean_speed: np.ndarray | None = None
     onsets: dict[str, list[Any]] = field(default_factory=dict)
 
     def variant_onsets(self, key: str, detect: Callable[[], list[Any]]) -> list[Any]:
@@ -128,7 +131,7 @@ class Metric:
         None for descriptive statistics.
     needs : tuple of str
         Inputs it reads: ``"positions"``, ``"directions"``, ``"euler"``, ``"features"``,
-        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``.
+        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``, ``"mean_speed"``.
     compute : callable
         ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float``.
     describe : str
@@ -317,6 +320,25 @@ def _bc_published(g: Takes, t: GroundTruth, seed: int) -> float:
     return _bc("ha2g")(residuals, t, seed)
 
 
+#: TED-43 joints EMAGE's "BC" scores: the counterparts of its SMPL-X upper body (neck, shoulders, elbows, wrists,
+#: the nose for the head; SMPL-X's spine joints have no moving counterpart, the spine root is fixed here).
+EMAGE_JOINTS = (1, 2, 3, 4, 5, 6, 7, 38)
+
+
+def _bc_emage(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.alignment import emage_audio_beats, emage_beat_align
+
+    beats = t.variant_onsets(
+        "BC (emage)",
+        lambda: [
+            emage_audio_beats(y, t.sr, len(p), t.fps) for y, p in zip(t.audio, t.takes.positions, strict=True)
+        ],
+    )
+    joints = list(EMAGE_JOINTS)
+    speed = np.asarray(t.mean_speed, np.float64)[joints]
+    return emage_beat_align(beats, [p[:, joints] for p in g.positions], t.fps, speed)
+
+
 def _kinematic(stat: Callable[..., dict[str, float]]) -> Callable[[Takes, GroundTruth, int], float]:
     """GENEA's average acceleration / jerk: per take the mean over frames and moving joints (the fixed root
     of the common space left out, as GENEA leaves out the fixed hips), then the mean over takes."""
@@ -376,6 +398,10 @@ def _metrics() -> dict[str, Metric]:
         "BeatAlign (reference)": Metric("BeatAlign", "reference", True, ("euler", "audio"), _beat_align_reference,
                                         "BEAT's code: Euler speed of columns 36:39, 10-500 s, RMS backtrack, "
                                         "times at 22050 Hz"),
+        "BC (emage)": Metric("BC", "emage", True, ("positions", "audio", "mean_speed"), _bc_emage,
+                             "EMAGE/BEAT2's 'BC': BEAT's BeatAlign on positions (neck, shoulders, elbows, wrists, "
+                             "nose), speeds / train mean, minima of order 7 at 30 fps above 0.3, σ = 0.3 s, 2 s "
+                             "left out at both ends, joints without beats 0, takes frame-weighted"),
         "BC": Metric("BC", "beatlite", True, ("directions", "beats", "change_angle"), _bc("beatlite"),
                      "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows, rigid angle pairs left out"),
         "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),

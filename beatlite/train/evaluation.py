@@ -246,6 +246,9 @@ class EvaluationSet:
         trained on other data are flagged as stale.
     train_speakers : tuple of int
         Speaker indices of the train windows (HA2G's sampled protocol draws from them).
+    mean_speed : (43,) float64, cm/s, optional
+        Mean speed of each TED-43 joint over the train windows in the common positions space (EMAGE's
+        ``avg_vel``, for ``"BC (emage)"``).
     """
 
     takes: list[str]
@@ -262,6 +265,7 @@ class EvaluationSet:
     audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
     fingerprint: str = ""
     train_speakers: tuple[int, ...] = ()
+    mean_speed: np.ndarray | None = None
 
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
@@ -284,6 +288,7 @@ class EvaluationSet:
             audio_beats=self.beats(),
             change_angle=self.change_angle,
             mean_direction=self.normalizers.dirvec.mean,
+            mean_speed=self.mean_speed,
         )
 
     @property
@@ -398,6 +403,7 @@ def load_test_set(index: Any = None, *, split: str = "test", vocab: Any = None) 
         audio=[np.asarray(item["audio"], np.float32) for item in items],
         normalizers=train.normalizers,
         change_angle=train_change_angle(train),
+        mean_speed=train_mean_speed(train),
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=data_fingerprint(train),
@@ -415,6 +421,17 @@ def train_change_angle(train: Any) -> np.ndarray:
     # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
     dirs = train.normalizers.dirvec.inverse_transform(np.asarray(train["dirvec"], np.float64))
     return mean_angle_change([prepare_directions(w) for w in dirs], default_angle_pairs())
+
+
+def train_mean_speed(train: Any) -> np.ndarray:
+    """(43,) float64 cm/s: mean speed of each TED-43 joint over the train windows (central differences within
+    each window, positions of the common space), EMAGE's per-joint ``avg_vel`` for ``"BC (emage)"``."""
+    from beatlite.metrics.beats import position_speed
+
+    dirs = train.normalizers.inverse_transform(np.asarray(train["dirvec"], np.float64), "dirvec126")
+    n, length = dirs.shape[:2]
+    positions = directions_to_ted_positions(dirs.reshape(n * length, 42, 3)).reshape(n, length, 43, 3)
+    return np.mean([position_speed(w, FPS) for w in positions], axis=(0, 1))
 
 
 # ------------------------------------------------------------------------------------ generation
