@@ -404,7 +404,7 @@ class ScoreResult:
             rows.append([r.key + arrow, f"{r.value:.4g}", ci, f"{own.get(r.key, math.nan):.4g}"])
         text = markdown_table(["metric", "value", "95 % interval", "ground truth"], rows)
         keys = [r.key for r in self.evaluation.results]
-        return text + "\n\n" + describe(keys) + "\n\n" + self._caption()
+        return text + "\n\n" + describe(keys, sources=True) + "\n\n" + self._caption()
 
     def _caption(self) -> str:
         i = self.info
@@ -437,6 +437,8 @@ class ScoreResult:
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly: ``{"metrics": {key: {value, ground_truth, interval, variant, describe, ...}}, "skipped",
         "info"}`` (non-finite numbers as None)."""
+        from beatlite.metrics.scoring import METRICS
+
         own = self.truth.values()
         metrics = {
             r.key: {
@@ -447,6 +449,7 @@ class ScoreResult:
                 "interval": [_finite(v) for v in self.intervals[r.key]] if r.key in self.intervals else None,
                 "higher_is_better": r.higher_is_better,
                 "describe": r.describe,
+                "source": METRICS[r.key].source,
             }
             for r in self.evaluation.results
         }

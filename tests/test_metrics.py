@@ -436,3 +436,12 @@ def test_emage_bc_of_a_drifting_sinusoid():
     neck = (math.exp(-(0.1**2) / 0.18) + 1.0 + math.exp(-(0.3**2) / 0.18)) / 3
     value = evaluate(Takes(positions=[pos]), truth, metrics=["BC (emage)"]).get("BC (emage)").value
     assert value == pytest.approx(neck / 8, rel=1e-9)
+
+
+def test_every_metric_key_names_its_variant_and_where_it_comes_from():
+    from beatlite.metrics.scoring import METRICS, describe
+
+    for key, m in METRICS.items():
+        assert m.describe and len(m.source) > 40, key
+        assert any(w in m.source for w in ("et al.", "code", "metric.py", "genea")), (key, m.source)
+        assert m.source in describe([key], sources=True) and m.source not in describe([key]), key
