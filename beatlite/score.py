@@ -10,6 +10,7 @@ take (matched by stem, everything before the first dot):
                        holds the 47 joints of ``spine_neck_141`` (the others at rest). Only the rotations
                        are read (and the root position): they are applied to beatlite's BEAT skeleton, as the
                        in-library evaluation of Euler models does.
+``{stem}.npz``         BEAT2's SMPL-X parameters: refused with one line (the SMPL-X body model is not shipped).
 ``{stem}.npy``         ``(T, 42, 3)`` TED-43 unit bone directions (HA2G's vector order,
                        :data:`beatlite.skeleton.ted.TED_BONES`), ``(T, 126)`` the same flattened, or
                        ``(T, 141)`` ``spine_neck_141`` Euler degrees (CaMN's output, BEAT's channel order).
@@ -76,7 +77,7 @@ MIN_FRAMES = WINDOW_LENGTH
 EXPORT_PRECISION = 12
 """Decimals of the BVH files :func:`export_checkpoint_takes` writes (5e-13 degrees: the scores equal the in-library ones to rtol 1e-6)."""
 
-_SUFFIXES = (".bvh", ".bvh.gz", ".npy")
+_SUFFIXES = (".bvh", ".bvh.gz", ".npy", ".npz")
 
 
 class ScoreInputError(ValueError):
@@ -298,6 +299,11 @@ def read_prediction(path: str | Path) -> Prediction:
         return _bvh_prediction(p)
     if p.name.endswith(".npy"):
         return _npy_prediction(p)
+    if p.name.endswith(".npz"):  # matched so that it is named, not silently ignored
+        raise FormatError(
+            p, "BEAT2's SMPL-X .npz needs the SMPL-X body model, which beatlite does not ship: write BEAT-skeleton "
+            "BVH or TED-43 direction .npy files instead",
+        )  # fmt: skip
     raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
 
 

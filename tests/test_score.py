@@ -330,3 +330,33 @@ def test_an_extractor_of_another_space_is_refused(truth_files, test_set):
         pytest.skip("no shipped Euler extractor")
     with pytest.raises(ScoreInputError, match="'pose' space"):
         score_folder(truth_files, test=test_set, metrics=["FGD"], extractor=path)
+
+
+def test_a_too_short_prediction_and_a_smplx_npz_are_refused_one_line_each(truth_files, test_set, tmp_path):
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    short, smplx = test_set.takes[0], test_set.takes[1]
+    m = read_bvh(folder / f"{short}.bvh")
+    write_bvh(folder / f"{short}.bvh", Motion(m.skeleton, m.channels[:20], m.fps), precision=12)
+    (folder / f"{smplx}.bvh").unlink()
+    np.savez(folder / f"{smplx}.npz", poses=np.zeros((10, 165)))
+    with pytest.raises(ScoreInputError) as info:
+        score_folder(folder, test=test_set)
+    lines = info.value.lines
+    assert len(lines) == 2 and all("\n" not in line for line in lines), lines
+    assert any(short in line and "20 frames" in line and "34-frame window" in line for line in lines), lines
+    assert any(f"{smplx}.npz" in line and "SMPL-X" in line for line in lines), lines
+
+
+def test_emage_audio_beats_leave_out_two_seconds_at_both_ends():
+    """Clicks at 1, 3, 5 and 7.5 s of an 8 s take: EMAGE scores 2 s to 6 s, so the onsets at 3 and 5 s remain,
+    reported 1 and 3 s after the cut (librosa reports each click about 0.032 s late, one hop of 512 at 16 kHz)."""
+    from beatlite.metrics.alignment import emage_audio_beats
+
+    sr = 16000
+    audio = np.zeros(8 * sr, np.float32)
+    audio[[1 * sr, 3 * sr, 5 * sr, int(7.5 * sr)]] = 1.0
+    beats = emage_audio_beats(audio, sr, n_frames=120, fps=15)
+    nearest = np.abs(beats[:, None] - np.array([1.0, 3.0])[None]).min(axis=1)
+    assert len(beats) >= 2 and nearest.max() < 0.05, beats  # librosa may report a click twice, 32 ms apart
+    assert np.abs(beats - 1.0).min() < 0.05 and np.abs(beats - 3.0).min() < 0.05, beats
