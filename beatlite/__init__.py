@@ -18,6 +18,7 @@ imports torch:
 ``beatlite.models``   CaMN, HA2G and baselines (torch)
 ``beatlite.train``    one training harness and generation of whole takes (torch)
 ``beatlite.viz``      skeleton plots and animations (matplotlib, pyvista)
+``beatlite.score``    ``python -m beatlite.score``: any model's outputs scored, variants named
 ==================  ==========================================================
 
 Taught in notebooks/00_setup_and_tour.ipynb, sections 1 (the environment) and 2 (the data folder); its section 6 maps every notebook.
@@ -40,6 +41,7 @@ _SUBMODULES = (
     "models",
     "train",
     "viz",
+    "score",
     "paths",
     "report",
     "exercise",

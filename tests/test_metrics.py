@@ -337,3 +337,111 @@ def test_evaluate_variants_equal_the_metric_functions_on_beat_skeleton_motion():
     assert rep.get("SRGR (reference)").value == pytest.approx(0.5 / 0.165)
     assert rep.get("L1div (reference)").value == l1_diversity(euler, windowed=True)
     assert {"FGD", "Diversity"} <= set(rep.skipped)  # no features given
+
+
+# ----------------------------------------------------------------------------- named variants of other papers
+def _root_and_joint(x: np.ndarray) -> np.ndarray:
+    """(T, 2, 3) positions: a fixed root at the origin and one joint at (x_t, 0, 0) cm."""
+    pos = np.zeros((len(x), 2, 3))
+    pos[:, 1, 0] = x
+    return pos
+
+
+def test_genea_acceleration_and_jerk_of_polynomial_paths():
+    """x = a t^2 / 2 has |x''| = a at every frame, x = j t^3 / 6 has |x'''| = j; the fixed root is left out and
+    takes count equally whatever their length (GENEA's mean over sequences)."""
+    fps = 15.0
+    t30, t50 = np.arange(30) / fps, np.arange(50) / fps
+    quadratic = [_root_and_joint(2.0 * t30**2 / 2), _root_and_joint(6.0 * t50**2 / 2)]
+    cubic = [_root_and_joint(6.0 * t30**3 / 6), _root_and_joint(12.0 * t50**3 / 6)]
+    for takes, key, want in ((quadratic, "Acceleration (GENEA)", 4.0), (cubic, "Jerk (GENEA)", 9.0)):
+        truth = GroundTruth(Takes(positions=takes), fps=fps)
+        assert evaluate(Takes(positions=takes), truth, metrics=[key]).get(key).value == pytest.approx(
+            want, rel=1e-6
+        )
+
+
+def test_genea_speed_hellinger_of_two_histograms():
+    """Generated: the joint always moves at 2.5 cm/s (bin [2, 3)); truth: 20 frames at 2.5 and 20 at 5.5 cm/s
+    (bins [2, 3) and [5, 6)). H = sqrt(1 - sqrt(1 * 1/2)); the fixed root (speed 0) is not counted."""
+    fps = 15.0
+    steps_gen = np.full(40, 2.5 / fps)
+    steps_truth = np.r_[np.full(20, 2.5 / fps), np.full(20, 5.5 / fps)]
+    gen = _root_and_joint(np.r_[0.0, np.cumsum(steps_gen)])
+    real = _root_and_joint(np.r_[0.0, np.cumsum(steps_truth)])
+    truth = GroundTruth(Takes(positions=[real]), fps=fps)
+    value = evaluate(Takes(positions=[gen]), truth, metrics=["Speed Hellinger (GENEA)"]).values()
+    assert value["Speed Hellinger (GENEA)"] == pytest.approx(math.sqrt(1 - math.sqrt(0.5)), rel=1e-9)
+
+
+def test_published_ha2g_bc_measures_angles_between_the_mean_subtracted_vectors():
+    """Bones turning about the vertical axis with a vertical mean direction m_i = (0, 0, z_i): the vectors HA2G's
+    published code measured, d_i - m_i, are the horizontal parts of the bones. Built directly as unit horizontal
+    vectors, they give BC (ha2g) the same value as the published variant gives on the 3-D bones."""
+    sr, fps, n = 16000, 15, 60
+    audio = np.zeros(4 * sr, dtype=np.float32)
+    audio[[12800, 25600, 38400, 51200]] = 1.0
+    phi = np.cos(np.pi * (np.arange(n) - 11.5) / 12)
+    rng = np.random.default_rng(0)
+    base, rate = rng.normal(size=(42, 3)), rng.uniform(0.5, 1.5, size=42)
+    base /= np.linalg.norm(base, axis=-1, keepdims=True)
+    angle = rate * phi[:, None]
+    x, y, z = base.T
+    horizontal = np.stack(
+        [np.cos(angle) * x - np.sin(angle) * y, np.sin(angle) * x + np.cos(angle) * y], axis=-1
+    )
+    bones = np.concatenate([horizontal, np.broadcast_to(z, angle.shape)[..., None]], axis=-1)
+    flat = np.concatenate([horizontal, np.zeros((n, 42, 1))], axis=-1)
+    flat /= np.linalg.norm(flat, axis=-1, keepdims=True)
+    mean = np.stack([np.zeros(42), np.zeros(42), z], axis=-1)
+    pos = [np.zeros((n, 43, 3))]
+    truth = GroundTruth(
+        Takes(positions=pos, directions=[flat]),
+        audio=[audio],
+        change_angle=np.full(41, 0.2),  # beats drop by 0.0075 / 0.2 >= 0.03 (horizontal), 0.0038 / 0.2 (3-D)
+        mean_direction=mean.ravel(),
+        sr=sr,
+        fps=fps,
+    )
+    published = evaluate(
+        Takes(positions=pos, directions=[bones]), truth, metrics=["BC (ha2g published)"]
+    ).values()
+    by_hand = evaluate(Takes(positions=pos, directions=[flat]), truth, metrics=["BC (ha2g)"]).values()
+    assert np.isfinite(by_hand["BC (ha2g)"])
+    assert published["BC (ha2g published)"] == pytest.approx(by_hand["BC (ha2g)"], abs=1e-12)
+    # the fixed code measures the 3-D bones, whose angles change half as much: no drop reaches 0.03, no beat
+    fixed = evaluate(Takes(positions=pos, directions=[bones]), truth, metrics=["BC (ha2g)"]).values()
+    assert np.isnan(fixed["BC (ha2g)"])
+
+
+def test_emage_bc_of_a_drifting_sinusoid():
+    """8 s at 15 fps; only the neck (TED joint 1) moves: x = sin(w t) / w + 2 t (speed 2 + cos(w t), period 1.6 s,
+    always above 0.3 x the mean speed 1), minima at t = 0.8 + 1.6 k. EMAGE leaves out 2 s (30 frames) at both ends:
+    beats at 0.4, 2.0 and 3.6 s after the cut (order 7 at 30 fps = 4 frames here). Audio beats 0.5, 2.0, 3.3 s:
+    the neck scores mean(exp(-0.1^2/0.18), 1, exp(-0.3^2/0.18)); the 7 other EMAGE joints never move (no beat,
+    0 each), so BC = that / 8."""
+    fps, n = 15.0, 120
+    t = np.arange(n) / fps
+    w = 2 * np.pi / 1.6
+    pos = np.zeros((n, 43, 3))
+    pos[:, 1, 0] = np.sin(w * t) / w + 2.0 * t
+    onsets = np.array([0.5, 2.0, 3.3])
+    truth = GroundTruth(
+        Takes(positions=[pos]),
+        audio=[np.zeros(8 * 16000, np.float32)],
+        mean_speed=np.ones(43),
+        fps=fps,
+        onsets={"BC (emage)": [onsets]},  # the onsets EMAGE's librosa call would give, set by hand
+    )
+    neck = (math.exp(-(0.1**2) / 0.18) + 1.0 + math.exp(-(0.3**2) / 0.18)) / 3
+    value = evaluate(Takes(positions=[pos]), truth, metrics=["BC (emage)"]).get("BC (emage)").value
+    assert value == pytest.approx(neck / 8, rel=1e-9)
+
+
+def test_every_metric_key_names_its_variant_and_where_it_comes_from():
+    from beatlite.metrics.scoring import METRICS, describe
+
+    for key, m in METRICS.items():
+        assert m.describe and len(m.source) > 40, key
+        assert any(w in m.source for w in ("et al.", "code", "metric.py", "genea")), (key, m.source)
+        assert m.source in describe([key], sources=True) and m.source not in describe([key]), key

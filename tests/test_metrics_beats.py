@@ -20,7 +20,7 @@ from beatlite.metrics.beats import (
     mean_angle_change,
     nearest_distance,
 )
-from beatlite.metrics.consistency import BCVariant
+from beatlite.metrics.consistency import BCVariant, clip_audio_beats
 
 SR = 16000
 FPS = 15.0
@@ -157,6 +157,17 @@ def test_precomputed_audio_beats_give_the_same_scores():
     with pytest.raises(ValueError, match="clip variant"):
         clips = BCVariant(pairs=((0, 1),), palm_normals=False, clip_length=34)
         beat_consistency(None, SR, rotating_bone(), FPS, variant=clips, audio_beats=beats)
+
+
+def test_precomputed_clip_onsets_give_the_same_clip_bc():
+    """``clip_audio_beats`` detects each 34-frame clip's onsets once; passed back they give the same score."""
+    clips = BCVariant(pairs=((0, 1),), palm_normals=False, clip_length=34)
+    motion = rotating_bone(-1 / FPS)
+    direct = beat_consistency(AUDIO, SR, motion, FPS, variant=clips)
+    beats = clip_audio_beats(AUDIO, SR, len(motion), FPS, variant=clips)
+    assert len(beats) == len(range(0, len(motion) - 34 + 1, 10)) and np.isfinite(direct)
+    assert beat_consistency(None, SR, motion, FPS, variant=clips, audio_beats=beats) == direct
+    assert beat_consistency(None, SR, [motion], FPS, variant=clips, audio_beats=[beats]) == direct
 
 
 def test_euler_motion_beats_hand_computed():

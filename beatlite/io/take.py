@@ -68,6 +68,7 @@ __all__ = [
     "reconcile_rate",
     "reference_duration",
     "resample_frames",
+    "rotation_columns",
     "clip_take",
     "PHASES",
     "TAKE_EXTENSIONS",
@@ -215,7 +216,8 @@ def resample_frames(
     return (a + w[:, None] * delta).astype(v.dtype)
 
 
-def _rotation_columns(motion: Motion) -> np.ndarray:
+def rotation_columns(motion: Motion) -> np.ndarray:
+    """(K,) int64: the columns of ``motion.channels`` that hold rotations (degrees), for :func:`resample_frames`."""
     cols = [
         int(start) + k
         for start, chans in zip(motion.skeleton.channel_starts, motion.skeleton.channels)
@@ -349,7 +351,7 @@ def _align(
     """Motion and face resampled to ``fps`` and every modality cut to the shortest (with a warning)."""
     shift = 1 if phase == "beat" else 0
     channels = resample_frames(
-        source.channels, source.fps, fps, shift=shift, angle_columns=_rotation_columns(source)
+        source.channels, source.fps, fps, shift=shift, angle_columns=rotation_columns(source)
     )
     lengths = {"motion": channels.shape[0] / fps}
     n_frames = channels.shape[0]

@@ -6,7 +6,7 @@
 ``beat_align``                  BEAT BeatAlign: audio onsets vs speed minima (sigma 0.3 s)
 ``beat_consistency``            HA2G Beat Consistency: onsets vs bone-angle-change minima (0.1 s)
 ``l1_diversity``, ``diversity`` BEAT L1div on poses; HA2G Diversity on features of clip pairs
-``pck``, ``mae``, ``mpjpe``     extras, plus ``velocity_stats``, ``jerk_stats``
+``pck``, ``mae``, ``mpjpe``     extras, plus ``velocity_stats``, ``acceleration_stats``, ``jerk_stats``, ``speed_histogram``, ``hellinger_distance``
 ``evaluate``                    the one evaluation path: metrics by name and variant -> ``Evaluation``
 ``load_extractor``              the shipped FGD feature extractor (imports torch lazily)
 ==============================  ===================================================================
@@ -21,7 +21,16 @@ from typing import Any
 from beatlite.metrics.alignment import beat_align
 from beatlite.metrics.beats import audio_beats, gaussian_alignment, mean_angle_change
 from beatlite.metrics.consistency import beat_consistency
-from beatlite.metrics.extras import jerk_stats, mae, mpjpe, pck, velocity_stats
+from beatlite.metrics.extras import (
+    acceleration_stats,
+    hellinger_distance,
+    jerk_stats,
+    mae,
+    mpjpe,
+    pck,
+    speed_histogram,
+    velocity_stats,
+)
 from beatlite.metrics.frechet import fgd, fit_gaussian, frechet_distance
 from beatlite.metrics.recall import srgr
 from beatlite.metrics.scoring import METRICS, Evaluation, GroundTruth, MetricResult, Takes, evaluate
@@ -51,6 +60,9 @@ __all__ = [
     "pck",
     "srgr",
     "velocity_stats",
+    "acceleration_stats",
+    "speed_histogram",
+    "hellinger_distance",
 ]
 
 

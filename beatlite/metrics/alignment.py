@@ -17,6 +17,9 @@ Variants (``variant=``, a name of :data:`VARIANTS` or a :class:`BeatAlignVariant
   only the 10-500 s window, audio onsets backtracked to RMS minima and converted to seconds
   with librosa's default 22050 Hz (times x 0.726 at 16 kHz). Each piece is a field of
   :class:`BeatAlignVariant`: ``dataclasses.replace(VARIANTS["reference"], window=None)`` mixes them.
+- EMAGE / BEAT2's "BC" (:func:`emage_beat_align`): the same score re-implemented by BEAT's authors for EMAGE on
+  joint positions, speeds normalised by the training mean, a 0.3 threshold, minima of order 7 at 30 fps, 2 s
+  left out at both ends.
 
 Taught in notebooks/04_metrics.ipynb, section 3 (BeatAlign and beat consistency); the idea first in notebooks/03_audio_and_text_features.ipynb, section 4.
 """
@@ -33,6 +36,7 @@ from beatlite.metrics.beats import (
     alignment_score,
     audio_beats,
     euler_speed,
+    gaussian_alignment,
     local_minima,
     position_speed,
 )
@@ -248,3 +252,97 @@ def _window_indices(window: tuple[float, float], rate: float, n: int) -> tuple[i
     if not 0 <= start < end:
         raise ValueError(f"window must be (start, end) seconds with 0 <= start < end, got {window}")
     return min(int(start * rate), n), min(int(end * rate), n)
+
+
+# ----------------------------------------------------------------------------- EMAGE / BEAT2's "BC"
+#: EMAGE's parameters (PantoMatrix, ``scripts/EMAGE_2024/utils/metric.py``, class ``alignment``, and its trainers),
+#: stated there at 30 fps and kept here in seconds: minima over 7 frames on each side, a normalised speed above
+#: 0.3 at a beat, ``align_mask`` = 60 frames (2 s) left out at both ends of each take.
+EMAGE_ORDER_S = 7 / 30
+EMAGE_MIN_SPEED = 0.3
+EMAGE_SKIP_S = 2.0
+
+
+def _emage_frames(fps: float, order_s: float, skip_s: float) -> tuple[int, int]:
+    return max(1, int(round(order_s * fps))), int(round(skip_s * fps))
+
+
+def emage_audio_beats(
+    audio: np.ndarray, sr: int, n_frames: int, fps: float = FPS, *, skip_s: float = EMAGE_SKIP_S
+) -> np.ndarray:
+    """EMAGE's audio beats of one take: librosa's onsets (hop 512, in seconds at ``sr``) of the take's audio
+    without its first and last ``skip_s`` seconds, times relative to ``skip_s``.
+
+    Parameters
+    ----------
+    audio : (N,) float
+    sr : int
+    n_frames : int
+        The take's motion frames (the audio is first cut to them, as EMAGE does).
+    fps : float
+    skip_s : float
+
+    Returns
+    -------
+    (A,) float64 seconds.
+    """
+    y = as_array(audio, "audio", ndim=1, dtype=np.float32)[: int(sr / positive(fps, "fps") * n_frames)]
+    offset = int(_emage_frames(fps, EMAGE_ORDER_S, skip_s)[1] * sr / fps)
+    return audio_beats(y[offset : len(y) - offset], sr, hop_length=512, peak_pick="librosa")
+
+
+def emage_beat_align(
+    audio_beats: list[np.ndarray],
+    positions: list[np.ndarray],
+    fps: float,
+    mean_speed: np.ndarray,
+    *,
+    sigma: float = 0.3,
+    order_s: float = EMAGE_ORDER_S,
+    min_speed: float = EMAGE_MIN_SPEED,
+    skip_s: float = EMAGE_SKIP_S,
+) -> float:
+    """EMAGE / BEAT2's "BC": BEAT's BeatAlign re-implemented on joint positions (Liu et al., EMAGE, CVPR 2024).
+
+    Per take (frames ``skip = skip_s * fps`` to ``T - skip``), per joint: speed by central differences
+    (:func:`~beatlite.metrics.beats.position_speed`) divided by the joint's mean training speed, motion beats
+    at its strict local minima over ``order_s * fps`` frames on each side where the normalised speed exceeds
+    ``min_speed`` (read, as EMAGE's code does, at the minimum's index *within the cut*, i.e. frame ``i`` of the
+    take for the minimum at frame ``skip + i``), and the Gaussian alignment over the audio beats
+    (:func:`~beatlite.metrics.beats.gaussian_alignment`, σ = 0.3 s; a joint without beats scores 0). The take
+    scores the mean over its joints; takes are weighted by their scored frames ``T - 2 skip``.
+    It differs from ``beat_align``: normalised speeds, a threshold, order 7 at 30 fps, joints without beats
+    counted as 0, 2 s skipped at both ends, frame-weighted takes.
+
+    Parameters
+    ----------
+    audio_beats : list of (A_k,) float
+        :func:`emage_audio_beats` of each take.
+    positions : list of (T_k, J, 3) float, cm
+        The scored joints of each take.
+    fps : float
+    mean_speed : (J,) float, cm/s
+        Mean speed of each joint over the training data (EMAGE's ``avg_vel``).
+    sigma, order_s, min_speed, skip_s : float
+
+    Returns
+    -------
+    float in [0, 1]; NaN when no take is longer than ``2 skip_s`` with audio beats.
+    """
+    fps = positive(fps, "fps")
+    order, skip = _emage_frames(fps, order_s, skip_s)
+    scale = as_array(mean_speed, "mean_speed", ndim=1)
+    total, weight = 0.0, 0
+    for a, p in zip(audio_beats, positions, strict=True):
+        n = len(p) - 2 * skip
+        if n < 3 or len(a) == 0:
+            continue
+        speed = position_speed(p, fps) / scale
+        scores = []
+        for j in range(speed.shape[1]):
+            found = local_minima(speed[skip : skip + n, j], order)
+            kept = found[speed[found, j] > min_speed]
+            scores.append(gaussian_alignment(a, kept / fps, sigma))
+        total += float(np.mean(scores)) * n
+        weight += n
+    return total / weight if weight else float("nan")

@@ -180,8 +180,8 @@ def beat_consistency(
     variant : str or BCVariant
         A name of :data:`VARIANTS` (``"beatlite"``, ``"ha2g"``) or a custom variant.
     audio_beats : (A,) float or list, optional
-        Precomputed onset times (s) per take, as ``variant.audio_beats(y, sr)`` returns them
-        (whole takes only: a clip variant detects the onsets of each clip's audio).
+        Precomputed onset times (s) per take, as ``variant.audio_beats(y, sr)`` returns them; with a clip
+        variant, per take the list of per-clip onsets of :func:`clip_audio_beats`.
 
     Returns
     -------
@@ -244,12 +244,22 @@ def beat_consistency(
 def _scored_pieces(audio, sr, given, vecs, many, fps, v: BCVariant):
     """(audio beat times, vectors) of every take, or of every clip with the clip protocol."""
     if given is not None:
-        if v.clip_length is not None:
-            raise ValueError("audio_beats= cannot be used with a clip variant (each clip has its own onsets)")
         items, many_b = as_list(given, "audio_beats") if many else ([given], False)
-        beats = [as_array(b, f"audio_beats[{i}]", ndim=1) for i, b in enumerate(items)]
-        _same_takes(len(beats), many_b, len(vecs), many)
-        yield from zip(beats, vecs)
+        _same_takes(len(items), many_b, len(vecs), many)
+        if v.clip_length is None:
+            yield from zip([as_array(b, f"audio_beats[{i}]", ndim=1) for i, b in enumerate(items)], vecs)
+            return
+        from beatlite.data.windows import window_starts
+
+        for clips, vec in zip(items, vecs):
+            starts = window_starts(int(vec.shape[0]), v.clip_length, v.clip_stride).tolist()
+            if not isinstance(clips, list | tuple) or len(clips) != len(starts):
+                raise ValueError(
+                    f"with a clip variant, audio_beats holds per take a list of {len(starts)} per-clip onset "
+                    "arrays (clip_audio_beats), not one array per take"
+                )
+            for b, start in zip(clips, starts):
+                yield as_array(b, "audio_beats", ndim=1), vec[start : start + v.clip_length]
         return
     audios, many_a = as_list(audio, "audio")
     _same_takes(len(audios), many_a, len(vecs), many)
@@ -260,6 +270,40 @@ def _scored_pieces(audio, sr, given, vecs, many, fps, v: BCVariant):
             continue
         for y_c, v_c in _clips(y, sr, vec, fps, v.clip_length, v.clip_stride):
             yield v.audio_beats(y_c, sr), v_c
+
+
+def clip_audio_beats(
+    audio: np.ndarray, sr: int, n_frames: int, fps: float = FPS, *, variant: str | BCVariant = "ha2g"
+) -> list[np.ndarray]:
+    """Onset times (s) of each clip's own audio under a clip variant, in the order the clips are scored.
+
+    One take's list is what :func:`beat_consistency` takes per take as ``audio_beats=`` with that variant
+    (the onsets are detected once, e.g. for bootstrap resamples of the same takes).
+
+    Parameters
+    ----------
+    audio : (N,) float
+        The take's waveform at ``sr``.
+    sr : int
+    n_frames : int
+        The take's motion frames (the clips are its 34-frame windows, stride 10).
+    fps : float
+    variant : str or BCVariant
+        A variant with ``clip_length`` (``"ha2g"``).
+
+    Returns
+    -------
+    list of (A_c,) float64, one per clip.
+    """
+    v = VARIANTS.get(variant) if isinstance(variant, str) else variant
+    if not isinstance(v, BCVariant) or v.clip_length is None:
+        raise ValueError(f"variant must be a clip variant (clip_length set), got {variant!r}")
+    y = as_array(audio, "audio", ndim=1, dtype=np.float32)
+    frames = np.zeros((int(n_frames), 1))
+    return [
+        v.audio_beats(y_c, sr)
+        for y_c, _ in _clips(y, sr, frames, positive(fps, "fps"), v.clip_length, v.clip_stride)
+    ]
 
 
 def _same_takes(n_audio: int, many_audio: bool, n_dirs: int, many_dirs: bool) -> None:

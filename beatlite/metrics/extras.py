@@ -1,4 +1,4 @@
-"""Extra motion statistics: PCK, MAE, and velocity / jerk statistics.
+"""Extra motion statistics: PCK, MAE, velocity / acceleration / jerk statistics, GENEA's speed histograms.
 
 Simple, interpretable numbers to report beside the paper metrics.
 
@@ -104,6 +104,70 @@ def jerk_stats(positions: np.ndarray, fps: float) -> dict[str, float]:
     """
     j = _derivative_norm(positions, fps, 3)
     return {"mean": float(j.mean()), "std": float(j.std()), "max": float(j.max())}
+
+
+def acceleration_stats(positions: np.ndarray, fps: float) -> dict[str, float]:
+    """Acceleration (second derivative) statistics: ``||Delta^2 p_t|| * fps^2`` in cm/s^2.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) float, centimetres, T >= 3
+    fps : float
+
+    Returns
+    -------
+    dict with ``mean``, ``std``, ``max`` over all frames and joints.
+    """
+    a = _derivative_norm(positions, fps, 2)
+    return {"mean": float(a.mean()), "std": float(a.std()), "max": float(a.max())}
+
+
+#: Speed-histogram bins of GENEA's numerical evaluation (``calc_histogram.py``: width 1, edges 0..49 cm/s).
+GENEA_SPEED_BINS = np.arange(0.0, 50.0, 1.0)
+
+
+def speed_histogram(
+    positions: np.ndarray | list[np.ndarray], fps: float, bins: np.ndarray = GENEA_SPEED_BINS
+) -> np.ndarray:
+    """Counts of per-frame joint speeds ``||p_{t+1,j} - p_{t,j}|| * fps`` (cm/s), all joints and takes pooled.
+
+    GENEA's "histogram of moving distance" for velocity (Kucherenko et al. 2021, the GENEA Challenge 2020;
+    ``calc_histogram.py`` of genea-workshop/genea_numerical_evaluations): speeds outside the bin edges
+    (by default at or above 49 cm/s) are not counted, as there.
+
+    Parameters
+    ----------
+    positions : (T, J, 3) float or list of them, centimetres
+    fps : float
+    bins : (B + 1,) float
+        Bin edges, cm/s.
+
+    Returns
+    -------
+    (B,) int64 counts.
+    """
+    takes = positions if isinstance(positions, list | tuple) else [positions]
+    speeds = np.concatenate([_derivative_norm(p, fps, 1).ravel() for p in takes])
+    return np.histogram(speeds, bins=np.asarray(bins, np.float64))[0].astype(np.int64)
+
+
+def hellinger_distance(hist1: np.ndarray, hist2: np.ndarray) -> float:
+    """Hellinger distance ``sqrt(1 - sum_i sqrt(p_i q_i))`` of two histograms normalised to sum 1.
+
+    GENEA's ``hellinger_distance.py``: 0 for equal distributions, 1 for disjoint ones.
+
+    Examples
+    --------
+    >>> round(hellinger_distance(np.array([0, 4, 0]), np.array([0, 1, 1])), 4)  # sqrt(1 - sqrt(1/2))
+    0.5412
+    """
+    p = as_array(hist1, "hist1", ndim=1)
+    q = as_array(hist2, "hist2", ndim=1)
+    if p.shape != q.shape or p.sum() <= 0 or q.sum() <= 0:
+        raise ValueError(
+            f"histograms must have the same shape and positive sums, got {p.shape} and {q.shape}"
+        )
+    return float(np.sqrt(max(0.0, 1.0 - np.sum(np.sqrt(p / p.sum() * q / q.sum())))))
 
 
 def _derivative_norm(positions: np.ndarray, fps: float, order: int) -> np.ndarray:

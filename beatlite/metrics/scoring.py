@@ -26,8 +26,10 @@ Taught in ``notebooks/04_metrics.ipynb`` (the metrics) and ``notebooks/07_benchm
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -79,6 +81,13 @@ class GroundTruth:
     change_angle : (P,) float, optional
         MAAC of the training directions per angle pair (beat consistency).
     fps, sr : float, int
+    mean_direction : (126,) or (42, 3) float, optional
+        The train split's mean bone direction (HA2G's ``mean_dir_vec``; ``"BC (ha2g published)"``).
+    mean_speed : (J,) float, cm/s, optional
+        The train split's mean speed of each joint of ``takes.positions`` (EMAGE's ``avg_vel``; ``"BC (emage)"``).
+    onsets : dict of str -> list
+        Per-take onsets of the variants that detect their own (``"BeatAlign (reference)"``: one array per
+        take; ``"BC (ha2g)"``: per take one array per 34-frame clip), filled on first use.
     """
 
     takes: Takes
@@ -88,6 +97,16 @@ class GroundTruth:
     change_angle: np.ndarray | None = None
     fps: float = FPS
     sr: int = SR
+    mean_direction: np.ndarray | None = None
+    mean_speed: np.ndarray | None = None
+    onsets: dict[str, list[Any]] = field(default_factory=dict)
+
+    def variant_onsets(self, key: str, detect: Callable[[], list[Any]]) -> list[Any]:
+        """Per-take audio onsets of one metric variant (``detect()``), computed on first use and kept in
+        :attr:`onsets` ``[key]`` (bootstrap resamples pick the takes' entries instead of detecting again)."""
+        if key not in self.onsets:
+            self.onsets[key] = detect()
+        return self.onsets[key]
 
     def beats(self) -> list[np.ndarray] | None:
         """:attr:`audio_beats`, detected from :attr:`audio` now if needed (None without audio)."""
@@ -112,11 +131,13 @@ class Metric:
         None for descriptive statistics.
     needs : tuple of str
         Inputs it reads: ``"positions"``, ``"directions"``, ``"euler"``, ``"features"``,
-        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``.
+        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``, ``"mean_speed"``.
     compute : callable
         ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float``.
     describe : str
         One line for a table caption: the variant and its parameters.
+    source : str
+        Where the variant comes from (paper, code, section) and what it differs in.
     """
 
     name: str
@@ -125,6 +146,7 @@ class Metric:
     needs: tuple[str, ...]
     compute: Callable[[Takes, GroundTruth, int], float]
     describe: str
+    source: str = ""
 
 
 @dataclass(frozen=True)
@@ -206,9 +228,13 @@ def evaluate(
     return Evaluation(results, skipped)
 
 
-def describe(keys: Sequence[str]) -> str:
-    """Caption lines ``- <key>: <variant and parameters>`` for the columns of a table."""
-    return "\n".join(f"- **{key}**: {METRICS[key].describe}" for key in keys)
+def describe(keys: Sequence[str], *, sources: bool = False) -> str:
+    """Caption lines ``- <key>: <variant and parameters>`` for the columns of a table (``sources``: each
+    followed by where the variant comes from)."""
+    return "\n".join(
+        f"- **{key}**: {METRICS[key].describe}" + (f" [{METRICS[key].source}]" if sources else "")
+        for key in keys
+    )
 
 
 def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:
@@ -262,24 +288,77 @@ def _beat_align(g: Takes, t: GroundTruth, seed: int) -> float:
 
 
 def _beat_align_reference(g: Takes, t: GroundTruth, seed: int) -> float:
-    from beatlite.metrics.alignment import beat_align
+    from beatlite.metrics.alignment import VARIANTS, beat_align
 
-    return beat_align(t.audio, t.sr, g.euler, t.fps, variant="reference")
+    detect = VARIANTS["reference"].audio_beats
+    beats = t.variant_onsets("BeatAlign (reference)", lambda: [detect(y, t.sr) for y in t.audio])
+    return beat_align(None, t.sr, g.euler, t.fps, variant="reference", audio_beats=beats)
 
 
 def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
-    from beatlite.metrics.consistency import beat_consistency
+    from beatlite.metrics.consistency import beat_consistency, clip_audio_beats
 
     def compute(g: Takes, t: GroundTruth, seed: int) -> float:
         if variant == "beatlite":
             return beat_consistency(
                 None, t.sr, g.directions, t.fps, change_angle=t.change_angle, audio_beats=t.beats()
             )
+        beats = t.variant_onsets(
+            f"BC ({variant})",
+            lambda: [
+                clip_audio_beats(y, t.sr, len(d), t.fps, variant=variant)
+                for y, d in zip(t.audio, t.takes.positions, strict=True)
+            ],
+        )
         return beat_consistency(
-            t.audio, t.sr, g.directions, t.fps, change_angle=t.change_angle, variant=variant
+            None, t.sr, g.directions, t.fps, change_angle=t.change_angle, variant=variant, audio_beats=beats
         )
 
     return compute
+
+
+def _bc_published(g: Takes, t: GroundTruth, seed: int) -> float:
+    """HA2G's clip BC as published before the 2023 fix of its README: the train mean direction is not added
+    back, so angles are measured between the mean-subtracted vectors (renormalised) the model outputs."""
+    mean = np.asarray(t.mean_direction, np.float64).reshape(-1, 3)
+    residuals = dataclasses.replace(
+        g, directions=[np.asarray(d).reshape(len(d), -1, 3) - mean for d in g.directions]
+    )
+    return _bc("ha2g")(residuals, t, seed)
+
+
+#: TED-43 joints EMAGE's "BC" scores: the counterparts of its SMPL-X upper body (neck, shoulders, elbows, wrists,
+#: the nose for the head; SMPL-X's spine joints have no moving counterpart, the spine root is fixed here).
+EMAGE_JOINTS = (1, 2, 3, 4, 5, 6, 7, 38)
+
+
+def _bc_emage(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.alignment import emage_audio_beats, emage_beat_align
+
+    beats = t.variant_onsets(
+        "BC (emage)",
+        lambda: [
+            emage_audio_beats(y, t.sr, len(p), t.fps) for y, p in zip(t.audio, t.takes.positions, strict=True)
+        ],
+    )
+    joints = list(EMAGE_JOINTS)
+    speed = np.asarray(t.mean_speed, np.float64)[joints]
+    return emage_beat_align(beats, [p[:, joints] for p in g.positions], t.fps, speed)
+
+
+def _kinematic(stat: Callable[..., dict[str, float]]) -> Callable[[Takes, GroundTruth, int], float]:
+    """GENEA's average acceleration / jerk: per take the mean over frames and moving joints (the fixed root
+    of the common space left out, as GENEA leaves out the fixed hips), then the mean over takes."""
+    return lambda g, t, seed: float(np.mean([stat(p[:, 1:], t.fps)["mean"] for p in g.positions]))
+
+
+def _speed_hellinger(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.extras import hellinger_distance, speed_histogram
+
+    def hist(takes: Takes) -> np.ndarray:
+        return speed_histogram([p[:, 1:] for p in takes.positions], t.fps)
+
+    return hellinger_distance(hist(g), hist(t.takes))
 
 
 def _diversity(g: Takes, t: GroundTruth, seed: int) -> float:
@@ -306,40 +385,75 @@ def _frame_weighted(fn: Callable[..., float]) -> Callable[[Takes, GroundTruth, i
 
 
 def _metrics() -> dict[str, Metric]:
-    from beatlite.metrics.extras import mpjpe, pck
+    from beatlite.metrics.extras import acceleration_stats, jerk_stats, mpjpe, pck
 
     win = f"{WINDOW_LENGTH}-frame windows, stride {WINDOW_STRIDE}"
     return {
         "FGD": Metric("FGD", "beatlite", False, ("features",), _fgd(False),
-                      f"Fréchet distance of extractor features of {win} (stable square root)"),
+                      f"Fréchet distance of extractor features of {win} (stable square root)",
+                    source="Yoon et al. 2020 (Trimodal, ACM TOG) define FGD; BEAT (Liu et al., ECCV 2022) §6.3 and HA2G (Liu et al., CVPR 2022) §4.3 report it; beatlite's own autoencoder on TED-43 directions (docs/reference_code.md#fgd)"),
         "FGD (reference)": Metric("FGD", "reference", False, ("features",), _fgd(True),
-                                  "the same with scipy's sqrtm, 1e10 on a complex result (BEAT's code)"),
+                                  "the same with scipy's sqrtm, 1e10 on a complex result (BEAT's code)",
+                    source="BEAT's and HA2G's code: pytorch-fid's scipy sqrtm, 1e10 on a complex result; differs from FGD only in the square root (docs/reference_code.md#fgd)"),
         "FGD (BEAT AE)": Metric("FGD", "beat_ae", False, ("euler_features",), _fgd_euler,
                                 f"the same on {win} of the 141 z-scored Euler channels, features of an "
-                                "autoencoder trained on them (BEAT's space; Euler models only)"),
+                                "autoencoder trained on them (BEAT's space; Euler models only)",
+                    source="BEAT's code: features of an autoencoder on the 141 Euler channels (docs/reference_code.md#fgd-autoencoder); here beatlite's own such autoencoder, not BEAT's weights"),
         "SRGR": Metric("SRGR", "paper", True, ("positions", "semantic"), _srgr_paper,
-                       "BEAT eq. 11 on joint positions, δ = 10 cm, ground-truth semantic scores"),
+                       "BEAT eq. 11 on joint positions, δ = 10 cm, ground-truth semantic scores",
+                    source='BEAT (Liu et al., ECCV 2022) eq. 11: PCK weighted by semantic scores, here on TED-43 positions with δ = 10 cm'),
         "SRGR (reference)": Metric("SRGR", "reference", True, ("euler", "semantic"), _srgr_reference,
-                                   "BEAT's code: Euler degrees, summed |diff| < 4°, weight score / 0.165"),
+                                   "BEAT's code: Euler degrees, summed |diff| < 4°, weight score / 0.165",
+                    source="BEAT's code (docs/reference_code.md#srgr-reference): Euler degrees, summed |diff| < 4°, score / 0.165; can exceed 1"),
         "BeatAlign": Metric("BeatAlign", "beatlite", True, ("positions", "beats"), _beat_align,
-                            "audio onsets vs joint-speed minima (positions), σ = 0.3 s, mean over audio beats"),
+                            "audio onsets vs joint-speed minima (positions), σ = 0.3 s, mean over audio beats",
+                    source="BEAT (Liu et al., ECCV 2022) §6.3 / supplement §D; beatlite's clean reading on joint positions (docs/reference_code.md#beatalign-reference)"),
         "BeatAlign (reference)": Metric("BeatAlign", "reference", True, ("euler", "audio"), _beat_align_reference,
                                         "BEAT's code: Euler speed of columns 36:39, 10-500 s, RMS backtrack, "
-                                        "times at 22050 Hz"),
+                                        "times at 22050 Hz",
+                    source="BEAT's code utils/metric.py (docs/reference_code.md#beatalign-reference): one Euler triplet (a finger joint), 10-500 s, RMS backtracking, times at 22050 Hz"),
+        "BC (emage)": Metric("BC", "emage", True, ("positions", "audio", "mean_speed"), _bc_emage,
+                             "EMAGE/BEAT2's 'BC': BEAT's BeatAlign on positions (neck, shoulders, elbows, wrists, "
+                             "nose), speeds / train mean, minima of order 7 at 30 fps above 0.3, σ = 0.3 s, 2 s "
+                             "left out at both ends, joints without beats 0, takes frame-weighted",
+                    source="EMAGE (Liu et al., CVPR 2024) and BEAT2 report BeatAlign as 'BC': PantoMatrix scripts/EMAGE_2024/utils/metric.py class alignment and its trainers (align_mask 60 frames at 30 fps); joints mapped from SMPL-X to TED-43"),
         "BC": Metric("BC", "beatlite", True, ("directions", "beats", "change_angle"), _bc("beatlite"),
-                     "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows, rigid angle pairs left out"),
+                     "HA2G beat consistency on whole takes, σ = 0.1 s, MAAC of the train windows, rigid angle pairs left out",
+                    source="HA2G (Liu et al., CVPR 2022) §4.3 eq. 10-11 on whole takes (docs/reference_code.md#beat-consistency); differs from HA2G's code in scoring whole takes and dropping rigid angle pairs"),
         "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),
-                            "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s"),
+                            "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s",
+                    source="HA2G's code scripts/train_expressive.py (docs/reference_code.md#beat-consistency): 34-frame clips with their own onsets, weighted by audio beats, mean direction added back (the 2023 README fix)"),
+        "BC (ha2g published)": Metric("BC", "ha2g_published", True, ("directions", "audio", "change_angle", "mean_direction"),
+                                      _bc_published,
+                                      "HA2G's code as published (before its 2023 README fix): BC (ha2g) on the "
+                                      "mean-subtracted directions, the train mean direction not added back",
+                    source="HA2G's code as released with the paper, before the 2023 README fix (docs/reference_code.md#beat-consistency): the clip protocol on mean-subtracted vectors"),
         "Diversity": Metric("Diversity", "ha2g", True, ("features",), _diversity,
-                            "mean L1 distance of extractor features of 500 random window pairs"),
+                            "mean L1 distance of extractor features of 500 random window pairs",
+                    source="HA2G (Liu et al., CVPR 2022) §4.3 / Trimodal's evaluator: mean L1 distance of features of random clip pairs (docs/reference_code.md#ha2g-diversity); beatlite's extractor"),
         "L1div": Metric("L1div", "beatlite", True, ("positions",), _l1div(False),
-                        "BEAT L1div on positions (cm summed over joints x 3 per frame)"),
+                        "BEAT L1div on positions (cm summed over joints x 3 per frame)",
+                    source="BEAT (Liu et al., ECCV 2022) §5-6 'L1 diversity', on TED-43 positions (docs/reference_code.md#l1-diversity)"),
         "L1div (reference)": Metric("L1div", "reference", True, ("euler",), _l1div(True),
-                                    f"BEAT's code: Euler degrees of the concatenated {win}"),
+                                    f"BEAT's code: Euler degrees of the concatenated {win}",
+                    source="BEAT's code utils/metric.py L1div (docs/reference_code.md#l1-diversity): Euler degrees of the concatenated 34-frame windows"),
         "PCK": Metric("PCK", "positions", True, ("positions",), _frame_weighted(lambda a, b: pck(a, b, 10.0)),
-                      "fraction of joints within 10 cm, frame-weighted over takes"),
+                      "fraction of joints within 10 cm, frame-weighted over takes",
+                    source='Percentage of Correct Keypoints (e.g. Ginosar et al., CVPR 2019, Speech2Gesture), 10 cm, positions'),
         "MPJPE": Metric("MPJPE", "positions", False, ("positions",), _frame_weighted(mpjpe),
-                        "mean per-joint position error, cm, frame-weighted over takes"),
+                        "mean per-joint position error, cm, frame-weighted over takes",
+                    source='Mean per-joint position error (Ionescu et al., Human3.6M, TPAMI 2014), positions'),
+        "Acceleration (GENEA)": Metric("Acceleration", "genea", None, ("positions",), _kinematic(acceleration_stats),
+                                       "GENEA's average acceleration: |Δ²p|·fps² (cm/s²), mean over frames and "
+                                       "moving joints per take, then over takes (compare with the ground truth's)",
+                    source='GENEA Challenge 2020 numerical evaluation (Kucherenko et al., IUI 2021; genea_numerical_evaluations calk_jerk_or_acceleration.py): average acceleration, fixed root left out'),
+        "Jerk (GENEA)": Metric("Jerk", "genea", None, ("positions",), _kinematic(jerk_stats),
+                               "GENEA's average jerk: |Δ³p|·fps³ (cm/s³), averaged as Acceleration (GENEA)",
+                    source='GENEA Challenge 2020 numerical evaluation (Kucherenko et al., IUI 2021; genea_numerical_evaluations calk_jerk_or_acceleration.py): average jerk, fixed root left out'),
+        "Speed Hellinger (GENEA)": Metric("Speed Hellinger", "genea", False, ("positions",), _speed_hellinger,
+                                          "GENEA's Hellinger distance of joint-speed histograms (1 cm/s bins, "
+                                          "0-49 cm/s, moving joints of all takes pooled) vs the ground truth's",
+                    source='GENEA Challenge numerical evaluation (Kucherenko et al., IUI 2021; genea_numerical_evaluations calc_histogram.py + hellinger_distance.py): histogram of moving distance, Hellinger distance'),
     }  # fmt: skip
 
 

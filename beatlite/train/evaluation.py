@@ -246,6 +246,9 @@ class EvaluationSet:
         trained on other data are flagged as stale.
     train_speakers : tuple of int
         Speaker indices of the train windows (HA2G's sampled protocol draws from them).
+    mean_speed : (43,) float64, cm/s, optional
+        Mean speed of each TED-43 joint over the train windows in the common positions space (EMAGE's
+        ``avg_vel``, for ``"BC (emage)"``).
     """
 
     takes: list[str]
@@ -262,6 +265,7 @@ class EvaluationSet:
     audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
     fingerprint: str = ""
     train_speakers: tuple[int, ...] = ()
+    mean_speed: np.ndarray | None = None
 
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
@@ -283,6 +287,8 @@ class EvaluationSet:
             audio=self.audio,
             audio_beats=self.beats(),
             change_angle=self.change_angle,
+            mean_direction=self.normalizers.dirvec.mean,
+            mean_speed=self.mean_speed,
         )
 
     @property
@@ -317,16 +323,33 @@ def euler_to_directions(euler: np.ndarray) -> np.ndarray:
     -------
     (T, 42, 3) float64 unit vectors (the construction of ``build_windows``' ``"dirvec"``).
     """
-    from beatlite.io.motion import Motion
-    from beatlite.skeleton.beat import beat_skeleton, expand_subset
-    from beatlite.skeleton.directions import positions_to_directions
-    from beatlite.skeleton.ted import TED_BONES, beat_to_ted43
+    from beatlite.skeleton.beat import expand_subset
 
     euler = np.asarray(euler, dtype=np.float64)
     if euler.ndim != 2 or euler.shape[1] != 141:
         raise ValueError(f"euler must be (T, 141) degrees, got shape {euler.shape}")
-    skeleton = beat_skeleton()
-    motion = Motion(skeleton, expand_subset(euler, "spine_neck_141", skeleton), FPS)
+    return channels_to_directions(expand_subset(euler, "spine_neck_141"))
+
+
+def channels_to_directions(channels: np.ndarray) -> np.ndarray:
+    """TED-43 unit bone directions of full BEAT motion rows on beatlite's BEAT skeleton.
+
+    Parameters
+    ----------
+    channels : (T, 228) float
+        :func:`beatlite.skeleton.beat.beat_skeleton` channel rows (root position cm, rotations degrees,
+        ``Xrotation Yrotation Zrotation``).
+
+    Returns
+    -------
+    (T, 42, 3) float64 unit vectors: forward kinematics -> ``beat_to_ted43`` -> bone directions.
+    """
+    from beatlite.io.motion import Motion
+    from beatlite.skeleton.beat import beat_skeleton
+    from beatlite.skeleton.directions import positions_to_directions
+    from beatlite.skeleton.ted import TED_BONES, beat_to_ted43
+
+    motion = Motion(beat_skeleton(), channels, FPS)
     return positions_to_directions(beat_to_ted43(motion.positions()), np.asarray(TED_BONES))
 
 
@@ -389,6 +412,7 @@ def load_test_set(
         audio=[np.asarray(item["audio"], np.float32) for item in items],
         normalizers=norms,
         change_angle=train_change_angle(train),
+        mean_speed=train_mean_speed(train),
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=train.fingerprint,
@@ -423,6 +447,17 @@ def train_change_angle(train: Any, batch_size: int = 1024) -> np.ndarray:
     return total / n
 
 
+def train_mean_speed(train: Any) -> np.ndarray:
+    """(43,) float64 cm/s: mean speed of each TED-43 joint over the train windows (central differences within
+    each window, positions of the common space), EMAGE's per-joint ``avg_vel`` for ``"BC (emage)"``."""
+    from beatlite.metrics.beats import position_speed
+
+    dirs = train.normalizers.inverse_transform(np.asarray(train["dirvec"], np.float64), "dirvec126")
+    n, length = dirs.shape[:2]
+    positions = directions_to_ted_positions(dirs.reshape(n * length, 42, 3)).reshape(n, length, 43, 3)
+    return np.mean([position_speed(w, FPS) for w in positions], axis=(0, 1))
+
+
 # ------------------------------------------------------------------------------------ generation
 def generated_directions(
     model: Any, test: EvaluationSet, normalizers: Normalizers | None = None
@@ -446,14 +481,28 @@ def generated_directions(
     -------
     list of (T, 42, 3) float64 unit vectors, one per take.
     """
-    directions, _ = _generate(model, test, normalizers)
+    directions, _ = generate_takes(model, test, normalizers)
     return directions
 
 
-def _generate(
+def generate_takes(
     model: Any, test: EvaluationSet, normalizers: Normalizers | None
 ) -> tuple[list[np.ndarray], list[np.ndarray] | None]:
-    """(directions per take, Euler degrees per take or None for direction models)."""
+    """Generate every take of ``test`` with ``model`` (the generation of :func:`evaluate_models`).
+
+    Parameters
+    ----------
+    model : GestureModel
+        In eval mode (call under ``torch.no_grad()``).
+    test : EvaluationSet
+    normalizers : Normalizers or None
+        The model's training statistics (default ``test.normalizers``).
+
+    Returns
+    -------
+    (directions, euler)
+        Per take (T, 42, 3) unit directions, and (T, 141) Euler degrees (None for direction models).
+    """
     from beatlite.train.generation import generate_sequences
 
     norms = test.normalizers if normalizers is None else normalizers
@@ -755,17 +804,21 @@ def _model_row(
 
     fingerprint, stale = "", False
     if model is None:
-        model, norms, fingerprint, stale = _load_checkpoint(source, test)
+        model, norms, fingerprint, stale = load_checkpoint_for(source, test)
     t0 = time.perf_counter()
     with torch.no_grad():
-        dirs, euler = _generate(model, test, norms)
+        dirs, euler = generate_takes(model, test, norms)
     seconds = time.perf_counter() - t0
     metrics = score_directions(dirs, test, extractor, truth, euler=euler, **scoring)
     return ResultRow(label, source, model.representation, metrics, seconds, fingerprint, stale)
 
 
-def _load_checkpoint(source: str, test: EvaluationSet) -> tuple[Any, Normalizers | None, str, bool]:
-    """(model, its training normalisers, data fingerprint, stale?) of a checkpoint name or path."""
+def load_checkpoint_for(source: str, test: EvaluationSet) -> tuple[Any, Normalizers | None, str, bool]:
+    """(model, its training normalisers, data fingerprint, stale?) of a checkpoint name or path.
+
+    Warns when the checkpoint was trained on other data than ``test``'s train split; a text model whose
+    vocabulary differs from the test set's is a ``ValueError``.
+    """
     from beatlite.train.checkpoint import load_model
 
     model, data = load_model(source)
@@ -917,10 +970,10 @@ def generated_euler(
     import torch
 
     if isinstance(model, str | Path):
-        model, stored, _, _ = _load_checkpoint(str(model), test)
+        model, stored, _, _ = load_checkpoint_for(str(model), test)
         normalizers = stored if normalizers is None else normalizers
     if model.representation != "euler141":
         raise ValueError(f"{type(model).__name__} predicts {model.representation}, not Euler angles")
     with torch.no_grad():
-        _, euler = _generate(model, test, normalizers)
+        _, euler = generate_takes(model, test, normalizers)
     return euler

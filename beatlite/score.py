@@ -1,0 +1,1006 @@
+"""Score any model's outputs: ``python -m beatlite.score PRED --data DATA``.
+
+``PRED`` is a folder of generated takes named like the ground-truth takes of the scored split, one file per
+take (matched by stem, everything before the first dot):
+
+=====================  ===================================================================================
+``{stem}.bvh[.gz]``    BEAT's skeleton (joint names), any frame rate (resampled to 15 fps by
+                       :func:`beatlite.io.take.resample_frames`, rotations along the shorter arc), any Euler
+                       channel order (converted through rotation matrices), or a subset of BEAT's joints that
+                       holds the 47 joints of ``spine_neck_141`` (the others at rest). Only the rotations
+                       are read (and the root position): they are applied to beatlite's BEAT skeleton, as the
+                       in-library evaluation of Euler models does.
+``{stem}.npz``         BEAT2's SMPL-X parameters: refused with one line (the SMPL-X body model is not shipped).
+``{stem}.npy``         ``(T, 42, 3)`` TED-43 unit bone directions (HA2G's vector order,
+                       :data:`beatlite.skeleton.ted.TED_BONES`), ``(T, 126)`` the same flattened, or
+                       ``(T, 141)`` ``spine_neck_141`` Euler degrees (CaMN's output, BEAT's channel order).
+                       Read with ``allow_pickle=False``.
+=====================  ===================================================================================
+
+Every prediction becomes the :class:`~beatlite.metrics.scoring.Takes` of one row exactly as
+:func:`beatlite.train.evaluation.evaluate_models` builds a model's row (TED-43 directions, positions of the
+common space, extractor features of the 34-frame windows, the 141 Euler channels where the file has them),
+and is scored against the split's ground truth by :func:`beatlite.metrics.scoring.evaluate`.
+
+Checks, each one line on stderr: a missing take is an error (``--allow-missing`` scores the takes that are
+there); an extra file is listed and ignored; a prediction longer than its take is cut to it, one shorter is
+scored against the take cut to the same length (one warning each saying by how many frames), and one shorter
+than a window (34 frames) is an error. A file that cannot be converted (another skeleton, NaN, another shape)
+is a :class:`~beatlite.io.FormatError` naming the file and the field. Errors end the command with exit code 2
+and no traceback.
+
+``--bootstrap N`` adds 95 % percentile intervals over takes (:func:`bootstrap_intervals`); ``--self-check``
+scores the split's own motion written as BVH files (:func:`self_check`); ``--export CHECKPOINT`` writes a
+shipped checkpoint's generations into ``PRED`` (:func:`export_checkpoint_takes`), ready to be scored.
+
+Not taught in a notebook yet; ``README.md`` ("Score your model") shows the command.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import hashlib
+import math
+import sys
+import tempfile
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from beatlite.constants import FPS, SR, WINDOW_LENGTH
+
+__all__ = [
+    "EXPORT_PRECISION",
+    "MIN_FRAMES",
+    "Prediction",
+    "ScoreInputError",
+    "ScoreResult",
+    "ScoreWarning",
+    "beat_channels",
+    "bootstrap_intervals",
+    "export_checkpoint_takes",
+    "main",
+    "match_predictions",
+    "read_prediction",
+    "score_folder",
+    "self_check",
+    "trim_test_set",
+]
+
+MIN_FRAMES = WINDOW_LENGTH
+"""A prediction needs at least one FGD window (34 frames at 15 fps)."""
+
+EXPORT_PRECISION = 12
+"""Decimals of the BVH files :func:`export_checkpoint_takes` writes (5e-13 degrees: the scores equal the in-library ones to rtol 1e-6)."""
+
+_SUFFIXES = (".bvh", ".bvh.gz", ".npy", ".npz")
+
+
+class ScoreInputError(ValueError):
+    """The prediction folder cannot be scored; ``lines`` holds one line per problem."""
+
+    def __init__(self, lines: Sequence[str]) -> None:
+        self.lines = [" ".join(str(line).split()) for line in lines]
+        super().__init__("\n".join(self.lines))
+
+
+class ScoreWarning(UserWarning):
+    """A prediction was scored after a change (trimmed, converted, normalised) or a file was ignored."""
+
+
+@dataclasses.dataclass(eq=False)
+class Prediction:
+    """One take's prediction in the forms the metrics read.
+
+    Attributes
+    ----------
+    directions : (T, 42, 3) float64
+        TED-43 unit bone directions.
+    euler : (T, 141) float64 or None
+        ``spine_neck_141`` Euler degrees (None for direction files).
+    form : str
+        What the file was, e.g. ``"bvh 30 fps -> 15 fps"`` or ``"npy directions (T, 42, 3)"``.
+    """
+
+    directions: np.ndarray
+    euler: np.ndarray | None
+    form: str
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.directions.shape[0])
+
+
+# ------------------------------------------------------------------------------------ reading one file
+def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
+    """Rows of beatlite's BEAT skeleton from a BVH motion of BEAT's joints, at the motion's own rate.
+
+    Parameters
+    ----------
+    motion : Motion
+        Read by :func:`beatlite.io.read_bvh`: BEAT's joint names, any Euler order per joint, possibly only a
+        subset of BEAT's joints (which must hold all 47 of ``spine_neck_141``).
+    path : str or Path
+        Named in errors.
+
+    Returns
+    -------
+    (T, 228) float64
+        :func:`beatlite.skeleton.beat.beat_skeleton` channel rows (degrees, ``Xrotation Yrotation
+        Zrotation``; root position in cm; joints the file lacks at 0 = rest). A joint in another Euler order
+        is converted through its rotation matrices; of the two equivalent angle triples the one continuous
+        with the previous frame is kept from the first frame's ``|Y| <= 90°`` on
+        (:func:`beatlite.synth.motion.continuous_euler`), so the Euler-space metrics see continuous tracks;
+        a file whose first frame lies on the other branch gives other (equivalent) Euler values.
+
+    Raises
+    ------
+    FormatError
+        Another skeleton (joints of ``spine_neck_141`` missing, a joint under another parent) or a joint
+        without three rotation channels (field ``HIERARCHY`` / ``CHANNELS``).
+    """
+    from beatlite.io import FormatError
+    from beatlite.skeleton.beat import JOINT_SUBSETS, beat_skeleton
+    from beatlite.skeleton.rotations import euler_to_matrix, matrix_to_euler
+    from beatlite.synth.motion import continuous_euler
+
+    beat, src = beat_skeleton(), motion.skeleton
+    if src.same_topology(beat):
+        return np.array(motion.channels, dtype=np.float64)
+    names = set(src.names)
+    lacking = [n for n in JOINT_SUBSETS["spine_neck_141"] if n not in names]
+    if lacking:
+        raise FormatError(
+            path,
+            f"not BEAT's skeleton: {len(lacking)} of the 47 spine_neck_141 joints are missing "
+            f"({', '.join(lacking[:3])}, ...); the file has {src.n_joints} joints ({', '.join(src.names[:3])}, ...)",
+            field="HIERARCHY",
+        )
+    _check_parents(src, beat, path)
+    out = np.zeros((motion.n_frames, beat.n_channels))
+    for j, name in enumerate(beat.names):
+        if name not in names:
+            continue
+        k = src.index(name)
+        order, want = src.rotation_order(k), beat.rotation_order(j)
+        if len(order) != 3:
+            raise FormatError(
+                path, f"joint {name} has {len(order)} rotation channels, not 3", field="CHANNELS"
+            )
+        angles = motion.channels[:, src.rotation_channel_indices(k)]
+        if order != want:  # the branch of the middle angle kept continuous over time (BEAT's tracks are)
+            angles = continuous_euler(matrix_to_euler(euler_to_matrix(angles, order), want))
+        out[:, beat.rotation_channel_indices(j)] = angles
+    root = src.position_channel_indices(src.index("Hips")) if "Hips" in names else []
+    if len(root):
+        out[:, beat.position_channel_indices(0)] = motion.channels[:, root]
+    extra = [n for n in src.names if n not in set(beat.names)]
+    if extra:
+        warnings.warn(
+            f"{path}: {len(extra)} joints that BEAT lacks ignored ({', '.join(extra[:3])})",
+            ScoreWarning,
+            stacklevel=2,
+        )
+    return out
+
+
+def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
+    """Each BEAT joint of ``src`` must hang under its nearest BEAT ancestor that ``src`` has."""
+    from beatlite.io import FormatError
+
+    have = set(src.names)
+    for j, name in enumerate(beat.names):
+        if name not in have or j == 0:
+            continue
+        p = int(beat.parents[j])
+        while p > 0 and beat.names[p] not in have:
+            p = int(beat.parents[p])
+        k = src.index(name)
+        got = src.names[int(src.parents[k])] if src.parents[k] >= 0 else None
+        if got != beat.names[p]:
+            raise FormatError(
+                path, f"not BEAT's skeleton: joint {name} hangs under {got}, in BEAT under {beat.names[p]}",
+                field="HIERARCHY",
+            )  # fmt: skip
+
+
+def _bvh_prediction(path: Path) -> Prediction:
+    """A BVH file -> directions and Euler channels at 15 fps (see :func:`beat_channels`)."""
+    from beatlite.io import read_bvh
+    from beatlite.io.motion import Motion
+    from beatlite.io.take import resample_frames, rotation_columns
+    from beatlite.skeleton.beat import beat_skeleton, subset_columns
+    from beatlite.train.evaluation import channels_to_directions
+
+    motion = read_bvh(path)
+    channels = beat_channels(motion, path)
+    form = f"bvh {motion.fps:g} fps"
+    if motion.fps != FPS:
+        cols = rotation_columns(Motion(beat_skeleton(), channels[:1], motion.fps))
+        channels = resample_frames(channels, motion.fps, FPS, angle_columns=cols)
+        form += f" -> {FPS:g} fps"
+    euler = channels[:, subset_columns(beat_skeleton(), "spine_neck_141")]
+    return Prediction(channels_to_directions(channels), euler, form)
+
+
+def _npy_prediction(path: Path) -> Prediction:
+    """A ``.npy`` of (T, 42, 3) / (T, 126) directions or (T, 141) Euler degrees."""
+    from beatlite.io import FormatError
+    from beatlite.train.evaluation import euler_to_directions
+
+    try:
+        x = np.load(path, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise FormatError(path, f"not a readable .npy array ({' '.join(str(exc).split())})") from None
+    if not isinstance(x, np.ndarray) or x.dtype.kind not in "iuf":
+        raise FormatError(
+            path, f"dtype {getattr(x, 'dtype', type(x).__name__)} is not a real number type", field="dtype"
+        )
+    x = np.asarray(x, np.float64)
+    if x.ndim == 2 and x.shape[1] == 141:
+        _check_finite(x, path)
+        return Prediction(euler_to_directions(x), x, "npy euler (T, 141)")
+    if (x.ndim == 3 and x.shape[1:] == (42, 3)) or (x.ndim == 2 and x.shape[1] == 126):
+        _check_finite(x, path)
+        return Prediction(
+            _unit_directions(x.reshape(len(x), 42, 3), path), None, f"npy directions {x.shape[1:]}"
+        )
+    raise FormatError(
+        path, f"shape {x.shape} is none of (T, 42, 3) or (T, 126) TED-43 directions, (T, 141) Euler degrees",
+        field="shape",
+    )  # fmt: skip
+
+
+def _check_finite(x: np.ndarray, path: Path) -> None:
+    from beatlite.io import FormatError
+
+    bad = np.argwhere(~np.isfinite(x))
+    if len(bad):
+        raise FormatError(
+            path,
+            f"value {x[tuple(bad[0])]} at index {tuple(int(i) for i in bad[0])} is not finite",
+            field="values",
+        )
+
+
+def _unit_directions(d: np.ndarray, path: Path) -> np.ndarray:
+    """``d`` divided by its norms; zero vectors are an error, norms off 1 by more than 1e-3 a warning."""
+    from beatlite.io import FormatError
+
+    norms = np.linalg.norm(d, axis=-1, keepdims=True)
+    if norms.min() < 1e-6:
+        frame, bone = (int(i) for i in np.argwhere(norms[..., 0] < 1e-6)[0])
+        raise FormatError(path, f"bone {bone} of frame {frame} has a zero direction vector", field="values")
+    if np.abs(norms - 1).max() > 1e-3:
+        warnings.warn(
+            f"{path.name}: directions are not unit vectors (norms {norms.min():.3g}..{norms.max():.3g}): normalised",
+            ScoreWarning,
+            stacklevel=2,
+        )
+    return d / norms
+
+
+def read_prediction(path: str | Path) -> Prediction:
+    """One prediction file (``.bvh``, ``.bvh.gz`` or ``.npy``, see the module docstring) at 15 fps.
+
+    Raises
+    ------
+    FormatError
+        Naming the file and the field when it cannot be converted.
+    """
+    from beatlite.io import FormatError
+
+    p = Path(path)
+    if p.name.endswith((".bvh", ".bvh.gz")):
+        return _bvh_prediction(p)
+    if p.name.endswith(".npy"):
+        return _npy_prediction(p)
+    if p.name.endswith(".npz"):  # matched so that it is named, not silently ignored
+        raise FormatError(
+            p, "BEAT2's SMPL-X .npz needs the SMPL-X body model, which beatlite does not ship: write BEAT-skeleton "
+            "BVH or TED-43 direction .npy files instead",
+        )  # fmt: skip
+    raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
+
+
+# ------------------------------------------------------------------------------------ the folder
+def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str, Path], list[str], list[str]]:
+    """Prediction files of ``pred`` by take stem.
+
+    Returns
+    -------
+    (files, missing, extra)
+        ``{stem: path}`` for the takes of ``takes`` that have a file, the takes without one, and the
+        prediction files whose stem is no take of the split (ignored).
+
+    Raises
+    ------
+    ScoreInputError
+        ``pred`` is not a folder, or two files predict the same take.
+    """
+    folder = Path(pred)
+    if not folder.is_dir():
+        raise ScoreInputError([f"{folder}: not a folder of predictions"])
+    by_stem: dict[str, list[Path]] = {}
+    for p in sorted(folder.iterdir()):
+        if p.is_file() and p.name.endswith(_SUFFIXES):
+            by_stem.setdefault(p.name.split(".")[0], []).append(p)
+    twice = [
+        f"{stem}: several predictions ({', '.join(p.name for p in ps)})"
+        for stem, ps in by_stem.items()
+        if len(ps) > 1
+    ]
+    if twice:
+        raise ScoreInputError(twice)
+    wanted = set(takes)
+    files = {t: by_stem[t][0] for t in takes if t in by_stem}
+    extra = [ps[0].name for stem, ps in by_stem.items() if stem not in wanted]
+    return files, [t for t in takes if t not in by_stem], extra
+
+
+def trim_test_set(test: Any, frames: Sequence[int]) -> Any:
+    """``test`` with take ``k`` cut to its first ``frames[k]`` frames (0 drops the take).
+
+    Every per-take array is cut (directions, Euler, semantic, streams; audio to
+    :func:`beatlite.data.windows.audio_samples`); the audio onsets of a cut take are detected again on its
+    cut audio. The train-split statistics (normalisers, MAAC) stay. For scoring, not for generation.
+    """
+    from beatlite.data.windows import audio_samples, mel_frames
+    from beatlite.metrics.beats import audio_beats
+
+    keep = [k for k, n in enumerate(frames) if n > 0]
+    beats = test.beats()
+    out: dict[str, list[Any]] = {key: [] for key in ("takes", "streams", "gt_directions", "gt_directions_141",
+                                                    "gt_euler", "semantic", "audio", "audio_beats")}  # fmt: skip
+    for k in keep:
+        n, total = int(frames[k]), len(test.gt_directions[k])
+        n_audio = audio_samples(n, FPS, SR)
+        stream = {
+            key: (v[:n] if isinstance(v, np.ndarray) and len(v) == total else v)
+            for key, v in test.streams[k].items()
+        }
+        stream["audio"], stream["mel"] = stream["audio"][:n_audio], stream["mel"][: mel_frames(n_audio)]
+        out["takes"].append(test.takes[k])
+        out["streams"].append(stream)
+        for key in ("gt_directions", "gt_directions_141", "gt_euler", "semantic"):
+            out[key].append(getattr(test, key)[k][:n])
+        out["audio"].append(test.audio[k][:n_audio])
+        out["audio_beats"].append(beats[k] if n == total else audio_beats(out["audio"][-1], SR))
+    return dataclasses.replace(test, **out)
+
+
+# ------------------------------------------------------------------------------------ scoring
+@dataclasses.dataclass
+class ScoreResult:
+    """The scores of one prediction folder.
+
+    Attributes
+    ----------
+    evaluation : Evaluation
+        The prediction's scores (:func:`beatlite.metrics.scoring.evaluate`).
+    truth : Evaluation
+        The ground truth's own value of each metric (scored against itself).
+    intervals : dict of str -> (float, float)
+        95 % bootstrap intervals per metric key (empty without ``bootstrap``).
+    info : dict
+        Data folder and fingerprints, takes, frames, extractor and its sha256, beatlite's version,
+        the files and what was done to them (JSON-friendly).
+    """
+
+    evaluation: Any
+    truth: Any
+    intervals: dict[str, tuple[float, float]]
+    info: dict[str, Any]
+
+    def to_markdown(self) -> str:
+        """The table (metric, value, 95 % interval, ground truth's value) and its caption."""
+        from beatlite.metrics.scoring import describe
+        from beatlite.report import markdown_table
+
+        own = self.truth.values()
+        rows = []
+        for r in self.evaluation.results:
+            lo, hi = self.intervals.get(r.key, (math.nan, math.nan))
+            ci = f"[{lo:.4g}, {hi:.4g}]" if r.key in self.intervals else ""
+            arrow = {True: " ↑", False: " ↓", None: ""}[r.higher_is_better]
+            rows.append([r.key + arrow, f"{r.value:.4g}", ci, f"{own.get(r.key, math.nan):.4g}"])
+        text = markdown_table(["metric", "value", "95 % interval", "ground truth"], rows)
+        keys = [r.key for r in self.evaluation.results]
+        return text + "\n\n" + describe(keys, sources=True) + "\n\n" + self._caption()
+
+    def _caption(self) -> str:
+        i = self.info
+        lines = [
+            f"Predictions `{i['pred']}` ({len(i['files'])} takes) vs the `{i['split']}` split of `{i['data']}` "
+            f"({len(i['takes'])} takes, {i['frames']} frames at {i['fps']:g} fps; ground truth sha256 "
+            f"{i['truth_sha256']}, train-split fingerprint {i['data_fingerprint'] or 'unknown'}).",
+            f"FGD extractor `{i['extractor']}` (sha256 {i['extractor_sha256']})"
+            + (
+                f", Euler autoencoder sha256 {i['euler_extractor_sha256']}"
+                if i.get("euler_extractor_sha256")
+                else ""
+            )
+            + f"; beatlite {i['beatlite_version']}.",
+        ]
+        if i.get("bootstrap"):
+            lines.append(
+                f"Intervals: 95 % percentiles of {i['bootstrap']} resamples of the takes with replacement "
+                f"(seed {i['seed']}), every metric recomputed on the drawn takes."
+            )
+        if i.get("missing"):
+            lines.append(f"Missing takes (not scored): {', '.join(i['missing'])}.")
+        if i.get("trimmed"):
+            lines.append(
+                "Trimmed: " + ", ".join(f"{s} ({d:+d} frames)" for s, d in i["trimmed"].items()) + "."
+            )
+        lines += [f"Skipped {key}: {why}." for key, why in self.evaluation.skipped.items()]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly: ``{"metrics": {key: {value, ground_truth, interval, variant, describe, ...}}, "skipped",
+        "info"}`` (non-finite numbers as None)."""
+        from beatlite.metrics.scoring import METRICS
+
+        own = self.truth.values()
+        metrics = {
+            r.key: {
+                "name": r.name,
+                "variant": r.variant,
+                "value": _finite(r.value),
+                "ground_truth": _finite(own.get(r.key, math.nan)),
+                "interval": [_finite(v) for v in self.intervals[r.key]] if r.key in self.intervals else None,
+                "higher_is_better": r.higher_is_better,
+                "describe": r.describe,
+                "source": METRICS[r.key].source,
+            }
+            for r in self.evaluation.results
+        }
+        return {"metrics": metrics, "skipped": dict(self.evaluation.skipped), "info": self.info}
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def _file_sha(path: str | Path) -> str:
+    """First 16 hex digits of the sha256 of a file's bytes."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()[:16]
+
+
+def _truth_sha(test: Any) -> str:
+    """First 16 hex digits of a sha256 over the scored takes' names and ground-truth arrays."""
+    h = hashlib.sha256()
+    for k, stem in enumerate(test.takes):
+        h.update(stem.encode())
+        for a in (test.gt_directions[k], test.gt_euler[k], test.semantic[k], test.audio[k]):
+            h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
+
+
+def _load_test_set(data: str | Path | None, split: str) -> Any:
+    from beatlite.data.index import index_folder
+    from beatlite.paths import data_dir
+    from beatlite.train.evaluation import load_test_set
+
+    folder = Path(data_dir() if data is None else data)
+    if not folder.is_dir():
+        raise ScoreInputError([f"{folder}: no such data folder"])
+    test = load_test_set(index_folder(folder), split=split)
+    if not test.takes:
+        raise ScoreInputError([f"{folder}: no usable takes in the {split!r} split"])
+    test.folder = str(folder.resolve())
+    return test
+
+
+def score_folder(
+    pred: str | Path,
+    data: str | Path | None = None,
+    *,
+    split: str = "test",
+    metrics: Sequence[str] | None = None,
+    bootstrap: int = 0,
+    seed: int = 0,
+    extractor: str | Path | None = None,
+    allow_missing: bool = False,
+    test: Any = None,
+    progress: bool = False,
+) -> ScoreResult:
+    """Score a folder of generated takes against the ground truth of ``split`` (see the module docstring).
+
+    Parameters
+    ----------
+    pred : str or Path
+        Folder of ``{stem}.bvh`` / ``{stem}.npy`` predictions.
+    data : str or Path, optional
+        BEAT-format data folder (default :func:`beatlite.paths.data_dir`).
+    split : str
+        Which takes are the ground truth (``"test"``).
+    metrics : sequence of str, optional
+        Keys of :data:`beatlite.metrics.scoring.METRICS` (default all; those whose inputs are missing, e.g.
+        Euler metrics for direction files, are skipped with the reason).
+    bootstrap : int
+        Resamples of :func:`bootstrap_intervals` (0: no intervals).
+    seed : int
+        Seed of the Diversity pairing and of the bootstrap draws.
+    extractor : str or Path, optional
+        FGD extractor checkpoint of the ``dirvec`` space (default the shipped ``checkpoints/fgd_dirvec.pt``).
+    allow_missing : bool
+        Score the takes that have a prediction when some have none (default: an error).
+    test : EvaluationSet, optional
+        The loaded split (instead of ``data`` and ``split``; its ``folder`` attribute names the data folder).
+    progress : bool
+        tqdm progress bars on stderr.
+
+    Returns
+    -------
+    ScoreResult
+
+    Raises
+    ------
+    ScoreInputError
+        One line per problem: missing takes, unreadable or unconvertible files, too short predictions.
+    """
+    test = _load_test_set(data, split) if test is None else test
+    files, missing, extra = match_predictions(pred, test.takes)
+    problems = []
+    if extra:
+        warnings.warn(
+            f"{pred}: {len(extra)} files are no take of the split, ignored: {', '.join(extra)}",
+            ScoreWarning,
+            stacklevel=2,
+        )
+    if missing:
+        message = (
+            f"{pred}: no prediction for {len(missing)} of the {len(test.takes)} takes: {', '.join(missing)}"
+        )
+        if not allow_missing:
+            problems.append(message + " (--allow-missing scores the others)")
+        else:
+            warnings.warn(message + ": scored without them", ScoreWarning, stacklevel=2)
+    preds = _read_all(files, problems, progress)
+    frames, trimmed = _frames(test, files, preds, problems)
+    if problems:
+        raise ScoreInputError(problems)
+    if frames != [len(d) for d in test.gt_directions]:
+        test = trim_test_set(test, frames)
+    chosen = [preds[stem] for stem in test.takes]
+    euler = None
+    if all(p.euler is not None for p in chosen):
+        euler = [p.euler[: len(d)] for p, d in zip(chosen, test.gt_directions, strict=True)]
+    elif any(p.euler is not None for p in chosen):
+        warnings.warn(
+            "some predictions are directions: the Euler metrics are skipped for all",
+            ScoreWarning,
+            stacklevel=2,
+        )
+    directions = [p.directions[: len(d)] for p, d in zip(chosen, test.gt_directions, strict=True)]
+    info = {
+        "pred": str(pred),
+        "files": {stem: f"{files[stem].name}: {preds[stem].form}" for stem in test.takes},
+        "missing": missing,
+        "extra": extra,
+        "trimmed": trimmed,
+    }
+    return _score(directions, euler, test, metrics, bootstrap, seed, extractor, progress, info)
+
+
+def _read_all(files: dict[str, Path], problems: list[str], progress: bool) -> dict[str, Prediction]:
+    """Read every file; each one that cannot be converted adds its error line to ``problems``."""
+    from tqdm import tqdm
+
+    from beatlite.io import FormatError
+
+    preds = {}
+    for stem, path in tqdm(
+        files.items(), desc="reading", unit="take", file=sys.stderr, disable=None if progress else True
+    ):
+        try:
+            preds[stem] = read_prediction(path)
+        except FormatError as exc:
+            problems.append(str(exc))
+    return preds
+
+
+def _frames(
+    test: Any, files: dict[str, Path], preds: dict[str, Prediction], problems: list[str]
+) -> tuple[list[int], dict[str, int]]:
+    """Frames scored per take (0: no prediction) and ``{stem: prediction frames - take frames}`` where they differ."""
+    frames, trimmed = [], {}
+    for stem, truth in zip(test.takes, test.gt_directions, strict=True):
+        have = len(truth)
+        n = preds[stem].n_frames if stem in preds else 0
+        if stem in preds and n < MIN_FRAMES:
+            problems.append(
+                f"{files[stem]}: {n} frames at {FPS:g} fps, fewer than one {MIN_FRAMES}-frame window"
+            )
+        elif n and n != have:
+            trimmed[stem] = n - have
+            what = (f"its last {n - have} frames dropped" if n > have
+                    else f"scored against the take's first {n} frames (the take has {have - n} more)")  # fmt: skip
+            warnings.warn(
+                f"{files[stem].name}: {n} frames at {FPS:g} fps, the take {have}: {what}",
+                ScoreWarning,
+                stacklevel=2,
+            )
+        frames.append(min(n, have))
+    return frames, trimmed
+
+
+def _score(
+    directions: list[np.ndarray],
+    euler: list[np.ndarray] | None,
+    test: Any,
+    metrics: Sequence[str] | None,
+    bootstrap: int,
+    seed: int,
+    extractor_path: str | Path | None,
+    progress: bool,
+    info: dict[str, Any],
+) -> ScoreResult:
+    """Build the row's Takes as :func:`~beatlite.train.evaluation.evaluate_models` does and score it."""
+    import torch
+
+    import beatlite
+    from beatlite.metrics.extractor import load_extractor
+    from beatlite.metrics.scoring import METRICS, evaluate
+    from beatlite.paths import n_threads
+    from beatlite.train.evaluation import directions_takes
+
+    keys = list(METRICS) if metrics is None else list(metrics)
+    unknown = [k for k in keys if k not in METRICS]
+    if unknown:
+        raise ScoreInputError([f"unknown metric {k!r}; known: {', '.join(METRICS)}" for k in unknown])
+    torch.set_num_threads(n_threads())
+    extractor = _extractor(extractor_path)
+    euler_ae = load_extractor("pose") if "FGD (BEAT AE)" in keys else None
+    truth = test.ground_truth(extractor, euler_ae)
+    generated = directions_takes(directions, test, extractor, euler=euler, euler_extractor=euler_ae)
+    evaluation = evaluate(generated, truth, metrics=keys, seed=seed)
+    own = evaluate(truth.takes, truth, metrics=keys, seed=seed)
+    scored = [r.key for r in evaluation.results]
+    intervals = bootstrap_intervals(generated, truth, scored, n=bootstrap, seed=seed, progress=progress)
+    info = {
+        **info,
+        "data": getattr(test, "folder", ""),
+        "split": test.split,
+        "takes": list(test.takes),
+        "frames": int(sum(len(d) for d in test.gt_directions)),
+        "fps": FPS,
+        "truth_sha256": _truth_sha(test),
+        "data_fingerprint": test.fingerprint,
+        "extractor": extractor.meta["path"],
+        "extractor_sha256": _file_sha(extractor.meta["path"]),
+        "euler_extractor_sha256": None if euler_ae is None else _file_sha(euler_ae.meta["path"]),
+        "beatlite_version": beatlite.__version__,
+        "bootstrap": int(bootstrap),
+        "seed": int(seed),
+    }
+    return ScoreResult(evaluation, own, intervals, info)
+
+
+def _extractor(path: str | Path | None) -> Any:
+    """The FGD extractor of the ``dirvec`` space: the shipped one, or the checkpoint at ``path``."""
+    from beatlite.metrics.extractor import load_extractor
+
+    if path is None:
+        return load_extractor("dirvec")
+    try:
+        extractor = load_extractor("dirvec", path)
+    except FileNotFoundError:
+        raise ScoreInputError([f"{path}: no such FGD extractor checkpoint"]) from None
+    except Exception as exc:  # torch.load(weights_only=True) raises several types on a foreign file
+        raise ScoreInputError(
+            [f"{path}: not a beatlite FGD extractor checkpoint ({type(exc).__name__})"]
+        ) from None
+    if extractor.space != "dirvec":
+        raise ScoreInputError(
+            [f"{path}: an extractor of the {extractor.space!r} space; FGD here needs 'dirvec' (126-d)"]
+        )
+    return extractor
+
+
+# ------------------------------------------------------------------------------------ intervals
+def bootstrap_intervals(
+    generated: Any,
+    truth: Any,
+    metrics: Sequence[str],
+    *,
+    n: int,
+    seed: int = 0,
+    level: float = 0.95,
+    progress: bool = False,
+) -> dict[str, tuple[float, float]]:
+    """Percentile intervals of every metric over takes drawn with replacement.
+
+    Each of the ``n`` resamples draws K of the K takes with replacement (``numpy.random.default_rng(seed)``)
+    and recomputes every metric with :func:`beatlite.metrics.scoring.evaluate` on the drawn takes, generated
+    and ground truth paired (a take drawn twice counts twice):
+
+    - FGD (all variants): Fréchet distance between the features of the drawn takes' generated windows and of
+      the same takes' ground-truth windows (the features are computed once; a take's windows are its rows);
+    - Diversity: 500 random pairs (seed ``seed``) of the drawn takes' windows;
+    - SRGR, PCK, MPJPE: over the drawn takes' frames; BeatAlign and BC: over the drawn takes' audio beats
+      (onsets detected once), or per drawn 34-frame clip for ``"BC (ha2g)"``; L1div: over the drawn takes;
+    - the train-split MAAC of BC is not resampled (it belongs to the training data).
+
+    Parameters
+    ----------
+    generated : Takes
+    truth : GroundTruth
+    metrics : sequence of str
+        Keys of :data:`beatlite.metrics.scoring.METRICS` (those ``evaluate`` can score on these inputs).
+    n : int
+        Resamples (0: no intervals).
+    seed : int
+    level : float
+        Coverage of the central interval (0.95: the 2.5th and 97.5th percentiles).
+    progress : bool
+        tqdm progress bar on stderr.
+
+    Returns
+    -------
+    dict of str -> (low, high)
+    """
+    from tqdm import tqdm
+
+    from beatlite.data.windows import window_starts
+    from beatlite.metrics.scoring import evaluate
+
+    if n <= 0:
+        return {}
+    counts = [len(window_starts(len(p))) for p in truth.takes.positions]
+    bounds = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    if generated.features is not None and len(generated.features) != bounds[-1]:
+        raise ValueError(f"features have {len(generated.features)} rows, the takes {bounds[-1]} windows")
+    rng = np.random.default_rng(seed)
+    beats = truth.beats()
+    values: dict[str, list[float]] = {key: [] for key in metrics}
+    for _ in tqdm(range(n), desc="bootstrap", file=sys.stderr, disable=None if progress else True):
+        idx = rng.integers(len(counts), size=len(counts))
+        draw_truth = dataclasses.replace(
+            truth, takes=_draw(truth.takes, idx, bounds), semantic=_pick(truth.semantic, idx),
+            audio=_pick(truth.audio, idx), audio_beats=_pick(beats, idx),
+            onsets={key: _pick(v, idx) for key, v in truth.onsets.items()},
+        )  # fmt: skip
+        scores = evaluate(_draw(generated, idx, bounds), draw_truth, metrics=metrics, seed=seed).values()
+        for key in metrics:
+            values[key].append(scores[key])
+    q = 50 * (1 - level)
+    return {key: tuple(float(x) for x in np.percentile(v, [q, 100 - q])) for key, v in values.items()}
+
+
+def _pick(xs: list[Any] | None, idx: np.ndarray) -> list[Any] | None:
+    return None if xs is None else [xs[i] for i in idx]
+
+
+def _draw(takes: Any, idx: np.ndarray, bounds: np.ndarray) -> Any:
+    """The :class:`~beatlite.metrics.scoring.Takes` of the drawn takes (feature rows of their windows)."""
+    rows = np.concatenate([np.arange(bounds[i], bounds[i + 1]) for i in idx])
+    return dataclasses.replace(
+        takes,
+        positions=_pick(takes.positions, idx),
+        directions=_pick(takes.directions, idx),
+        euler=_pick(takes.euler, idx),
+        features=None if takes.features is None else takes.features[rows],
+        euler_features=None if takes.euler_features is None else takes.euler_features[rows],
+    )
+
+
+# ------------------------------------------------------------------------------------ writing takes
+def _save_npy(path: Path, array: np.ndarray) -> None:
+    from beatlite.io.atomic import atomic_write
+
+    with atomic_write(path, "wb") as fh:
+        np.save(fh, np.asarray(array, np.float64), allow_pickle=False)
+
+
+def export_checkpoint_takes(
+    checkpoint: str | Path,
+    out_dir: str | Path,
+    data: str | Path | None = None,
+    *,
+    split: str = "test",
+    format: str = "bvh",
+    test: Any = None,
+    precision: int = EXPORT_PRECISION,
+) -> list[Path]:
+    """Write a checkpoint's generation of every take of ``split``, ready for :func:`score_folder`.
+
+    The generation is :func:`beatlite.train.evaluation.evaluate_models`' (whole takes seeded by their first 4
+    ground-truth frames, the checkpoint's own normalisers), at 15 fps, so scoring the folder gives the
+    in-library numbers.
+
+    Parameters
+    ----------
+    checkpoint : str or Path
+        A shipped checkpoint name (``"camn_tiny"``) or a checkpoint path.
+    out_dir : str or Path
+        Created if needed; files ``{stem}.bvh`` or ``{stem}.npy``.
+    data, split, test
+        As :func:`score_folder`.
+    format : {"bvh", "npy"}
+        ``"bvh"``: an Euler model's 141 channels in BEAT's full 228-channel skeleton (other joints at rest,
+        root at the origin; :func:`beatlite.skeleton.beat.expand_subset`), ``precision`` decimals. A direction
+        model (HA2G) writes ``(T, 42, 3)`` direction ``.npy`` files instead: a BVH would need inverse
+        kinematics and could not hold its directions exactly. ``"npy"``: ``(T, 141)`` Euler degrees or
+        ``(T, 42, 3)`` directions.
+    precision : int
+        BVH decimals.
+
+    Returns
+    -------
+    list of Path
+        The files written, in take order.
+    """
+    import torch
+
+    from beatlite.io import write_bvh
+    from beatlite.io.motion import Motion
+    from beatlite.paths import n_threads
+    from beatlite.skeleton.beat import beat_skeleton, expand_subset
+    from beatlite.train.evaluation import generate_takes, load_checkpoint_for
+
+    if format not in ("bvh", "npy"):
+        raise ValueError(f"format must be 'bvh' or 'npy', got {format!r}")
+    test = _load_test_set(data, split) if test is None else test
+    torch.set_num_threads(n_threads())
+    model, norms, _, _ = load_checkpoint_for(str(checkpoint), test)
+    with torch.no_grad():
+        directions, euler = generate_takes(model, test, norms)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, stem in enumerate(test.takes):
+        if euler is not None and format == "bvh":
+            path = out / f"{stem}.bvh"
+            write_bvh(
+                path,
+                Motion(beat_skeleton(), expand_subset(euler[k], "spine_neck_141"), FPS),
+                precision=precision,
+            )
+        else:
+            path = out / f"{stem}.npy"
+            _save_npy(path, directions[k] if euler is None else euler[k])
+        written.append(path)
+    return written
+
+
+def export_ground_truth(test: Any, out_dir: str | Path, data: str | Path | None = None) -> list[Path]:
+    """Write the ground truth of ``test``'s takes as ``{stem}.bvh`` files (the data's own skeleton and 228
+    channels at 15 fps, as the evaluation loads them), for :func:`self_check`."""
+    from beatlite.data.index import index_folder
+    from beatlite.io import load_take, write_bvh
+    from beatlite.io.motion import Motion
+
+    index = index_folder(getattr(test, "folder", None) or data, read_durations=False)
+    out, written = Path(out_dir), []
+    for stem, truth in zip(test.takes, test.gt_directions, strict=True):
+        record = index[stem]
+        take = load_take(record.path("motion"), fps=FPS, bvh_fps=record.bvh_fps)
+        motion = Motion(take.motion.skeleton, take.motion.channels[: len(truth)], FPS)
+        written.append(out / f"{stem}.bvh")
+        write_bvh(written[-1], motion, precision=EXPORT_PRECISION)
+    return written
+
+
+def self_check(
+    data: str | Path | None = None,
+    *,
+    split: str = "test",
+    metrics: Sequence[str] | None = None,
+    bootstrap: int = 0,
+    seed: int = 0,
+    extractor: str | Path | None = None,
+    test: Any = None,
+    progress: bool = False,
+) -> ScoreResult:
+    """Score the split's own motion, written as BVH files and read back like any prediction.
+
+    A sound pipeline gives FGD about 0 and every other metric equal to the ground truth's own value (the
+    ``ground truth`` column); a difference shows where files and evaluation disagree (e.g. a data skeleton
+    whose offsets are not beatlite's: predictions are scored on beatlite's BEAT skeleton).
+    Arguments as :func:`score_folder`.
+    """
+    test = _load_test_set(data, split) if test is None else test
+    with tempfile.TemporaryDirectory(prefix="beatlite_self_check_") as tmp:
+        export_ground_truth(test, tmp, data)
+        result = score_folder(
+            tmp, split=split, metrics=metrics, bootstrap=bootstrap, seed=seed, extractor=extractor, test=test,
+            progress=progress,
+        )  # fmt: skip
+    result.info["pred"] = f"self-check: the {split} split's own BVH motion"
+    return result
+
+
+# ------------------------------------------------------------------------------------ command line
+def _print_warning(
+    message: Any, category: Any, filename: str, lineno: int, file: Any = None, line: Any = None
+) -> None:
+    print(f"warning: {' '.join(str(message).split())}", file=sys.stderr, flush=True)
+
+
+def _parser() -> argparse.ArgumentParser:
+    from beatlite.metrics.scoring import METRICS
+
+    p = argparse.ArgumentParser(prog="python -m beatlite.score", description=__doc__.split("\n")[0])
+    p.add_argument("pred", nargs="?", help="folder of {stem}.bvh / {stem}.npy predictions")
+    p.add_argument("--data", help="BEAT-format data folder (default $BEATLITE_DATA or data_samples/)")
+    p.add_argument("--split", default="test")
+    p.add_argument(
+        "--metrics", nargs="+", choices=list(METRICS), metavar="KEY", help="METRICS keys (default all)"
+    )
+    p.add_argument("--json", help="also write the scores as JSON here")
+    p.add_argument("--md", help="also write the Markdown table here")
+    p.add_argument(
+        "--bootstrap", type=int, default=0, metavar="N", help="95 %% intervals from N resamples of takes"
+    )
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--self-check", action="store_true", help="score the ground truth written as BVH files")
+    p.add_argument("--extractor", help="FGD extractor checkpoint (dirvec space; default the shipped one)")
+    p.add_argument("--allow-missing", action="store_true", help="score the takes that have a prediction")
+    p.add_argument("--export", metavar="CHECKPOINT", help="write CHECKPOINT's generations into PRED and stop")
+    p.add_argument("--format", choices=("bvh", "npy"), default="bvh", help="--export file format")
+    return p
+
+
+def _run(args: argparse.Namespace) -> int:
+    from beatlite.io.atomic import atomic_write
+
+    if args.export:
+        if not args.pred:
+            raise ScoreInputError(["--export needs PRED, the folder to write"])
+        files = export_checkpoint_takes(
+            args.export, args.pred, args.data, split=args.split, format=args.format
+        )
+        print(f"wrote {len(files)} files to {args.pred}")
+        return 0
+    common = {"split": args.split, "metrics": args.metrics, "bootstrap": args.bootstrap, "seed": args.seed,
+              "extractor": args.extractor, "progress": True}  # fmt: skip
+    if args.self_check:
+        result = self_check(args.data, **common)
+    elif args.pred:
+        result = score_folder(args.pred, args.data, allow_missing=args.allow_missing, **common)
+    else:
+        raise ScoreInputError(["give PRED (a folder of predictions) or --self-check"])
+    text = result.to_markdown()
+    print(text)
+    if args.md:
+        with atomic_write(args.md, "w") as fh:
+            fh.write(text + "\n")
+    if args.json:
+        import json
+
+        with atomic_write(args.json, "w") as fh:
+            json.dump(result.to_dict(), fh, indent=2, sort_keys=True)
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m beatlite.score PRED --data DATA ...``: 0 on success, 2 when the input cannot be scored."""
+    from beatlite.io import FormatError
+
+    args = _parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.showwarning = _print_warning
+        try:
+            return _run(args)
+        except ScoreInputError as exc:
+            lines = exc.lines
+        except (FormatError, FileNotFoundError, NotADirectoryError) as exc:
+            lines = [" ".join(str(exc).split())]
+    for line in lines:
+        print(f"error: {line}", file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,362 @@
+"""beatlite.score: scoring a folder of another model's outputs, its checks, intervals and the round trip."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.io import FormatError, read_bvh, write_bvh  # noqa: E402
+from beatlite.io.motion import Motion  # noqa: E402
+from beatlite.metrics.scoring import METRICS, GroundTruth, Takes  # noqa: E402
+from beatlite.paths import checkpoints_dir  # noqa: E402
+from beatlite.score import (  # noqa: E402
+    ScoreInputError,
+    ScoreWarning,
+    bootstrap_intervals,
+    export_checkpoint_takes,
+    export_ground_truth,
+    read_prediction,
+    score_folder,
+    self_check,
+)
+from beatlite.skeleton.beat import beat_skeleton  # noqa: E402
+from beatlite.skeleton.core import Skeleton  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+KEYS = list(METRICS)
+REPRESENTATIVE = ("camn_tiny", "ha2g_tiny", "mean_pose")  # an Euler model, a direction model, a baseline
+
+
+@pytest.fixture(scope="module")
+def test_set():
+    from beatlite.score import _load_test_set
+
+    return _load_test_set(REPO / "data_samples", "test")
+
+
+@pytest.fixture(scope="module")
+def library(test_set):
+    """The in-library numbers: evaluate_models' rows (ground truth and the representative checkpoints)."""
+    from beatlite.train.evaluation import evaluate_models
+
+    missing = [n for n in REPRESENTATIVE if not (checkpoints_dir() / f"{n}.pt").is_file()]
+    if missing:
+        pytest.skip(f"checkpoints {missing} not shipped")
+    return evaluate_models(list(REPRESENTATIVE), test=test_set, columns=KEYS)
+
+
+@pytest.fixture(scope="module")
+def truth_files(test_set, tmp_path_factory):
+    """The test split's own motion as {stem}.bvh files (15 fps, 228 channels)."""
+    out = tmp_path_factory.mktemp("truth")
+    export_ground_truth(test_set, out)
+    return out
+
+
+def _assert_same_scores(
+    got: dict[str, float], want: dict[str, float], label: str, atol: float = 1e-8
+) -> None:
+    """Equal to rtol 1e-6; ``atol`` for values that are 0 by definition (a constant pose's L1div is 2e-9 of
+    round-off; the ground truth's own MPJPE is 2e-7 cm of its float32 storage)."""
+    for key in KEYS:
+        a, b = got[key], want[key]
+        if np.isnan(b):
+            assert np.isnan(a), (label, key, a)
+        else:
+            np.testing.assert_allclose(a, b, rtol=1e-6, atol=atol, err_msg=f"{label} {key}")
+
+
+def _run_cli(*args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(REPO), "BEATLITE_THREADS": "1"}
+    return subprocess.run(
+        [sys.executable, "-m", "beatlite.score", *args], capture_output=True, text=True, env=env, cwd=REPO
+    )
+
+
+# ----------------------------------------------------------------------------- self-check
+def test_self_check_gives_zero_fgd_and_the_ground_truths_own_values(test_set, library):
+    result = self_check(test=test_set)
+    values = result.evaluation.values()
+    assert values["FGD"] < 1e-6 and values["FGD (reference)"] < 1e-6 and values["FGD (BEAT AE)"] < 1e-6
+    assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4
+    # the ground truth's values as the in-library results table computes them (its "Ground truth" row)
+    _assert_same_scores(values, library.get("Ground truth").metrics, "self-check", atol=1e-6)
+    _assert_same_scores(result.truth.values(), library.get("Ground truth").metrics, "ground truth column")
+
+
+def test_import_does_not_import_torch():
+    code = "import sys, beatlite.score; assert 'torch' not in sys.modules, 'torch imported'"
+    subprocess.run([sys.executable, "-c", code], check=True, env={**os.environ, "PYTHONPATH": str(REPO)})
+
+
+# ----------------------------------------------------------------------------- round trip
+@pytest.mark.parametrize("name", REPRESENTATIVE)
+def test_exported_then_scored_equals_the_in_library_evaluation(name, test_set, library, tmp_path):
+    files = export_checkpoint_takes(name, tmp_path, test=test_set)
+    assert [f.name.split(".")[0] for f in files] == list(test_set.takes)
+    if library.get(name).representation == "euler141":
+        motion = read_bvh(files[0])
+        assert motion.fps == 15 and motion.skeleton.same_topology(beat_skeleton())
+    else:
+        assert files[0].suffix == ".npy" and np.load(files[0]).shape[1:] == (42, 3)
+    result = score_folder(tmp_path, test=test_set)
+    _assert_same_scores(result.evaluation.values(), library.get(name).metrics, name)
+
+
+@pytest.mark.slow
+def test_every_shipped_checkpoint_round_trips(test_set, tmp_path):
+    from beatlite.train.evaluation import evaluate_models
+    from beatlite.train.recipes import RECIPES
+
+    names = [n for n in RECIPES if (checkpoints_dir() / f"{n}.pt").is_file()]
+    if not names:
+        pytest.skip("no shipped checkpoints")
+    res = evaluate_models(names, test=test_set, columns=KEYS, ground_truth=False)
+    for name in names:
+        folder = tmp_path / name
+        export_checkpoint_takes(name, folder, test=test_set)
+        _assert_same_scores(
+            score_folder(folder, test=test_set).evaluation.values(), res.get(name).metrics, name
+        )
+
+
+# ----------------------------------------------------------------------------- conversions
+def test_a_bvh_at_30_fps_is_resampled_to_the_takes_frames(test_set):
+    """The corpus' own 30 fps BVH of a test take reads as the take's 15 fps ground truth."""
+    stem = test_set.takes[0]
+    pred = read_prediction(REPO / "data_samples" / f"{stem}.bvh.gz")
+    n = len(test_set.gt_directions[0])
+    assert pred.n_frames >= n and "30 fps -> 15 fps" in pred.form
+    np.testing.assert_allclose(pred.directions[:n], test_set.gt_directions[0], atol=1e-5)  # GT is float32
+    np.testing.assert_allclose(pred.euler[:n], test_set.gt_euler[0], atol=1e-9)
+
+
+def _reordered(motion: Motion, order: str) -> Motion:
+    """The same motion with every joint's rotation channels in ``order`` (scipy does the conversion)."""
+    from scipy.spatial.transform import Rotation
+
+    skel = motion.skeleton
+    channels, out = [], []
+    for j in range(skel.n_joints):
+        cols = skel.rotation_channel_indices(j)
+        angles = Rotation.from_euler(skel.rotation_order(j), motion.channels[:, cols], degrees=True)
+        pos = skel.position_channel_indices(j)
+        channels.append(tuple(skel.channels[j][: len(pos)]) + tuple(f"{a}rotation" for a in order))
+        out += [motion.channels[:, pos], angles.as_euler(order, degrees=True)]
+    return Motion(
+        Skeleton(skel.names, skel.parents, skel.offsets, tuple(channels)), np.hstack(out), motion.fps
+    )
+
+
+def _without_legs(motion: Motion) -> Motion:
+    """The motion on the skeleton without BEAT's 12 leg joints."""
+    skel = motion.skeleton
+    keep = [j for j, n in enumerate(skel.names) if not any(w in n for w in ("UpLeg", "Leg", "Foot", "Toe"))]
+    new = {j: i for i, j in enumerate(keep)}
+    parents = np.array([-1 if skel.parents[j] < 0 else new[int(skel.parents[j])] for j in keep])
+    cols = np.concatenate(
+        [np.arange(s, s + len(skel.channels[j])) for j, s in enumerate(skel.channel_starts) if j in new]
+    )
+    sub = Skeleton(
+        tuple(skel.names[j] for j in keep), parents, skel.offsets[keep], tuple(skel.channels[j] for j in keep)
+    )
+    return Motion(sub, motion.channels[:, cols], motion.fps)
+
+
+def test_another_channel_order_and_a_joint_subset_read_as_the_same_directions(
+    truth_files, test_set, tmp_path
+):
+    stem = test_set.takes[1]
+    motion = read_bvh(truth_files / f"{stem}.bvh")
+    motion.channels[:, 3:6] += 10.0  # a root rotation, so the conversion of the root is exercised too
+    write_bvh(tmp_path / "xyz.bvh", motion, precision=12)
+    reference = read_prediction(tmp_path / "xyz.bvh")
+    write_bvh(tmp_path / "zxy.bvh", _reordered(motion, "ZXY"), precision=12)
+    write_bvh(tmp_path / "upper.bvh", _without_legs(motion), precision=12)
+    for name in ("zxy.bvh", "upper.bvh"):
+        pred = read_prediction(tmp_path / name)
+        np.testing.assert_allclose(pred.directions, reference.directions, atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(pred.euler, reference.euler, atol=1e-7, err_msg=name)
+
+
+def test_another_skeleton_is_refused_naming_file_and_field(real_samples):
+    path = real_samples / "dataset-1_bye_normal_001.bvh"
+    with pytest.raises(FormatError) as info:
+        read_prediction(path)
+    assert info.value.field == "HIERARCHY" and info.value.path == path
+    assert "not BEAT's skeleton" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_npy_representations(test_set, tmp_path):
+    from beatlite.train.evaluation import euler_to_directions
+
+    d, e = test_set.gt_directions[0], test_set.gt_euler[0]
+    np.save(tmp_path / "d126.npy", d.reshape(len(d), 126))
+    np.save(tmp_path / "e141.npy", e)
+    np.testing.assert_allclose(read_prediction(tmp_path / "d126.npy").directions, d, atol=1e-12)
+    pred = read_prediction(tmp_path / "e141.npy")
+    np.testing.assert_array_equal(pred.euler, e)
+    np.testing.assert_allclose(pred.directions, euler_to_directions(e), atol=1e-12)
+    np.save(tmp_path / "long.npy", 2.0 * d)  # not unit: normalised with a warning
+    with pytest.warns(ScoreWarning, match="not unit vectors"):
+        np.testing.assert_allclose(read_prediction(tmp_path / "long.npy").directions, d, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("array", "field"),
+    [
+        (np.zeros((40, 40)), "shape"),
+        (np.full((40, 141), np.nan), "values"),
+        (np.array([{"a": 1}], dtype=object), None),  # a pickled object: refused, never unpickled
+        (np.zeros((40, 42, 3)), "values"),  # zero direction vectors
+    ],
+)
+def test_bad_npy_files_are_format_errors(array, field, tmp_path):
+    path = tmp_path / "bad.npy"
+    np.save(path, array, allow_pickle=True)
+    with pytest.raises(FormatError) as info:
+        read_prediction(path)
+    assert info.value.field == field and info.value.path == path
+
+
+# ----------------------------------------------------------------------------- the folder
+def test_trimmed_and_extended_predictions_are_scored_on_the_overlap(truth_files, test_set, tmp_path):
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    short, long = test_set.takes[2], test_set.takes[3]
+    m = read_bvh(folder / f"{short}.bvh")
+    write_bvh(folder / f"{short}.bvh", Motion(m.skeleton, m.channels[:-20], m.fps), precision=12)
+    m = read_bvh(folder / f"{long}.bvh")
+    write_bvh(
+        folder / f"{long}.bvh",
+        Motion(m.skeleton, np.vstack([m.channels, m.channels[:7]]), m.fps),
+        precision=12,
+    )
+    with pytest.warns(ScoreWarning) as record:
+        result = score_folder(folder, test=test_set)
+    messages = [str(w.message) for w in record]
+    assert any(short in s and "20 more" in s for s in messages) and any(
+        long in s and "last 7" in s for s in messages
+    )
+    values = result.evaluation.values()
+    assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4 and values["FGD"] < 1e-6  # frames stay aligned
+    assert result.info["trimmed"] == {short: -20, long: 7}
+    assert result.info["frames"] == sum(len(d) for d in test_set.gt_directions) - 20
+
+
+def test_missing_takes_are_an_error_unless_allowed(truth_files, test_set, tmp_path):
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    (folder / f"{test_set.takes[0]}.bvh").unlink()
+    with pytest.raises(ScoreInputError, match=test_set.takes[0]):
+        score_folder(folder, test=test_set)
+    with pytest.warns(ScoreWarning, match="scored without them"):
+        result = score_folder(folder, test=test_set, allow_missing=True, metrics=["FGD", "PCK"])
+    assert result.info["takes"] == list(test_set.takes[1:]) and result.evaluation.get("PCK").value == 1.0
+
+
+def test_cli_refuses_a_bad_folder_with_one_line_per_problem(truth_files, test_set, real_samples, tmp_path):
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    missing, truncated, other = test_set.takes[0], test_set.takes[1], test_set.takes[2]
+    (folder / f"{missing}.bvh").unlink()
+    shutil.copy(folder / f"{truncated}.bvh", folder / "30_katya_0_1_1.bvh")  # a take of no split: extra
+    m = read_bvh(folder / f"{truncated}.bvh")
+    write_bvh(folder / f"{truncated}.bvh", Motion(m.skeleton, m.channels[:-15], m.fps), precision=12)
+    shutil.copy(real_samples / "dataset-1_bye_normal_001.bvh", folder / f"{other}.bvh")
+    r = _run_cli(str(folder), "--data", str(REPO / "data_samples"))
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert "Traceback" not in r.stderr and all(line.startswith(("error: ", "warning: ")) for line in lines), (
+        r.stderr
+    )
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 2, r.stderr
+    assert any(missing in e and "no prediction" in e for e in errors), r.stderr
+    assert any(f"{other}.bvh" in e and "HIERARCHY" in e for e in errors), r.stderr
+    assert sum("30_katya_0_1_1.bvh" in line and "ignored" in line for line in lines) == 1, r.stderr
+    assert sum(f"{truncated}.bvh" in line and "15 more" in line for line in lines) == 1, r.stderr
+
+
+def test_cli_writes_the_table_and_json(truth_files, tmp_path):
+    out = tmp_path / "scores.json"
+    r = _run_cli(str(truth_files), "--data", str(REPO / "data_samples"), "--metrics", "FGD", "SRGR",
+                 "--json", str(out), "--md", str(tmp_path / "scores.md"), "--bootstrap", "20")  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert "| FGD ↓ |" in r.stdout and "**SRGR**: BEAT eq. 11" in r.stdout and "sha256" in r.stdout
+    data = json.loads(out.read_text())
+    assert set(data["metrics"]) == {"FGD", "SRGR"} and data["info"]["beatlite_version"]
+    assert len(data["info"]["extractor_sha256"]) == 16 and len(data["metrics"]["SRGR"]["interval"]) == 2
+    assert (tmp_path / "scores.md").read_text().strip() == r.stdout.strip()
+
+
+# ----------------------------------------------------------------------------- bootstrap
+def test_bootstrap_of_two_takes_spans_their_own_values():
+    """Two takes: a draw is (a, a), (a, b), (b, a) or (b, b), each 1/4 likely, so with enough draws the 2.5th and
+    97.5th percentiles of a frame-weighted MPJPE are the two takes' own MPJPEs."""
+    rng = np.random.default_rng(0)
+    real = [rng.normal(size=(50, 3, 3)), rng.normal(size=(40, 3, 3))]
+    gen = [real[0] + 1.0, real[1] + rng.normal(size=(40, 3, 3))]
+    own = [float(np.linalg.norm(g - t, axis=-1).mean()) for g, t in zip(gen, real, strict=True)]
+    truth = GroundTruth(Takes(positions=real))
+    low, high = bootstrap_intervals(Takes(positions=gen), truth, ["MPJPE"], n=400, seed=3)["MPJPE"]
+    assert low == pytest.approx(min(own), rel=1e-12) and high == pytest.approx(max(own), rel=1e-12)
+
+
+def test_bootstrap_intervals_are_seeded_and_contain_the_estimate(test_set, tmp_path):
+    export_checkpoint_takes("camn_tiny", tmp_path, test=test_set)
+    keys = ["FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div"]
+    a = score_folder(tmp_path, test=test_set, metrics=keys, bootstrap=30, seed=1)
+    b = score_folder(tmp_path, test=test_set, metrics=keys, bootstrap=30, seed=1)
+    c = score_folder(tmp_path, test=test_set, metrics=keys, bootstrap=30, seed=2)
+    assert a.intervals == b.intervals and a.intervals != c.intervals
+    for key in keys:
+        low, high = a.intervals[key]
+        assert low <= a.evaluation.get(key).value <= high, (key, low, a.evaluation.get(key).value, high)
+
+
+def test_an_extractor_of_another_space_is_refused(truth_files, test_set):
+    path = checkpoints_dir() / "fgd_euler141.pt"
+    if not path.is_file():
+        pytest.skip("no shipped Euler extractor")
+    with pytest.raises(ScoreInputError, match="'pose' space"):
+        score_folder(truth_files, test=test_set, metrics=["FGD"], extractor=path)
+
+
+def test_a_too_short_prediction_and_a_smplx_npz_are_refused_one_line_each(truth_files, test_set, tmp_path):
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    short, smplx = test_set.takes[0], test_set.takes[1]
+    m = read_bvh(folder / f"{short}.bvh")
+    write_bvh(folder / f"{short}.bvh", Motion(m.skeleton, m.channels[:20], m.fps), precision=12)
+    (folder / f"{smplx}.bvh").unlink()
+    np.savez(folder / f"{smplx}.npz", poses=np.zeros((10, 165)))
+    with pytest.raises(ScoreInputError) as info:
+        score_folder(folder, test=test_set)
+    lines = info.value.lines
+    assert len(lines) == 2 and all("\n" not in line for line in lines), lines
+    assert any(short in line and "20 frames" in line and "34-frame window" in line for line in lines), lines
+    assert any(f"{smplx}.npz" in line and "SMPL-X" in line for line in lines), lines
+
+
+def test_emage_audio_beats_leave_out_two_seconds_at_both_ends():
+    """Clicks at 1, 3, 5 and 7.5 s of an 8 s take: EMAGE scores 2 s to 6 s, so the onsets at 3 and 5 s remain,
+    reported 1 and 3 s after the cut (librosa reports each click about 0.032 s late, one hop of 512 at 16 kHz)."""
+    from beatlite.metrics.alignment import emage_audio_beats
+
+    sr = 16000
+    audio = np.zeros(8 * sr, np.float32)
+    audio[[1 * sr, 3 * sr, 5 * sr, int(7.5 * sr)]] = 1.0
+    beats = emage_audio_beats(audio, sr, n_frames=120, fps=15)
+    nearest = np.abs(beats[:, None] - np.array([1.0, 3.0])[None]).min(axis=1)
+    assert len(beats) >= 2 and nearest.max() < 0.05, beats  # librosa may report a click twice, 32 ms apart
+    assert np.abs(beats - 1.0).min() < 0.05 and np.abs(beats - 3.0).min() < 0.05, beats
