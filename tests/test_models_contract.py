@@ -104,3 +104,17 @@ def test_the_contract_names_the_rule_a_model_breaks(broken: str, tmp_path: Path)
     cls, check, message = _broken_models()[broken]
     with pytest.raises(AssertionError, match=re.escape(message)):
         CHECKS[check](model_case(cls, tmp_path))
+
+
+def test_the_registry_table_of_the_models_package_lists_the_registry() -> None:
+    """``beatlite.models``' docstring table: one row per built-in model, its class and representation."""
+    import beatlite.models
+    from beatlite.models import model_class
+
+    rows = re.findall(r"^``(\w+)``\s+(?::class:)?`+([\w.]+)`+\s+(\w+)$", beatlite.models.__doc__, re.M)
+    built_in = [n for n, e in MODELS.items() if isinstance(e, tuple) and e[0].startswith("beatlite.models.")]
+    want = [
+        (n, f"{model_class(n).__module__}.{model_class(n).__name__}", model_class(n).representation)
+        for n in built_in
+    ]
+    assert rows == want
