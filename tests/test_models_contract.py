@@ -118,3 +118,19 @@ def test_the_registry_table_of_the_models_package_lists_the_registry() -> None:
         for n in built_in
     ]
     assert rows == want
+
+
+def test_validation_losses_of_a_store_view_equal_those_of_the_windows_in_memory(
+    small_store_windows: tuple,
+) -> None:
+    """``evaluate_losses`` (fit's per-epoch validation) reads a store view batch by batch: same means."""
+    import torch
+
+    from beatlite.models import build_model
+    from beatlite.train.training import evaluate_losses
+
+    train, reference = small_store_windows
+    torch.manual_seed(0)
+    model = build_model("trimodal", preset="tiny", vocab_size=len(train.vocab))
+    got = evaluate_losses(model, train, epoch=0, batch_size=8)
+    assert got == evaluate_losses(model, reference, epoch=0, batch_size=8) and set(got) >= {"rec", "total"}
