@@ -96,12 +96,12 @@ def model_class(name: str) -> type[GestureModel]:
     return entry
 
 
-def presets(name: str) -> dict[str, dict[str, Any]]:
-    """Preset table of model ``name`` (preset -> config field overrides).
+def presets(name: str | type[GestureModel]) -> dict[str, dict[str, Any]]:
+    """Preset table of model ``name`` (a registry name or a model class; preset -> config field overrides).
 
     The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module.
     """
-    cls = model_class(name)
+    cls = model_class(name) if isinstance(name, str) else name
     table = cls.presets if cls.presets is not None else importlib.import_module(cls.__module__).PRESETS
     return {k: dict(v) for k, v in table.items()}
 

@@ -123,11 +123,12 @@ class ModelCase:
 
     def build(self, seed: int = 0) -> Any:
         """A freshly initialised model (torch seeded with ``seed``), in training mode."""
+        from beatlite.models import presets
         from beatlite.models.base import config_from_preset
 
         torch.manual_seed(seed)
-        presets = self.cls.presets if self.cls.presets is not None else _module_presets(self.cls)
-        return self.cls(config_from_preset(self.cls.config_class, presets, self.preset, **self.overrides))
+        table = presets(self.cls)
+        return self.cls(config_from_preset(self.cls.config_class, table, self.preset, **self.overrides))
 
     def batch(self, model: Any, b: int = 2, seed: int = 0) -> dict[str, torch.Tensor]:
         """A fake batch of ``b`` windows holding exactly the model's :meth:`batch_keys` (ids in its ranges)."""
@@ -137,12 +138,6 @@ class ModelCase:
             n_speakers=min(4, int(getattr(cfg, "n_speakers", 4))),
         )  # fmt: skip
         return {k: full[k] for k in type(model).batch_keys(cfg)}
-
-
-def _module_presets(cls: type) -> Mapping[str, Any]:
-    import importlib
-
-    return importlib.import_module(cls.__module__).PRESETS
 
 
 def _prepared(case: ModelCase, model: Any) -> Any:
