@@ -22,6 +22,7 @@ Per row:
 - **% of peak**: achieved FLOP/s (GFLOP/window x step windows/s) over the rate of a large matrix product
   of the same precision measured in the same run on the same device (``peak`` line; 1024^2 on the CPU, 8192^2
   on CUDA), i.e. of what this device reaches on dense GEMMs, not of its datasheet.
+- ``--profile N`` prints, per row, the ``torch.profiler`` table of one step (its N most costly operators).
 - **peak MiB**: on CUDA ``torch.cuda.max_memory_allocated`` during the timed steps; on the CPU the peak
   resident set above its level before the steps (``VmHWM`` after resetting it through
   ``/proc/self/clear_refs``).
@@ -179,9 +180,10 @@ def _config(device: str, precision: str, batch: int, **kw: Any) -> TrainConfig:
 
 
 def measure_step(
-    name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int
+    name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0
 ) -> Row:
-    """The step columns of one row: FLOPs, windows/s and peak memory of ``fit``'s training step."""
+    """The step columns of one row: FLOPs, windows/s and peak memory of ``fit``'s training step (and, with
+    ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly operators)."""
     model = _model(name, preset, train)
     run = _Run(model, _config(device, precision, batch, epochs=1), "bench", {})
     keys = model_keys(model)
@@ -202,6 +204,8 @@ def measure_step(
             run.step(step, 1, 0, {})
         _sync(run.device)
         seconds = (time.perf_counter() - start) / steps
+    if profile:
+        _profile(run, step, profile)
     dtype = torch.bfloat16 if precision == "bf16" else torch.float32
     gflop = counter.get_total_flops() / batch / 1e9
     row = Row(
@@ -210,6 +214,18 @@ def measure_step(
     row.peak_mib = memory.mib
     row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
     return row
+
+
+def _profile(run: _Run, step: list, top: int) -> None:
+    """Print the operators of one training step by self time (CPU, and CUDA when on the GPU)."""
+    from torch.profiler import ProfilerActivity, profile
+
+    activities = [ProfilerActivity.CPU] + ([ProfilerActivity.CUDA] if run.device.type == "cuda" else [])
+    with profile(activities=activities) as prof:
+        run.step(step, 1, 0, {})
+        _sync(run.device)
+    key = "self_cuda_time_total" if run.device.type == "cuda" else "self_cpu_time_total"
+    print(prof.key_averages().table(sort_by=key, row_limit=top))
 
 
 _PEAKS: dict[tuple[str, torch.dtype], float] = {}
@@ -301,6 +317,9 @@ def _parse() -> argparse.Namespace:
         "--fit-steps", type=int, default=None, help="steps of the timed fit epoch (default 10, quick 2)"
     )
     p.add_argument("--json", type=Path, default=None, help="also write the rows as JSON here")
+    p.add_argument(
+        "--profile", type=int, default=0, help="print the N most costly operators of one step per row"
+    )
     args = p.parse_args()
     args.models = args.models or (["camn", "ha2g"] if args.quick else trainable)
     args.batch_sizes = args.batch_sizes or ([16] if args.quick else [16, 64])
@@ -332,7 +351,7 @@ def main() -> None:
             if device == "cuda" and not torch.cuda.is_available():
                 rows.append(Row(name, preset, device, precision, batch, note=UNMEASURED))
                 continue
-            row = measure_step(name, preset, device, precision, batch, train, args.steps)
+            row = measure_step(name, preset, device, precision, batch, train, args.steps, args.profile)
             measure_fit(row, train, args.fit_steps)
             rows.append(row)
             print(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -52,3 +53,84 @@ def test_a_store_view_without_a_key_the_losses_read_is_refused_by_name(small_sto
     view = train.store.windows("train", keys=CaMN.keys_for(model.config), stats=train.normalizers)
     with pytest.raises(KeyError, match="semantic"):
         fit(model, view, TrainConfig(epochs=1, batch_size=4, progress=False))
+
+
+def test_check_model_runs_every_check_and_returns_their_names(
+    small_store_windows: tuple, tmp_path: Path
+) -> None:
+    train, reference = small_store_windows
+    from beatlite.models.testing import check_model
+
+    assert check_model("s2g", tmp_path, train=train, reference=reference) == [*CHECKS, *STORE_CHECKS]
+    assert check_model("s2g", tmp_path) == list(CHECKS)
+    with pytest.raises(ValueError, match="reference"):
+        check_model("s2g", tmp_path, train=train)
+
+
+def _broken_models() -> dict[str, tuple[type, str]]:
+    """S2G variants that each break one rule: class -> (rule's check, words of its message)."""
+    import torch
+
+    from beatlite.models.baselines import S2G
+
+    class DeadParameter(S2G):
+        def __init__(self, config) -> None:  # noqa: ANN001
+            super().__init__(config)
+            self.unused = torch.nn.Linear(3, 3)
+
+    class ReadsTheFuture(S2G):  # generate without the base class's zeroing of the later target frames
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            out = super().forward(batch)
+            return {"pose": out["pose"] + batch["pose"].mean(dim=1, keepdim=True)}
+
+        @torch.no_grad()
+        def generate(self, batch):  # noqa: ANN001, ANN202
+            return self.forward(batch)["pose"]
+
+    class ForgetsAKey(S2G):
+        @classmethod
+        def batch_keys(cls, config) -> tuple[str, ...]:  # noqa: ANN001
+            return ("mel",)
+
+    return {
+        "dead parameter": (DeadParameter, "gradients", "no gradient: ['unused.weight', 'unused.bias']"),
+        "reads the future": (ReadsTheFuture, "shapes", "generate reads frames after the seed"),
+        "forgets a key": (ForgetsAKey, "shapes", "batch_keys lacks ['pose']"),
+    }
+
+
+@pytest.mark.parametrize("broken", ["dead parameter", "reads the future", "forgets a key"])
+def test_the_contract_names_the_rule_a_model_breaks(broken: str, tmp_path: Path) -> None:
+    cls, check, message = _broken_models()[broken]
+    with pytest.raises(AssertionError, match=re.escape(message)):
+        CHECKS[check](model_case(cls, tmp_path))
+
+
+def test_the_registry_table_of_the_models_package_lists_the_registry() -> None:
+    """``beatlite.models``' docstring table: one row per built-in model, its class and representation."""
+    import beatlite.models
+    from beatlite.models import model_class
+
+    rows = re.findall(r"^``(\w+)``\s+(?::class:)?`+([\w.]+)`+\s+(\w+)$", beatlite.models.__doc__, re.M)
+    built_in = [n for n, e in MODELS.items() if isinstance(e, tuple) and e[0].startswith("beatlite.models.")]
+    want = [
+        (n, f"{model_class(n).__module__}.{model_class(n).__name__}", model_class(n).representation)
+        for n in built_in
+    ]
+    assert rows == want
+
+
+def test_validation_losses_of_a_store_view_equal_those_of_the_windows_in_memory(
+    small_store_windows: tuple,
+) -> None:
+    """``evaluate_losses`` (fit's per-epoch validation) reads a store view batch by batch: same means."""
+    import torch
+
+    from beatlite.models import build_model
+    from beatlite.train.training import evaluate_losses
+
+    train, reference = small_store_windows
+    torch.manual_seed(0)
+    model = build_model("trimodal", preset="tiny", vocab_size=len(train.vocab))
+    got = evaluate_losses(model, train, epoch=0, batch_size=8)
+    assert got == evaluate_losses(model, reference, epoch=0, batch_size=8) and set(got) >= {"rec", "total"}

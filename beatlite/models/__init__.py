@@ -9,18 +9,6 @@ Usage (skipped by the doctests: building a network is covered by ``tests/test_mo
 :func:`model_class` import the model module on first use. Every model follows the
 :class:`beatlite.models.base.GestureModel` contract.
 
-name                class                                          representation
-==================  =============================================  ===============
-``camn``            :class:`beatlite.models.camn.CaMN`             euler141
-``ha2g``            ``beatlite.models.ha2g.HA2G``                  dirvec126
-``s2g``             :class:`beatlite.models.baselines.S2G`         euler141
-``trimodal``        :class:`beatlite.models.baselines.Trimodal`    euler141
-``mean_pose``       :class:`beatlite.models.baselines.MeanPose`    euler141
-``random_clip``     :class:`beatlite.models.baselines.RandomClip`  euler141
-==================  =============================================  ===============
-
-Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
-=======
 ===================  =======================================================  ==============
 name                 class                                                    representation
 ===================  =======================================================  ==============
@@ -34,6 +22,10 @@ name                 class                                                    re
 ``a2g``              :class:`beatlite.models.a2g.A2G`                         euler141
 ``joint_embedding``  :class:`beatlite.models.joint_embedding.JointEmbedding`  euler141
 ===================  =======================================================  ==============
+
+The table lists the built-in registry :data:`MODELS` (``tests/test_models_contract.py`` checks it).
+
+Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
 """
 
 from __future__ import annotations
@@ -104,12 +96,12 @@ def model_class(name: str) -> type[GestureModel]:
     return entry
 
 
-def presets(name: str) -> dict[str, dict[str, Any]]:
-    """Preset table of model ``name`` (preset -> config field overrides).
+def presets(name: str | type[GestureModel]) -> dict[str, dict[str, Any]]:
+    """Preset table of model ``name`` (a registry name or a model class; preset -> config field overrides).
 
     The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module.
     """
-    cls = model_class(name)
+    cls = model_class(name) if isinstance(name, str) else name
     table = cls.presets if cls.presets is not None else importlib.import_module(cls.__module__).PRESETS
     return {k: dict(v) for k, v in table.items()}
 

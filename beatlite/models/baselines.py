@@ -27,6 +27,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import N_SPEAKERS, WINDOW_LENGTH
 from beatlite.models.base import (
     AdversarialConfig,
     Batch,
@@ -89,7 +90,7 @@ class RandomClipConfig(ModelConfig):
     """``n_clips`` training windows are kept (drawn with ``seed``); ``n_frames`` per clip."""
 
     n_clips: int = 32
-    n_frames: int = 34
+    n_frames: int = WINDOW_LENGTH
     seed: int = 0
 
 
@@ -287,7 +288,7 @@ class TrimodalConfig(TextConfig, AdversarialConfig):
 
     preset: str = "paper"
     audio_channels: tuple[int, ...] = (16, 32, 64, 32)
-    n_speakers: int = 30
+    n_speakers: int = N_SPEAKERS
     speaker_z: int = 16
     hidden: int = 300
     n_layers: int = 4

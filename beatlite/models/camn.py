@@ -39,6 +39,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import N_SPEAKERS
 from beatlite.models.base import (
     AdversarialConfig,
     Batch,
@@ -78,7 +79,7 @@ class CaMNConfig(TextConfig, AdversarialConfig):
     preset: str = "paper"
     text_hidden: int = 256
     text_features: int = 128
-    n_speakers: int = 30
+    n_speakers: int = N_SPEAKERS
     speaker_features: int = 8
     n_emotions: int = 8
     emotion_features: int = 8

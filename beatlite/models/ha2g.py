@@ -62,6 +62,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import N_SPEAKERS
 from beatlite.data.normalize import Normalizers
 from beatlite.metrics.consistency import default_angle_pairs
 from beatlite.models.base import (
@@ -125,7 +126,7 @@ class HA2GConfig(TextConfig, AdversarialConfig):
 
     preset: str = "paper"
     text_per_level: bool = True
-    n_speakers: int = 30
+    n_speakers: int = N_SPEAKERS
     z_dim: int = 16
     style_hidden: int = 32
     audio_channels: tuple[int, ...] = (32, 64, 128, 256)

@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 import torch
 
+from beatlite.constants import FPS, SR, WINDOW_LENGTH
+
 FAKE_SHAPES: dict[str, tuple[int, ...]] = {
     "pose": (34, 141),
     "dirvec": (34, 126),
@@ -39,7 +41,7 @@ FAKE_SHAPES: dict[str, tuple[int, ...]] = {
 
 
 def fake_windows(
-    n: int, *, seed: int = 0, vocab_size: int = 100, n_speakers: int = 4, n_frames: int = 34
+    n: int, *, seed: int = 0, vocab_size: int = 100, n_speakers: int = 4, n_frames: int = WINDOW_LENGTH
 ) -> dict[str, np.ndarray]:
     """A numpy window dict of ``n`` random windows (the layout of ``build_windows``).
 
@@ -67,8 +69,8 @@ def fake_windows(
         raise ValueError(f"n and n_frames must be >= 1, got n={n}, n_frames={n_frames}")
     rng = np.random.default_rng(seed)
     t = n_frames
-    n_audio = int(np.floor(t / 15 * 16000))
-    n_mel = int(round((t / 15 * 16000 - 1024) / 512 + 1))
+    n_audio = int(np.floor(t / FPS * SR))
+    n_mel = int(round((t / FPS * SR - 1024) / 512 + 1))
     emotion = np.repeat(rng.integers(0, 8, size=(n, 1)), t, axis=1).astype(np.int64)
     return {
         "pose": rng.standard_normal((n, t, 141)).astype(np.float32),
@@ -121,11 +123,12 @@ class ModelCase:
 
     def build(self, seed: int = 0) -> Any:
         """A freshly initialised model (torch seeded with ``seed``), in training mode."""
+        from beatlite.models import presets
         from beatlite.models.base import config_from_preset
 
         torch.manual_seed(seed)
-        presets = self.cls.presets if self.cls.presets is not None else _module_presets(self.cls)
-        return self.cls(config_from_preset(self.cls.config_class, presets, self.preset, **self.overrides))
+        table = presets(self.cls)
+        return self.cls(config_from_preset(self.cls.config_class, table, self.preset, **self.overrides))
 
     def batch(self, model: Any, b: int = 2, seed: int = 0) -> dict[str, torch.Tensor]:
         """A fake batch of ``b`` windows holding exactly the model's :meth:`batch_keys` (ids in its ranges)."""
@@ -135,12 +138,6 @@ class ModelCase:
             n_speakers=min(4, int(getattr(cfg, "n_speakers", 4))),
         )  # fmt: skip
         return {k: full[k] for k in type(model).batch_keys(cfg)}
-
-
-def _module_presets(cls: type) -> Mapping[str, Any]:
-    import importlib
-
-    return importlib.import_module(cls.__module__).PRESETS
 
 
 def _prepared(case: ModelCase, model: Any) -> Any:

@@ -170,15 +170,22 @@ def configure_torch(seed: int, threads: int | None) -> None:
     torch.set_num_threads(threads if threads is not None else n_threads())
 
 
-def _mean_losses(sums: dict[str, float], n: int) -> dict[str, float]:
-    return {k: v / max(n, 1) for k, v in sums.items()}
+def _mean_losses(sums: Mapping[str, Any], n: int) -> dict[str, float]:
+    return {k: v / max(n, 1) for k, v in _floats(sums).items()}
+
+
+def _floats(sums: Mapping[str, Any]) -> dict[str, float]:
+    """Loss sums as Python floats (one device-to-host copy per key, where the sums are read)."""
+    return {k: float(v) for k, v in sums.items()}
 
 
 def _accumulate(
-    sums: dict[str, float], losses: Mapping[str, torch.Tensor], weight: int, prefix: str = ""
+    sums: dict[str, Any], losses: Mapping[str, torch.Tensor], weight: int, prefix: str = ""
 ) -> None:
+    """Add ``weight * loss`` to ``sums`` as float64 tensors on the losses' device: no host copy per step
+    (a float per loss would wait for the device every step); the same float64 sums as Python floats."""
     for k, v in losses.items():
-        sums[prefix + k] = sums.get(prefix + k, 0.0) + float(v.detach()) * weight
+        sums[prefix + k] = sums.get(prefix + k, 0.0) + v.detach().double() * weight
 
 
 @torch.no_grad()
@@ -195,7 +202,7 @@ def evaluate_losses(
     n = len(store) if store is not None else _n_windows(arrays, keys, "evaluate_losses")
     was_training = model.training
     model.eval()
-    sums: dict[str, float] = {}
+    sums: dict[str, Any] = {}
     device = model_device(model)
     try:
         for start in range(0, n, batch_size):
@@ -457,18 +464,20 @@ class _Run:
         for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
             self.step(batches, parts, epoch, sums)
             if every and (k + 1) % every == 0 and k + 1 < len(steps):
-                total = sum_over_processes(dict(sums), self.world)  # (a collective: every process calls it)
+                total = sum_over_processes(
+                    _floats(sums), self.world
+                )  # (a collective: every process calls it)
                 self.partial = {"epoch": epoch, "step": k + 1, "sums": total}
                 self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
                 self.partial = None
-        return _mean_losses(sum_over_processes(sums, self.world), seen)
+        return _mean_losses(sum_over_processes(_floats(sums), self.world), seen)
 
     def step(
         self,
         batches: list[tuple[dict[str, torch.Tensor], int]],
         parts: int,
         epoch: int,
-        sums: dict[str, float],
+        sums: dict[str, Any],
     ) -> None:
         """The discriminator step (when adversarial) then the generator step on one global batch.
 
