@@ -112,6 +112,14 @@ def test_exported_then_scored_equals_the_in_library_evaluation(name, test_set, l
     _assert_same_scores(result.evaluation.values(), library.get(name).metrics, name)
 
 
+def test_an_euler_model_exported_as_npy_scores_the_same(test_set, library, tmp_path):
+    files = export_checkpoint_takes("camn_tiny", tmp_path, test=test_set, format="npy")
+    assert np.load(files[0], allow_pickle=False).shape[1:] == (141,)
+    _assert_same_scores(
+        score_folder(tmp_path, test=test_set).evaluation.values(), library.get("camn_tiny").metrics, "npy"
+    )
+
+
 @pytest.mark.slow
 def test_every_shipped_checkpoint_round_trips(test_set, tmp_path):
     from beatlite.train.evaluation import evaluate_models
