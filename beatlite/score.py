@@ -194,18 +194,20 @@ def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
 
     have = set(src.names)
     for j, name in enumerate(beat.names):
-        if name not in have or j == 0:
+        if name not in have:
             continue
         p = int(beat.parents[j])
-        while p > 0 and beat.names[p] not in have:
+        while p >= 0 and beat.names[p] not in have:
             p = int(beat.parents[p])
+        want = beat.names[p] if p >= 0 else None
         k = src.index(name)
         got = src.names[int(src.parents[k])] if src.parents[k] >= 0 else None
-        if got != beat.names[p]:
+        if got != want and not (want is None and got not in beat.names):  # a root above BEAT's is allowed
             raise FormatError(
-                path, f"not BEAT's skeleton: joint {name} hangs under {got}, in BEAT under {beat.names[p]}",
+                path,
+                f"not BEAT's skeleton: joint {name} hangs under {got}, in BEAT under {want}",
                 field="HIERARCHY",
-            )  # fmt: skip
+            )
 
 
 def _bvh_prediction(path: Path) -> Prediction:

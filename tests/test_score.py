@@ -165,12 +165,12 @@ def _reordered(motion: Motion, order: str) -> Motion:
     )
 
 
-def _without_legs(motion: Motion) -> Motion:
-    """The motion on the skeleton without BEAT's 12 leg joints."""
+def _without(motion: Motion, words: tuple[str, ...]) -> Motion:
+    """The motion on the skeleton without the joints whose names hold one of ``words``."""
     skel = motion.skeleton
-    keep = [j for j, n in enumerate(skel.names) if not any(w in n for w in ("UpLeg", "Leg", "Foot", "Toe"))]
+    keep = [j for j, n in enumerate(skel.names) if not any(w in n for w in words)]
     new = {j: i for i, j in enumerate(keep)}
-    parents = np.array([-1 if skel.parents[j] < 0 else new[int(skel.parents[j])] for j in keep])
+    parents = np.array([new.get(int(skel.parents[j]), -1) for j in keep])  # a dropped root: the child is root
     cols = np.concatenate(
         [np.arange(s, s + len(skel.channels[j])) for j, s in enumerate(skel.channel_starts) if j in new]
     )
@@ -189,11 +189,21 @@ def test_another_channel_order_and_a_joint_subset_read_as_the_same_directions(
     write_bvh(tmp_path / "xyz.bvh", motion, precision=12)
     reference = read_prediction(tmp_path / "xyz.bvh")
     write_bvh(tmp_path / "zxy.bvh", _reordered(motion, "ZXY"), precision=12)
-    write_bvh(tmp_path / "upper.bvh", _without_legs(motion), precision=12)
+    write_bvh(tmp_path / "upper.bvh", _without(motion, ("UpLeg", "Leg", "Foot", "Toe")), precision=12)
     for name in ("zxy.bvh", "upper.bvh"):
         pred = read_prediction(tmp_path / name)
         np.testing.assert_allclose(pred.directions, reference.directions, atol=1e-9, err_msg=name)
         np.testing.assert_allclose(pred.euler, reference.euler, atol=1e-7, err_msg=name)
+    # without Hips (root Spine) the body's rotation is BEAT's rest: as the file with the root rotation zeroed
+    write_bvh(
+        tmp_path / "no_hips.bvh", _without(motion, ("Hips", "UpLeg", "Leg", "Foot", "Toe")), precision=12
+    )
+    motion.channels[:, :6] = 0.0
+    write_bvh(tmp_path / "rest_root.bvh", motion, precision=12)
+    np.testing.assert_allclose(
+        read_prediction(tmp_path / "no_hips.bvh").directions, read_prediction(tmp_path / "rest_root.bvh").directions,
+        atol=1e-9,
+    )  # fmt: skip
 
 
 def test_another_skeleton_is_refused_naming_file_and_field(real_samples):
