@@ -439,6 +439,10 @@ class ScoreResult:
             lines.append(
                 "Trimmed: " + ", ".join(f"{s} ({d:+d} frames)" for s, d in i["trimmed"].items()) + "."
             )
+        gap = (i.get("self_check") or {}).get("largest_gap")
+        if gap:
+            lines.append(f"Self-check: FGD as in the table; the largest gap of any other metric to the ground truth's "
+                         f"own value is {gap[1]:.2g} ({gap[0]}; relative, absolute for values below 1).")  # fmt: skip
         lines += [f"Skipped {key}: {why}." for key, why in self.evaluation.skipped.items()]
         return "\n".join(lines)
 
@@ -919,6 +923,14 @@ def self_check(
             progress=progress,
         )  # fmt: skip
     result.info["pred"] = f"self-check: the {split} split's own BVH motion"
+    own = result.truth.values()
+    gaps = {
+        r.key: abs(r.value - own[r.key]) / max(abs(own[r.key]), 1.0)  # absolute where 0 by definition (MPJPE)
+        for r in result.evaluation.results
+        if math.isfinite(r.value) and math.isfinite(own[r.key]) and not r.key.startswith("FGD")
+    }
+    worst = max(gaps, key=gaps.get) if gaps else None
+    result.info["self_check"] = {"largest_gap": worst and [worst, gaps[worst]]}
     return result
 
 

@@ -88,6 +88,8 @@ def test_self_check_gives_zero_fgd_and_the_ground_truths_own_values(test_set, li
     values = result.evaluation.values()
     assert values["FGD"] < 1e-6 and values["FGD (reference)"] < 1e-6 and values["FGD (BEAT AE)"] < 1e-6
     assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4
+    key, gap = result.info["self_check"]["largest_gap"]
+    assert gap < 1e-6 and f"{gap:.2g} ({key};" in result.to_markdown()
     # the ground truth's values as the in-library results table computes them (its "Ground truth" row)
     _assert_same_scores(values, library.get("Ground truth").metrics, "self-check", atol=1e-6)
     _assert_same_scores(result.truth.values(), library.get("Ground truth").metrics, "ground truth column")
