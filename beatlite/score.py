@@ -947,16 +947,20 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m beatlite.score", description=__doc__.split("\n")[0])
     p.add_argument("pred", nargs="?", help="folder of {stem}.bvh / {stem}.npy predictions")
     p.add_argument("--data", help="BEAT-format data folder (default $BEATLITE_DATA or data_samples/)")
-    p.add_argument("--split", default="test")
+    p.add_argument("--split", default="test", help="the ground-truth takes (default test)")
     p.add_argument(
-        "--metrics", nargs="+", choices=list(METRICS), metavar="KEY", help="METRICS keys (default all)"
+        "--metrics",
+        nargs="+",
+        choices=list(METRICS),
+        metavar="KEY",
+        help=f"keys of beatlite.metrics.scoring.METRICS (default all): {', '.join(METRICS)}",
     )
     p.add_argument("--json", help="also write the scores as JSON here")
     p.add_argument("--md", help="also write the Markdown table here")
     p.add_argument(
         "--bootstrap", type=int, default=0, metavar="N", help="95 %% intervals from N resamples of takes"
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the Diversity pairs and the bootstrap draws")
     p.add_argument("--self-check", action="store_true", help="score the ground truth written as BVH files")
     p.add_argument("--extractor", help="FGD extractor checkpoint (dirvec space; default the shipped one)")
     p.add_argument("--allow-missing", action="store_true", help="score the takes that have a prediction")
