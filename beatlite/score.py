@@ -194,18 +194,20 @@ def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
 
     have = set(src.names)
     for j, name in enumerate(beat.names):
-        if name not in have or j == 0:
+        if name not in have:
             continue
         p = int(beat.parents[j])
-        while p > 0 and beat.names[p] not in have:
+        while p >= 0 and beat.names[p] not in have:
             p = int(beat.parents[p])
+        want = beat.names[p] if p >= 0 else None
         k = src.index(name)
         got = src.names[int(src.parents[k])] if src.parents[k] >= 0 else None
-        if got != beat.names[p]:
+        if got != want and not (want is None and got not in beat.names):  # a root above BEAT's is allowed
             raise FormatError(
-                path, f"not BEAT's skeleton: joint {name} hangs under {got}, in BEAT under {beat.names[p]}",
+                path,
+                f"not BEAT's skeleton: joint {name} hangs under {got}, in BEAT under {want}",
                 field="HIERARCHY",
-            )  # fmt: skip
+            )
 
 
 def _bvh_prediction(path: Path) -> Prediction:
@@ -437,6 +439,10 @@ class ScoreResult:
             lines.append(
                 "Trimmed: " + ", ".join(f"{s} ({d:+d} frames)" for s, d in i["trimmed"].items()) + "."
             )
+        gap = (i.get("self_check") or {}).get("largest_gap")
+        if gap:
+            lines.append(f"Self-check: FGD as in the table; the largest gap of any other metric to the ground truth's "
+                         f"own value is {gap[1]:.2g} ({gap[0]}; relative, absolute for values below 1).")  # fmt: skip
         lines += [f"Skipped {key}: {why}." for key, why in self.evaluation.skipped.items()]
         return "\n".join(lines)
 
@@ -917,6 +923,14 @@ def self_check(
             progress=progress,
         )  # fmt: skip
     result.info["pred"] = f"self-check: the {split} split's own BVH motion"
+    own = result.truth.values()
+    gaps = {
+        r.key: abs(r.value - own[r.key]) / max(abs(own[r.key]), 1.0)  # absolute where 0 by definition (MPJPE)
+        for r in result.evaluation.results
+        if math.isfinite(r.value) and math.isfinite(own[r.key]) and not r.key.startswith("FGD")
+    }
+    worst = max(gaps, key=gaps.get) if gaps else None
+    result.info["self_check"] = {"largest_gap": worst and [worst, gaps[worst]]}
     return result
 
 
@@ -933,16 +947,20 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m beatlite.score", description=__doc__.split("\n")[0])
     p.add_argument("pred", nargs="?", help="folder of {stem}.bvh / {stem}.npy predictions")
     p.add_argument("--data", help="BEAT-format data folder (default $BEATLITE_DATA or data_samples/)")
-    p.add_argument("--split", default="test")
+    p.add_argument("--split", default="test", help="the ground-truth takes (default test)")
     p.add_argument(
-        "--metrics", nargs="+", choices=list(METRICS), metavar="KEY", help="METRICS keys (default all)"
+        "--metrics",
+        nargs="+",
+        choices=list(METRICS),
+        metavar="KEY",
+        help=f"keys of beatlite.metrics.scoring.METRICS (default all): {', '.join(METRICS)}",
     )
     p.add_argument("--json", help="also write the scores as JSON here")
     p.add_argument("--md", help="also write the Markdown table here")
     p.add_argument(
         "--bootstrap", type=int, default=0, metavar="N", help="95 %% intervals from N resamples of takes"
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the Diversity pairs and the bootstrap draws")
     p.add_argument("--self-check", action="store_true", help="score the ground truth written as BVH files")
     p.add_argument("--extractor", help="FGD extractor checkpoint (dirvec space; default the shipped one)")
     p.add_argument("--allow-missing", action="store_true", help="score the takes that have a prediction")

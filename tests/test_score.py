@@ -88,6 +88,8 @@ def test_self_check_gives_zero_fgd_and_the_ground_truths_own_values(test_set, li
     values = result.evaluation.values()
     assert values["FGD"] < 1e-6 and values["FGD (reference)"] < 1e-6 and values["FGD (BEAT AE)"] < 1e-6
     assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4
+    key, gap = result.info["self_check"]["largest_gap"]
+    assert gap < 1e-6 and f"{gap:.2g} ({key};" in result.to_markdown()
     # the ground truth's values as the in-library results table computes them (its "Ground truth" row)
     _assert_same_scores(values, library.get("Ground truth").metrics, "self-check", atol=1e-6)
     _assert_same_scores(result.truth.values(), library.get("Ground truth").metrics, "ground truth column")
@@ -110,6 +112,14 @@ def test_exported_then_scored_equals_the_in_library_evaluation(name, test_set, l
         assert files[0].suffix == ".npy" and np.load(files[0]).shape[1:] == (42, 3)
     result = score_folder(tmp_path, test=test_set)
     _assert_same_scores(result.evaluation.values(), library.get(name).metrics, name)
+
+
+def test_an_euler_model_exported_as_npy_scores_the_same(test_set, library, tmp_path):
+    files = export_checkpoint_takes("camn_tiny", tmp_path, test=test_set, format="npy")
+    assert np.load(files[0], allow_pickle=False).shape[1:] == (141,)
+    _assert_same_scores(
+        score_folder(tmp_path, test=test_set).evaluation.values(), library.get("camn_tiny").metrics, "npy"
+    )
 
 
 @pytest.mark.slow
@@ -157,12 +167,12 @@ def _reordered(motion: Motion, order: str) -> Motion:
     )
 
 
-def _without_legs(motion: Motion) -> Motion:
-    """The motion on the skeleton without BEAT's 12 leg joints."""
+def _without(motion: Motion, words: tuple[str, ...]) -> Motion:
+    """The motion on the skeleton without the joints whose names hold one of ``words``."""
     skel = motion.skeleton
-    keep = [j for j, n in enumerate(skel.names) if not any(w in n for w in ("UpLeg", "Leg", "Foot", "Toe"))]
+    keep = [j for j, n in enumerate(skel.names) if not any(w in n for w in words)]
     new = {j: i for i, j in enumerate(keep)}
-    parents = np.array([-1 if skel.parents[j] < 0 else new[int(skel.parents[j])] for j in keep])
+    parents = np.array([new.get(int(skel.parents[j]), -1) for j in keep])  # a dropped root: the child is root
     cols = np.concatenate(
         [np.arange(s, s + len(skel.channels[j])) for j, s in enumerate(skel.channel_starts) if j in new]
     )
@@ -181,11 +191,21 @@ def test_another_channel_order_and_a_joint_subset_read_as_the_same_directions(
     write_bvh(tmp_path / "xyz.bvh", motion, precision=12)
     reference = read_prediction(tmp_path / "xyz.bvh")
     write_bvh(tmp_path / "zxy.bvh", _reordered(motion, "ZXY"), precision=12)
-    write_bvh(tmp_path / "upper.bvh", _without_legs(motion), precision=12)
+    write_bvh(tmp_path / "upper.bvh", _without(motion, ("UpLeg", "Leg", "Foot", "Toe")), precision=12)
     for name in ("zxy.bvh", "upper.bvh"):
         pred = read_prediction(tmp_path / name)
         np.testing.assert_allclose(pred.directions, reference.directions, atol=1e-9, err_msg=name)
         np.testing.assert_allclose(pred.euler, reference.euler, atol=1e-7, err_msg=name)
+    # without Hips (root Spine) the body's rotation is BEAT's rest: as the file with the root rotation zeroed
+    write_bvh(
+        tmp_path / "no_hips.bvh", _without(motion, ("Hips", "UpLeg", "Leg", "Foot", "Toe")), precision=12
+    )
+    motion.channels[:, :6] = 0.0
+    write_bvh(tmp_path / "rest_root.bvh", motion, precision=12)
+    np.testing.assert_allclose(
+        read_prediction(tmp_path / "no_hips.bvh").directions, read_prediction(tmp_path / "rest_root.bvh").directions,
+        atol=1e-9,
+    )  # fmt: skip
 
 
 def test_another_skeleton_is_refused_naming_file_and_field(real_samples):
