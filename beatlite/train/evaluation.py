@@ -424,38 +424,48 @@ def load_test_set(
     return test
 
 
-def train_change_angle(train: Any, batch_size: int = 1024) -> np.ndarray:
+def _dirvec_batches(train: Any, batch_size: int = 1024) -> Any:
+    """The train windows' ``dirvec`` (B, 34, 126) float64, ``batch_size`` windows at a time: memory flat in
+    the corpus size (``train``: a :class:`~beatlite.data.windows.Windows` or a store's ``StoreWindows``)."""
+    for start in range(0, len(train), batch_size):
+        idx = np.arange(start, min(len(train), start + batch_size))
+        yield np.asarray(train.batch(idx, keys=("dirvec",))["dirvec"], np.float64)
+
+
+def train_change_angle(train: Any) -> np.ndarray:
     """(41,) MAAC per HA2G angle pair over the train windows (beat consistency's normaliser, HA2G eq. 10).
 
-    ``train`` is a :class:`~beatlite.data.windows.Windows` or a store's
-    :class:`~beatlite.data.store.StoreWindows`; its ``dirvec`` is read ``batch_size`` windows at a
-    time (memory flat) and the per-window sums of :func:`beatlite.metrics.beats.mean_angle_change`
-    are pooled (every window has ``length - 1`` frame steps, so the pooled mean is the batch means'
-    average weighted by their window counts).
+    Read in batches (:func:`_dirvec_batches`); every window has ``length - 1`` frame steps, so the pooled
+    :func:`beatlite.metrics.beats.mean_angle_change` is the batch means' average weighted by window counts.
     """
     from beatlite.metrics.beats import mean_angle_change
     from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 
-    pairs, n = default_angle_pairs(), len(train)
-    total = np.zeros(len(pairs))
-    for start in range(0, n, batch_size):
-        idx = np.arange(start, min(n, start + batch_size))
-        batch = train.batch(idx, keys=("dirvec",))
+    pairs, total = default_angle_pairs(), 0.0
+    for batch in _dirvec_batches(train):
         # mean added back without re-normalising here: prepare_directions normalises once (as HA2G does)
-        dirs = train.normalizers.dirvec.inverse_transform(np.asarray(batch["dirvec"], np.float64))
-        total += mean_angle_change([prepare_directions(w) for w in dirs], pairs) * len(idx)
-    return total / n
+        dirs = train.normalizers.dirvec.inverse_transform(batch)
+        total = total + mean_angle_change([prepare_directions(w) for w in dirs], pairs) * len(batch)
+    return total / len(train)
 
 
 def train_mean_speed(train: Any) -> np.ndarray:
     """(43,) float64 cm/s: mean speed of each TED-43 joint over the train windows (central differences within
-    each window, positions of the common space), EMAGE's per-joint ``avg_vel`` for ``"BC (emage)"``."""
+    each window, positions of the common space), EMAGE's per-joint ``avg_vel`` for ``"BC (emage)"``.
+
+    Read in batches (:func:`_dirvec_batches`); the mean over windows and frames is pooled from their sums.
+    """
     from beatlite.metrics.beats import position_speed
 
-    dirs = train.normalizers.inverse_transform(np.asarray(train["dirvec"], np.float64), "dirvec126")
-    n, length = dirs.shape[:2]
-    positions = directions_to_ted_positions(dirs.reshape(n * length, 42, 3)).reshape(n, length, 43, 3)
-    return np.mean([position_speed(w, FPS) for w in positions], axis=(0, 1))
+    total, count = 0.0, 0
+    for batch in _dirvec_batches(train):
+        dirs = train.normalizers.inverse_transform(batch, "dirvec126")
+        n, length = dirs.shape[:2]
+        positions = directions_to_ted_positions(dirs.reshape(n * length, 42, 3)).reshape(n, length, 43, 3)
+        speeds = [position_speed(w, FPS) for w in positions]  # (frames, 43) each
+        total = total + sum(v.sum(axis=0) for v in speeds)
+        count += sum(len(v) for v in speeds)
+    return total / count
 
 
 # ------------------------------------------------------------------------------------ generation
