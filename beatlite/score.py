@@ -33,7 +33,8 @@ and no traceback.
 scores the split's own motion written as BVH files (:func:`self_check`); ``--export CHECKPOINT`` writes a
 shipped checkpoint's generations into ``PRED`` (:func:`export_checkpoint_takes`), ready to be scored.
 
-Not taught in a notebook yet; ``README.md`` ("Score your model") shows the command.
+Taught in ``notebooks/09_scoring.ipynb`` (export, score, variants, bootstrap intervals); ``README.md`` ("Score
+your model") shows the command.
 """
 
 from __future__ import annotations

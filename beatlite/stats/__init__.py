@@ -8,13 +8,23 @@
 ``semantic``                Fig. 4 analogs: semantic score histogram, per word, per speaker
 ``correlations``            gesture energy vs audio, face, emotion, speaker, with p-values
 ``emotion_classifier``      Table 6 analog: :class:`EmotionClassifier` on motion windows
+``agreement``               metrics vs people: Bradley–Terry strengths from votes, Kendall's τ with intervals
 =========================  ================================================================
 
-Taught in notebooks/02_dataset_statistics.ipynb (dataset statistics), sections 1-6.
+Taught in notebooks/02_dataset_statistics.ipynb (dataset statistics), sections 1-6; ``agreement`` in
+notebooks/09_scoring.ipynb, section 4.
 """
 
 from __future__ import annotations
 
+from beatlite.stats.agreement import (
+    TauResult,
+    bradley_terry,
+    bradley_terry_step,
+    kendall_tau,
+    simulate_votes,
+    vote_agreement,
+)
 from beatlite.stats.corpus import CorpusTake, iter_corpus, load_corpus
 from beatlite.stats.corpus_table import PAPER_TABLE1, corpus_row, table1, table1_markdown
 from beatlite.stats.correlations import gesture_correlations, plot_correlations, speed_by_emotion
@@ -38,6 +48,12 @@ __all__ = [
     "PAPER_TABLE1",
     "PAPER_TABLE6",
     "CorpusTake",
+    "TauResult",
+    "bradley_terry",
+    "bradley_terry_step",
+    "kendall_tau",
+    "simulate_votes",
+    "vote_agreement",
     "EmotionClassifier",
     "corpus_row",
     "emotion_features",

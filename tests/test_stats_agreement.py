@@ -1,0 +1,119 @@
+"""Bradley–Terry strengths and Kendall's τ (beatlite.stats.agreement) against closed forms and scipy."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+import scipy.stats
+
+from beatlite.stats.agreement import (
+    bradley_terry,
+    bradley_terry_step,
+    kendall_tau,
+    simulate_votes,
+    vote_agreement,
+)
+
+
+@pytest.mark.parametrize(("won", "lost"), [(7, 3), (1, 9), (50, 50), (0, 4)])
+def test_two_systems_strength_is_the_share_of_wins(won, lost):
+    p = bradley_terry(np.array([[0, won], [lost, 0]]))
+    np.testing.assert_allclose(p, [won / (won + lost), lost / (won + lost)], atol=1e-9)
+
+
+def test_mm_step_hand_computed():
+    # p = (1/3, 1/3, 1/3); wins: 0 beat 1 twice, 1 beat 0 once, 0 beat 2 once, 2 beat 1 three times
+    wins = np.array([[0, 2, 1], [1, 0, 0], [0, 3, 0]])
+    # n01 = 3, n02 = 1, n12 = 3; every p_i + p_j = 2/3, so p_i <- W_i / (1.5 * sum_j n_ij)
+    raw = np.array([3 / (1.5 * 4), 1 / (1.5 * 6), 3 / (1.5 * 4)])
+    np.testing.assert_allclose(bradley_terry_step(np.full(3, 1 / 3), wins), raw / raw.sum())
+
+
+def test_fit_satisfies_the_likelihood_equations():
+    """At the maximum, each system's wins equal its expected wins: W_i = sum_j n_ij p_i / (p_i + p_j)."""
+    wins = np.array([[0, 12, 9, 15], [8, 0, 11, 10], [11, 9, 0, 14], [5, 10, 6, 0]])
+    p = bradley_terry(wins)
+    n = wins + wins.T
+    expected = (n * p[:, None] / (p[:, None] + p[None, :])).sum(axis=1)
+    np.testing.assert_allclose(expected, wins.sum(axis=1), rtol=1e-8)
+    assert np.isclose(p.sum(), 1.0)
+
+
+def test_fit_equals_scipy_maximum_likelihood():
+    """The MM fit reaches the optimum that a general-purpose optimiser finds on the log-likelihood."""
+    from scipy.optimize import minimize
+
+    wins = simulate_votes([0.4, 0.3, 0.2, 0.1], 30, seed=3).astype(float)
+
+    def nll(theta):
+        t = np.concatenate([[0.0], theta])  # log-strengths, the first fixed
+        return -(wins * (t[:, None] - np.logaddexp(t[:, None], t[None, :]))).sum()
+
+    theta = minimize(nll, np.zeros(3), method="BFGS", options={"gtol": 1e-10}).x
+    want = np.exp(np.concatenate([[0.0], theta]))
+    np.testing.assert_allclose(bradley_terry(wins), want / want.sum(), rtol=1e-5)
+
+
+def test_recovers_a_known_order_from_many_votes():
+    truth = np.array([0.05, 0.4, 0.1, 0.25, 0.2])
+    p = bradley_terry(simulate_votes(truth, 2000, seed=0))
+    assert list(np.argsort(p)) == list(np.argsort(truth))
+    np.testing.assert_allclose(p, truth, rtol=0.1)
+
+
+def test_simulated_votes_are_complementary_and_unbiased():
+    wins = simulate_votes([0.75, 0.25], 4000, seed=1)
+    assert wins[0, 1] + wins[1, 0] == 4000 and np.trace(wins) == 0
+    assert abs(wins[0, 1] / 4000 - 0.75) < 0.03  # 5 standard errors of a share of 4000 votes
+
+
+def test_bad_win_matrices_are_refused():
+    with pytest.raises(ValueError, match="square"):
+        bradley_terry(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="never compared"):
+        bradley_terry(np.array([[0, 1, 0], [1, 0, 0], [0, 0, 0]]))
+    with pytest.raises(ValueError, match=">= 0"):
+        bradley_terry(np.array([[0, -1], [1, 0]]))
+
+
+def test_kendall_tau_equals_scipy_and_the_pair_count():
+    rng = np.random.default_rng(0)
+    for n in (5, 8, 12):
+        a, b = rng.normal(size=n), rng.normal(size=n)
+        pairs = list(itertools.combinations(range(n), 2))
+        concordant = sum(np.sign(a[i] - a[j]) == np.sign(b[i] - b[j]) for i, j in pairs)
+        r = kendall_tau(a, b)
+        assert np.isclose(r.tau, (2 * concordant - len(pairs)) / len(pairs))
+        assert np.isclose(r.tau, scipy.stats.kendalltau(a, b).statistic)
+        assert np.isclose(r.p_value, scipy.stats.kendalltau(a, b).pvalue)
+
+
+def test_kendall_tau_exact_p_value_of_a_perfect_order_of_five():
+    # 1 of the 5! = 120 orders agrees perfectly, 1 perfectly reversed: two-sided p = 2 / 120
+    r = kendall_tau([1, 2, 3, 4, 5], [2, 4, 6, 8, 10])
+    assert np.isclose(r.tau, 1.0) and np.isclose(r.p_value, 2 / 120)
+
+
+def test_kendall_tau_bootstrap_interval_contains_tau_and_is_seeded():
+    a, b = [1, 2, 3, 4, 5, 6], [2, 1, 4, 3, 6, 5]
+    r = kendall_tau(a, b, n_boot=300, seed=4)
+    assert r.low <= r.tau <= r.high and r.method == "items" and r.n == 6
+    assert kendall_tau(a, b, n_boot=300, seed=4) == r
+    assert np.isnan(kendall_tau(a, b).low)
+
+
+def test_kendall_tau_drops_nan_pairs():
+    r = kendall_tau([1.0, np.nan, 3.0, 2.0], [1.0, 5.0, 3.0, 2.0])
+    assert r.n == 3 and np.isclose(r.tau, 1.0)
+
+
+def test_vote_agreement_interval_widens_with_fewer_votes():
+    truth = [0.3, 0.25, 0.2, 0.15, 0.1]
+    scores = [5.0, 4.0, 3.0, 2.0, 1.0]
+    many = vote_agreement(scores, simulate_votes(truth, 500, seed=0), n_boot=200, seed=0)
+    few = vote_agreement(scores, simulate_votes(truth, 5, seed=0), n_boot=200, seed=0)
+    assert many.method == "votes" and many.low <= many.tau <= many.high
+    assert (few.high - few.low) > (many.high - many.low)
+    assert many.tau == kendall_tau(scores, bradley_terry(simulate_votes(truth, 500, seed=0))).tau
