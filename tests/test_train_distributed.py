@@ -149,3 +149,20 @@ def test_summed_losses_keep_the_models_order(tmp_path):
     )
     rows = [json.loads((tmp_path / f"{rank}.json").read_text()) for rank in (0, 1)]
     assert rows == [[["rec", 3.0], ["adv", 20.0], ["D_real", 1.0]]] * 2
+
+
+@pytest.mark.slow
+def test_the_fit_command_prepares_new_data_once_under_torchrun(tmp_path):
+    """Two processes of ``torchrun -m beatlite.train fit`` on a corpus other than data_samples/: one builds the
+    window store and trains the FGD extractor (each under a file lock, before any process group exists), the
+    other waits and finds them built (it used to wait in a gloo barrier that timed out after 30 minutes)."""
+    from test_train_recipes import symlinked_corpus
+
+    corpus, out = symlinked_corpus(tmp_path / "corpus", 1), tmp_path / "run"
+    cmd = [_torchrun(), "--standalone", "--nproc_per_node=2", "-m", "beatlite.train", "fit", "s2g_tiny",
+           "--data", str(corpus), "--out", str(out), "--epochs", "1", "--device", "cpu", "--extractor-epochs", "1"]  # fmt: skip
+    env = {k: v for k, v in _env().items() if k != "BEATLITE_BUILD"}
+    done = run_ok(cmd, env=env, timeout=900)
+    assert done.stdout.count("training the FGD extractor") == 1, done.stdout
+    assert (out / "fgd_dirvec.pt").is_file() and (out / "s2g_tiny.pt").is_file()
+    assert len(list((out / "build" / "cache" / "store").iterdir())) == 1  # one store, built once
