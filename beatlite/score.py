@@ -398,7 +398,7 @@ class ScoreResult:
 
     def to_markdown(self) -> str:
         """The table (metric, value, 95 % interval, ground truth's value) and its caption."""
-        from beatlite.metrics.scoring import describe
+        from beatlite.metrics.scoring import ARROWS, describe
         from beatlite.report import markdown_table
 
         own = self.truth.values()
@@ -406,7 +406,7 @@ class ScoreResult:
         for r in self.evaluation.results:
             lo, hi = self.intervals.get(r.key, (math.nan, math.nan))
             ci = f"[{lo:.4g}, {hi:.4g}]" if r.key in self.intervals else ""
-            arrow = {True: " ↑", False: " ↓", None: ""}[r.higher_is_better]
+            arrow = ARROWS[r.higher_is_better]
             rows.append([r.key + arrow, f"{r.value:.4g}", ci, f"{own.get(r.key, math.nan):.4g}"])
         text = markdown_table(["metric", "value", "95 % interval", "ground truth"], rows)
         keys = [r.key for r in self.evaluation.results]

@@ -26,7 +26,8 @@ seed (``build/seeds/<seed>/``; existing ones, the shipped checkpoint for its own
 kept when their stored settings and model config match today's recipe, see
 :func:`beatlite.train.seeds.recipe_mismatch`), writes the mean ± sd table over the seeds to
 ``build/results_seeds.md`` and ``.json`` and, with ``--ship``, copies each row's median-FGD seed to
-``checkpoints/`` (:mod:`beatlite.train.seeds`).
+``checkpoints/`` (:mod:`beatlite.train.seeds`). With ``--only``, an existing ``--out`` table keeps its other
+rows (``make seeds ONLY=NAME`` records a new model's rows in the shipped table).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import os
 import subprocess
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from beatlite.train.recipes import RECIPES, SEED
 
@@ -119,7 +121,13 @@ def _results_command(args: argparse.Namespace) -> int:
 
 def _seeds_command(args: argparse.Namespace) -> int:
     from beatlite.train.evaluation import RECORD_COLUMNS
-    from beatlite.train.seeds import evaluate_seeds, ship_median_seeds, train_seeds, write_seed_results
+    from beatlite.train.seeds import (
+        evaluate_seeds,
+        recorded_seed_results,
+        ship_median_seeds,
+        train_seeds,
+        write_seed_results,
+    )
 
     if not args.evaluate_only:
         train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
@@ -130,6 +138,8 @@ def _seeds_command(args: argparse.Namespace) -> int:
     if args.ship:
         for name, seed in ship_median_seeds(table, args.only or None).items():
             print(f"shipped {name}: seed {seed}", flush=True)
+    if args.only and args.out and Path(f"{args.out}.json").is_file():  # record these rows, keep the others
+        table = recorded_seed_results(f"{args.out}.json").merged(table)
     md, js = write_seed_results(table, args.out)
     print(table.to_markdown())
     print(f"wrote {md} and {js}")
@@ -163,7 +173,6 @@ def _fit_command(args: argparse.Namespace) -> int:
     ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
-    from pathlib import Path
 
     from beatlite.io.atomic import exclusive_lock
     from beatlite.paths import repo_root

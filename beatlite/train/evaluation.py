@@ -54,7 +54,7 @@ import numpy as np
 
 from beatlite.constants import FPS, SR, WINDOW_LENGTH
 from beatlite.data.normalize import Normalizers
-from beatlite.metrics.scoring import METRICS, GroundTruth, Takes, describe, evaluate
+from beatlite.metrics.scoring import ARROWS, METRICS, GroundTruth, Takes, describe, evaluate
 
 COLUMNS: tuple[str, ...] = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div")
 """The results table's columns, in order: keys of :data:`beatlite.metrics.scoring.METRICS`
@@ -198,8 +198,15 @@ class ModelResults:
 
 
 def column_headers(keys: Sequence[str]) -> list[str]:
-    """``"FGD ↓"``, ``"SRGR ↑"``, ...: each metric key with the arrow of its better direction."""
-    return [f"{key} {'↑' if METRICS[key].higher_is_better else '↓'}" for key in keys]
+    """``"FGD ↓"``, ``"SRGR ↑"``, ``"Jerk (GENEA)"``: each metric key with the arrow of its better direction
+    (none for a descriptive metric, ``higher_is_better=None``).
+
+    Examples
+    --------
+    >>> column_headers(["FGD", "SRGR", "Jerk (GENEA)"])
+    ['FGD ↓', 'SRGR ↑', 'Jerk (GENEA)']
+    """
+    return [key + ARROWS[METRICS[key].higher_is_better] for key in keys]
 
 
 def fmt_metric(v: float, key: str) -> str:

@@ -302,6 +302,23 @@ class SeedResults:
         }
         return cls(values, [int(s) for s in data["seeds"]], dict(data.get("info", {})))
 
+    def merged(self, other: SeedResults) -> SeedResults:
+        """This table with ``other``'s rows added or replacing these (``make seeds ONLY=NAME`` records NAME's
+        rows into the shipped table without dropping the others); ``info["checkpoints"]`` / ``["shipped"]``
+        are merged, the rest of ``info`` is ``other``'s.
+
+        Raises
+        ------
+        ValueError
+            The two tables are over different seeds.
+        """
+        if list(other.seeds) != list(self.seeds):
+            raise ValueError(f"cannot merge a table over seeds {other.seeds} into one over {self.seeds}")
+        info = {**self.info, **other.info}
+        for key in ("checkpoints", "shipped"):
+            info[key] = {**(self.info.get(key) or {}), **(other.info.get(key) or {})}
+        return SeedResults({**self.values, **other.values}, list(self.seeds), info)
+
     def to_markdown(self, columns: Sequence[str] | None = None, rows: Sequence[str] | None = None) -> str:
         """A Markdown table of ``mean ± sd`` over seeds, the seed count and the shipped seed.
 
@@ -588,26 +605,83 @@ def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
 RECORD_RTOL, RECORD_ATOL = 1e-3, 1e-9
 
 
-def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None) -> None:
+def record_command(name: str | None = None) -> str:
+    """The command that records recipe ``name``'s rows (every row when None) in the shipped seed table."""
+    return "make seeds" + (f" ONLY={name}" if name else "")
+
+
+@dataclasses.dataclass(frozen=True)
+class NotRecorded:
+    """A row, or one metric of a row, of a live table that the seed record does not have yet.
+
+    A model or metric registered after the record was written (``make seeds``, about 2 hours) is reported
+    so, not failed: its ``str`` is ``"<row>[ <metric>]: not recorded: run `make seeds ONLY=<recipe>`"``.
+
+    Attributes
+    ----------
+    row : str
+        Row label.
+    metric : str or None
+        The metric key the recorded row lacks; None when the whole row is missing.
+    recipe : str or None
+        The recipe to record (:func:`record_command`); None for the ground-truth rows (every row).
+    """
+
+    row: str
+    metric: str | None
+    recipe: str | None
+
+    def __str__(self) -> str:
+        what = self.row if self.metric is None else f"{self.row} {self.metric}"
+        return f"{what}: not recorded: run `{record_command(self.recipe)}`"
+
+
+def check_against_record(
+    results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None
+) -> list[NotRecorded]:
     """Assert that a live :func:`~beatlite.train.evaluation.evaluate_models` table equals the record.
 
     Each row's value must equal the record's value for the seed of the shipped checkpoint
     (``record.info["shipped"]``, :data:`~beatlite.train.recipes.SEED` for a row it does not name;
-    ground-truth rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`.
+    ground-truth rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`. Rows and
+    metrics the record does not have yet are not compared: they are returned.
+
+    Returns
+    -------
+    list of NotRecorded
+        The rows (and metrics of recorded rows) left unchecked, each saying which ``make seeds`` records it.
 
     Raises
     ------
     AssertionError
         Naming the row and metric and ``make seeds``: the record or the checkpoint is stale.
+
+    Examples
+    --------
+    >>> from beatlite.train.evaluation import ModelResults, ResultRow
+    >>> record = SeedResults({"CaMN": {"FGD": [3.0]}}, [SEED], {})
+    >>> live = ModelResults([ResultRow("CaMN", "camn_tiny", "euler141", {"FGD": 3.0, "Speed": 1.0}),
+    ...                      ResultRow("Mine", "/tmp/mine_tiny.pt", "euler141", {"FGD": 2.0})], {})
+    >>> for gap in check_against_record(live, record):
+    ...     print(gap)
+    CaMN Speed: not recorded: run `make seeds ONLY=camn_tiny`
+    Mine: not recorded: run `make seeds ONLY=mine_tiny`
     """
     shipped = record.info.get("shipped") or {}
+    gaps = []
     for row in results.rows:
-        assert row.label in record.values, f"{row.label} is not in the recorded table: make seeds"
+        recipe = None if row.representation == "ground_truth" else Path(row.source).stem
+        if row.label not in record.values:
+            gaps.append(NotRecorded(row.label, None, recipe))
+            continue
         seed = SEED if shipped.get(row.label) is None else int(shipped[row.label])
         assert seed in record.seeds, f"{row.label}: shipped seed {seed} is not in the record: make seeds"
         k = 0 if row.representation == "ground_truth" else record.seeds.index(seed)
         for metric, value in row.metrics.items():
             if metrics is not None and metric not in metrics:
+                continue
+            if metric not in record.values[row.label]:
+                gaps.append(NotRecorded(row.label, metric, recipe))
                 continue
             recorded = record.values[row.label][metric][k]
             np.testing.assert_allclose(
@@ -617,6 +691,7 @@ def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence
                 atol=RECORD_ATOL,
                 err_msg=f"{row.label} {metric}: make seeds",
             )
+    return gaps
 
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
