@@ -214,7 +214,7 @@ def _bvh_prediction(path: Path) -> Prediction:
     from beatlite.io.motion import Motion
     from beatlite.io.take import resample_frames, rotation_columns
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
-    from beatlite.train.evaluation import channels_to_directions
+    from beatlite.skeleton.ted import channels_to_directions
 
     motion = read_bvh(path)
     channels = beat_channels(motion, path)
@@ -230,7 +230,7 @@ def _bvh_prediction(path: Path) -> Prediction:
 def _npy_prediction(path: Path) -> Prediction:
     """A ``.npy`` of (T, 42, 3) / (T, 126) directions or (T, 141) Euler degrees."""
     from beatlite.io import FormatError
-    from beatlite.train.evaluation import euler_to_directions
+    from beatlite.skeleton.ted import euler_to_directions
 
     try:
         x = np.load(path, allow_pickle=False)
@@ -488,7 +488,7 @@ def _truth_sha(test: Any) -> str:
 def _load_test_set(data: str | Path | None, split: str) -> Any:
     from beatlite.data.index import index_folder
     from beatlite.paths import data_dir
-    from beatlite.train.evaluation import load_test_set
+    from beatlite.train.testset import load_test_set
 
     folder = Path(data_dir() if data is None else data)
     if not folder.is_dir():
@@ -652,7 +652,7 @@ def _score(
     from beatlite.metrics.extractor import load_extractor
     from beatlite.metrics.scoring import METRICS, evaluate
     from beatlite.paths import n_threads
-    from beatlite.train.evaluation import directions_takes
+    from beatlite.train.testset import directions_takes
 
     keys = list(METRICS) if metrics is None else list(metrics)
     unknown = [k for k in keys if k not in METRICS]
@@ -846,7 +846,7 @@ def export_checkpoint_takes(
     from beatlite.io.motion import Motion
     from beatlite.paths import n_threads
     from beatlite.skeleton.beat import beat_skeleton, expand_subset
-    from beatlite.train.evaluation import generate_takes, load_checkpoint_for
+    from beatlite.train.testset import generate_takes, load_checkpoint_for
 
     if format not in ("bvh", "npy"):
         raise ValueError(f"format must be 'bvh' or 'npy', got {format!r}")

@@ -75,8 +75,9 @@ def test_a_new_model_and_metric_train_evaluate_and_appear_in_the_table(
     from beatlite import models
     from beatlite.paths import checkpoints_dir
     from beatlite.train import recipes
-    from beatlite.train.evaluation import COLUMNS, evaluate_models, load_test_set
+    from beatlite.train.evaluation import COLUMNS, evaluate_models
     from beatlite.train.seeds import NotRecorded, check_against_record, recorded_seed_results
+    from beatlite.train.testset import load_test_set
 
     (tmp_path / "throwaway_model.py").write_text(textwrap.dedent(MODULE))
     (tmp_path / "throwaway_metric.py").write_text(textwrap.dedent(METRIC_MODULE))

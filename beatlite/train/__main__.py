@@ -39,17 +39,25 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from beatlite.train.recipes import RECIPES, SEED
+from beatlite import paths
+from beatlite.io.atomic import atomic_write, exclusive_lock
+from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
+from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
+from beatlite.train.seeds import (
+    evaluate_seeds,
+    recorded_seed_results,
+    recorded_shipped_seed,
+    ship_median_seeds,
+    train_seeds,
+    write_seed_results,
+)
 
 
 def _record_times(seconds: dict[str, float]) -> None:
     """Merge ``seconds`` into ``build/train/times.json`` (name -> training seconds)."""
     import json
 
-    from beatlite.io.atomic import atomic_write
-    from beatlite.paths import build_dir
-
-    path = build_dir() / "train" / "times.json"
+    path = paths.build_dir() / "train" / "times.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     times = json.loads(path.read_text()) if path.is_file() else {}
     times.update({k: round(v, 1) for k, v in seconds.items()})
@@ -110,7 +118,6 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _results_command(args: argparse.Namespace) -> int:
-    from beatlite.train.evaluation import evaluate_models, write_results
 
     results = evaluate_models(args.only or None, progress=True)
     md, js = write_results(results, args.out)
@@ -120,14 +127,6 @@ def _results_command(args: argparse.Namespace) -> int:
 
 
 def _seeds_command(args: argparse.Namespace) -> int:
-    from beatlite.train.evaluation import RECORD_COLUMNS
-    from beatlite.train.seeds import (
-        evaluate_seeds,
-        recorded_seed_results,
-        ship_median_seeds,
-        train_seeds,
-        write_seed_results,
-    )
 
     if not args.evaluate_only:
         train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
@@ -147,13 +146,10 @@ def _seeds_command(args: argparse.Namespace) -> int:
 
 
 def _retrain_all_command(args: argparse.Namespace) -> int:
-    from beatlite.train.recipes import retrain_many
 
     def report(name: str, seed: int, seconds: float) -> None:
         print(f"{name}: {seconds:.1f} s", flush=True)
         _record_times({name: seconds})
-
-    from beatlite.train.seeds import recorded_shipped_seed
 
     names = args.only or list(RECIPES)
     runs = [(name, recorded_shipped_seed(name) if args.seed is None else args.seed, None) for name in names]
@@ -174,10 +170,6 @@ def _fit_command(args: argparse.Namespace) -> int:
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
 
-    from beatlite.io.atomic import exclusive_lock
-    from beatlite.paths import repo_root
-    from beatlite.train.recipes import retrain, training_data
-
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
     os.environ.setdefault(
@@ -186,7 +178,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     rank = int(os.environ.get("RANK", "0"))
     data = training_data(data_dir, progress=rank == 0)
     extractor = None
-    if data_dir != (repo_root() / "data_samples").resolve():
+    if data_dir != (paths.repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
         with exclusive_lock(out / ".fgd_dirvec.lock"):
             if not extractor.is_file():

@@ -34,7 +34,14 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from beatlite import models, paths
+from beatlite.data.index import index_folder
+from beatlite.data.store import build_store
+from beatlite.data.vocab import build_vocab, take_sentences, word_vectors
+from beatlite.models import build_model, model_class, presets
 from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
+from beatlite.train.config import TrainConfig
+from beatlite.train.testset import fgd_scorer, load_test_set
 
 SEED = 2021
 """Seed of every shipped checkpoint (the reference's ``random_seed``)."""
@@ -60,7 +67,7 @@ class Recipe:
         :attr:`beatlite.train.TrainConfig.lr_schedule` (``"constant"`` or ``"cosine"``).
     select_best : bool
         Score every epoch by FGD on the validation takes
-        (:func:`beatlite.train.evaluation.fgd_scorer`) and export the best epoch, as BEAT's
+        (:func:`beatlite.train.testset.fgd_scorer`) and export the best epoch, as BEAT's
         reference trainer does; ``False`` exports the last epoch.
     """
 
@@ -80,7 +87,6 @@ class Recipe:
         Asked of the model class (:meth:`beatlite.models.base.GestureModel.keys_for`) with the
         recipe's ``tiny`` config, so a new model needs no entry here.
         """
-        from beatlite.models import model_class, presets
         from beatlite.models.base import config_from_preset
 
         cls = model_class(self.model)
@@ -172,9 +178,8 @@ def register_recipe(name: str, recipe: Recipe) -> None:
     ValueError
         The recipe's model is not registered, or ``name`` is taken by another recipe.
     """
-    from beatlite.models import MODELS
 
-    if recipe.model not in MODELS:
+    if recipe.model not in models.MODELS:
         raise ValueError(f"register_recipe: model {recipe.model!r} is not registered (register_model first)")
     if name in RECIPES and RECIPES[name] != recipe:
         raise ValueError(f"register_recipe: {name!r} is already a recipe ({RECIPES[name]})")
@@ -201,9 +206,8 @@ class TrainingData:
 
     @functools.cached_property
     def val_takes(self) -> Any:
-        """The whole validation takes that :func:`~beatlite.train.evaluation.fgd_scorer` generates
-        (an :class:`~beatlite.train.evaluation.EvaluationSet`, prepared on first use, then shared)."""
-        from beatlite.train.evaluation import load_test_set
+        """The whole validation takes that :func:`~beatlite.train.testset.fgd_scorer` generates
+        (an :class:`~beatlite.train.testset.EvaluationSet`, prepared on first use, then shared)."""
 
         return load_test_set(self.index, split="val", vocab=self.vocab, store=self.store)
 
@@ -214,12 +218,8 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
 
     ``progress`` shows the store's tqdm bar over the takes it builds.
     """
-    from beatlite.data.index import index_folder
-    from beatlite.data.store import build_store
-    from beatlite.data.vocab import build_vocab, take_sentences
-    from beatlite.paths import data_dir
 
-    root = Path(data) if data is not None else data_dir()
+    root = Path(data) if data is not None else paths.data_dir()
     index = index_folder(root)
     vocab = build_vocab(index)
     store = build_store(index, vocab=vocab, progress=progress)
@@ -240,9 +240,6 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     choice of clips).
     """
     import torch
-
-    from beatlite.data.vocab import word_vectors
-    from beatlite.models import build_model, model_class
 
     recipe = _recipe(name)
     kw = dict(recipe.overrides)
@@ -303,9 +300,7 @@ def retrain(
     float
         Seconds spent in :func:`beatlite.train.fit` (window building excluded).
     """
-    from beatlite.paths import build_dir, checkpoints_dir
     from beatlite.train.checkpoint import export_checkpoint
-    from beatlite.train.config import TrainConfig
     from beatlite.train.distributed import distributed_rank
     from beatlite.train.training import fit
 
@@ -313,7 +308,7 @@ def retrain(
     data = training_data() if data is None else data
     model = build_recipe_model(name, data, seed=seed)
     if out_dir is None:
-        export, full = checkpoints_dir() / f"{name}.pt", build_dir() / "train" / f"{name}.pt"
+        export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
     else:
         export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
     config = TrainConfig(
@@ -331,7 +326,6 @@ def retrain(
     score = None
     if recipe.select_best and config.epochs > 0:
         from beatlite.metrics.extractor import load_extractor
-        from beatlite.train.evaluation import fgd_scorer
 
         features = load_extractor("dirvec", extractor)
         score = fgd_scorer(normalizers=data.train.normalizers, takes=data.val_takes, extractor=features)

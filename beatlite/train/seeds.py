@@ -33,14 +33,28 @@ from typing import Any
 
 import numpy as np
 
-from beatlite.train.recipes import RECIPES, SEED, retrain_many
+from beatlite import paths
+from beatlite.io.atomic import atomic_write
+from beatlite.io.errors import FormatError
+from beatlite.metrics.scoring import METRICS, describe
+from beatlite.models import build_model
+from beatlite.report import markdown_table, write_markdown_and_json
+from beatlite.train.evaluation import (
+    COLUMNS,
+    GROUND_TRUTH,
+    GROUND_TRUTH_141,
+    column_headers,
+    evaluate_models,
+    fmt_metric,
+)
+from beatlite.train.recipes import RECIPES, SEED, label_of, retrain_many
+from beatlite.train.testset import load_test_set
 
 
 def seeds_dir() -> Path:
     """``build/seeds``: one folder per extra seed."""
-    from beatlite.paths import build_dir
 
-    return build_dir() / "seeds"
+    return paths.build_dir() / "seeds"
 
 
 def checkpoint_path(name: str, seed: int) -> Path:
@@ -49,10 +63,9 @@ def checkpoint_path(name: str, seed: int) -> Path:
     ``build/seeds/<seed>/<name>.pt``; when that file does not exist and the shipped
     ``checkpoints/<name>.pt`` was trained with ``seed``, the shipped one.
     """
-    from beatlite.paths import checkpoints_dir
 
     path = seeds_dir() / str(seed) / f"{name}.pt"
-    shipped = checkpoints_dir() / f"{name}.pt"
+    shipped = paths.checkpoints_dir() / f"{name}.pt"
     if not path.is_file() and shipped_seed(shipped) == seed:
         return shipped
     return path
@@ -108,14 +121,12 @@ def ship_median_seeds(
     -------
     dict recipe name -> shipped seed
     """
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.recipes import label_of
 
     names = [n for n in RECIPES if label_of(n) in results.values] if names is None else list(names)
     chosen = {}
     for name in names:
         seed = median_seed(results.values[label_of(name)][metric], results.seeds)
-        src, dst = checkpoint_path(name, seed), checkpoints_dir() / f"{name}.pt"
+        src, dst = checkpoint_path(name, seed), paths.checkpoints_dir() / f"{name}.pt"
         if src.resolve() != dst.resolve():
             kept = shipped_seed(dst)  # the replaced checkpoint stays its seed's copy in build/seeds/
             if kept is not None and not (seeds_dir() / str(kept) / dst.name).is_file():
@@ -160,7 +171,6 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     builds now (same vocabulary size and seed), so a seed table is never filled with checkpoints of
     an older recipe. Code changes that leave both unchanged are not seen: retrain with ``force``.
     """
-    from beatlite.models import build_model
 
     recipe = RECIPES[name]
     stored = checkpoint.get("train_config") or {}
@@ -190,8 +200,6 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
 def _copy(src: Path, dst: Path) -> None:
     """Copy a file atomically (the folder of ``dst`` created)."""
     import shutil
-
-    from beatlite.io.atomic import atomic_write
 
     dst.parent.mkdir(parents=True, exist_ok=True)
     with open(src, "rb") as fin, atomic_write(dst, "wb") as fout:
@@ -325,9 +333,6 @@ class SeedResults:
         ``columns``: metric keys (default :data:`~beatlite.train.evaluation.COLUMNS`); ``rows``: row
         labels in table order (default every row, ground truth first, then in recipe order).
         """
-        from beatlite.report import markdown_table
-        from beatlite.train.evaluation import COLUMNS, GROUND_TRUTH, GROUND_TRUTH_141, column_headers
-        from beatlite.train.recipes import RECIPES
 
         columns = COLUMNS if columns is None else tuple(columns)
         if rows is None:
@@ -347,7 +352,6 @@ class SeedResults:
 
     def cell(self, row: str, metric: str) -> str:
         """``"mean ± sd"`` of one row and metric as the tables print it (``"mean"`` with one seed)."""
-        from beatlite.train.evaluation import fmt_metric
 
         mean, sd = self.mean(row, metric), self.sd(row, metric)
         return fmt_metric(mean, metric) + (" ± " + fmt_metric(sd, metric) if math.isfinite(sd) else "")
@@ -423,8 +427,6 @@ def compare_rows(
     -------
     list of Effect, variant-major.
     """
-    from beatlite.metrics.scoring import METRICS
-    from beatlite.train.evaluation import COLUMNS
 
     higher = {key: METRICS[key].higher_is_better for key in COLUMNS}
     effects = []
@@ -499,9 +501,6 @@ def evaluate_seeds(
         A requested checkpoint is missing (names the file and the command that trains it).
     """
     from beatlite.metrics.extractor import load_extractor
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.evaluation import COLUMNS, evaluate_models, load_test_set
-    from beatlite.train.recipes import label_of
 
     seeds = [int(s) for s in seeds]
     if not seeds:
@@ -536,7 +535,7 @@ def evaluate_seeds(
         if progress:
             print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
     info["checkpoints"] = {n: _seed_files(n, seeds) for n in names}
-    info["shipped"] = {label_of(n): shipped_seed(checkpoints_dir() / f"{n}.pt") for n in names}
+    info["shipped"] = {label_of(n): shipped_seed(paths.checkpoints_dir() / f"{n}.pt") for n in names}
     return SeedResults(values, seeds, info)
 
 
@@ -572,10 +571,8 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
     FileNotFoundError
         No recorded table (names the file and the command that writes it).
     """
-    from beatlite.io.errors import FormatError
-    from beatlite.paths import checkpoints_dir
 
-    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no recorded seed table; write it with `make seeds`")
     try:
@@ -587,10 +584,8 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
 def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
     """The seed of recipe ``name``'s shipped checkpoint in the recorded seed table (``info["shipped"]``),
     :data:`~beatlite.train.recipes.SEED` when there is no record or it does not name the row."""
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.recipes import label_of
 
-    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
     if not path.is_file():
         return SEED
     seed = (recorded_seed_results(path).info.get("shipped") or {}).get(label_of(name))
@@ -696,12 +691,8 @@ def check_against_record(
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
     """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``)."""
-    from beatlite.metrics.scoring import describe
-    from beatlite.paths import build_dir
-    from beatlite.report import write_markdown_and_json
-    from beatlite.train.evaluation import COLUMNS
 
-    stem = Path(stem) if stem is not None else build_dir() / "results_seeds"
+    stem = Path(stem) if stem is not None else paths.build_dir() / "results_seeds"
     info = results.info
     text = (
         f"# Gesture models on the `{info.get('split', 'test')}` split, seeds {results.seeds}\n\n"
@@ -768,8 +759,6 @@ def ablation_table(
     ...                      metrics=("FGD",), deltas=("FGD",), absent={"B": "needs X"}).splitlines()[-1])
     | — | B | 6.00 | not trained: needs X |  | 0 |
     """
-    from beatlite.report import markdown_table
-    from beatlite.train.evaluation import column_headers, fmt_metric
 
     variants = [label for label in rows if label != full]
     by = {(e.variant, e.metric): e for e in compare_rows(record, full, variants, metrics=deltas)}
