@@ -27,6 +27,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import WINDOW_LENGTH
 from beatlite.models.base import (
     AdversarialConfig,
     Batch,
@@ -89,7 +90,7 @@ class RandomClipConfig(ModelConfig):
     """``n_clips`` training windows are kept (drawn with ``seed``); ``n_frames`` per clip."""
 
     n_clips: int = 32
-    n_frames: int = 34
+    n_frames: int = WINDOW_LENGTH
     seed: int = 0
 
 

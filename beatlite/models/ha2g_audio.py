@@ -29,6 +29,8 @@ from collections.abc import Sequence
 import torch
 from torch import nn
 
+from beatlite.constants import WINDOW_LENGTH
+
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
 
@@ -151,7 +153,7 @@ class HierarchicalAudioEncoder(nn.Module):
         reduction: int = 8,
         out_features: int = 32,
         levels: Sequence[str] = AUDIO_LEVELS,
-        n_frames: int = 34,
+        n_frames: int = WINDOW_LENGTH,
         freq_stride: int = 1,
     ) -> None:
         super().__init__()

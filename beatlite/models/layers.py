@@ -20,6 +20,8 @@ import torch
 from torch import nn
 from torch.nn.utils.parametrizations import weight_norm
 
+from beatlite.constants import WINDOW_LENGTH
+
 
 class BasicBlock1d(nn.Module):
     """timm-style residual block on 1-D sequences (CaMN's ``BasicBlock``).
@@ -256,7 +258,7 @@ class ConvDiscriminator(nn.Module):
         *,
         hidden: int = 64,
         n_layers: int = 4,
-        n_frames: int = 34,
+        n_frames: int = WINDOW_LENGTH,
         slope: float = 0.1,
         rnn: str = "lstm",
     ) -> None:

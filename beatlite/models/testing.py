@@ -24,22 +24,24 @@ from typing import Any
 import numpy as np
 import torch
 
+from beatlite.constants import FPS, SR, WINDOW_LENGTH
+
 FAKE_SHAPES: dict[str, tuple[int, ...]] = {
-    "pose": (34, 141),
-    "dirvec": (34, 126),
+    "pose": (WINDOW_LENGTH, 141),
+    "dirvec": (WINDOW_LENGTH, 126),
     "audio": (36266,),
     "mel": (70, 128),
-    "face": (34, 51),
-    "word": (34,),
-    "emotion": (34,),
-    "semantic": (34,),
+    "face": (WINDOW_LENGTH, 51),
+    "word": (WINDOW_LENGTH,),
+    "emotion": (WINDOW_LENGTH,),
+    "semantic": (WINDOW_LENGTH,),
     "speaker": (),
 }
 """Per-window shape of each key (the batch adds a leading B)."""
 
 
 def fake_windows(
-    n: int, *, seed: int = 0, vocab_size: int = 100, n_speakers: int = 4, n_frames: int = 34
+    n: int, *, seed: int = 0, vocab_size: int = 100, n_speakers: int = 4, n_frames: int = WINDOW_LENGTH
 ) -> dict[str, np.ndarray]:
     """A numpy window dict of ``n`` random windows (the layout of ``build_windows``).
 
@@ -67,8 +69,8 @@ def fake_windows(
         raise ValueError(f"n and n_frames must be >= 1, got n={n}, n_frames={n_frames}")
     rng = np.random.default_rng(seed)
     t = n_frames
-    n_audio = int(np.floor(t / 15 * 16000))
-    n_mel = int(round((t / 15 * 16000 - 1024) / 512 + 1))
+    n_audio = int(np.floor(t / FPS * SR))
+    n_mel = int(round((t / FPS * SR - 1024) / 512 + 1))
     emotion = np.repeat(rng.integers(0, 8, size=(n, 1)), t, axis=1).astype(np.int64)
     return {
         "pose": rng.standard_normal((n, t, 141)).astype(np.float32),
