@@ -426,6 +426,16 @@ PAPER_HA2G_ABLATIONS: dict[str, dict[str, float]] = {
 }
 
 
+PAPER_TABLES: dict[tuple[str, str], dict[str, dict[str, float]]] = {
+    ("BEAT", "Table 4"): PAPER_BEAT_TABLE4,
+    ("BEAT", "Table 5"): PAPER_BEAT_TABLE5,
+    ("HA2G", "Table 1"): PAPER_HA2G_TABLE1,
+    ("HA2G", "Table 3"): PAPER_HA2G_ABLATIONS,
+    ("HA2G", "Table 4"): PAPER_HA2G_ABLATIONS,
+}
+"""(paper, table) of a :class:`~beatlite.train.recipes.PaperRow` -> the published rows above."""
+
+
 def paper_table(rows: Mapping[str, Mapping[str, float]], *, digits: int = 3) -> str:
     """A Markdown table of a paper's published rows (one of the ``PAPER_*`` dicts above).
 
