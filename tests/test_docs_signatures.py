@@ -84,6 +84,8 @@ def _index() -> dict[str, object]:
             continue
         try:
             module = importlib.import_module(info.name)
+            for name in getattr(module, "__all__", ()):  # lazy packages fill their namespace on first access:
+                getattr(module, name)  # fill it now, so the index does not depend on what ran before
         except Exception:  # an optional dependency missing here: its names stay unresolved
             continue
         for attr, obj in vars(module).items():
