@@ -441,3 +441,26 @@ def test_every_paper_row_of_a_recipe_is_a_published_row_and_every_published_row_
     assert list(ablations.values())[:2] == ["HA2G Full", "f_a^low only (T3)"]
     assert ablations["ha2g_tiny_no_contrastive"] is None and list(ablations)[-1] == "ha2g_tiny_no_physical"
     assert paper_rows("BEAT", ["Table 4"], ["camn_tiny", "mean_pose"]) == {"camn_tiny": "CaMN"}
+
+
+def test_seeds_only_records_its_rows_into_the_table_beside_the_others(tmp_path, monkeypatch, capsys):
+    """`make seeds ONLY=NAME` (`seeds --only NAME --out checkpoints/results_seeds`) keeps the other rows."""
+    import argparse
+
+    from beatlite.train import __main__ as cli
+    from beatlite.train.seeds import recorded_seed_results, write_seed_results
+
+    out = tmp_path / "results_seeds"
+    write_seed_results(SeedResults({"CaMN": {"FGD": [3.0, 4.0]}}, [1, 2], {"shipped": {"CaMN": 1}}), out)
+    mine = SeedResults({"Mine": {"FGD": [2.0, 2.5]}}, [1, 2], {"shipped": {"Mine": 2}})
+    monkeypatch.setattr(cli, "evaluate_seeds", lambda *a, **kw: mine)
+    args = argparse.Namespace(
+        only=["mine_tiny"], seeds=[1, 2], evaluate_only=True, jobs=1, force=False, ship=False
+    )
+    assert cli._seeds_command(argparse.Namespace(**vars(args), out=str(out))) == 0
+    back = recorded_seed_results(f"{out}.json")
+    assert back.values == {"CaMN": {"FGD": [3.0, 4.0]}, "Mine": {"FGD": [2.0, 2.5]}}
+    assert back.info["shipped"] == {"CaMN": 1, "Mine": 2}
+    # without --only the table is the new one alone
+    assert cli._seeds_command(argparse.Namespace(**{**vars(args), "only": None}, out=str(out))) == 0
+    assert list(recorded_seed_results(f"{out}.json").values) == ["Mine"]

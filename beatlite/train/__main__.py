@@ -118,7 +118,6 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _results_command(args: argparse.Namespace) -> int:
-
     results = evaluate_models(args.only or None, progress=True)
     md, js = write_results(results, args.out)
     print(results.to_markdown())
@@ -127,7 +126,6 @@ def _results_command(args: argparse.Namespace) -> int:
 
 
 def _seeds_command(args: argparse.Namespace) -> int:
-
     if not args.evaluate_only:
         train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
     missing = "skip" if args.evaluate_only else "error"
@@ -146,7 +144,6 @@ def _seeds_command(args: argparse.Namespace) -> int:
 
 
 def _retrain_all_command(args: argparse.Namespace) -> int:
-
     def report(name: str, seed: int, seconds: float) -> None:
         print(f"{name}: {seconds:.1f} s", flush=True)
         _record_times({name: seconds})
