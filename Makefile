@@ -14,6 +14,8 @@ export BEATLITE_MODE ?= lecture
 export PYTHONHASHSEED ?= 0
 # Training processes at once for `make checkpoints` / `make seeds` (1 torch thread each; 2 on an idle 2-core machine).
 JOBS ?= 1
+# Recipes `make seeds` trains and records (default: all).
+ONLY ?=
 
 .PHONY: run test test-fast lint lab venv system-deps data checkpoints results seeds bench clean
 
@@ -79,8 +81,9 @@ results: $(STAMP)
 
 ## Train every recipe with seeds 2021-2023 (build/seeds/), ship each row's median-FGD seed to checkpoints/
 ## and record the mean ± sd table in checkpoints/results_seeds.md/.json (about 2 h with JOBS=2 on 2 idle cores).
+## `make seeds ONLY="NAME ..."`: only these recipes' rows, recorded into the table beside the others'.
 seeds: $(STAMP)
-	$(VPY) -m beatlite.train seeds --jobs $(JOBS) --ship --out checkpoints/results_seeds
+	$(VPY) -m beatlite.train seeds --jobs $(JOBS) --ship --out checkpoints/results_seeds $(if $(ONLY),--only $(ONLY))
 
 ## Speed benchmarks (run on demand; they print ratios against the named alternatives).
 bench: $(STAMP)

@@ -217,7 +217,7 @@ def _bvh_prediction(path: Path) -> Prediction:
     from beatlite.io.motion import Motion
     from beatlite.io.take import resample_frames, rotation_columns
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
-    from beatlite.train.evaluation import channels_to_directions
+    from beatlite.skeleton.ted import channels_to_directions
 
     motion = read_bvh(path)
     channels = beat_channels(motion, path)
@@ -233,7 +233,7 @@ def _bvh_prediction(path: Path) -> Prediction:
 def _npy_prediction(path: Path) -> Prediction:
     """A ``.npy`` of (T, 42, 3) / (T, 126) directions or (T, 141) Euler degrees."""
     from beatlite.io import FormatError
-    from beatlite.train.evaluation import euler_to_directions
+    from beatlite.skeleton.ted import euler_to_directions
 
     try:
         x = np.load(path, allow_pickle=False)
@@ -401,7 +401,7 @@ class ScoreResult:
 
     def to_markdown(self) -> str:
         """The table (metric, value, 95 % interval, ground truth's value) and its caption."""
-        from beatlite.metrics.scoring import describe
+        from beatlite.metrics.scoring import ARROWS, describe
         from beatlite.report import markdown_table
 
         own = self.truth.values()
@@ -409,7 +409,7 @@ class ScoreResult:
         for r in self.evaluation.results:
             lo, hi = self.intervals.get(r.key, (math.nan, math.nan))
             ci = f"[{lo:.4g}, {hi:.4g}]" if r.key in self.intervals else ""
-            arrow = {True: " ↑", False: " ↓", None: ""}[r.higher_is_better]
+            arrow = ARROWS[r.higher_is_better]
             rows.append([r.key + arrow, f"{r.value:.4g}", ci, f"{own.get(r.key, math.nan):.4g}"])
         text = markdown_table(["metric", "value", "95 % interval", "ground truth"], rows)
         keys = [r.key for r in self.evaluation.results]
@@ -495,7 +495,7 @@ def _truth_sha(test: Any) -> str:
 def _load_test_set(data: str | Path | None, split: str) -> Any:
     from beatlite.data.index import index_folder
     from beatlite.paths import data_dir
-    from beatlite.train.evaluation import load_test_set
+    from beatlite.train.testset import load_test_set
 
     folder = Path(data_dir() if data is None else data)
     if not folder.is_dir():
@@ -659,7 +659,7 @@ def _score(
     from beatlite.metrics.extractor import load_extractor
     from beatlite.metrics.scoring import METRICS, evaluate
     from beatlite.paths import n_threads
-    from beatlite.train.evaluation import directions_takes
+    from beatlite.train.testset import directions_takes
 
     keys = list(METRICS) if metrics is None else list(metrics)
     unknown = [k for k in keys if k not in METRICS]
@@ -853,7 +853,7 @@ def export_checkpoint_takes(
     from beatlite.io.motion import Motion
     from beatlite.paths import n_threads
     from beatlite.skeleton.beat import beat_skeleton, expand_subset
-    from beatlite.train.evaluation import generate_takes, load_checkpoint_for
+    from beatlite.train.testset import generate_takes, load_checkpoint_for
 
     if format not in ("bvh", "npy"):
         raise ValueError(f"format must be 'bvh' or 'npy', got {format!r}")

@@ -79,7 +79,7 @@ def main() -> None:
     take["speaker"] = 1
     print(f"threads={torch.get_num_threads()} {source}: {n} windows; take={args.seconds:g}s ({t} frames)")
     try:  # the per-epoch validation FGD of the recipes (select_best)
-        from beatlite.train.evaluation import fgd_scorer
+        from beatlite.train.testset import fgd_scorer
 
         score = fgd_scorer("val")
     except (OSError, ValueError) as exc:

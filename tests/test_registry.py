@@ -1,4 +1,6 @@
-"""Adding a model through the documented route: one module plus two registry calls, nothing else edited."""
+"""Adding a model and a metric through the route of docs/architecture.md ("Adding a model and a metric"): one
+module plus two registry calls for the model, one function plus one registry call for the metric, nothing else
+edited, and the seed record (not re-recorded) reports both as not recorded instead of failing."""
 
 from __future__ import annotations
 
@@ -45,12 +47,40 @@ class SeedMean(GestureModel):
 '''
 
 
-def test_a_new_model_trains_evaluates_and_appears_in_the_table(tmp_path, monkeypatch):
+METRIC_MODULE = '''
+"""A throwaway descriptive metric: the mean joint speed."""
+
+import numpy as np
+
+
+def mean_speed(positions, fps):
+    """Mean joint speed (cm/s) over frames, joints and takes of positions (T, J, 3) cm."""
+    return float(np.mean([np.linalg.norm(np.diff(p, axis=0), axis=-1).mean() * fps for p in positions]))
+'''
+
+
+@pytest.fixture
+def metrics_restored():
+    from beatlite.metrics import scoring
+
+    saved = dict(scoring.METRICS)
+    yield scoring
+    scoring.METRICS.clear()
+    scoring.METRICS.update(saved)
+
+
+def test_a_new_model_and_metric_train_evaluate_and_appear_in_the_table(
+    tmp_path, monkeypatch, metrics_restored
+):
     from beatlite import models
+    from beatlite.paths import checkpoints_dir
     from beatlite.train import recipes
-    from beatlite.train.evaluation import evaluate_models, load_test_set
+    from beatlite.train.evaluation import COLUMNS, evaluate_models
+    from beatlite.train.seeds import NotRecorded, check_against_record, recorded_seed_results
+    from beatlite.train.testset import load_test_set
 
     (tmp_path / "throwaway_model.py").write_text(textwrap.dedent(MODULE))
+    (tmp_path / "throwaway_metric.py").write_text(textwrap.dedent(METRIC_MODULE))
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
     monkeypatch.setattr(recipes, "RECIPES", dict(recipes.RECIPES))
@@ -59,17 +89,38 @@ def test_a_new_model_trains_evaluates_and_appears_in_the_table(tmp_path, monkeyp
     recipes.register_recipe(
         "seed_mean_tiny", recipes.Recipe("seed_mean", "Seed mean", epochs=1, select_best=False)
     )
+    from throwaway_metric import mean_speed
+
+    scoring = metrics_restored
+    scoring.register_metric(
+        "Speed", scoring.Metric("Speed", "beatlite", None, None, mean_speed, "mean joint speed, cm/s")
+    )
+    assert scoring.METRICS["Speed"].needs == ("positions",)
     seconds = recipes.retrain("seed_mean_tiny", out_dir=tmp_path / "ckpt", progress=False)
     assert seconds > 0 and (tmp_path / "ckpt" / "seed_mean_tiny.pt").is_file()
 
     res = evaluate_models(
-        [str(tmp_path / "ckpt" / "seed_mean_tiny.pt")], test=load_test_set(), ground_truth=False
+        [str(tmp_path / "ckpt" / "seed_mean_tiny.pt")], test=load_test_set(), columns=(*COLUMNS, "Speed")
     )
     row = res.get("Seed mean")
     assert row.source.endswith("seed_mean_tiny.pt") and row.representation == "euler141"
     assert all(v == v for k, v in row.metrics.items() if k != "BC")  # finite scores (BC may have no beats)
-    assert "| Seed mean |" in res.to_markdown()
+    assert 0 <= row.metrics["Speed"] < res.get("Ground truth").metrics["Speed"]
+    table = res.to_markdown()
+    assert "| Seed mean |" in table and "| Speed | gen. s |" in table  # descriptive: no arrow
+    assert "- **Speed**: mean joint speed, cm/s" in table
     assert "throwaway_model" in sys.modules
+
+    if not (checkpoints_dir() / "results_seeds.json").is_file():
+        pytest.skip("no recorded seed table to check against (make seeds)")
+    gaps = check_against_record(res, recorded_seed_results(), metrics=("Speed",))
+    assert gaps == [
+        NotRecorded("Ground truth", "Speed", None),
+        NotRecorded("Ground truth (141 Euler channels)", "Speed", None),
+        NotRecorded("Seed mean", None, "seed_mean_tiny"),
+    ]
+    assert str(gaps[-1]) == "Seed mean: not recorded: run `make seeds ONLY=seed_mean_tiny`"
+    assert str(gaps[0]) == "Ground truth Speed: not recorded: run `make seeds`"
 
 
 def test_registration_refuses_conflicts(monkeypatch):
@@ -86,3 +137,27 @@ def test_registration_refuses_conflicts(monkeypatch):
         recipes.register_recipe("ghost_tiny", recipes.Recipe("ghost", "Ghost"))
     with pytest.raises(ValueError, match="already a recipe"):
         recipes.register_recipe("camn_tiny", recipes.Recipe("s2g", "Other"))
+
+
+def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_restored):
+    import numpy as np
+
+    scoring = metrics_restored
+
+    def gap(positions, truth_positions, fps, scale=1.0):
+        return (
+            scale * fps * float(np.mean([np.abs(a - b).mean() for a, b in zip(positions, truth_positions)]))
+        )
+
+    metric = scoring.Metric("Gap", "test", False, None, gap, "mean gap")
+    assert metric.needs == ("positions",)
+    gen, truth = scoring.Takes([np.ones((3, 2, 3))]), scoring.Takes([np.zeros((3, 2, 3))])
+    assert scoring.bind_inputs(gap)(gen, scoring.GroundTruth(truth, fps=10), 0) == 10.0
+    scoring.register_metric("Gap", metric)
+    assert scoring.evaluate(gen, scoring.GroundTruth(truth, fps=10), metrics=["Gap"]).get("Gap").value == 10.0
+    with pytest.raises(ValueError, match="already a metric"):
+        scoring.register_metric("FGD", metric)
+    with pytest.raises(ValueError, match="does not list"):
+        scoring.register_metric("Gap2", scoring.Metric("Gap", "test", False, ("euler",), gap, "mean gap"))
+    with pytest.raises(ValueError, match="does not name its inputs"):
+        scoring.Metric("Gap", "test", False, None, lambda g, t, seed: 0.0, "no names")

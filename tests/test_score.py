@@ -217,7 +217,7 @@ def test_another_skeleton_is_refused_naming_file_and_field(real_samples):
 
 
 def test_npy_representations(test_set, tmp_path):
-    from beatlite.train.evaluation import euler_to_directions
+    from beatlite.skeleton.ted import euler_to_directions
 
     d, e = test_set.gt_directions[0], test_set.gt_euler[0]
     np.save(tmp_path / "d126.npy", d.reshape(len(d), 126))

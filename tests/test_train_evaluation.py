@@ -15,20 +15,22 @@ from beatlite.models import build_model  # noqa: E402
 from beatlite.skeleton.beat import beat_skeleton  # noqa: E402
 from beatlite.skeleton.directions import positions_to_directions  # noqa: E402
 from beatlite.skeleton.kinematics import rest_pose  # noqa: E402
-from beatlite.skeleton.ted import TED_BONES, TED_VECTOR_NAMES, beat_to_ted43  # noqa: E402
+from beatlite.skeleton.ted import (  # noqa: E402
+    TED_BONES,
+    TED_VECTOR_NAMES,
+    beat_to_ted43,
+    directions_to_ted_positions,
+    euler_to_directions,
+    rest_bone_lengths,
+)
 from beatlite.train.evaluation import (  # noqa: E402
     COLUMNS,
     GROUND_TRUTH,
     GROUND_TRUTH_141,
-    EvaluationSet,
-    _in_units,
-    direction_features,
-    directions_to_ted_positions,
-    euler_to_directions,
     evaluate_models,
-    rest_bone_lengths,
     write_results,
 )
+from beatlite.train.testset import EvaluationSet, _in_units, direction_features  # noqa: E402
 
 LENGTHS = (200, 150)
 
@@ -306,7 +308,7 @@ def test_evaluate_seeds_collects_each_seeds_row_and_names_missing_checkpoints(
 
 
 def test_fgd_scorer_equals_the_fgd_column(test_set, results):
-    from beatlite.train.evaluation import fgd_scorer
+    from beatlite.train.testset import fgd_scorer
 
     mean_pose = build_model("mean_pose")
     mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
@@ -317,7 +319,7 @@ def test_fgd_scorer_equals_the_fgd_column(test_set, results):
 @pytest.mark.slow
 def test_ha2g_code_protocol_is_seeded_and_differs_from_the_deterministic_one():
     from beatlite.paths import checkpoints_dir
-    from beatlite.train.evaluation import SampledProtocol, load_test_set
+    from beatlite.train.testset import SampledProtocol, load_test_set
 
     if not (checkpoints_dir() / "ha2g_tiny.pt").is_file():
         pytest.skip("no shipped ha2g_tiny checkpoint")
@@ -416,7 +418,7 @@ def test_to_markdown_shows_the_chosen_columns_and_names_each_variant(results):
 
 
 def test_generated_euler_of_the_mean_pose_is_its_mean_and_directions_are_refused(test_set):
-    from beatlite.train.evaluation import generated_euler
+    from beatlite.train.testset import generated_euler
 
     mean_pose = build_model("mean_pose")
     pose = np.full((2, 34, 141), 0.5, np.float32)  # z-scored mean 0.5 -> 0.5 degrees (std 1, mean 0)

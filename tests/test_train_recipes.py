@@ -420,3 +420,47 @@ def test_fit_command_memory_does_not_grow_with_the_corpus(tmp_path):
     assert train[1] >= 3 * train[0], train  # (the 1-hour speakers' split rule leaves a few copied takes out)
     print(f"peak RSS: 1x {peaks[1]:.0f} MiB, 4x {peaks[4]:.0f} MiB")
     assert peaks[4] < peaks[1] + 150, peaks
+
+
+def test_every_paper_row_of_a_recipe_is_a_published_row_and_every_published_row_has_one():
+    from beatlite.train.evaluation import PAPER_TABLES
+    from beatlite.train.recipes import RECIPES, paper_rows
+
+    for name, recipe in RECIPES.items():
+        for row in recipe.paper_rows:
+            assert (row.paper, row.table) in PAPER_TABLES, (name, row)
+            assert row.row is None or row.row in PAPER_TABLES[row.paper, row.table], (name, row)
+    for (paper, table), rows in PAPER_TABLES.items():
+        ours = set(paper_rows(paper, [table]).values())
+        if table in ("Table 3", "Table 4"):  # one published dict for both HA2G studies: "(T3)" / "(T4)" rows
+            rows = [r for r in rows if not r.endswith(")") or r.endswith(f"(T{table[-1]})")]
+        missing = set(rows) - ours - {"Ground Truth", "HA2G-ASR (T3)"}  # no checkpoint can stand for these
+        assert not missing, (paper, table, missing)
+    # the order of the ablation tables: the full model, then each study's rows in RECIPES order
+    ablations = paper_rows("HA2G", ["Table 3", "Table 4"])
+    assert list(ablations.values())[:2] == ["HA2G Full", "f_a^low only (T3)"]
+    assert ablations["ha2g_tiny_no_contrastive"] is None and list(ablations)[-1] == "ha2g_tiny_no_physical"
+    assert paper_rows("BEAT", ["Table 4"], ["camn_tiny", "mean_pose"]) == {"camn_tiny": "CaMN"}
+
+
+def test_seeds_only_records_its_rows_into_the_table_beside_the_others(tmp_path, monkeypatch, capsys):
+    """`make seeds ONLY=NAME` (`seeds --only NAME --out checkpoints/results_seeds`) keeps the other rows."""
+    import argparse
+
+    from beatlite.train import __main__ as cli
+    from beatlite.train.seeds import recorded_seed_results, write_seed_results
+
+    out = tmp_path / "results_seeds"
+    write_seed_results(SeedResults({"CaMN": {"FGD": [3.0, 4.0]}}, [1, 2], {"shipped": {"CaMN": 1}}), out)
+    mine = SeedResults({"Mine": {"FGD": [2.0, 2.5]}}, [1, 2], {"shipped": {"Mine": 2}})
+    monkeypatch.setattr(cli, "evaluate_seeds", lambda *a, **kw: mine)
+    args = argparse.Namespace(
+        only=["mine_tiny"], seeds=[1, 2], evaluate_only=True, jobs=1, force=False, ship=False
+    )
+    assert cli._seeds_command(argparse.Namespace(**vars(args), out=str(out))) == 0
+    back = recorded_seed_results(f"{out}.json")
+    assert back.values == {"CaMN": {"FGD": [3.0, 4.0]}, "Mine": {"FGD": [2.0, 2.5]}}
+    assert back.info["shipped"] == {"CaMN": 1, "Mine": 2}
+    # without --only the table is the new one alone
+    assert cli._seeds_command(argparse.Namespace(**{**vars(args), "only": None}, out=str(out))) == 0
+    assert list(recorded_seed_results(f"{out}.json").values) == ["Mine"]

@@ -59,6 +59,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.data.normalize import MIN_STD, Normalizer, Normalizers
 from beatlite.data.windows import (
     MEL_SETTINGS,
@@ -459,8 +460,8 @@ class WindowStore:
         self,
         split: str | None,
         *,
-        length: int = 34,
-        stride: int = 10,
+        length: int = WINDOW_LENGTH,
+        stride: int = WINDOW_STRIDE,
         keys: Sequence[str] | None = None,
         stats: Normalizers | None = None,
         vocab: Vocab | None = None,
@@ -698,9 +699,7 @@ def _streams_of(store: WindowStore) -> set[str]:
 
 
 # ---------------------------------------------------------------------- building
-def store_params(
-    *, fps: float = 15, sr: int = 16000, positions: bool = False, word_rule: str = "span"
-) -> dict:
+def store_params(*, fps: float = FPS, sr: int = SR, positions: bool = False, word_rule: str = "span") -> dict:
     """The parameters that decide a store's content (they enter every take's fingerprint)."""
     return {
         "fps": float(fps),
@@ -829,8 +828,8 @@ def build_store(
     index: TakeIndex,
     folder: str | Path | None = None,
     *,
-    fps: float = 15,
-    sr: int = 16000,
+    fps: float = FPS,
+    sr: int = SR,
     positions: bool = False,
     word_rule: str = "span",
     vocab: Vocab | None = None,

@@ -154,7 +154,7 @@ def mel_frames(n_samples: int) -> int:
     return max(1, int(round((n_samples - MEL_SETTINGS["n_fft"]) / MEL_SETTINGS["hop_length"] + 1)))
 
 
-def log_mel(audio: np.ndarray, sr: int = 16000) -> np.ndarray:
+def log_mel(audio: np.ndarray, sr: int = SR) -> np.ndarray:
     """Log-mel spectrogram with HA2G settings, (M, 128) float32 dB (``power_to_db(ref=np.max)``).
 
     Parameters
@@ -218,8 +218,8 @@ class TakeFeatures:
 def take_features(
     record: TakeRecord,
     *,
-    fps: float = 15,
-    sr: int = 16000,
+    fps: float = FPS,
+    sr: int = SR,
     vocab: Mapping | None = None,
     word_rule: str = "span",
     positions: bool = False,

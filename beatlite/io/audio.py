@@ -30,6 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from beatlite.constants import SR
 from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError, FormatWarning
 from beatlite.io.textfile import GZIP_MAGIC, describe_bytes, read_bytes
@@ -200,7 +201,7 @@ def audio_info(path: str | os.PathLike[str]) -> AudioInfo:
 
 
 def read_audio(
-    path: str | os.PathLike[str], *, sr: int | None = 16000, mono: bool = True
+    path: str | os.PathLike[str], *, sr: int | None = SR, mono: bool = True
 ) -> tuple[np.ndarray, int]:
     """Read an audio file as float32 samples in [-1, 1].
 

@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from beatlite.constants import FPS, SR
 from beatlite.io.audio import read_audio
 from beatlite.io.bvh import parse_frame_time, read_bvh, read_bvh_header
 from beatlite.io.emotion import EmotionSegment, emotion_to_frames, read_emotion
@@ -400,9 +401,9 @@ def _annotations(
 def load_take(
     stem_or_path: str | os.PathLike[str],
     *,
-    fps: float = 15,
+    fps: float = FPS,
     phase: str = "start",
-    audio_sr: int = 16000,
+    audio_sr: int = SR,
     bvh_fps: float | None = None,
     blendshapes: Sequence[str] | None = ARKIT_51,
 ) -> Take:

@@ -41,6 +41,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from beatlite.constants import WINDOW_LENGTH
+
 FORMAT = "beatlite-fgd-extractor/1"
 #: Window key of ``beatlite.data.windows`` for each extractor space, and the shipped file name.
 SPACES = {"dirvec": ("dirvec", "fgd_dirvec.pt"), "pose": ("pose", "fgd_euler141.pt")}
@@ -48,7 +50,6 @@ SPACES = {"dirvec": ("dirvec", "fgd_dirvec.pt"), "pose": ("pose", "fgd_euler141.
 #: the encoder blind to timing (FGD of frame-shuffled test windows 0.9x that of held-out real
 #: windows on data_samples), 10 makes it see it (2.4x) — measured, see the module docstring.
 VELOCITY_WEIGHT = {"dirvec": 10.0, "pose": 0.1}
-WINDOW = 34
 
 
 @dataclass(frozen=True)
@@ -165,8 +166,10 @@ class FeatureExtractor:
     def _check(self, windows: np.ndarray) -> np.ndarray:
         w = np.asarray(windows, dtype=np.float32)
         d = self.model.config.input_dim
-        if w.ndim != 3 or w.shape[1] != WINDOW or w.shape[2] != d:
-            raise ValueError(f"windows must be (N, {WINDOW}, {d}) ({self.space} space), got shape {w.shape}")
+        if w.ndim != 3 or w.shape[1] != WINDOW_LENGTH or w.shape[2] != d:
+            raise ValueError(
+                f"windows must be (N, {WINDOW_LENGTH}, {d}) ({self.space} space), got shape {w.shape}"
+            )
         if not np.all(np.isfinite(w)):
             raise ValueError("windows contain NaN or infinite values")
         return (w - self.mean) / self.std
@@ -260,8 +263,8 @@ def train_autoencoder(
     from beatlite.paths import n_threads
 
     w = WindowSource(windows, key)
-    if len(w) and w.shape != (WINDOW, config.input_dim):
-        raise ValueError(f"windows must be (N, {WINDOW}, {config.input_dim}), got (N, *{w.shape})")
+    if len(w) and w.shape != (WINDOW_LENGTH, config.input_dim):
+        raise ValueError(f"windows must be (N, {WINDOW_LENGTH}, {config.input_dim}), got (N, *{w.shape})")
     if len(w) < 2:
         raise ValueError(f"need at least 2 training windows, got {len(w)}")
     val = None if val_windows is None else WindowSource(val_windows, key)

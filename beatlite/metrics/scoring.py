@@ -12,8 +12,10 @@ Metrics are looked up by name in :data:`METRICS`; each names its variant and par
 table can say which definition produced each column (:func:`describe`). A metric whose input
 is missing (e.g. Euler angles for a direction model) is skipped with the reason.
 
-Adding a metric: write the function (its own module in ``beatlite.metrics``), then one
-:class:`Metric` entry in :data:`METRICS` that reads what it needs from the two objects.
+Adding a metric: write one function (its own module in ``beatlite.metrics``) whose parameters are named
+after the inputs it reads (:data:`INPUTS`: ``positions``, ``truth_positions``, ``semantic``, ``fps``, ...),
+then one :class:`Metric` entry (:func:`register_metric`, or a line in :data:`METRICS`): the adapter from
+:class:`Takes` / :class:`GroundTruth` is generated from those names (:func:`bind_inputs`).
 
 >>> import numpy as np
 >>> pos = [np.zeros((40, 2, 3))]
@@ -27,6 +29,7 @@ Taught in ``notebooks/04_metrics.ipynb`` (the metrics) and ``notebooks/07_benchm
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -129,11 +132,15 @@ class Metric:
         Which definition (``"beatlite"``, ``"paper"``, ``"reference"``, ``"ha2g"``, ...).
     higher_is_better : bool or None
         None for descriptive statistics.
-    needs : tuple of str
+    needs : tuple of str or None
         Inputs it reads: ``"positions"``, ``"directions"``, ``"euler"``, ``"features"``,
-        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``, ``"mean_speed"``.
+        ``"semantic"``, ``"audio"``, ``"beats"``, ``"change_angle"``, ``"mean_direction"``, ``"mean_speed"``;
+        None: :func:`needs_of` ``(compute)`` (a function that names its inputs).
     compute : callable
-        ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float``.
+        The metric function: its parameters are named after :data:`INPUTS` (bound by :func:`bind_inputs`:
+        ``positions`` is the system's, ``truth_positions`` the ground truth's, ``fps`` the ground truth's
+        rate, ...), or it is ``compute(generated: Takes, truth: GroundTruth, seed: int) -> float`` when a
+        required parameter is not an input name (the built-in metrics, which combine several inputs).
     describe : str
         One line for a table caption: the variant and its parameters.
     source : str
@@ -143,10 +150,18 @@ class Metric:
     name: str
     variant: str
     higher_is_better: bool | None
-    needs: tuple[str, ...]
+    needs: tuple[str, ...] | None
     compute: Callable[[Takes, GroundTruth, int], float]
     describe: str
     source: str = ""
+
+    def __post_init__(self) -> None:
+        if self.needs is None:
+            object.__setattr__(self, "needs", needs_of(self.compute))
+
+
+ARROWS: dict[bool | None, str] = {True: " ↑", False: " ↓", None: ""}
+"""A column header's suffix for a metric's ``higher_is_better``: none for a descriptive metric."""
 
 
 @dataclass(frozen=True)
@@ -223,7 +238,7 @@ def evaluate(
         if missing:
             skipped[key] = f"needs {', '.join(missing)}"
             continue
-        value = float(m.compute(generated, truth, seed))
+        value = float(bind_inputs(m.compute)(generated, truth, seed))
         results.append(MetricResult(key, m.name, value, m.variant, m.higher_is_better, m.describe))
     return Evaluation(results, skipped)
 
@@ -235,6 +250,102 @@ def describe(keys: Sequence[str], *, sources: bool = False) -> str:
         f"- **{key}**: {METRICS[key].describe}" + (f" [{METRICS[key].source}]" if sources else "")
         for key in keys
     )
+
+
+#: Generated per take (a list in take order, or an (N, F) array of window features): the system's under
+#: these names, the ground truth's as ``truth_<name>``.
+TAKE_INPUTS: tuple[str, ...] = ("positions", "directions", "euler", "features", "euler_features")
+#: Every parameter name :func:`bind_inputs` fills: :data:`TAKE_INPUTS`, their ``truth_`` twins, the
+#: :class:`GroundTruth` fields (``beats``: :meth:`GroundTruth.beats`) and ``seed``.
+INPUTS: tuple[str, ...] = (
+    *TAKE_INPUTS,
+    *(f"truth_{name}" for name in TAKE_INPUTS),
+    "semantic",
+    "audio",
+    "beats",
+    "change_angle",
+    "mean_direction",
+    "mean_speed",
+    "fps",
+    "sr",
+    "seed",
+)
+
+
+def _input(name: str, gen: Takes, truth: GroundTruth, seed: int) -> Any:
+    if name in TAKE_INPUTS:
+        return getattr(gen, name)
+    if name.startswith("truth_"):
+        return getattr(truth.takes, name[len("truth_") :])
+    if name == "beats":
+        return truth.beats()
+    return seed if name == "seed" else getattr(truth, name)
+
+
+def bind_inputs(fn: Callable[..., float]) -> Callable[[Takes, GroundTruth, int], float]:
+    """``compute(generated, truth, seed)`` for a metric function whose parameters name its inputs.
+
+    Parameters
+    ----------
+    fn : callable
+        A function whose required parameters all are names of :data:`INPUTS` (``positions`` the system's,
+        ``truth_positions`` the ground truth's, ``semantic``, ``fps``, ``seed``, ...; parameters with a
+        default that are not inputs keep it). A function with another required parameter is taken to be
+        ``compute(generated, truth, seed)`` already and returned as is.
+
+    Returns
+    -------
+    callable
+        ``(generated: Takes, truth: GroundTruth, seed: int) -> float``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> def mean_height(positions, fps):
+    ...     return float(np.mean([p[..., 1].mean() for p in positions]))
+    >>> takes = Takes(positions=[np.ones((4, 2, 3))])
+    >>> bind_inputs(mean_height)(takes, GroundTruth(takes), 0)
+    1.0
+    >>> needs_of(mean_height)
+    ('positions',)
+    """
+    params = inspect.signature(fn).parameters.values()
+    required = [p.name for p in params if p.default is inspect.Parameter.empty]
+    if any(name not in INPUTS for name in required):
+        return fn
+    names = [p.name for p in params if p.name in INPUTS]
+
+    def compute(generated: Takes, truth: GroundTruth, seed: int) -> float:
+        return fn(**{name: _input(name, generated, truth, seed) for name in names})
+
+    return compute
+
+
+def needs_of(fn: Callable[..., float]) -> tuple[str, ...]:
+    """The :class:`Metric` ``needs`` of a function :func:`bind_inputs` binds by name: its parameters that
+    name an input which may be missing (``truth_positions`` reads as ``positions``; ``fps``, ``sr`` and
+    ``seed`` are always there)."""
+    if bind_inputs(fn) is fn:
+        raise ValueError(f"{getattr(fn, '__name__', fn)!r} does not name its inputs; give needs explicitly")
+    names = [p for p in inspect.signature(fn).parameters if p in INPUTS and p not in ("fps", "sr", "seed")]
+    return tuple(dict.fromkeys(n.removeprefix("truth_") for n in names))
+
+
+def register_metric(key: str, metric: Metric) -> None:
+    """Add a metric to :data:`METRICS` under ``key`` (``"<name>"`` or ``"<name> (<variant>)"``).
+
+    Raises
+    ------
+    ValueError
+        ``key`` is already a metric, or ``metric.compute`` reads an input its ``needs`` does not list.
+    """
+    if key in METRICS:
+        raise ValueError(f"{key!r} is already a metric ({METRICS[key].describe})")
+    if bind_inputs(metric.compute) is not metric.compute:
+        unlisted = sorted(set(needs_of(metric.compute)) - set(metric.needs))
+        if unlisted:
+            raise ValueError(f"{key!r}: compute reads {unlisted}, which needs={metric.needs} does not list")
+    METRICS[key] = metric
 
 
 def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:

@@ -27,14 +27,14 @@ import torch
 from beatlite.constants import FPS, SR, WINDOW_LENGTH
 
 FAKE_SHAPES: dict[str, tuple[int, ...]] = {
-    "pose": (34, 141),
-    "dirvec": (34, 126),
+    "pose": (WINDOW_LENGTH, 141),
+    "dirvec": (WINDOW_LENGTH, 126),
     "audio": (36266,),
     "mel": (70, 128),
-    "face": (34, 51),
-    "word": (34,),
-    "emotion": (34,),
-    "semantic": (34,),
+    "face": (WINDOW_LENGTH, 51),
+    "word": (WINDOW_LENGTH,),
+    "emotion": (WINDOW_LENGTH,),
+    "semantic": (WINDOW_LENGTH,),
     "speaker": (),
 }
 """Per-window shape of each key (the batch adds a leading B)."""

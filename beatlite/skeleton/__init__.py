@@ -6,7 +6,8 @@
 ``rotations``                Euler (6 orders) <-> matrix <-> quaternion <-> axis-angle <-> 6D
 ``kinematics``               forward kinematics: channel rows -> world positions/rotations
 ``directions``               unit bone vectors <-> joint positions
-``ted``                      the TED-Expressive 43-joint body for HA2G (bones, levels, angle pairs)
+``ted``                      the TED-Expressive 43-joint body for HA2G (bones, levels, angle pairs) and
+                             the results tables' common space (BEAT Euler/channels <-> TED-43)
 ==========================  ==================================================================
 
 Taught in notebooks/01_beat_formats.ipynb, sections 2 and 4-7 (the skeleton, Euler angles, forward kinematics, joint subsets).
@@ -49,8 +50,12 @@ from beatlite.skeleton.ted import (
     TED_BONES,
     TED_VECTOR_NAMES,
     beat_to_ted43,
+    channels_to_directions,
+    directions_to_ted_positions,
+    euler_to_directions,
     pair_angles,
     palm_normals,
+    rest_bone_lengths,
 )
 
 __all__ = [
@@ -62,7 +67,10 @@ __all__ = [
     "TED_BONES",
     "TED_VECTOR_NAMES",
     "beat_to_ted43",
+    "channels_to_directions",
     "directions_to_positions",
+    "directions_to_ted_positions",
+    "euler_to_directions",
     "pair_angles",
     "palm_normals",
     "positions_to_directions",
@@ -89,6 +97,7 @@ __all__ = [
     "matrix_to_euler",
     "matrix_to_quat",
     "quat_to_matrix",
+    "rest_bone_lengths",
     "rest_pose",
     "sixd_to_matrix",
     "subset_columns",

@@ -18,16 +18,23 @@ and turn with the head. They need the head's world rotation, which :func:`beat_t
 from forward kinematics when given channels, or from ``rotations``; from positions alone the
 head frame is estimated (see there).
 
+**The common space of the results tables** (every model scored as TED-43 directions and positions):
+:func:`euler_to_directions` (``spine_neck_141`` Euler degrees), :func:`channels_to_directions` (full BEAT channel
+rows) and :func:`directions_to_ted_positions` (directions back to positions with :func:`rest_bone_lengths`).
+
 Taught in notebooks/06_ha2g.ipynb, sections 1 (poses as unit bone directions), 2 (the body hierarchy) and 6 (the angle pairs of the physical constraint).
 """
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from beatlite.skeleton.beat import beat_skeleton
+from beatlite.skeleton.beat import beat_skeleton, expand_subset
 from beatlite.skeleton.core import Skeleton
-from beatlite.skeleton.kinematics import global_transforms
+from beatlite.skeleton.directions import directions_to_positions, positions_to_directions
+from beatlite.skeleton.kinematics import forward_kinematics, global_transforms, rest_pose
 
 __all__ = [
     "ANGLE_PAIRS",
@@ -38,8 +45,12 @@ __all__ = [
     "TED_BONES",
     "TED_VECTOR_NAMES",
     "beat_to_ted43",
+    "channels_to_directions",
+    "directions_to_ted_positions",
+    "euler_to_directions",
     "pair_angles",
     "palm_normals",
+    "rest_bone_lengths",
 ]
 
 _FINGERS = ("index", "middle", "pinky", "ring", "thumb")  # HA2G's finger order
@@ -351,3 +362,59 @@ def _check_ted_joints(names: tuple[str, ...]) -> None:
     ]
     if missing:
         raise ValueError(f"the skeleton lacks the BEAT joints {missing[:5]} needed for the TED-43 mapping")
+
+
+# ------------------------------------------------------------- the common space of the results tables
+@functools.cache
+def rest_bone_lengths() -> np.ndarray:
+    """(42,) float64 cm: TED-43 bone lengths of the BEAT rest skeleton (the common positions space of the
+    results tables)."""
+    ted = beat_to_ted43(rest_pose(beat_skeleton())[None])[0]
+    bones = np.asarray(TED_BONES)
+    lengths = np.linalg.norm(ted[bones[:, 1]] - ted[bones[:, 0]], axis=-1)
+    lengths.setflags(write=False)
+    return lengths
+
+
+def euler_to_directions(euler: np.ndarray) -> np.ndarray:
+    """TED-43 unit bone directions of ``spine_neck_141`` Euler angles.
+
+    Parameters
+    ----------
+    euler : (T, 141) float, degrees
+        Denormalised CaMN-layout channels; every other BEAT channel is 0 (rest), root at the origin.
+
+    Returns
+    -------
+    (T, 42, 3) float64 unit vectors (the construction of ``build_windows``' ``"dirvec"``).
+    """
+    euler = np.asarray(euler, dtype=np.float64)
+    if euler.ndim != 2 or euler.shape[1] != 141:
+        raise ValueError(f"euler must be (T, 141) degrees, got shape {euler.shape}")
+    return channels_to_directions(expand_subset(euler, "spine_neck_141"))
+
+
+def channels_to_directions(channels: np.ndarray) -> np.ndarray:
+    """TED-43 unit bone directions of full BEAT motion rows on beatlite's BEAT skeleton.
+
+    Parameters
+    ----------
+    channels : (T, 228) float
+        :func:`beatlite.skeleton.beat.beat_skeleton` channel rows (root position cm, rotations degrees,
+        ``Xrotation Yrotation Zrotation``).
+
+    Returns
+    -------
+    (T, 42, 3) float64 unit vectors: forward kinematics -> ``beat_to_ted43`` -> bone directions.
+    """
+    positions = forward_kinematics(beat_skeleton(), np.asarray(channels, dtype=np.float64))
+    return positions_to_directions(beat_to_ted43(positions), np.asarray(TED_BONES))
+
+
+def directions_to_ted_positions(directions: np.ndarray, lengths: np.ndarray | None = None) -> np.ndarray:
+    """(T, 42, 3) unit directions -> (T, 43, 3) cm TED-43 positions, root at the origin.
+
+    ``lengths`` (42,) cm default to :func:`rest_bone_lengths` (the common positions space).
+    """
+    lengths = rest_bone_lengths() if lengths is None else lengths
+    return directions_to_positions(directions, np.asarray(TED_BONES), lengths, np.zeros(3))

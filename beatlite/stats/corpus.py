@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from beatlite.constants import FPS, SR
+
 if TYPE_CHECKING:
     from beatlite.data.index import TakeIndex, TakeRecord
 
@@ -115,7 +117,7 @@ def frame_rms(audio: np.ndarray, n_frames: int, fps: float, sr: int) -> np.ndarr
     return np.sqrt(np.divide(energy, counts, out=np.zeros(n_frames), where=counts > 0))
 
 
-def corpus_take(record: TakeRecord, *, fps: float = 15, sr: int = 16000) -> CorpusTake:
+def corpus_take(record: TakeRecord, *, fps: float = FPS, sr: int = SR) -> CorpusTake:
     """Load one take (:func:`beatlite.io.load_take`, at the index's ``record.bvh_fps``) and compute its streams."""
     from beatlite.io import load_take
     from beatlite.skeleton import forward_kinematics, subset_columns
@@ -162,8 +164,8 @@ def corpus_take(record: TakeRecord, *, fps: float = 15, sr: int = 16000) -> Corp
 def iter_corpus(
     index: TakeIndex,
     *,
-    fps: float = 15,
-    sr: int = 16000,
+    fps: float = FPS,
+    sr: int = SR,
     splits: tuple[str, ...] | None = None,
     skipped: list[str] | None = None,
 ) -> Iterator[CorpusTake]:
@@ -187,7 +189,7 @@ def iter_corpus(
 
 
 def load_corpus(
-    index: TakeIndex, *, fps: float = 15, sr: int = 16000, splits: tuple[str, ...] | None = None
+    index: TakeIndex, *, fps: float = FPS, sr: int = SR, splits: tuple[str, ...] | None = None
 ) -> list[CorpusTake]:
     """:func:`corpus_take` of every usable take of ``index`` (optionally only some splits), in order.
 

@@ -24,11 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
+from beatlite.constants import SR
+
 ESPEAK_SR = 22050
 """Sample rate of espeak-ng's WAV output, Hz."""
 
-OUTPUT_SR = 16000
-"""Sample rate of the generated corpus audio, Hz (BEAT's loaders read 16 kHz)."""
+OUTPUT_SR = SR
+"""Sample rate of the generated corpus audio, Hz (BEAT's loaders read 16 kHz): the models' rate."""
 
 # espeak-ng's ASCII phoneme mnemonics for English (``-x`` output), longest first, so a greedy
 # left-to-right match cuts "h@l'oU" into h, @, l, oU. Stress marks and syllable marks are dropped.

@@ -4,8 +4,9 @@
 - :func:`save_checkpoint`, :func:`load_checkpoint`, :func:`load_model`, :func:`export_checkpoint`
   (``beatlite.train.checkpoint``),
 - :func:`generate`, :func:`generate_sequence`, :func:`generate_sequences` (``beatlite.train.generation``),
-- :func:`evaluate_models`, :func:`load_test_set`, :func:`write_results`, :class:`ModelResults`
-  (``beatlite.train.evaluation``: the results table on whole test takes),
+- :func:`evaluate_models`, :func:`write_results`, :class:`ModelResults` (``beatlite.train.evaluation``: the
+  results table on whole test takes), :func:`load_test_set` (``beatlite.train.testset``: the test takes and
+  scoring one model on them),
 - ``beatlite.train.recipes`` (how every shipped checkpoint is trained: ``RECIPES``, ``retrain``)
   and ``beatlite.train.seeds`` (the results table as mean ± sd over training seeds), both
   reachable as attributes (``bl.train.recipes.RECIPES``).
@@ -35,7 +36,7 @@ _NAMES = {
     "generate_sequences": "beatlite.train.generation",
     "GeneratedTake": "beatlite.train.generation",
     "evaluate_models": "beatlite.train.evaluation",
-    "load_test_set": "beatlite.train.evaluation",
+    "load_test_set": "beatlite.train.testset",
     "write_results": "beatlite.train.evaluation",
     "ModelResults": "beatlite.train.evaluation",
 }
@@ -43,7 +44,7 @@ _NAMES = {
 __all__ = sorted(_NAMES)
 
 
-_SUBMODULES = ("recipes", "seeds", "evaluation", "training", "generation", "checkpoint", "config")
+_SUBMODULES = ("recipes", "seeds", "evaluation", "testset", "training", "generation", "checkpoint", "config")
 
 
 def __getattr__(name: str) -> Any:

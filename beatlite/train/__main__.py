@@ -26,7 +26,8 @@ seed (``build/seeds/<seed>/``; existing ones, the shipped checkpoint for its own
 kept when their stored settings and model config match today's recipe, see
 :func:`beatlite.train.seeds.recipe_mismatch`), writes the mean ± sd table over the seeds to
 ``build/results_seeds.md`` and ``.json`` and, with ``--ship``, copies each row's median-FGD seed to
-``checkpoints/`` (:mod:`beatlite.train.seeds`).
+``checkpoints/`` (:mod:`beatlite.train.seeds`). With ``--only``, an existing ``--out`` table keeps its other
+rows (``make seeds ONLY=NAME`` records a new model's rows in the shipped table).
 """
 
 from __future__ import annotations
@@ -36,18 +37,27 @@ import os
 import subprocess
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
-from beatlite.train.recipes import RECIPES, SEED
+from beatlite import paths
+from beatlite.io.atomic import atomic_write, exclusive_lock
+from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
+from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
+from beatlite.train.seeds import (
+    evaluate_seeds,
+    recorded_seed_results,
+    recorded_shipped_seed,
+    ship_median_seeds,
+    train_seeds,
+    write_seed_results,
+)
 
 
 def _record_times(seconds: dict[str, float]) -> None:
     """Merge ``seconds`` into ``build/train/times.json`` (name -> training seconds)."""
     import json
 
-    from beatlite.io.atomic import atomic_write
-    from beatlite.paths import build_dir
-
-    path = build_dir() / "train" / "times.json"
+    path = paths.build_dir() / "train" / "times.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     times = json.loads(path.read_text()) if path.is_file() else {}
     times.update({k: round(v, 1) for k, v in seconds.items()})
@@ -108,8 +118,6 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _results_command(args: argparse.Namespace) -> int:
-    from beatlite.train.evaluation import evaluate_models, write_results
-
     results = evaluate_models(args.only or None, progress=True)
     md, js = write_results(results, args.out)
     print(results.to_markdown())
@@ -118,9 +126,6 @@ def _results_command(args: argparse.Namespace) -> int:
 
 
 def _seeds_command(args: argparse.Namespace) -> int:
-    from beatlite.train.evaluation import RECORD_COLUMNS
-    from beatlite.train.seeds import evaluate_seeds, ship_median_seeds, train_seeds, write_seed_results
-
     if not args.evaluate_only:
         train_seeds(args.only or None, args.seeds, jobs=args.jobs, force=args.force)
     missing = "skip" if args.evaluate_only else "error"
@@ -130,6 +135,8 @@ def _seeds_command(args: argparse.Namespace) -> int:
     if args.ship:
         for name, seed in ship_median_seeds(table, args.only or None).items():
             print(f"shipped {name}: seed {seed}", flush=True)
+    if args.only and args.out and Path(f"{args.out}.json").is_file():  # record these rows, keep the others
+        table = recorded_seed_results(f"{args.out}.json").merged(table)
     md, js = write_seed_results(table, args.out)
     print(table.to_markdown())
     print(f"wrote {md} and {js}")
@@ -137,13 +144,9 @@ def _seeds_command(args: argparse.Namespace) -> int:
 
 
 def _retrain_all_command(args: argparse.Namespace) -> int:
-    from beatlite.train.recipes import retrain_many
-
     def report(name: str, seed: int, seconds: float) -> None:
         print(f"{name}: {seconds:.1f} s", flush=True)
         _record_times({name: seconds})
-
-    from beatlite.train.seeds import recorded_shipped_seed
 
     names = args.only or list(RECIPES)
     runs = [(name, recorded_shipped_seed(name) if args.seed is None else args.seed, None) for name in names]
@@ -163,11 +166,6 @@ def _fit_command(args: argparse.Namespace) -> int:
     ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
-    from pathlib import Path
-
-    from beatlite.io.atomic import exclusive_lock
-    from beatlite.paths import repo_root
-    from beatlite.train.recipes import retrain, training_data
 
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -177,7 +175,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     rank = int(os.environ.get("RANK", "0"))
     data = training_data(data_dir, progress=rank == 0)
     extractor = None
-    if data_dir != (repo_root() / "data_samples").resolve():
+    if data_dir != (paths.repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
         with exclusive_lock(out / ".fgd_dirvec.lock"):
             if not extractor.is_file():

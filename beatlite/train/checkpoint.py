@@ -27,6 +27,8 @@ from typing import Any
 
 import torch
 
+from beatlite import paths
+from beatlite.io.errors import FormatError
 from beatlite.models.base import GestureModel
 
 FORMAT = "beatlite-checkpoint/1"
@@ -67,7 +69,6 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     beatlite.io.FormatError
         The file is not a beatlite checkpoint.
     """
-    from beatlite.io.errors import FormatError
 
     path = Path(path)
     if not path.is_file():
@@ -107,11 +108,10 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
     -------
     (GestureModel in eval mode, checkpoint dict)
     """
-    from beatlite.paths import checkpoints_dir
 
     path = Path(path_or_name)
     if path.suffix != ".pt" and not path.is_file():
-        path = checkpoints_dir() / f"{path_or_name}.pt"
+        path = paths.checkpoints_dir() / f"{path_or_name}.pt"
     data = load_checkpoint(path)
     return model_from_checkpoint(data), data
 

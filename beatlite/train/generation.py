@@ -24,6 +24,8 @@ from beatlite.data.normalize import Normalizers
 from beatlite.data.windows import MEL_SETTINGS, mel_frames
 from beatlite.io.motion import Motion
 from beatlite.models.base import GestureModel
+from beatlite.skeleton.beat import beat_skeleton, expand_subset
+from beatlite.skeleton.ted import directions_to_ted_positions
 from beatlite.train.training import model_device
 
 UNIT = WINDOW_LENGTH
@@ -47,7 +49,7 @@ class GeneratedTake:
     positions : (T, J, 3) float64 or None, centimetres
         Direction models: TED-43 joint positions from the denormalised unit directions
         and the BEAT rest-pose bone lengths (root at the origin; the common space of the
-        results tables, :func:`beatlite.train.evaluation.rest_bone_lengths`). Euler models: ``None``
+        results tables, :func:`beatlite.skeleton.ted.rest_bone_lengths`). Euler models: ``None``
         (use ``motion.positions()``).
     fps : float
         15.
@@ -249,12 +251,8 @@ def generate(
     if normalizers is not None:
         values = normalizers.inverse_transform(pose, model.representation)
         if model.representation == "euler141":
-            from beatlite.skeleton.beat import beat_skeleton, expand_subset
-
             skeleton = beat_skeleton()
             motion = Motion(skeleton, expand_subset(values, "spine_neck_141", skeleton), FPS)
         else:
-            from beatlite.train.evaluation import directions_to_ted_positions
-
             positions = directions_to_ted_positions(values)
     return GeneratedTake(pose=pose, representation=model.representation, motion=motion, positions=positions)

@@ -32,12 +32,37 @@ import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
+from beatlite import models, paths
+from beatlite.data.index import index_folder
+from beatlite.data.store import build_store
+from beatlite.data.vocab import build_vocab, take_sentences, word_vectors
+from beatlite.models import build_model, model_class, presets
 from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
+from beatlite.train.config import TrainConfig
+from beatlite.train.testset import fgd_scorer, load_test_set
 
 SEED = 2021
 """Seed of every shipped checkpoint (the reference's ``random_seed``)."""
+
+
+class PaperRow(NamedTuple):
+    """The row of a published table that a checkpoint reproduces.
+
+    Attributes
+    ----------
+    paper : str
+        ``"BEAT"`` (Liu et al., ECCV 2022) or ``"HA2G"`` (Liu et al., CVPR 2022).
+    table : str
+        ``"Table 4"``, ...: the keys of the ``PAPER_*`` dicts of :mod:`beatlite.train.evaluation` are its rows.
+    row : str or None
+        The paper's row label; None for an ablation of that study the paper has no row for.
+    """
+
+    paper: str
+    table: str
+    row: str | None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,8 +85,10 @@ class Recipe:
         :attr:`beatlite.train.TrainConfig.lr_schedule` (``"constant"`` or ``"cosine"``).
     select_best : bool
         Score every epoch by FGD on the validation takes
-        (:func:`beatlite.train.evaluation.fgd_scorer`) and export the best epoch, as BEAT's
+        (:func:`beatlite.train.testset.fgd_scorer`) and export the best epoch, as BEAT's
         reference trainer does; ``False`` exports the last epoch.
+    paper_rows : tuple of PaperRow
+        The published rows this checkpoint stands for (:func:`paper_rows` collects a table's).
     """
 
     model: str
@@ -72,6 +99,7 @@ class Recipe:
     lr: float = 1e-3
     lr_schedule: str = "constant"
     select_best: bool = True
+    paper_rows: tuple[PaperRow, ...] = ()
 
     @property
     def uses_text(self) -> bool:
@@ -80,7 +108,6 @@ class Recipe:
         Asked of the model class (:meth:`beatlite.models.base.GestureModel.keys_for`) with the
         recipe's ``tiny`` config, so a new model needs no entry here.
         """
-        from beatlite.models import model_class, presets
         from beatlite.models.base import config_from_preset
 
         cls = model_class(self.model)
@@ -99,6 +126,13 @@ CAMN_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
     "camn_tiny_no_semantic": ("CaMN w/o semantic weighting", {"semantic_weighting": False}),
 }
 """Shipped CaMN checkpoints: name -> (row label, config overrides of the ``tiny`` preset) (BEAT Table 5)."""
+
+BEAT_TABLE5_ROWS: dict[str, str] = {
+    "camn_tiny": "full cascaded", "camn_tiny_no_cascade": "w/o cascaded", "camn_tiny_no_text": "w/o text",
+    "camn_tiny_no_audio": "w/o audio", "camn_tiny_no_speaker": "w/o speaker ID", "camn_tiny_no_face": "w/o face",
+    "camn_tiny_no_emotion": "w/o emotion", "camn_tiny_no_semantic": "w/o semantic",
+}  # fmt: skip
+"""The row of BEAT's Table 5 (CaMN ablations) of each CaMN checkpoint."""
 
 EPOCHS = 40
 """Epochs of the CaMN, S2G and Trimodal checkpoints (see :data:`LR`)."""
@@ -135,6 +169,26 @@ HA2G_LABELS: dict[str, str] = {
 }
 """Table row label of each HA2G ablation switch (the rows of HA2G Tables 3-4)."""
 
+HA2G_PAPER_ROWS: dict[str, tuple[PaperRow, ...]] = {
+    "full": (PaperRow("HA2G", "Table 1", "HA2G"), PaperRow("HA2G", "Table 3", "HA2G Full"),
+             PaperRow("HA2G", "Table 4", "HA2G Full")),
+    "single_audio": (PaperRow("HA2G", "Table 3", "f_a^low only (T3)"),),
+    "mid_only": (PaperRow("HA2G", "Table 3", "f_a^mid only (T3)"),),
+    "high_only": (PaperRow("HA2G", "Table 3", "f_a^high only (T3)"),),
+    "no_high_negatives": (PaperRow("HA2G", "Table 3", "w/o high-level negatives (T3)"),),
+    "no_low_mid_negatives": (PaperRow("HA2G", "Table 3", "w/o low/mid-level negatives (T3)"),),
+    "no_text": (PaperRow("HA2G", "Table 3", "w/o text (T3)"),),
+    "no_contrastive": (PaperRow("HA2G", "Table 3", None),),
+    "holistic": (PaperRow("HA2G", "Table 4", "Holistic (T4)"),),
+    "no_hand_hierarchy": (PaperRow("HA2G", "Table 4", "w/o hand hierarchy (T4)"),),
+    "no_body_hierarchy": (PaperRow("HA2G", "Table 4", "w/o body hierarchy (T4)"),),
+    "same_audio": (PaperRow("HA2G", "Table 4", "Same audio f_a^h (T4)"),),
+    "no_physical": (PaperRow("HA2G", "Table 4", "w/o L_phy (T4)"),),
+}  # fmt: skip
+"""The published rows of each HA2G ablation switch: Table 3 ablates the audio learner, Table 4 the pose inferer
+(the keys of :data:`beatlite.train.evaluation.PAPER_HA2G_ABLATIONS`; None: a switch the paper has no row for); the
+full model is the reference row of both and HA2G's row of Table 1."""
+
 HA2G_ABLATIONS: dict[str, tuple[str, dict[str, Any]]] = {
     ("ha2g_tiny" if name == "full" else f"ha2g_tiny_{name}"): (HA2G_LABELS[name], dict(overrides))
     for name, overrides in HA2G_SWITCHES.items()
@@ -147,17 +201,36 @@ needs a pretrained ASR network."""
 RECIPES: dict[str, Recipe] = {
     "mean_pose": Recipe("mean_pose", "Mean pose", epochs=0),
     "random_clip": Recipe("random_clip", "Random clip", epochs=0),
-    "s2g_tiny": Recipe("s2g", "S2G-style", epochs=EPOCHS, lr=LR),
-    "trimodal_tiny": Recipe("trimodal", "Trimodal-style", epochs=EPOCHS, lr=LR),
-    "seq2seq_tiny": Recipe("seq2seq", "Seq2Seq-style", epochs=EPOCHS, lr=LR),
-    "a2g_tiny": Recipe("a2g", "A2G-style", epochs=EPOCHS, lr=LR),
-    "joint_embedding_tiny": Recipe("joint_embedding", "Joint Embedding-style", epochs=EPOCHS, lr=LR),
-    **{name: Recipe("camn", label, kw, epochs=EPOCHS, lr=LR) for name, (label, kw) in CAMN_ABLATIONS.items()},
+    "s2g_tiny": Recipe(
+        "s2g", "S2G-style", epochs=EPOCHS, lr=LR,
+        paper_rows=(PaperRow("BEAT", "Table 4", "S2G"), PaperRow("HA2G", "Table 1", "Speech2Gesture")),
+    ),
+    "trimodal_tiny": Recipe(
+        "trimodal", "Trimodal-style", epochs=EPOCHS, lr=LR,
+        paper_rows=(PaperRow("BEAT", "Table 4", "MultiContext"), PaperRow("HA2G", "Table 1", "Trimodal")),
+    ),
+    "seq2seq_tiny": Recipe(
+        "seq2seq", "Seq2Seq-style", epochs=EPOCHS, lr=LR,
+        paper_rows=(PaperRow("BEAT", "Table 4", "Seq2Seq"), PaperRow("HA2G", "Table 1", "Attention Seq2Seq")),
+    ),
+    "a2g_tiny": Recipe("a2g", "A2G-style", epochs=EPOCHS, lr=LR, paper_rows=(PaperRow("BEAT", "Table 4", "A2G"),)),
+    "joint_embedding_tiny": Recipe(
+        "joint_embedding", "Joint Embedding-style", epochs=EPOCHS, lr=LR,
+        paper_rows=(PaperRow("HA2G", "Table 1", "Joint Embedding"),),
+    ),
     **{
-        name: Recipe("ha2g", label, kw, epochs=HA2G_EPOCHS, lr=HA2G_LR)
-        for name, (label, kw) in HA2G_ABLATIONS.items()
+        name: Recipe(
+            "camn", label, kw, epochs=EPOCHS, lr=LR,
+            paper_rows=((PaperRow("BEAT", "Table 4", "CaMN"),) if name == "camn_tiny" else ())
+            + (PaperRow("BEAT", "Table 5", BEAT_TABLE5_ROWS[name]),),
+        )
+        for name, (label, kw) in CAMN_ABLATIONS.items()
     },
-}
+    **{
+        name: Recipe("ha2g", label, kw, epochs=HA2G_EPOCHS, lr=HA2G_LR, paper_rows=HA2G_PAPER_ROWS[switch])
+        for switch, (name, (label, kw)) in zip(HA2G_SWITCHES, HA2G_ABLATIONS.items(), strict=True)
+    },
+}  # fmt: skip
 """Every trained checkpoint (``checkpoints/<name>.pt``) -> its :class:`Recipe`, in table row order.
 
 Adding a model: :func:`beatlite.models.register_model`, then :func:`register_recipe`
@@ -172,9 +245,8 @@ def register_recipe(name: str, recipe: Recipe) -> None:
     ValueError
         The recipe's model is not registered, or ``name`` is taken by another recipe.
     """
-    from beatlite.models import MODELS
 
-    if recipe.model not in MODELS:
+    if recipe.model not in models.MODELS:
         raise ValueError(f"register_recipe: model {recipe.model!r} is not registered (register_model first)")
     if name in RECIPES and RECIPES[name] != recipe:
         raise ValueError(f"register_recipe: {name!r} is already a recipe ({RECIPES[name]})")
@@ -184,6 +256,44 @@ def register_recipe(name: str, recipe: Recipe) -> None:
 def label_of(name: str) -> str:
     """The table row label of checkpoint ``name`` (its recipe's; the name itself when it has none)."""
     return RECIPES[name].label if name in RECIPES else name
+
+
+def paper_rows(
+    paper: str, tables: Sequence[str], names: Sequence[str] | None = None
+) -> dict[str, str | None]:
+    """The checkpoints that stand for rows of ``paper``'s ``tables`` and their row labels.
+
+    Parameters
+    ----------
+    paper : str
+        ``"BEAT"`` or ``"HA2G"`` (:attr:`PaperRow.paper`).
+    tables : sequence of str
+        E.g. ``["Table 5"]`` or ``["Table 3", "Table 4"]``.
+    names : sequence of str, optional
+        Keys of :data:`RECIPES` to look at (default all).
+
+    Returns
+    -------
+    dict
+        Checkpoint name -> the paper's row label (None: an ablation of that study without a published row),
+        table by table in the order of ``tables``, within a table in :data:`RECIPES` order; a checkpoint in two
+        tables comes once, at its first.
+
+    Examples
+    --------
+    >>> paper_rows("BEAT", ["Table 4"])["trimodal_tiny"]
+    'MultiContext'
+    >>> list(paper_rows("HA2G", ["Table 3", "Table 4"]).items())[:2]
+    [('ha2g_tiny', 'HA2G Full'), ('ha2g_tiny_single_audio', 'f_a^low only (T3)')]
+    """
+    names = list(RECIPES) if names is None else list(names)
+    found: dict[str, str | None] = {}
+    for table in tables:
+        for name in names:
+            for row in RECIPES[name].paper_rows:
+                if (row.paper, row.table) == (paper, table) and name not in found:
+                    found[name] = row.row
+    return found
 
 
 @dataclasses.dataclass
@@ -201,9 +311,8 @@ class TrainingData:
 
     @functools.cached_property
     def val_takes(self) -> Any:
-        """The whole validation takes that :func:`~beatlite.train.evaluation.fgd_scorer` generates
-        (an :class:`~beatlite.train.evaluation.EvaluationSet`, prepared on first use, then shared)."""
-        from beatlite.train.evaluation import load_test_set
+        """The whole validation takes that :func:`~beatlite.train.testset.fgd_scorer` generates
+        (an :class:`~beatlite.train.testset.EvaluationSet`, prepared on first use, then shared)."""
 
         return load_test_set(self.index, split="val", vocab=self.vocab, store=self.store)
 
@@ -214,12 +323,8 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
 
     ``progress`` shows the store's tqdm bar over the takes it builds.
     """
-    from beatlite.data.index import index_folder
-    from beatlite.data.store import build_store
-    from beatlite.data.vocab import build_vocab, take_sentences
-    from beatlite.paths import data_dir
 
-    root = Path(data) if data is not None else data_dir()
+    root = Path(data) if data is not None else paths.data_dir()
     index = index_folder(root)
     vocab = build_vocab(index)
     store = build_store(index, vocab=vocab, progress=progress)
@@ -240,9 +345,6 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     choice of clips).
     """
     import torch
-
-    from beatlite.data.vocab import word_vectors
-    from beatlite.models import build_model, model_class
 
     recipe = _recipe(name)
     kw = dict(recipe.overrides)
@@ -303,9 +405,7 @@ def retrain(
     float
         Seconds spent in :func:`beatlite.train.fit` (window building excluded).
     """
-    from beatlite.paths import build_dir, checkpoints_dir
     from beatlite.train.checkpoint import export_checkpoint
-    from beatlite.train.config import TrainConfig
     from beatlite.train.distributed import distributed_rank
     from beatlite.train.training import fit
 
@@ -313,7 +413,7 @@ def retrain(
     data = training_data() if data is None else data
     model = build_recipe_model(name, data, seed=seed)
     if out_dir is None:
-        export, full = checkpoints_dir() / f"{name}.pt", build_dir() / "train" / f"{name}.pt"
+        export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
     else:
         export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
     config = TrainConfig(
@@ -331,7 +431,6 @@ def retrain(
     score = None
     if recipe.select_best and config.epochs > 0:
         from beatlite.metrics.extractor import load_extractor
-        from beatlite.train.evaluation import fgd_scorer
 
         features = load_extractor("dirvec", extractor)
         score = fgd_scorer(normalizers=data.train.normalizers, takes=data.val_takes, extractor=features)

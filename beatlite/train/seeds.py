@@ -33,14 +33,28 @@ from typing import Any
 
 import numpy as np
 
-from beatlite.train.recipes import RECIPES, SEED, retrain_many
+from beatlite import paths
+from beatlite.io.atomic import atomic_write
+from beatlite.io.errors import FormatError
+from beatlite.metrics.scoring import METRICS, describe
+from beatlite.models import build_model
+from beatlite.report import markdown_table, write_markdown_and_json
+from beatlite.train.evaluation import (
+    COLUMNS,
+    GROUND_TRUTH,
+    GROUND_TRUTH_141,
+    column_headers,
+    evaluate_models,
+    fmt_metric,
+)
+from beatlite.train.recipes import RECIPES, SEED, label_of, retrain_many
+from beatlite.train.testset import load_test_set
 
 
 def seeds_dir() -> Path:
     """``build/seeds``: one folder per extra seed."""
-    from beatlite.paths import build_dir
 
-    return build_dir() / "seeds"
+    return paths.build_dir() / "seeds"
 
 
 def checkpoint_path(name: str, seed: int) -> Path:
@@ -49,10 +63,9 @@ def checkpoint_path(name: str, seed: int) -> Path:
     ``build/seeds/<seed>/<name>.pt``; when that file does not exist and the shipped
     ``checkpoints/<name>.pt`` was trained with ``seed``, the shipped one.
     """
-    from beatlite.paths import checkpoints_dir
 
     path = seeds_dir() / str(seed) / f"{name}.pt"
-    shipped = checkpoints_dir() / f"{name}.pt"
+    shipped = paths.checkpoints_dir() / f"{name}.pt"
     if not path.is_file() and shipped_seed(shipped) == seed:
         return shipped
     return path
@@ -108,14 +121,12 @@ def ship_median_seeds(
     -------
     dict recipe name -> shipped seed
     """
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.recipes import label_of
 
     names = [n for n in RECIPES if label_of(n) in results.values] if names is None else list(names)
     chosen = {}
     for name in names:
         seed = median_seed(results.values[label_of(name)][metric], results.seeds)
-        src, dst = checkpoint_path(name, seed), checkpoints_dir() / f"{name}.pt"
+        src, dst = checkpoint_path(name, seed), paths.checkpoints_dir() / f"{name}.pt"
         if src.resolve() != dst.resolve():
             kept = shipped_seed(dst)  # the replaced checkpoint stays its seed's copy in build/seeds/
             if kept is not None and not (seeds_dir() / str(kept) / dst.name).is_file():
@@ -160,7 +171,6 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     builds now (same vocabulary size and seed), so a seed table is never filled with checkpoints of
     an older recipe. Code changes that leave both unchanged are not seen: retrain with ``force``.
     """
-    from beatlite.models import build_model
 
     recipe = RECIPES[name]
     stored = checkpoint.get("train_config") or {}
@@ -190,8 +200,6 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
 def _copy(src: Path, dst: Path) -> None:
     """Copy a file atomically (the folder of ``dst`` created)."""
     import shutil
-
-    from beatlite.io.atomic import atomic_write
 
     dst.parent.mkdir(parents=True, exist_ok=True)
     with open(src, "rb") as fin, atomic_write(dst, "wb") as fout:
@@ -302,15 +310,29 @@ class SeedResults:
         }
         return cls(values, [int(s) for s in data["seeds"]], dict(data.get("info", {})))
 
+    def merged(self, other: SeedResults) -> SeedResults:
+        """This table with ``other``'s rows added or replacing these (``make seeds ONLY=NAME`` records NAME's
+        rows into the shipped table without dropping the others); ``info["checkpoints"]`` / ``["shipped"]``
+        are merged, the rest of ``info`` is ``other``'s.
+
+        Raises
+        ------
+        ValueError
+            The two tables are over different seeds.
+        """
+        if list(other.seeds) != list(self.seeds):
+            raise ValueError(f"cannot merge a table over seeds {other.seeds} into one over {self.seeds}")
+        info = {**self.info, **other.info}
+        for key in ("checkpoints", "shipped"):
+            info[key] = {**(self.info.get(key) or {}), **(other.info.get(key) or {})}
+        return SeedResults({**self.values, **other.values}, list(self.seeds), info)
+
     def to_markdown(self, columns: Sequence[str] | None = None, rows: Sequence[str] | None = None) -> str:
         """A Markdown table of ``mean ± sd`` over seeds, the seed count and the shipped seed.
 
         ``columns``: metric keys (default :data:`~beatlite.train.evaluation.COLUMNS`); ``rows``: row
         labels in table order (default every row, ground truth first, then in recipe order).
         """
-        from beatlite.report import markdown_table
-        from beatlite.train.evaluation import COLUMNS, GROUND_TRUTH, GROUND_TRUTH_141, column_headers
-        from beatlite.train.recipes import RECIPES
 
         columns = COLUMNS if columns is None else tuple(columns)
         if rows is None:
@@ -330,7 +352,6 @@ class SeedResults:
 
     def cell(self, row: str, metric: str) -> str:
         """``"mean ± sd"`` of one row and metric as the tables print it (``"mean"`` with one seed)."""
-        from beatlite.train.evaluation import fmt_metric
 
         mean, sd = self.mean(row, metric), self.sd(row, metric)
         return fmt_metric(mean, metric) + (" ± " + fmt_metric(sd, metric) if math.isfinite(sd) else "")
@@ -406,8 +427,6 @@ def compare_rows(
     -------
     list of Effect, variant-major.
     """
-    from beatlite.metrics.scoring import METRICS
-    from beatlite.train.evaluation import COLUMNS
 
     higher = {key: METRICS[key].higher_is_better for key in COLUMNS}
     effects = []
@@ -482,9 +501,6 @@ def evaluate_seeds(
         A requested checkpoint is missing (names the file and the command that trains it).
     """
     from beatlite.metrics.extractor import load_extractor
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.evaluation import COLUMNS, evaluate_models, load_test_set
-    from beatlite.train.recipes import label_of
 
     seeds = [int(s) for s in seeds]
     if not seeds:
@@ -519,7 +535,7 @@ def evaluate_seeds(
         if progress:
             print(f"seed {seed}: {len(names)} checkpoints scored in {res.info['seconds']:.1f} s", flush=True)
     info["checkpoints"] = {n: _seed_files(n, seeds) for n in names}
-    info["shipped"] = {label_of(n): shipped_seed(checkpoints_dir() / f"{n}.pt") for n in names}
+    info["shipped"] = {label_of(n): shipped_seed(paths.checkpoints_dir() / f"{n}.pt") for n in names}
     return SeedResults(values, seeds, info)
 
 
@@ -555,10 +571,8 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
     FileNotFoundError
         No recorded table (names the file and the command that writes it).
     """
-    from beatlite.io.errors import FormatError
-    from beatlite.paths import checkpoints_dir
 
-    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no recorded seed table; write it with `make seeds`")
     try:
@@ -570,10 +584,8 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
 def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
     """The seed of recipe ``name``'s shipped checkpoint in the recorded seed table (``info["shipped"]``),
     :data:`~beatlite.train.recipes.SEED` when there is no record or it does not name the row."""
-    from beatlite.paths import checkpoints_dir
-    from beatlite.train.recipes import label_of
 
-    path = Path(path) if path is not None else checkpoints_dir() / "results_seeds.json"
+    path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
     if not path.is_file():
         return SEED
     seed = (recorded_seed_results(path).info.get("shipped") or {}).get(label_of(name))
@@ -588,26 +600,83 @@ def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
 RECORD_RTOL, RECORD_ATOL = 1e-3, 1e-9
 
 
-def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None) -> None:
+def record_command(name: str | None = None) -> str:
+    """The command that records recipe ``name``'s rows (every row when None) in the shipped seed table."""
+    return "make seeds" + (f" ONLY={name}" if name else "")
+
+
+@dataclasses.dataclass(frozen=True)
+class NotRecorded:
+    """A row, or one metric of a row, of a live table that the seed record does not have yet.
+
+    A model or metric registered after the record was written (``make seeds``, about 2 hours) is reported
+    so, not failed: its ``str`` is ``"<row>[ <metric>]: not recorded: run `make seeds ONLY=<recipe>`"``.
+
+    Attributes
+    ----------
+    row : str
+        Row label.
+    metric : str or None
+        The metric key the recorded row lacks; None when the whole row is missing.
+    recipe : str or None
+        The recipe to record (:func:`record_command`); None for the ground-truth rows (every row).
+    """
+
+    row: str
+    metric: str | None
+    recipe: str | None
+
+    def __str__(self) -> str:
+        what = self.row if self.metric is None else f"{self.row} {self.metric}"
+        return f"{what}: not recorded: run `{record_command(self.recipe)}`"
+
+
+def check_against_record(
+    results: Any, record: SeedResults, *, metrics: Sequence[str] | None = None
+) -> list[NotRecorded]:
     """Assert that a live :func:`~beatlite.train.evaluation.evaluate_models` table equals the record.
 
     Each row's value must equal the record's value for the seed of the shipped checkpoint
     (``record.info["shipped"]``, :data:`~beatlite.train.recipes.SEED` for a row it does not name;
-    ground-truth rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`.
+    ground-truth rows: the recorded one) within :data:`RECORD_RTOL` / :data:`RECORD_ATOL`. Rows and
+    metrics the record does not have yet are not compared: they are returned.
+
+    Returns
+    -------
+    list of NotRecorded
+        The rows (and metrics of recorded rows) left unchecked, each saying which ``make seeds`` records it.
 
     Raises
     ------
     AssertionError
         Naming the row and metric and ``make seeds``: the record or the checkpoint is stale.
+
+    Examples
+    --------
+    >>> from beatlite.train.evaluation import ModelResults, ResultRow
+    >>> record = SeedResults({"CaMN": {"FGD": [3.0]}}, [SEED], {})
+    >>> live = ModelResults([ResultRow("CaMN", "camn_tiny", "euler141", {"FGD": 3.0, "Speed": 1.0}),
+    ...                      ResultRow("Mine", "/tmp/mine_tiny.pt", "euler141", {"FGD": 2.0})], {})
+    >>> for gap in check_against_record(live, record):
+    ...     print(gap)
+    CaMN Speed: not recorded: run `make seeds ONLY=camn_tiny`
+    Mine: not recorded: run `make seeds ONLY=mine_tiny`
     """
     shipped = record.info.get("shipped") or {}
+    gaps = []
     for row in results.rows:
-        assert row.label in record.values, f"{row.label} is not in the recorded table: make seeds"
+        recipe = None if row.representation == "ground_truth" else Path(row.source).stem
+        if row.label not in record.values:
+            gaps.append(NotRecorded(row.label, None, recipe))
+            continue
         seed = SEED if shipped.get(row.label) is None else int(shipped[row.label])
         assert seed in record.seeds, f"{row.label}: shipped seed {seed} is not in the record: make seeds"
         k = 0 if row.representation == "ground_truth" else record.seeds.index(seed)
         for metric, value in row.metrics.items():
             if metrics is not None and metric not in metrics:
+                continue
+            if metric not in record.values[row.label]:
+                gaps.append(NotRecorded(row.label, metric, recipe))
                 continue
             recorded = record.values[row.label][metric][k]
             np.testing.assert_allclose(
@@ -617,16 +686,13 @@ def check_against_record(results: Any, record: SeedResults, *, metrics: Sequence
                 atol=RECORD_ATOL,
                 err_msg=f"{row.label} {metric}: make seeds",
             )
+    return gaps
 
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
     """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``)."""
-    from beatlite.metrics.scoring import describe
-    from beatlite.paths import build_dir
-    from beatlite.report import write_markdown_and_json
-    from beatlite.train.evaluation import COLUMNS
 
-    stem = Path(stem) if stem is not None else build_dir() / "results_seeds"
+    stem = Path(stem) if stem is not None else paths.build_dir() / "results_seeds"
     info = results.info
     text = (
         f"# Gesture models on the `{info.get('split', 'test')}` split, seeds {results.seeds}\n\n"
@@ -693,8 +759,6 @@ def ablation_table(
     ...                      metrics=("FGD",), deltas=("FGD",), absent={"B": "needs X"}).splitlines()[-1])
     | — | B | 6.00 | not trained: needs X |  | 0 |
     """
-    from beatlite.report import markdown_table
-    from beatlite.train.evaluation import column_headers, fmt_metric
 
     variants = [label for label in rows if label != full]
     by = {(e.variant, e.metric): e for e in compare_rows(record, full, variants, metrics=deltas)}

@@ -15,8 +15,10 @@ from typing import Any
 import numpy as np
 import torch
 
+from beatlite import paths
 from beatlite.data.normalize import Normalizers
 from beatlite.models.base import GestureModel
+from beatlite.notebook import progress
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
 from beatlite.train.config import TrainConfig
 from beatlite.train.distributed import (
@@ -161,13 +163,11 @@ def configure_torch(seed: int, threads: int | None) -> None:
     """Seed torch, force deterministic algorithms and set the CPU thread count."""
     import os
 
-    from beatlite.paths import n_threads
-
     # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
     torch.manual_seed(seed)
     torch.use_deterministic_algorithms(True)
-    torch.set_num_threads(threads if threads is not None else n_threads())
+    torch.set_num_threads(threads if threads is not None else paths.n_threads())
 
 
 def _mean_losses(sums: Mapping[str, Any], n: int) -> dict[str, float]:
@@ -245,7 +245,7 @@ def fit(
         :meth:`~beatlite.data.normalize.Normalizers.to_meta` needed by :func:`beatlite.train.generate`).
     val_score : callable, optional
         ``val_score(model) -> float``, lower is better, called in eval mode after every epoch
-        (e.g. :func:`beatlite.train.evaluation.fgd_scorer`: FGD on the validation takes, the
+        (e.g. :func:`beatlite.train.testset.fgd_scorer`: FGD on the validation takes, the
         reference's choice of its best checkpoint). Recorded as ``history[e]["val_score"]``; the
         lowest-scoring epoch's weights are kept in the checkpoint as ``"best"``.
 
@@ -267,7 +267,6 @@ def fit(
         raise TypeError(f"fit: model must be a GestureModel, got {type(model).__name__}")
     if not isinstance(config, TrainConfig):
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
-    from beatlite.notebook import progress
 
     data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads)

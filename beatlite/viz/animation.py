@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
+from beatlite.constants import SR
 from beatlite.viz._files import atomic_target
 from beatlite.viz._inputs import (
     Bones,
@@ -200,7 +201,7 @@ class Timeline:
     """
 
     audio: Any = None
-    sr: float = 16000
+    sr: float = SR
     audio_beats: Any = None
     motion_beats: Any = None
 
