@@ -9,7 +9,23 @@ Usage (skipped by the doctests: building a network is covered by ``tests/test_mo
 :func:`model_class` import the model module on first use. Every model follows the
 :class:`beatlite.models.base.GestureModel` contract.
 
-===================  =======================================================  =======
+===================  =======================================================  ==============
+name                 class                                                    representation
+===================  =======================================================  ==============
+``camn``             :class:`beatlite.models.camn.CaMN`                       euler141
+``ha2g``             ``beatlite.models.ha2g.HA2G``                            dirvec126
+``s2g``              :class:`beatlite.models.baselines.S2G`                   euler141
+``trimodal``         :class:`beatlite.models.baselines.Trimodal`              euler141
+``mean_pose``        :class:`beatlite.models.baselines.MeanPose`              euler141
+``random_clip``      :class:`beatlite.models.baselines.RandomClip`            euler141
+``seq2seq``          :class:`beatlite.models.seq2seq.Seq2Seq`                 euler141
+``a2g``              :class:`beatlite.models.a2g.A2G`                         euler141
+``joint_embedding``  :class:`beatlite.models.joint_embedding.JointEmbedding`  euler141
+===================  =======================================================  ==============
+
+The table lists the built-in registry :data:`MODELS` (``tests/test_models_contract.py`` checks it);
+``docs/architecture.md`` ("Adding a model and a metric") is the guide.
+
 Taught in notebooks/05_camn.ipynb, section 2 (the architecture, piece by piece) and notebooks/06_ha2g.ipynb, section 7 (training).
 """
 
