@@ -1,11 +1,13 @@
 """Dataset index, vocabulary and aligned training windows (NumPy; torch only in ``torch_dataset``).
 
 =====================  =============================================================
-``index``               :func:`index_folder` -> :class:`TakeIndex` of :class:`TakeRecord`
+``index``               :func:`index_folder` -> :class:`TakeIndex` of :class:`TakeRecord` (cached: ``index_cache``)
+``fingerprint``         one fingerprint of files (content) + overrides + parameters, the same on every machine
 ``vocab``               :class:`Vocab` (PAD/SOS/EOS/UNK = 0..3), offline word vectors
 ``normalize``           :class:`Normalizer` (train-split mean/std)
-``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract, in memory)
-``store``               :func:`build_store` -> :class:`WindowStore` (per-take streams on disk; same batches)
+``windows``             :func:`build_windows` -> :class:`Windows` (the batch contract in memory: the teaching view)
+``store``               :func:`build_store` -> :class:`WindowStore` (per-take streams on disk, same batches: what
+                        training, evaluation and scoring read)
 ``torch_dataset``       ``WindowDataset``, ``window_loader`` (imports torch; import it explicitly)
 =====================  =============================================================
 
