@@ -85,7 +85,7 @@ def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path, mo
     with pytest.raises(KeyboardInterrupt):
         fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt", checkpoint_every=1), val)
     monkeypatch.setattr(training._Run, "step", real_step)
-    saved = torch.load(tmp_path / "part.pt", weights_only=False)
+    saved = torch.load(tmp_path / "part.pt", weights_only=True)
     assert saved["epoch"] == 1 and saved["partial"]["step"] == 1  # 3 steps per epoch: killed in epoch 2
     resumed = fit(
         camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt", checkpoint_every=1, resume=True), val
@@ -95,7 +95,7 @@ def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path, mo
     b, _ = load_model(tmp_path / "part.pt")
     for (name, p), q in zip(a.state_dict().items(), b.state_dict().values(), strict=True):
         assert torch.equal(p, q), name
-    assert torch.load(tmp_path / "part.pt", weights_only=False)["partial"] is None
+    assert torch.load(tmp_path / "part.pt", weights_only=True)["partial"] is None
 
 
 def test_cosine_schedule_factors_closed_form():
@@ -432,3 +432,66 @@ def test_resume_keeps_the_best_epoch_so_far(windows, tmp_path):
     )
     assert (res.best_epoch, res.best_score) == (1, 1.0)
     assert [h["val_score"] for h in res.history] == [2.0, 1.0, 5.0]
+
+
+class _Marker:
+    """A pickled object whose loading would run code: it writes a file when unpickled with the full loader."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def __reduce__(self):
+        import pathlib
+
+        return (pathlib.Path.touch, (pathlib.Path(self.path),))  # unpickling calls Path(path).touch()
+
+
+def test_a_checkpoint_that_would_run_code_is_refused_and_runs_nothing(windows, tmp_path):
+    from beatlite.io import FormatError
+    from beatlite.train.checkpoint import load_checkpoint
+
+    marker = tmp_path / "ran.txt"
+    payload = {
+        "format": "beatlite-checkpoint/1",
+        "model": {"name": "camn"},
+        "state": {},
+        "x": _Marker(str(marker)),
+    }
+    torch.save(payload, tmp_path / "evil.pt")
+    assert not marker.exists()
+    with pytest.raises(FormatError, match="plain torch checkpoint"):
+        load_checkpoint(tmp_path / "evil.pt")
+    assert not marker.exists(), "loading ran code from the checkpoint"
+    torch.load(tmp_path / "evil.pt", weights_only=False)  # the unsafe loader does run it: the test can fail
+    assert marker.exists()
+
+
+def test_checkpoint_metadata_is_saved_as_tensors_and_read_back_as_numpy(windows, tmp_path):
+    from beatlite.train.checkpoint import load_checkpoint, save_checkpoint
+
+    meta = {"pose_mean": np.arange(3, dtype=np.float64) / 3, "n": np.int64(4), "vocab": ["a", "b"]}
+    save_checkpoint(
+        tmp_path / "c.pt", {"format": "beatlite-checkpoint/1", "model": {}, "state": {}, "meta": meta}
+    )
+    raw = torch.load(tmp_path / "c.pt", weights_only=True)  # no allow-list needed: tensors and plain values
+    assert torch.is_tensor(raw["meta"]["pose_mean"]) and raw["meta"]["n"] == 4
+    back = load_checkpoint(tmp_path / "c.pt")["meta"]
+    assert back["pose_mean"].dtype == np.float64 and np.array_equal(back["pose_mean"], meta["pose_mean"])
+    assert back["vocab"] == ["a", "b"]
+
+
+def test_a_checkpoint_whose_weights_do_not_fit_is_a_format_error(windows, tmp_path):
+    from beatlite.io import FormatError
+    from beatlite.train.checkpoint import load_checkpoint, save_checkpoint
+
+    train, _ = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "t.pt"))
+    data = load_checkpoint(tmp_path / "t.pt")
+    name = next(k for k, v in data["state"].items() if v.ndim == 2)
+    bad_shape = {**data, "state": {**data["state"], name: data["state"][name][:, :1]}}
+    unknown = {**data, "state": {**data["state"], "no_such.weight": torch.zeros(1)}}
+    bad_field = {**data, "model": {**data["model"], "no_such_field": 1}}
+    for i, payload in enumerate((bad_shape, unknown, bad_field)):
+        save_checkpoint(tmp_path / f"bad{i}.pt", payload)
+        with pytest.raises(FormatError, match="do not fit the model"):
+            load_model(tmp_path / f"bad{i}.pt")

@@ -40,7 +40,7 @@ def _one_and_two_processes(tmp_path: Path, micro: int, windows: int) -> tuple[di
     run_ok([sys.executable, str(SCRIPT), str(one), *args], env=_env(), timeout=900)
     cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(SCRIPT), str(two), *args]
     run_ok(cmd, env=_env(), timeout=900)
-    return torch.load(one, weights_only=False), torch.load(two, weights_only=False)
+    return torch.load(one, weights_only=True), torch.load(two, weights_only=True)
 
 
 @pytest.mark.slow
@@ -90,7 +90,7 @@ def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path)
         path = tmp_path / f"{mode}.pt"
         cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode]
         run_ok(cmd, env=_env(), timeout=900)
-        out[mode] = torch.load(str(path) + ".out", weights_only=False)
+        out[mode] = torch.load(str(path) + ".out", weights_only=True)
     whole, resumed = out["whole"], out["kill"]
     for name, p in whole["params"].items():
         assert torch.equal(p, resumed["params"][name]), name

@@ -14,6 +14,12 @@ A checkpoint is a ``torch.save`` dict::
 Files are written to a temporary file in the same folder and moved into place with
 :func:`os.replace`, so a crash never leaves a half-written checkpoint.
 
+Loading never runs code from the file: :func:`load_checkpoint` uses ``torch.load(weights_only=True)``
+(tensors and plain Python values only). numpy arrays in the metadata are saved as float64 tensors and
+given back as numpy arrays; checkpoints written before that (numpy arrays pickled as such, e.g. the
+shipped ones) load through an allow-list (:data:`NUMPY_ARRAY_GLOBALS`: an ndarray's reconstructor, its
+class, ``numpy.dtype`` and the numeric dtype classes), which rebuilds arrays and nothing else.
+
 Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkpoint) and notebooks/07_benchmark.ipynb, section 1 (exporting one).
 """
 
@@ -25,6 +31,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 
 from beatlite import paths
@@ -32,6 +39,32 @@ from beatlite.io.errors import FormatError
 from beatlite.models.base import GestureModel
 
 FORMAT = "beatlite-checkpoint/1"
+
+
+def _numpy_array_globals() -> list[Any]:
+    try:  # numpy >= 2
+        from numpy._core.multiarray import _reconstruct
+    except ImportError:  # pragma: no cover - numpy 1.x
+        from numpy.core.multiarray import _reconstruct
+    numeric = (np.float64, np.float32, np.float16, np.int64, np.int32, np.int16, np.int8, np.uint8, np.bool_)
+    return [_reconstruct, np.ndarray, np.dtype, *(type(np.dtype(t)) for t in numeric)]
+
+
+#: What ``weights_only`` loading may rebuild besides tensors: numpy arrays of older checkpoints' metadata.
+NUMPY_ARRAY_GLOBALS = _numpy_array_globals()
+
+
+def _tensors_for_numpy(value: Any) -> Any:
+    """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones."""
+    if isinstance(value, np.ndarray):
+        return torch.from_numpy(np.array(value))
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {k: _tensors_for_numpy(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_tensors_for_numpy(v) for v in value)
+    return value
 
 
 def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
@@ -47,7 +80,7 @@ def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
-            torch.save(dict(payload), fh)
+            torch.save({**payload, "meta": _tensors_for_numpy(payload.get("meta", {}))}, fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o644)  # mkstemp creates 0600; checkpoints are shared repository files
@@ -60,28 +93,43 @@ def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Read a checkpoint dict (on CPU; ``weights_only=False`` because of numpy metadata).
+    """Read a checkpoint dict on the CPU, running no code from the file (``weights_only=True``).
+
+    The metadata's arrays come back as float64 numpy arrays (saved as tensors, or as numpy arrays by
+    older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`).
 
     Raises
     ------
     FileNotFoundError
         No file at ``path``.
     beatlite.io.FormatError
-        The file is not a beatlite checkpoint.
+        The file is not a beatlite checkpoint, or it holds anything but tensors and plain values
+        (a pickled object that would run code when loaded is refused, never executed).
     """
 
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"checkpoint not found: {path}")
     try:
-        data = torch.load(path, map_location="cpu", weights_only=False)
+        with torch.serialization.safe_globals(NUMPY_ARRAY_GLOBALS):
+            data = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # noqa: BLE001 - any unpickling failure is a format problem
-        raise FormatError(path, f"not a torch checkpoint ({type(exc).__name__}: {exc})") from exc
+        lines = [
+            ln.strip()
+            for ln in str(exc).splitlines()
+            if "GLOBAL" in ln or "got <" in ln or "Unsupported" in ln
+        ]
+        reason = lines[0] if lines else type(exc).__name__
+        raise FormatError(
+            path, f"not a plain torch checkpoint (tensors and plain values only): {reason}"
+        ) from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise FormatError(path, f"not a beatlite checkpoint (missing format {FORMAT!r})", field="format")
     for key in ("model", "state"):
         if key not in data:
             raise FormatError(path, f"checkpoint has no {key!r}", field=key)
+    if isinstance(data.get("meta"), dict):
+        data["meta"] = {k: v.numpy() if torch.is_tensor(v) else v for k, v in data["meta"].items()}
     return data
 
 
@@ -107,13 +155,30 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
     Returns
     -------
     (GestureModel in eval mode, checkpoint dict)
+
+    Raises
+    ------
+    beatlite.io.FormatError
+        Not a plain beatlite checkpoint (:func:`load_checkpoint`), or weights of other shapes or names
+        than the model its config builds, or an unknown config field.
     """
 
     path = Path(path_or_name)
     if path.suffix != ".pt" and not path.is_file():
         path = paths.checkpoints_dir() / f"{path_or_name}.pt"
     data = load_checkpoint(path)
-    return model_from_checkpoint(data), data
+    try:
+        return model_from_checkpoint(data), data
+    except (
+        RuntimeError,
+        KeyError,
+        TypeError,
+        ValueError,
+    ) as exc:  # wrong shapes, unknown keys or config fields
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise FormatError(
+            path, f"the weights or config do not fit the model: {first}", field="state"
+        ) from None
 
 
 def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, best: bool = True) -> Path:
