@@ -495,3 +495,24 @@ def test_a_checkpoint_whose_weights_do_not_fit_is_a_format_error(windows, tmp_pa
         save_checkpoint(tmp_path / f"bad{i}.pt", payload)
         with pytest.raises(FormatError, match="do not fit the model"):
             load_model(tmp_path / f"bad{i}.pt")
+
+
+def test_a_save_killed_midway_leaves_no_temp_file_after_the_next_save(windows, tmp_path):
+    """A kill during save_checkpoint left a temp file no cleanup recognised (its name had no pid)."""
+    import subprocess
+    import sys
+
+    from beatlite.train.checkpoint import load_checkpoint, save_checkpoint
+
+    code = (
+        "import os, torch, beatlite.train.checkpoint as c\n"
+        "torch.save = lambda obj, f: (f.write(b'partial'), f.flush(), os._exit(9))  # killed mid-write\n"
+        f"c.save_checkpoint({str(tmp_path / 'c.pt')!r}, {{'format': 'x', 'model': {{}}, 'state': {{}}}})\n"
+    )
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True).returncode == 9
+    assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")], (
+        "the kill should leave a temp file"
+    )
+    save_checkpoint(tmp_path / "c.pt", {"format": "beatlite-checkpoint/1", "model": {}, "state": {}})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.pt"]
+    assert load_checkpoint(tmp_path / "c.pt")["state"] == {}

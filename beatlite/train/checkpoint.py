@@ -25,8 +25,6 @@ Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkp
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -35,6 +33,7 @@ import numpy as np
 import torch
 
 from beatlite import paths
+from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError
 from beatlite.models.base import GestureModel
 
@@ -68,7 +67,9 @@ def _tensors_for_numpy(value: Any) -> Any:
 
 
 def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
-    """``torch.save(payload)`` atomically (temp file in the same folder + ``os.replace``).
+    """``torch.save(payload)`` atomically (:func:`beatlite.io.atomic.atomic_write`: a temp file
+    ``.{name}.{pid}.*.tmp`` in the same folder, fsync, ``os.replace``; temp files of killed writers
+    are removed by the next save). Numpy arrays of ``payload["meta"]`` are stored as tensors.
 
     Returns
     -------
@@ -77,18 +78,8 @@ def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            torch.save({**payload, "meta": _tensors_for_numpy(payload.get("meta", {}))}, fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; checkpoints are shared repository files
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_write(path, "wb") as fh:
+        torch.save({**payload, "meta": _tensors_for_numpy(payload.get("meta", {}))}, fh)
     return path
 
 
