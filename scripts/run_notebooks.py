@@ -164,6 +164,7 @@ def export_html(nb) -> str:
 def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     """Execute one notebook in its own folder; save the executed copy and its HTML."""
     import nbformat
+    from nbclient.exceptions import CellTimeoutError, DeadKernelError
     from nbconvert.preprocessors import CellExecutionError, ExecutePreprocessor
 
     nb = nbformat.read(path, as_version=4)
@@ -174,7 +175,11 @@ def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     ok, message = True, ""
     try:
         ep.preprocess(nb, {"metadata": {"path": str(path.parent)}})
-    except CellExecutionError as exc:
+    except (
+        CellExecutionError,
+        CellTimeoutError,
+        DeadKernelError,
+    ) as exc:  # a dead kernel fails this notebook only
         ok, message = False, str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
     seconds = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -285,3 +285,25 @@ def screenshot(page: Path, png: Path, selector: str = "math[display=block]", pro
         return browser.requested_urls()
     finally:
         browser.close()
+
+
+@pytest.mark.slow
+def test_a_notebook_whose_kernel_dies_is_reported_and_the_next_one_runs(tmp_path, monkeypatch):
+    """``make run`` used to stop at a dead kernel (only CellExecutionError was caught): no results.md."""
+    for name in ("BEATLITE_BUILD", "BEATLITE_INTERACTIVE"):  # main() sets them: restored after the test
+        monkeypatch.setenv(name, os.environ.get(name, ""))
+
+    folder = tmp_path / "nbs"
+    folder.mkdir()
+    for name, source in (("01_dies", "import os\nos._exit(3)"), ("02_fine", "print(6 * 7)")):
+        nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(source)])
+        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+        nbformat.write(nb, folder / f"{name}.ipynb")
+    runner = _runner()
+    code = runner.main(
+        ["--out", str(tmp_path / "out"), str(folder / "01_dies.ipynb"), str(folder / "02_fine.ipynb")]
+    )
+    results = (tmp_path / "out" / "results.md").read_text()
+    assert code == 1
+    assert "| [01_dies](notebooks/01_dies.html) | FAILED" in results
+    assert "| [02_fine](notebooks/02_fine.html) | ok |" in results and "1/2 ok" in results
