@@ -375,3 +375,35 @@ def test_docs_state_the_position_mode_default() -> None:
     default = inspect.signature(forward_kinematics).parameters["position_mode"].default
     docs = (REPO / "docs" / "architecture.md").read_text(encoding="utf-8")
     assert f'position_mode="{default}"' in docs and 'position_mode="add") ->' not in docs
+
+
+def test_gzip_bombs_are_refused_while_they_inflate(tmp_path: Path) -> None:
+    """A small .gz that inflates without limit (1.7 MB -> 700 MB took 71 s and 3.7 GB) is refused once it passes
+    GZIP_MAX_RATIO times its size; the readers never hold more than that."""
+    import gzip
+
+    from beatlite.io import read_audio, read_bvh
+    from beatlite.io.textfile import GZIP_MAX_RATIO, read_bytes
+
+    repo = Path(__file__).resolve().parents[1]
+    body = gzip.decompress((repo / "data_samples" / "2_scott_0_1_1.bvh.gz").read_bytes())
+    head, _, rows = body.partition(b"MOTION")
+    row = rows.split(b"\n")[3] + b"\n"
+    with gzip.open(
+        tmp_path / "bomb.bvh.gz", "wb"
+    ) as f:  # a real header, then one row 300,000 times (about 330 MB)
+        f.write(head + b"MOTION\nFrames: 300000\nFrame Time: 0.0333333\n")
+        for _ in range(30):
+            f.write(row * 10000)
+    size = (tmp_path / "bomb.bvh.gz").stat().st_size
+    assert len(row) * 300000 > GZIP_MAX_RATIO * size + 2**20  # it does inflate beyond the limit
+    with pytest.raises(FormatError, match="decompression bomb"):
+        read_bvh(tmp_path / "bomb.bvh.gz")
+    wav = io.BytesIO()
+    sf.write(wav, np.zeros(16000 * 600, np.int16), 16000, subtype="PCM_16", format="WAV")  # 10 min of silence
+    (tmp_path / "quiet.wav.gz").write_bytes(gzip.compress(wav.getvalue()))
+    with pytest.raises(FormatError, match="decompression bomb"):
+        read_audio(tmp_path / "quiet.wav.gz")
+    # what real files inflate to passes: every gzipped file of data_samples reads whole
+    for p in sorted((repo / "data_samples").glob("*.gz"))[:10]:
+        assert len(read_bytes(p)) == len(gzip.decompress(p.read_bytes()))
