@@ -26,28 +26,14 @@ def write_text(path: Path, text: str) -> None:
 
 
 def write_tiny_bvh(path: Path, n_frames: int, frame_time: float = 1 / FPS_BVH) -> None:
-    """A 2-joint BVH whose header says ``n_frames`` x ``frame_time`` (for index tests only)."""
-    lines = [
-        "HIERARCHY",
-        "ROOT Hips",
-        "{",
-        "  OFFSET 0 0 0",
-        "  CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation",
-        "  JOINT Spine",
-        "  {",
-        "    OFFSET 0 10 0",
-        "    CHANNELS 3 Xrotation Yrotation Zrotation",
-        "    End Site",
-        "    {",
-        "      OFFSET 0 10 0",
-        "    }",
-        "  }",
-        "}",
-        "MOTION",
-        f"Frames: {n_frames}",
-        f"Frame Time: {frame_time:.6f}",
-    ]
-    lines += ["0 0 0 0 0 0 0 0 0"] * n_frames
+    """A rest-pose BVH of BEAT's skeleton whose header says ``n_frames`` x ``frame_time`` (for index tests;
+    BEAT's skeleton, because the index runs the skeleton code every window build runs)."""
+    from beatlite.io.bvh import _header_text  # the HIERARCHY lines of beatlite's own writer
+    from beatlite.skeleton.beat import beat_skeleton
+
+    skeleton = beat_skeleton()
+    lines = _header_text(skeleton) + ["MOTION", f"Frames: {n_frames}", f"Frame Time: {frame_time:.6f}"]
+    lines += [" ".join(["0"] * skeleton.n_channels)] * n_frames
     write_text(path, "\n".join(lines) + "\n")
 
 
@@ -154,7 +140,9 @@ def test_tiny_bvh_header_reads_back(tmp_path: Path) -> None:
 
     write_tiny_bvh(tmp_path / "a.bvh", 30)
     skeleton, n, ft = read_bvh_header(tmp_path / "a.bvh")
-    assert skeleton.names == ("Hips", "Spine") and n == 30 and abs(ft - 1 / 15) < 1e-6
+    from beatlite.skeleton.beat import beat_skeleton
+
+    assert skeleton.names == beat_skeleton().names and n == 30 and abs(ft - 1 / 15) < 1e-6
 
 
 def test_wav_writer_round_trip(tmp_path: Path) -> None:

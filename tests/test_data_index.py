@@ -289,3 +289,27 @@ def test_usable_means_load_take_succeeds(tmp_path: Path) -> None:
         assert abs(take.duration - r.duration) <= 1 / 15 + 1e-9, r.stem  # and it lasts what the index says
     # the mutations leave some takes usable and break others (so the property is exercised both ways)
     assert 40 <= len(usable) <= 200, len(usable)
+
+
+def test_one_stem_rule_and_a_foreign_skeleton_make_takes_unusable_with_a_reason(tmp_path: Path) -> None:
+    """``2_scott_0_1_1.v2.bvh`` was "usable" (the index kept ``.v2`` in the stem, load_take cut it off and
+    read the other take's files); a BVH of another skeleton under a BEAT name was "usable" and then failed
+    in build_store (``KeyError: no joint named 'Spine'``). "usable" now means: loads and windows."""
+    from beatlite.io.take import take_stem
+
+    make_tiny_take(tmp_path, "2_scott_0_1_1", 3.0)
+    make_tiny_take(tmp_path, "2_scott_0_1_1.v2", 3.0)
+    make_tiny_take(tmp_path, "2_scott_0_9_9", 3.0)
+    lines = ["HIERARCHY", "ROOT Hips", "{", "  OFFSET 0 0 0", "  CHANNELS 6 Xposition Yposition Zposition "
+             "Xrotation Yrotation Zrotation", "  JOINT Chest", "  {", "    OFFSET 0 10 0",
+             "    CHANNELS 3 Xrotation Yrotation Zrotation", "    End Site", "    {", "      OFFSET 0 10 0",
+             "    }", "  }", "}", "MOTION", "Frames: 45", "Frame Time: 0.066667"]  # fmt: skip
+    (tmp_path / "2_scott_0_9_9.bvh").write_text("\n".join(lines + ["0 0 0 0 0 0 0 0 0"] * 45) + "\n")
+    idx = index_folder(tmp_path, cache=False)
+    assert idx["2_scott_0_1_1"].usable
+    assert idx["2_scott_0_1_1"].files["motion"].name == "2_scott_0_1_1.bvh"
+    v2 = idx["2_scott_0_1_1.v2"]
+    assert not v2.usable and any("take name" in p for p in v2.problems), v2.problems
+    assert take_stem(tmp_path / "2_scott_0_1_1.v2.bvh").name == "2_scott_0_1_1.v2"  # the index's stem
+    foreign = idx["2_scott_0_9_9"]
+    assert not foreign.usable and any("not BEAT's skeleton" in p and "Spine" in p for p in foreign.problems)

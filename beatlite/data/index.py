@@ -39,6 +39,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
+from beatlite.io.names import split_take_file
+
 #: File extension (lower case, without ``.gz``) -> modality name.
 MODALITIES: dict[str, str] = {
     "bvh": "motion",
@@ -54,8 +56,6 @@ REQUIRED = ("motion", "audio")
 TIMED = ("motion", "audio", "face", "text")
 #: Largest allowed disagreement between two modality durations, seconds.
 MAX_DURATION_GAP = 1.0
-
-_SUFFIX = re.compile(r"^(?P<stem>.+)\.(?P<ext>bvh|wav|json|textgrid|txt|csv)(?P<gz>\.gz)?$", re.IGNORECASE)
 
 
 @dataclass
@@ -462,11 +462,10 @@ def _scan(root: Path, recursive: bool) -> dict[str, dict[str, list[Path]]]:
         walker = iter([(root, [p.name for p in root.iterdir() if p.is_file()])])
     for folder, names in walker:
         for name in names:
-            m = _SUFFIX.match(name)
-            if m is None or name.startswith("."):
+            stem, ext = split_take_file(name)
+            if ext is None or name.startswith("."):
                 continue
-            modality = MODALITIES[m.group("ext").lower()]
-            found.setdefault(m.group("stem"), {}).setdefault(modality, []).append(folder / name)
+            found.setdefault(stem, {}).setdefault(MODALITIES[ext], []).append(folder / name)
     for by_modality in found.values():
         for paths in by_modality.values():
             paths.sort(key=lambda p: (p.suffix.lower() == ".gz", str(p)))
@@ -518,9 +517,24 @@ def _check_motion(record: TakeRecord, bvh_fps: float | None) -> None:
     reference = reference_duration(record.durations, record.half)
     motion = read_take_motion(path, bvh_fps=bvh_fps, reference_s=reference)
     record.durations["motion"] = motion.duration
+    _check_skeleton(motion)
     header_fps = parse_frame_time(repr(read_bvh_header(path)[2]))
     if bvh_fps is not None or motion.fps != header_fps:
         record.bvh_fps = motion.fps
+
+
+def _check_skeleton(motion: Any) -> None:
+    """Run, on the first frame, the skeleton code every window build runs (the ``spine_neck_141`` columns and the
+    TED-43 joints), so that a BVH of another skeleton under a BEAT name is unusable with the joint it lacks."""
+    from beatlite.data.windows import POSE_SUBSET
+    from beatlite.skeleton.beat import subset_columns
+    from beatlite.skeleton.ted import beat_to_ted43
+
+    try:
+        subset_columns(motion.skeleton, POSE_SUBSET)
+        beat_to_ted43(motion.skeleton, motion.channels[:1])
+    except (KeyError, ValueError) as exc:
+        raise ValueError(f"not BEAT's skeleton: {str(exc).strip(chr(34))}") from None
 
 
 def _check_files(record: TakeRecord, bvh_fps: float | None) -> None:

@@ -11,6 +11,7 @@ Taught in notebooks/00_setup_and_tour.ipynb, section 2 (what is in the data fold
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +25,7 @@ __all__ = [
     "SPLITS",
     "TakeName",
     "parse_take_name",
+    "split_take_file",
     "emotion_of",
     "split_of",
 ]
@@ -207,8 +209,32 @@ def _int_field(path: str, text: str, field: str) -> int:
     return int(text)
 
 
+#: A take's file name: its stem, then one of BEAT's extensions (any case), optionally ``.gz``.
+TAKE_FILE = re.compile(r"^(?P<stem>.+)\.(?P<ext>bvh|wav|json|textgrid|txt|csv)(?P<gz>\.gz)?$", re.IGNORECASE)
+
+
+def split_take_file(name: str | os.PathLike[str]) -> tuple[str, str | None]:
+    """The one stem rule of beatlite (index, ``load_take``, names): ``(stem, extension)`` of a file name.
+
+    The stem is everything before a BEAT extension (``bvh wav json TextGrid txt csv``, optionally ``.gz``),
+    dots included; a name without one is all stem (a stem given as such).
+
+    Examples
+    --------
+    >>> split_take_file("data/2_scott_0_1_1.bvh.gz")
+    ('2_scott_0_1_1', 'bvh')
+    >>> split_take_file("2_scott_0_1_1.v2.TextGrid")
+    ('2_scott_0_1_1.v2', 'textgrid')
+    >>> split_take_file("2_scott_0_1_1")
+    ('2_scott_0_1_1', None)
+    """
+    base = Path(name).name
+    m = TAKE_FILE.match(base)
+    return (m.group("stem"), m.group("ext").lower()) if m else (base, None)
+
+
 def parse_take_name(name: str | os.PathLike[str]) -> TakeName:
-    """Parse a BEAT take name (a stem or a path; extensions are ignored).
+    """Parse a BEAT take name (a stem or a path; a BEAT extension is ignored: :func:`split_take_file`).
 
     Parameters
     ----------
@@ -225,7 +251,7 @@ def parse_take_name(name: str | os.PathLike[str]) -> TakeName:
         Naming the field that is wrong (``speaker_id``, ``speaker``,
         ``session_type``, ``start``, ``end``, ``half``).
     """
-    stem = Path(name).name.split(".")[0]
+    stem = split_take_file(name)[0]
     parts = stem.split("_")
     half: str | None = None
     if len(parts) == 6:

@@ -153,9 +153,12 @@ class Take:
 
 
 def take_stem(path_or_stem: str | os.PathLike[str]) -> Path:
-    """``data/2_scott_0_1_1.bvh.gz`` -> ``data/2_scott_0_1_1`` (everything after the first dot dropped)."""
+    """``data/2_scott_0_1_1.bvh.gz`` -> ``data/2_scott_0_1_1`` (:func:`beatlite.io.names.split_take_file`: the
+    BEAT extension dropped; other dots are part of the stem, as the index reads it)."""
+    from beatlite.io.names import split_take_file
+
     p = Path(path_or_stem)
-    return p.with_name(p.name.split(".")[0]) if "." in p.name else p
+    return p.with_name(split_take_file(p)[0])
 
 
 def _sample_times(n_source: int, source_fps: float, fps: float, shift: int) -> np.ndarray:
