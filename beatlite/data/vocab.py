@@ -390,7 +390,7 @@ def word_vectors(
 
 
 def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarray:
-    """Map a FastText/word2vec ``.vec`` text file (``word v1 ... vD`` per line) onto ``vocab``.
+    r"""Map a FastText/word2vec ``.vec`` text file (``word v1 ... vD`` per line) onto ``vocab``.
 
     For users who have the paper's ``cc.en.300.vec`` offline. Words missing from the
     file get random N(0, 1/D) vectors (seeded), PAD the zero vector.
@@ -404,7 +404,7 @@ def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarra
     >>> import tempfile
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "words.vec"
-    >>> _ = path.write_text("2 3\\nhello 1 0 0\\nworld 0 1 0\\n")  # fastText header: count and dimension
+    >>> _ = path.write_text("2 3\nhello 1 0 0\nworld 0 1 0\n")  # fastText header: count and dimension
     >>> vocab = vocab_from_sentences([["hello", "there"]])
     >>> vectors = read_vec_file(path, vocab)
     >>> vectors.shape, vectors[vocab.id("hello")].tolist(), bool(np.all(vectors[0] == 0))

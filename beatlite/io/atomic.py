@@ -27,7 +27,7 @@ _MODES = ("w", "wb")
 def atomic_write(
     path: str | os.PathLike[str], mode: str = "w", *, encoding: str = "utf-8", newline: str | None = "\n"
 ) -> Iterator[IO[Any]]:
-    """Open ``path`` for writing so that it appears complete or not at all.
+    r"""Open ``path`` for writing so that it appears complete or not at all.
 
     Data go to a temporary file ``.{name}.{pid}.*.tmp`` in the same folder, which
     is flushed, ``fsync``-ed and renamed over ``path`` with :func:`os.replace` when
@@ -46,7 +46,7 @@ def atomic_write(
     encoding : str
         Text encoding (text mode only).
     newline : str or None
-        Newline translation for text mode; ``"\\n"`` (default) writes LF on
+        Newline translation for text mode; ``"\n"`` (default) writes LF on
         every platform.
 
     Yields
@@ -59,9 +59,9 @@ def atomic_write(
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "notes.txt"
     >>> with atomic_write(path) as f:
-    ...     _ = f.write("complete or not at all\\n")
+    ...     _ = f.write("complete or not at all\n")
     >>> path.read_text()
-    'complete or not at all\\n'
+    'complete or not at all\n'
     >>> try:
     ...     with atomic_write(path) as f:
     ...         _ = f.write("half a line")
@@ -69,7 +69,7 @@ def atomic_write(
     ... except RuntimeError:
     ...     pass
     >>> path.read_text(), sorted(p.name for p in Path(tmp.name).iterdir())  # old content, no temp file left
-    ('complete or not at all\\n', ['notes.txt'])
+    ('complete or not at all\n', ['notes.txt'])
     >>> tmp.cleanup()
     """
     if mode not in _MODES:

@@ -43,7 +43,7 @@ class EmotionSegment(NamedTuple):
 
 
 def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
-    """Read a BEAT emotion ``.csv`` file (``.gz`` transparent).
+    r"""Read a BEAT emotion ``.csv`` file (``.gz`` transparent).
 
     Returns
     -------
@@ -63,7 +63,7 @@ def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
     >>> import tempfile
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.csv"
-    >>> _ = path.write_text("neutral,0.0,14.8,14.8,0\\n")
+    >>> _ = path.write_text("neutral,0.0,14.8,14.8,0\n")
     >>> read_emotion(path)
     [EmotionSegment(name='neutral', start=0.0, end=14.8, duration=14.8, emotion=0)]
     >>> tmp.cleanup()

@@ -111,7 +111,7 @@ def warn_durations(path: Path, notes: list[str]) -> None:
 
 
 def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
-    """Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
+    r"""Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
 
     Parameters
     ----------
@@ -136,7 +136,7 @@ def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
     >>> import tempfile
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.txt"
-    >>> _ = path.write_text("00_nogesture\\t0.0\\t0.734\\t0.734\\t0.0\\n02_deictic_l\\t0.734\\t2.315\\t1.581\\t0.3\\tmy\\n")
+    >>> _ = path.write_text("00_nogesture\t0.0\t0.734\t0.734\t0.0\n02_deictic_l\t0.734\t2.315\t1.581\t0.3\tmy\n")
     >>> [(s.type, s.start, s.score, s.keywords) for s in read_semantic(path)]
     [('00_nogesture', 0.0, 0.0, ''), ('02_deictic_l', 0.734, 0.3, 'my')]
     >>> tmp.cleanup()
