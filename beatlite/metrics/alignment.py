@@ -357,11 +357,13 @@ def emage_beat_align(
     --------
     >>> fps, frames = 15, np.arange(90)
     >>> positions = np.zeros((90, 1, 3))
-    >>> positions[:, 0, 0] = 10 * np.cos(np.pi * frames / 15)  # (T, J, 3) cm, turns each second
-    >>> speed = np.abs(np.gradient(positions[:, 0, 0])) * fps
-    >>> score = emage_beat_align([np.array([1.0, 2.0])], [positions], fps, np.array([speed.mean()]))
-    >>> 0 <= score <= 1
-    True
+    >>> positions[:, 0, 0] = 10 * np.cos(np.pi * frames / 12)  # (T, J, 3) cm, turns every 12 frames
+    >>> mean_speed = np.array([np.abs(np.gradient(positions[:, 0, 0])).mean() * fps])
+    >>> # scored frames 30..59 (2 s skipped): motion beats at frames 36 and 48, i.e. 0.4 and 1.2 s after the skip
+    >>> emage_beat_align([np.array([0.4, 1.2])], [positions], fps, mean_speed)
+    1.0
+    >>> round(emage_beat_align([np.array([0.8, 1.6])], [positions], fps, mean_speed), 4)  # 0.4 s off: exp(-0.16 / 0.18)
+    0.4111
     """
     fps = positive(fps, "fps")
     order, skip = _emage_frames(fps, order_s, skip_s)
