@@ -402,14 +402,15 @@ def save_extractor(
     Examples
     --------
     >>> import tempfile
-    >>> windows = np.random.default_rng(0).normal(size=(16, 34, 6)).astype(np.float32)
-    >>> config = ExtractorConfig(input_dim=6, latent_dim=4, channels=8, epochs=1, batch_size=8)
-    >>> model, info = train_autoencoder(windows, config, log=False)
+    >>> model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8)).eval()
+    >>> info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}  # as train_autoencoder returns it
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     path = save_extractor(f"{tmp}/ae.pt", model, info, space="dirvec", meta={})
     ...     extractor = load_extractor("dirvec", path)
-    >>> extractor(windows).shape  # features of the 16 windows
-    (16, 4)
+    >>> windows = np.random.default_rng(0).normal(size=(5, 34, 6)).astype(np.float32)
+    >>> features = extractor(windows)  # (N, L); the same as the saved model's
+    >>> features.shape, np.allclose(features, model.encode(torch.from_numpy(windows)).detach().numpy(), atol=1e-6)
+    ((5, 4), True)
     """
     from beatlite.io.atomic import atomic_write
 
