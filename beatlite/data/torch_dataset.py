@@ -67,7 +67,8 @@ class WindowDataset(Dataset):
     >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
     ...     _ = shutil.copy(p, tmp.name)
     >>> index = index_folder(tmp.name, cache=False)
-    >>> dataset = WindowDataset(build_store(index, Path(tmp.name) / "store").windows("test"), keys=("pose", "word"))
+    >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
+    >>> dataset = WindowDataset(windows, keys=("pose", "word"))
     >>> len(dataset), tuple(dataset[0]["pose"].shape), tuple(dataset[[0, 1]]["pose"].shape)
     (19, (34, 141), (2, 34, 141))
     >>> tmp.cleanup()
@@ -148,7 +149,8 @@ def window_loader(
     >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
     ...     _ = shutil.copy(p, tmp.name)
     >>> index = index_folder(tmp.name, cache=False)
-    >>> loader = window_loader(build_store(index, Path(tmp.name) / "store").windows("test"), batch_size=8, keys=("pose",))
+    >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
+    >>> loader = window_loader(windows, batch_size=8, keys=("pose",))
     >>> [tuple(batch["pose"].shape) for batch in loader]  # 19 windows
     [(8, 34, 141), (8, 34, 141), (3, 34, 141)]
     >>> tmp.cleanup()

@@ -243,8 +243,11 @@ def parse_take_name(name: str | os.PathLike[str]) -> TakeName:
 
     Examples
     --------
-    >>> parse_take_name("data/2_scott_0_1_1.bvh.gz")
-    TakeName(speaker_id=2, speaker='scott', session_type=0, language='english', conversation=False, start=1, end=1, half=None, emotion=0, emotion_name='neutral', split='test')
+    >>> name = parse_take_name("data/2_scott_0_1_1.bvh.gz")
+    >>> name.speaker_id, name.speaker, name.session_type, name.start, name.end, name.half
+    (2, 'scott', 0, 1, 1, None)
+    >>> name.language, name.conversation, name.emotion_name, name.split
+    ('english', False, 'neutral', 'test')
     """
     stem = Path(name).name.split(".")[0]
     parts = stem.split("_")

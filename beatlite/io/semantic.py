@@ -136,7 +136,8 @@ def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
     >>> import tempfile
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.txt"
-    >>> _ = path.write_text("00_nogesture\t0.0\t0.734\t0.734\t0.0\n02_deictic_l\t0.734\t2.315\t1.581\t0.3\tmy\n")
+    >>> _ = path.write_text("00_nogesture\t0.0\t0.734\t0.734\t0.0\n"
+    ...                     "02_deictic_l\t0.734\t2.315\t1.581\t0.3\tmy\n")
     >>> [(s.type, s.start, s.score, s.keywords) for s in read_semantic(path)]
     [('00_nogesture', 0.0, 0.0, ''), ('02_deictic_l', 0.734, 0.3, 'my')]
     >>> tmp.cleanup()
@@ -257,7 +258,8 @@ def write_semantic(path: str | os.PathLike[str], segments: Sequence[SemanticSegm
     >>> import tempfile
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.txt"
-    >>> segments = [SemanticSegment("00_nogesture", 0.0, 0.5, 0.5, 0.0), SemanticSegment("02_deictic_l", 0.5, 1.0, 0.5, 0.3, "my")]
+    >>> segments = [SemanticSegment("00_nogesture", 0.0, 0.5, 0.5, 0.0),
+    ...             SemanticSegment("02_deictic_l", 0.5, 1.0, 0.5, 0.3, "my")]
     >>> write_semantic(path, segments)
     >>> read_semantic(path) == segments
     True

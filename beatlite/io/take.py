@@ -280,8 +280,8 @@ def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Pa
     --------
     >>> from beatlite.paths import repo_root
     >>> stem, files = take_files(repo_root() / "data_samples" / "2_scott_0_1_1.wav")
-    >>> stem.name, sorted(p.name for p in files.values())
-    ('2_scott_0_1_1', ['2_scott_0_1_1.TextGrid', '2_scott_0_1_1.bvh.gz', '2_scott_0_1_1.csv', '2_scott_0_1_1.json.gz', '2_scott_0_1_1.txt', '2_scott_0_1_1.wav'])
+    >>> stem.name, list(files), files[".bvh"].name
+    ('2_scott_0_1_1', ['.bvh', '.wav', '.json', '.TextGrid', '.txt', '.csv'], '2_scott_0_1_1.bvh.gz')
     """
     stem = take_stem(stem_or_path)
     paths = {".bvh": resolve(stem, ".bvh")}
@@ -381,10 +381,13 @@ def read_take_motion(
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.bvh"
     >>> from beatlite.io.bvh import write_bvh
-    >>> write_bvh(path, Motion(beat_skeleton(), np.zeros((240, 228)), fps=120))
-    >>> motion = read_take_motion(path, reference_s=2.0)  # 240 rows at 120 fps: 2 s, as the audio
-    >>> motion.fps, motion.n_frames
-    (120.0, 240)
+    >>> write_bvh(path, Motion(beat_skeleton(), np.zeros((240, 228)), fps=24))  # a wrong Frame Time
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     motion = read_take_motion(path, reference_s=2.0)  # the audio lasts 2 s: the rows are 120 fps
+    >>> motion.fps, motion.n_frames, [w.category.__name__ for w in caught]
+    (120.0, 240, ['BVHWarning'])
     >>> tmp.cleanup()
     """
     p = Path(path)

@@ -347,8 +347,11 @@ def read_textgrid(path: str | os.PathLike[str]) -> dict[str, list[Interval]]:
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = Path(tmp.name) / "take.TextGrid"
     >>> write_textgrid(path, {"words": [Interval(0.2, 0.5, "hi")]}, 1.0)
-    >>> read_textgrid(path)["words"]
-    [Interval(start=0.0, end=0.2, text=''), Interval(start=0.2, end=0.5, text='hi'), Interval(start=0.5, end=1.0, text='')]
+    >>> for interval in read_textgrid(path)["words"]:  # gaps filled with "" (silence)
+    ...     print(interval)
+    Interval(start=0.0, end=0.2, text='')
+    Interval(start=0.2, end=0.5, text='hi')
+    Interval(start=0.5, end=1.0, text='')
     >>> tmp.cleanup()
     """
     _, _, tiers = read_textgrid_tiers(path)

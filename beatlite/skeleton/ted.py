@@ -281,8 +281,10 @@ def pair_angles(dirs: np.ndarray) -> np.ndarray:
     >>> dirs[17] = [0, 1, 0]  # palm normals exist: left pinky (x) and thumb (y) are not parallel
     >>> dirs[34] = [0, 1, 0]
     >>> angles = pair_angles(dirs)
-    >>> angles.shape, bool(((angles >= 0) & (angles <= np.pi)).all())
-    ((41,), True)
+    >>> angles.shape, ANGLE_PAIRS[0], float(angles[0])  # bones 0 and 1 are parallel
+    ((41,), (0, 1), 0.0)
+    >>> ANGLE_PAIRS[12], round(float(angles[12]), 6)  # bone 17 (along y) against bone 18 (along x): pi / 2
+    ((17, 18), 1.570796)
     """
     d = _unit(_check_dirs(dirs))
     vecs = np.concatenate([d, palm_normals(d)], axis=-2)
