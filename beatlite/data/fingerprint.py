@@ -45,13 +45,32 @@ _DIGESTS: dict[tuple[str, int, int], str] = {}
 
 
 def file_key(path: str | os.PathLike[str]) -> tuple[str, int, int]:
-    """(resolved path, size, mtime_ns): what decides whether a remembered digest still holds."""
+    """(resolved path, size, mtime_ns): what decides whether a remembered digest still holds.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> p = Path(tmp.name) / "a.txt"
+    >>> _ = p.write_bytes(b"beat")
+    >>> key = file_key(p)
+    >>> key[0] == str(p.resolve()), key[1]  # (resolved path, size in bytes, mtime_ns)
+    (True, 4)
+    >>> tmp.cleanup()
+    """
     st = Path(path).stat()
     return (str(Path(path).resolve()), int(st.st_size), int(st.st_mtime_ns))
 
 
 def settled(key: tuple[str, int, int], now_ns: int | None = None) -> bool:
-    """Whether a file with this :func:`file_key` was last modified at least :data:`SETTLE_S` ago."""
+    """Whether a file with this :func:`file_key` was last modified at least :data:`SETTLE_S` ago.
+
+    Examples
+    --------
+    >>> key = ("/data/take.bvh", 100, 1_000_000_000)  # modified at t = 1 s
+    >>> settled(key, now_ns=2_000_000_000), settled(key, now_ns=4_000_000_000)  # SETTLE_S = 2 s
+    (False, True)
+    """
     now_ns = time.time_ns() if now_ns is None else now_ns
     return key[2] <= now_ns - int(SETTLE_S * 1e9)
 
@@ -62,6 +81,16 @@ def file_digest(path: str | os.PathLike[str]) -> str:
     Remembered by :func:`file_key` for the life of the process (:func:`remember_digest` primes it from
     a cache), so a file is read again only when it changed; files modified in the last
     :data:`SETTLE_S` seconds are not remembered (they are hashed on every call).
+
+    Examples
+    --------
+    >>> import hashlib, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> p = Path(tmp.name) / "a.txt"
+    >>> _ = p.write_bytes(b"beat")
+    >>> file_digest(p) == hashlib.sha256(b"beat").hexdigest()
+    True
+    >>> tmp.cleanup()
     """
     key = file_key(path)
     digest = _DIGESTS.get(key)
@@ -77,7 +106,20 @@ def file_digest(path: str | os.PathLike[str]) -> str:
 
 
 def remember_digest(key: tuple[str, int, int], digest: str) -> None:
-    """Prime :func:`file_digest` with a digest computed earlier for the file of this :func:`file_key`."""
+    """Prime :func:`file_digest` with a digest computed earlier for the file of this :func:`file_key`.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> p = Path(tmp.name) / "a.txt"
+    >>> _ = p.write_bytes(b"beat")
+    >>> os.utime(p, ns=(10**9, 10**9))  # modified long ago: digests are remembered
+    >>> remember_digest(file_key(p), "0" * 64)  # e.g. from the index cache
+    >>> file_digest(p) == "0" * 64  # taken from memory, the file is not read again
+    True
+    >>> tmp.cleanup()
+    """
     if settled(key):
         _DIGESTS[(str(key[0]), int(key[1]), int(key[2]))] = str(digest)
 
@@ -104,6 +146,19 @@ def take_fingerprint(record: TakeRecord, params: Mapping[str, Any]) -> str:
         The take (its ``files`` are hashed by content).
     params : Mapping
         JSON-serialisable parameters of what is built from the take (frame rate, audio rate, ...).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.data.index import TakeRecord
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> bvh = Path(tmp.name) / "2_scott_0_1_1.bvh"
+    >>> _ = bvh.write_bytes(b"HIERARCHY")
+    >>> record = TakeRecord("2_scott_0_1_1", files={"motion": bvh})
+    >>> a = take_fingerprint(record, {"fps": 15})
+    >>> len(a), a == take_fingerprint(record, {"fps": 15}), a == take_fingerprint(record, {"fps": 30})
+    (64, True, False)
+    >>> tmp.cleanup()
     """
     h = _params_hash(params)
     _update_with_take(h, record)
@@ -111,7 +166,21 @@ def take_fingerprint(record: TakeRecord, params: Mapping[str, Any]) -> str:
 
 
 def takes_fingerprint(records: Iterable[TakeRecord], params: Mapping[str, Any]) -> str:
-    """64 hex digits identifying several takes (in stem order) and ``params``: a split, a corpus."""
+    """64 hex digits identifying several takes (in stem order) and ``params``: a split, a corpus.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.data.index import TakeRecord
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> records = []
+    >>> for stem in ("2_scott_0_1_1", "2_scott_0_9_9"):
+    ...     _ = (Path(tmp.name) / f"{stem}.bvh").write_bytes(stem.encode())
+    ...     records.append(TakeRecord(stem, files={"motion": Path(tmp.name) / f"{stem}.bvh"}))
+    >>> takes_fingerprint(records, {}) == takes_fingerprint(records[::-1], {})  # stem order, whatever the input order
+    True
+    >>> tmp.cleanup()
+    """
     h = _params_hash(params)
     for record in sorted(records, key=lambda r: r.stem):
         _update_with_take(h, record)
@@ -133,6 +202,12 @@ def windows_fingerprint(
         Window length and stride in frames.
     vocab : iterable of str
         The vocabulary the word ids refer to (``Vocab.itos``).
+
+    Examples
+    --------
+    >>> a = windows_fingerprint(["ab" * 32], split="test", length=34, stride=10, vocab=["<pad>", "hello"])
+    >>> len(a), a == windows_fingerprint(["ab" * 32], split="test", length=34, stride=5, vocab=["<pad>", "hello"])
+    (16, False)
     """
     vocab_hash = hashlib.sha256("\n".join(vocab).encode()).hexdigest()
     h = _params_hash({"split": split, "length": int(length), "stride": int(stride), "vocab": vocab_hash})

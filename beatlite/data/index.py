@@ -100,6 +100,12 @@ class TakeRecord:
         the override given to :func:`index_folder`, or the rate reconciled from the
         files (e.g. 15 for 15 fps rows under a 120 fps header). Windows and
         statistics pass it to :func:`beatlite.io.load_take`.
+
+    Examples
+    --------
+    >>> record = TakeRecord("2_scott_0_1_1", speaker_id=2, split="test", durations={"motion": 14.8, "audio": 14.8})
+    >>> record.stem, record.split, record.duration
+    ('2_scott_0_1_1', 'test', 14.8)
     """
 
     stem: str
@@ -358,6 +364,12 @@ def bvh_duration(path: str | Path) -> float:
     This is what the header claims; the index itself reports the rows at the rate
     loading uses (:func:`beatlite.io.take.read_take_motion`), which differs for files
     whose ``Frame Time`` or ``Frames`` is wrong (docs/reference_code.md#bvh-header).
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> round(bvh_duration(repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"), 3)  # Frames x Frame Time
+    14.8
     """
     from beatlite.io import read_bvh_header
 
@@ -370,6 +382,12 @@ def wav_duration(path: str | Path) -> float:
 
     Checked exactly as :func:`beatlite.io.read_audio` checks it (:func:`beatlite.io.audio.audio_info`:
     sniffed bytes, bounded rate, channels and size), decoding no samples.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> wav_duration(repo_root() / "data_samples" / "2_scott_0_1_1.wav")
+    14.8
     """
     from beatlite.io.audio import audio_info
 
@@ -380,6 +398,12 @@ def face_duration(path: str | Path) -> float:
     """Duration of a BEAT facial JSON as :func:`beatlite.io.read_facial` reads it: frames / fps, seconds.
 
     The fps comes from the median spacing of the frames' ``time`` values (60 in BEAT).
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> round(face_duration(repo_root() / "data_samples" / "2_scott_0_1_1.json.gz"), 3)
+    14.8
     """
     from beatlite.io import read_facial
 
@@ -391,7 +415,14 @@ _XMAX = re.compile(r"^\s*xmax\s*=\s*([-+0-9.eE]+)")
 
 
 def textgrid_duration(path: str | Path) -> float:
-    """The ``xmax`` of a Praat TextGrid (long or short text format), seconds."""
+    """The ``xmax`` of a Praat TextGrid (long or short text format), seconds.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> textgrid_duration(repo_root() / "data_samples" / "2_scott_0_1_1.TextGrid")
+    14.8
+    """
     from beatlite.io.errors import FormatError
 
     path = Path(path)
@@ -575,6 +606,15 @@ def index_take(
         Read every file as loading would (default True); False lists files only.
     bvh_fps : float, optional
         Rate of the BVH rows (an override, kept in :attr:`TakeRecord.bvh_fps`).
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> folder = repo_root() / "data_samples"
+    >>> files = {"motion": [folder / "2_scott_0_1_1.bvh.gz"], "audio": [folder / "2_scott_0_1_1.wav"]}
+    >>> record = index_take("2_scott_0_1_1", files)
+    >>> record.speaker, record.split, record.usable, sorted(record.durations)
+    ('scott', 'test', True, ['audio', 'motion'])
     """
     fields, problem = _name_fields(stem)
     record = TakeRecord(stem=stem, **fields)
@@ -647,6 +687,20 @@ def index_folder(
     ------
     FileNotFoundError
         If ``root`` is not a folder.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> index.stems, [r.split for r in index], all(r.usable for r in index)
+    (['2_scott_0_1_1', '2_scott_0_9_9'], ['test', 'train'], True)
+    >>> tmp.cleanup()
     """
     from beatlite.paths import data_dir
 
@@ -695,7 +749,14 @@ PARALLEL_BYTES = 256 * 2**20
 def default_workers(paths: Iterable[Path]) -> int:
     """Worker processes for reading ``paths``: ``os.cpu_count()`` when they exceed :data:`PARALLEL_BYTES`,
     else 1 (spawning costs about a second per process, and a script that spawns needs an
-    ``if __name__ == "__main__":`` guard: small corpora such as ``data_samples/`` need neither)."""
+    ``if __name__ == "__main__":`` guard: small corpora such as ``data_samples/`` need neither).
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> default_workers((repo_root() / "data_samples").glob("*.wav"))  # a small corpus: no worker processes
+    1
+    """
     size = sum(Path(p).stat().st_size for p in paths)
     return (os.cpu_count() or 1) if size > PARALLEL_BYTES else 1
 

@@ -29,7 +29,14 @@ INDEX_VERSION = 2
 
 
 def cache_path(root: Path, recursive: bool) -> Path:
-    """``cache_dir()/index/{hash of the resolved folder and recursive}.json``."""
+    """``cache_dir()/index/{hash of the resolved folder and recursive}.json``.
+
+    Examples
+    --------
+    >>> p = cache_path(Path("data_samples"), recursive=True)
+    >>> p.parent.name, p.suffix, len(p.stem)
+    ('index', '.json', 16)
+    """
     from beatlite.paths import cache_dir
 
     key = json.dumps({"root": str(Path(root).resolve()), "recursive": bool(recursive)})
@@ -37,7 +44,16 @@ def cache_path(root: Path, recursive: bool) -> Path:
 
 
 def take_key(files: dict[str, list[Path]], bvh_fps: float | None) -> list[Any] | None:
-    """The JSON key a take's cached record must match, or None when a file is too fresh to cache."""
+    """The JSON key a take's cached record must match, or None when a file is too fresh to cache.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> files = {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]}
+    >>> key = take_key(files, None)
+    >>> key[0] == INDEX_VERSION, key[1], key[2][0][0]  # version, bvh_fps override, (modality, path, size, mtime)
+    (True, None, 'motion')
+    """
     keys = sorted([modality, *file_key(p)] for modality, paths in files.items() for p in paths)
     if not all(settled((k[1], k[2], k[3])) for k in keys):
         return None
@@ -45,7 +61,19 @@ def take_key(files: dict[str, list[Path]], bvh_fps: float | None) -> list[Any] |
 
 
 def load(path: Path) -> dict[str, Any]:
-    """``{stem: {"key": ..., "record": ..., "digests": ...}}`` of a cache file ({} if absent or unreadable)."""
+    """``{stem: {"key": ..., "record": ..., "digests": ...}}`` of a cache file ({} if absent or unreadable).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> load(Path(tmp.name) / "absent.json")  # absent or unreadable: empty
+    {}
+    >>> save(Path(tmp.name) / "index.json", {"2_scott_0_1_1": {"key": [1]}})
+    >>> load(Path(tmp.name) / "index.json")
+    {'2_scott_0_1_1': {'key': [1]}}
+    >>> tmp.cleanup()
+    """
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
@@ -60,7 +88,18 @@ def load(path: Path) -> dict[str, Any]:
 
 
 def cached_record(entry: Any, key: list[Any] | None) -> TakeRecord | None:
-    """The record of a cache ``entry`` if it was computed from ``key`` (its digests primed), else None."""
+    """The record of a cache ``entry`` if it was computed from ``key`` (its digests primed), else None.
+
+    Examples
+    --------
+    >>> from beatlite.data.index import index_take
+    >>> from beatlite.paths import repo_root
+    >>> files = {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]}
+    >>> key = take_key(files, None)
+    >>> cached = entry(index_take("2_scott_0_1_1", files), key)
+    >>> cached_record(cached, key).stem, cached_record(cached, ["another key"])
+    ('2_scott_0_1_1', None)
+    """
     from beatlite.data.index import TakeRecord
 
     if key is None or not isinstance(entry, dict) or entry.get("key") != key:
@@ -77,14 +116,35 @@ def cached_record(entry: Any, key: list[Any] | None) -> TakeRecord | None:
 
 
 def entry(record: TakeRecord, key: list[Any]) -> dict[str, Any]:
-    """The cache entry of a freshly indexed record (its files hashed now, with :func:`file_digest`)."""
+    """The cache entry of a freshly indexed record (its files hashed now, with :func:`file_digest`).
+
+    Examples
+    --------
+    >>> from beatlite.data.index import index_take
+    >>> from beatlite.paths import repo_root
+    >>> files = {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]}
+    >>> e = entry(index_take("2_scott_0_1_1", files), take_key(files, None))
+    >>> sorted(e), len(e["digests"]["motion"])  # sha256 of each file
+    (['digests', 'key', 'record'], 64)
+    """
     fields = dataclasses.asdict(record)
     fields["files"] = {m: str(p) for m, p in record.files.items()}
     return {"key": key, "record": fields, "digests": {m: file_digest(p) for m, p in record.files.items()}}
 
 
 def save(path: Path, takes: dict[str, Any]) -> None:
-    """Write the cache atomically (a failure to write, e.g. a read-only build folder, is ignored)."""
+    """Write the cache atomically (a failure to write, e.g. a read-only build folder, is ignored).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "index" / "cache.json"  # parent folders are made
+    >>> save(path, {})
+    >>> load(path), path.exists()
+    ({}, True)
+    >>> tmp.cleanup()
+    """
     from beatlite.io.atomic import atomic_write
 
     try:

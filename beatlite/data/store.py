@@ -159,7 +159,17 @@ def quantize_audio(audio: np.ndarray) -> tuple[np.ndarray, float]:
 
 def take_fingerprint(record: TakeRecord, params: Mapping[str, Any]) -> str:
     """:func:`beatlite.data.fingerprint.take_fingerprint` with :data:`STORE_VERSION`: the take's files
-    (content), its ``bvh_fps`` override and the store parameters."""
+    (content), its ``bvh_fps`` override and the store parameters.
+
+    Examples
+    --------
+    >>> from beatlite.data.index import index_take
+    >>> from beatlite.paths import repo_root
+    >>> record = index_take("2_scott_0_1_1", {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]})
+    >>> fp = take_fingerprint(record, store_params())
+    >>> len(fp), fp == take_fingerprint(record, store_params(fps=30))
+    (64, False)
+    """
     from beatlite.data.fingerprint import take_fingerprint as fingerprint
 
     return fingerprint(record, {**params, "version": STORE_VERSION})
@@ -184,6 +194,18 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
 
     ``meta.json`` is removed first and written last, so a half-written entry is never taken as valid.
     Runs in the worker processes of :func:`build_store`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> index = index_folder(repo_root() / "data_samples", recursive=False, cache=False, read_durations=False)
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> meta = build_take(index["2_scott_0_1_1"], tmp.name, store_params())
+    >>> meta["n_frames"], sorted(p.name for p in Path(tmp.name).glob("*.npy"))[:3]
+    (222, ['audio.npy', 'dirs.npy', 'emotion.npy'])
+    >>> tmp.cleanup()
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -250,7 +272,20 @@ def _need(data: Mapping[str, Any], path: Path, *fields: str) -> None:
 
 @dataclass(frozen=True)
 class StreamFile:
-    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``."""
+    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "pose.npy"
+    >>> np.save(path, np.arange(12, dtype=np.float32).reshape(4, 3))
+    >>> stream = StreamFile.open(path, "float32", (4, 3))
+    >>> stream.shape, stream.read(1, 3)  # rows 1 and 2, read from the file
+    ((4, 3), array([[3., 4., 5.],
+           [6., 7., 8.]], dtype=float32))
+    >>> tmp.cleanup()
+    """
 
     path: Path
     offset: int
@@ -328,7 +363,24 @@ _FILES = _FileCache()
 
 @dataclass
 class StoreTake:
-    """One take of a store: its folder, meta data and (lazily parsed) stream files."""
+    """One take of a store: its folder, meta data and (lazily parsed) stream files.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> store = build_store(index, Path(tmp.name) / "store")
+    >>> take = store.take("2_scott_0_1_1")
+    >>> take.stem, take.n_frames, take.stream("pose_raw").shape
+    ('2_scott_0_1_1', 222, (222, 141))
+    >>> tmp.cleanup()
+    """
 
     folder: Path
     meta: dict[str, Any]
@@ -391,6 +443,23 @@ class WindowStore:
         In index order.
     vocab : Vocab
         The vocabulary the ``word`` key maps to (``build_vocab(index)`` at build time).
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> store = build_store(index, Path(tmp.name) / "store")
+    >>> len(store), store.n_frames("test")
+    (2, 222)
+    >>> WindowStore.open(Path(tmp.name) / "store").params == store.params  # reopened without an index
+    True
+    >>> tmp.cleanup()
     """
 
     def __init__(self, folder: Path, params: dict[str, Any], takes: list[StoreTake], vocab: Vocab) -> None:
@@ -522,6 +591,24 @@ class StoreWindows:
         Position of each window's take in ``store.takes``.
     starts : (N,) int64
         First frame of each window.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
+    >>> len(windows)  # 34-frame windows every 10 frames of a 222-frame take
+    19
+    >>> batch = windows.batch(np.array([0, 5]), keys=("pose", "word"))
+    >>> batch["pose"].shape, batch["word"].shape
+    ((2, 34, 141), (2, 34))
+    >>> tmp.cleanup()
     """
 
     def __init__(
@@ -700,7 +787,14 @@ def _streams_of(store: WindowStore) -> set[str]:
 
 # ---------------------------------------------------------------------- building
 def store_params(*, fps: float = FPS, sr: int = SR, positions: bool = False, word_rule: str = "span") -> dict:
-    """The parameters that decide a store's content (they enter every take's fingerprint)."""
+    """The parameters that decide a store's content (they enter every take's fingerprint).
+
+    Examples
+    --------
+    >>> params = store_params(fps=30)
+    >>> params["fps"], params["sr"], params["word_rule"]
+    (30.0, 16000, 'span')
+    """
     return {
         "fps": float(fps),
         "sr": int(sr),
@@ -712,7 +806,15 @@ def store_params(*, fps: float = FPS, sr: int = SR, positions: bool = False, wor
 
 
 def default_store_folder(index: TakeIndex, params: Mapping[str, Any]) -> Path:
-    """``cache_dir()/store/{hash of the corpus folder and params}``."""
+    """``cache_dir()/store/{hash of the corpus folder and params}``.
+
+    Examples
+    --------
+    >>> from beatlite.data.index import TakeIndex
+    >>> folder = default_store_folder(TakeIndex([], root="data_samples"), store_params())
+    >>> folder.parent.name, len(folder.name)
+    ('store', 16)
+    """
     from beatlite.paths import cache_dir
 
     root = index.root if index.root is not None else Path(next(iter(index)).path("motion")).parent
@@ -872,6 +974,23 @@ def build_store(
     ValueError
         Bad parameters or no usable take. A take that cannot be read raises its reader's
         ``FormatError``.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> store = build_store(index, Path(tmp.name) / "store")
+    >>> [t.stem for t in store.takes], len(store.vocab) > 4
+    (['2_scott_0_1_1', '2_scott_0_9_9'], True)
+    >>> build_store(index, Path(tmp.name) / "store").takes[0].meta == store.takes[0].meta  # unchanged: kept
+    True
+    >>> tmp.cleanup()
     """
     if not isinstance(sr, int | np.integer) or sr < 1 or not fps > 0:
         raise ValueError(f"build_store: fps and sr must be positive (sr an int), got {fps!r}, {sr!r}")

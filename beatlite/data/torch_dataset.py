@@ -55,6 +55,23 @@ class WindowDataset(Dataset):
 
     ``dataset[i]`` is one item (tensors without the batch axis); ``dataset[[i, j, ...]]`` is a
     batch dict (tensors with a leading batch axis, ``take`` a list of str).
+
+    Examples
+    --------
+    >>> from beatlite.data.store import build_store
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
+    >>> dataset = WindowDataset(windows, keys=("pose", "word"))
+    >>> len(dataset), tuple(dataset[0]["pose"].shape), tuple(dataset[[0, 1]]["pose"].shape)
+    (19, (34, 141), (2, 34, 141))
+    >>> tmp.cleanup()
     """
 
     def __init__(self, windows: Windows | StoreWindows, keys: Sequence[str] | None = None) -> None:
@@ -120,6 +137,23 @@ def window_loader(
     Returns
     -------
     torch.utils.data.DataLoader
+
+    Examples
+    --------
+    >>> from beatlite.data.store import build_store
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
+    >>> loader = window_loader(windows, batch_size=8, keys=("pose",))
+    >>> [tuple(batch["pose"].shape) for batch in loader]  # 19 windows
+    [(8, 34, 141), (8, 34, 141), (3, 34, 141)]
+    >>> tmp.cleanup()
     """
     if not isinstance(batch_size, int) or batch_size < 1:
         raise ValueError(f"window_loader: batch_size must be a positive int, got {batch_size!r}")

@@ -39,6 +39,11 @@ def normalize_word(word: str) -> str:
     """Lower-case ``word`` and strip surrounding punctuation/quotes (``"Hello,"`` -> ``"hello"``).
 
     Internal apostrophes and hyphens stay (``"don't"``). Returns ``""`` for silence marks.
+
+    Examples
+    --------
+    >>> normalize_word('"Hello,"'), normalize_word("Don't"), normalize_word("")
+    ('hello', "don't", '')
     """
     return word.strip(_STRIP).lower()
 
@@ -165,6 +170,15 @@ def take_sentences(index: TakeIndex, *, splits: Iterable[str] | None = None) -> 
         Indexed corpus.
     splits : iterable of str, optional
         Only takes of these splits (default: all, as the reference does).
+
+    Examples
+    --------
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> from beatlite.paths import repo_root
+    >>> record = index_take("2_scott_0_1_1", {"text": [repo_root() / "data_samples" / "2_scott_0_1_1.TextGrid"]})
+    >>> sentences = take_sentences(TakeIndex([record]))
+    >>> len(sentences), sentences[0][:4]
+    (1, ['my', 'idea', 'is', 'to'])
     """
     from beatlite.io import read_words
 
@@ -188,6 +202,14 @@ def vocab_from_sentences(sentences: Iterable[Iterable[str]], *, min_count: int =
         Words (normalised here).
     min_count : int
         Keep words seen at least this many times (others map to UNK).
+
+    Examples
+    --------
+    >>> vocab = vocab_from_sentences([["The", "cat"], ["the", "dog"]])
+    >>> vocab.itos  # special tokens, then words by count, ties alphabetical
+    ('<pad>', '<sos>', '<eos>', '<unk>', 'the', 'cat', 'dog')
+    >>> vocab.encode(["the", "bird"])  # unknown words map to UNK
+    array([4, 3])
     """
     if min_count < 1:
         raise ValueError(f"vocab_from_sentences: min_count must be >= 1, got {min_count}")
@@ -209,6 +231,15 @@ def build_vocab(index: TakeIndex, *, splits: Iterable[str] | None = None, min_co
         Restrict to these splits.
     min_count : int
         Minimum count of a word (default 1).
+
+    Examples
+    --------
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> from beatlite.paths import repo_root
+    >>> record = index_take("2_scott_0_1_1", {"text": [repo_root() / "data_samples" / "2_scott_0_1_1.TextGrid"]})
+    >>> vocab = build_vocab(TakeIndex([record]))
+    >>> vocab.itos[:4], "idea" in vocab
+    (('<pad>', '<sos>', '<eos>', '<unk>'), True)
     """
     return vocab_from_sentences(take_sentences(index, splits=splits), min_count=min_count)
 
@@ -220,6 +251,14 @@ def cooccurrence(sentences: Iterable[Sequence[str]], vocab: Vocab, *, window: in
     -------
     scipy.sparse.csr_matrix, (V, V) float64
         Row/column = vocabulary id; special tokens' rows are empty.
+
+    Examples
+    --------
+    >>> vocab = vocab_from_sentences([["a", "b", "c"]])
+    >>> counts = cooccurrence([["a", "b", "c"]], vocab, window=2)
+    >>> a, b, c = vocab.encode(["a", "b", "c"])
+    >>> float(counts[a, b]), float(counts[a, c]), float(counts[b, a])  # weighted 1 / distance, symmetric
+    (1.0, 0.5, 1.0)
     """
     from scipy import sparse
 
@@ -256,6 +295,14 @@ def ppmi(counts) -> object:
     Returns
     -------
     scipy.sparse.csr_matrix, same shape, float64
+
+    Examples
+    --------
+    >>> import scipy.sparse
+    >>> counts = scipy.sparse.csr_matrix(np.array([[0.0, 2.0], [2.0, 0.0]]))
+    >>> ppmi(counts).toarray().round(6)  # log(2 * 4 / (2 * 2)) = log 2
+    array([[0.      , 0.693147],
+           [0.693147, 0.      ]])
     """
     from scipy import sparse
 
@@ -306,6 +353,16 @@ def word_vectors(
     Returns
     -------
     (len(vocab), dim) float32
+
+    Examples
+    --------
+    >>> sentences = [["the", "cat", "sat"], ["the", "dog", "sat"]]
+    >>> vocab = vocab_from_sentences(sentences)
+    >>> vectors = word_vectors(vocab, sentences, dim=2)
+    >>> vectors.shape, bool(np.all(vectors[0] == 0))  # PAD is the zero vector
+    ((8, 2), True)
+    >>> np.allclose(np.linalg.norm(vectors[4:], axis=1), 1.0)  # ordinary words: unit length
+    True
     """
     if not isinstance(dim, int | np.integer) or dim < 1:
         raise ValueError(f"word_vectors: dim must be a positive int, got {dim!r}")
@@ -333,7 +390,7 @@ def word_vectors(
 
 
 def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarray:
-    """Map a FastText/word2vec ``.vec`` text file (``word v1 ... vD`` per line) onto ``vocab``.
+    r"""Map a FastText/word2vec ``.vec`` text file (``word v1 ... vD`` per line) onto ``vocab``.
 
     For users who have the paper's ``cc.en.300.vec`` offline. Words missing from the
     file get random N(0, 1/D) vectors (seeded), PAD the zero vector.
@@ -341,6 +398,18 @@ def read_vec_file(path: str | Path, vocab: Vocab, *, seed: int = 0) -> np.ndarra
     Returns
     -------
     (len(vocab), D) float32
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "words.vec"
+    >>> _ = path.write_text("2 3\nhello 1 0 0\nworld 0 1 0\n")  # fastText header: count and dimension
+    >>> vocab = vocab_from_sentences([["hello", "there"]])
+    >>> vectors = read_vec_file(path, vocab)
+    >>> vectors.shape, vectors[vocab.id("hello")].tolist(), bool(np.all(vectors[0] == 0))
+    ((6, 3), [1.0, 0.0, 0.0], True)
+    >>> tmp.cleanup()
     """
     from beatlite.io.errors import FormatError
 

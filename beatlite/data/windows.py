@@ -140,17 +140,35 @@ def sliding_windows(
 
 
 def audio_samples(n_frames: int, fps: float, sr: int) -> int:
-    """Audio samples covering ``n_frames`` pose frames: ``floor(n_frames / fps * sr)`` (36266 for 34)."""
+    """Audio samples covering ``n_frames`` pose frames: ``floor(n_frames / fps * sr)`` (36266 for 34).
+
+    Examples
+    --------
+    >>> audio_samples(34, 15, 16000)  # floor(34 / 15 * 16000)
+    36266
+    """
     return int(np.floor(n_frames * sr / fps + 1e-9))
 
 
 def audio_start(frame: int, fps: float, sr: int) -> int:
-    """First audio sample of pose frame ``frame``: ``floor(frame * sr / fps)``."""
+    """First audio sample of pose frame ``frame``: ``floor(frame * sr / fps)``.
+
+    Examples
+    --------
+    >>> audio_start(10, 15, 16000)  # floor(10 * 16000 / 15)
+    10666
+    """
     return int(np.floor(frame * sr / fps + 1e-9))
 
 
 def mel_frames(n_samples: int) -> int:
-    """Mel frames per clip of ``n_samples`` (HA2G): ``round((n - n_fft) / hop + 1)`` (70 for 36266)."""
+    """Mel frames per clip of ``n_samples`` (HA2G): ``round((n - n_fft) / hop + 1)`` (70 for 36266).
+
+    Examples
+    --------
+    >>> mel_frames(36266)  # round((36266 - 1024) / 512 + 1), n_fft 1024 and hop 512
+    70
+    """
     return max(1, int(round((n_samples - MEL_SETTINGS["n_fft"]) / MEL_SETTINGS["hop_length"] + 1)))
 
 
@@ -167,6 +185,13 @@ def log_mel(audio: np.ndarray, sr: int = SR) -> np.ndarray:
     Returns
     -------
     (M, 128) float32, M = 1 + N // 512 (librosa ``center=True``); max 0 dB, min -80 dB.
+
+    Examples
+    --------
+    >>> t = np.arange(16000) / 16000
+    >>> mel = log_mel(np.sin(2 * np.pi * 440 * t).astype(np.float32))  # 1 s of A4
+    >>> mel.shape, float(mel.max()), float(mel.min())  # 1 + 16000 // 512 frames, 128 mels, [-80, 0] dB
+    ((32, 128), 0.0, -80.0)
     """
     import librosa
 
@@ -196,6 +221,15 @@ class TakeFeatures:
     word : (T,) int64
     emotion : (T,) int64
     semantic : (T,) float32
+
+    Examples
+    --------
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> index = index_folder(repo_root() / "data_samples", recursive=False, cache=False, read_durations=False)
+    >>> f = take_features(index["2_scott_0_1_1"], mel=False)
+    >>> f.n_frames, f.pose_raw.shape, f.dirs.shape, f.face.shape, f.word.shape
+    (222, (222, 141), (222, 126), (222, 51), (222,))
     """
 
     stem: str
@@ -232,6 +266,15 @@ def take_features(
     The frame count is the one :func:`beatlite.io.load_take` aligned every modality to: the
     smallest of the motion frames, ``floor(audio seconds * fps)`` and the face frames (BEAT:
     truncate to the shortest modality, docs/reference_code.md#audio).
+
+    Examples
+    --------
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> index = index_folder(repo_root() / "data_samples", recursive=False, cache=False, read_durations=False)
+    >>> f = take_features(index["2_scott_0_1_1"])
+    >>> f.n_frames, f.audio.shape[0] >= audio_samples(f.n_frames, 15, 16000), f.mel.shape[1]
+    (222, True, 128)
     """
     from beatlite.io import load_take, words_to_frames
     from beatlite.skeleton import subset_columns
@@ -310,6 +353,23 @@ class Windows:
         One full-length item per take.
     path : Path or None
         Cache file the windows were loaded from / saved to.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> windows = build_windows(index, split="test", cache=False)  # statistics from the train take
+    >>> len(windows), windows["pose"].shape, windows["dirvec"].shape
+    (19, (19, 34, 141), (19, 34, 126))
+    >>> windows.batch(np.array([0, 1]))["audio"].shape  # audio_samples(34, 15, 16000) samples per window
+    (2, 36266)
+    >>> tmp.cleanup()
     """
 
     def __init__(
@@ -564,6 +624,21 @@ def build_windows(
     ------
     ValueError
         Bad parameters, or no usable take in ``split``.
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
+    ...     _ = shutil.copy(p, tmp.name)
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> takes = build_windows(index, split="test", whole_takes=True, cache=False)
+    >>> len(takes), takes["pose"][0].shape  # one 222-frame take
+    (1, (222, 141))
+    >>> tmp.cleanup()
     """
     from beatlite.data.vocab import build_vocab
 

@@ -27,7 +27,7 @@ _MODES = ("w", "wb")
 def atomic_write(
     path: str | os.PathLike[str], mode: str = "w", *, encoding: str = "utf-8", newline: str | None = "\n"
 ) -> Iterator[IO[Any]]:
-    """Open ``path`` for writing so that it appears complete or not at all.
+    r"""Open ``path`` for writing so that it appears complete or not at all.
 
     Data go to a temporary file ``.{name}.{pid}.*.tmp`` in the same folder, which
     is flushed, ``fsync``-ed and renamed over ``path`` with :func:`os.replace` when
@@ -46,13 +46,31 @@ def atomic_write(
     encoding : str
         Text encoding (text mode only).
     newline : str or None
-        Newline translation for text mode; ``"\\n"`` (default) writes LF on
+        Newline translation for text mode; ``"\n"`` (default) writes LF on
         every platform.
 
     Yields
     ------
     file object
         Text or binary file to write to.
+
+    Examples
+    --------
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "notes.txt"
+    >>> with atomic_write(path) as f:
+    ...     _ = f.write("complete or not at all\n")
+    >>> path.read_text()
+    'complete or not at all\n'
+    >>> try:
+    ...     with atomic_write(path) as f:
+    ...         _ = f.write("half a line")
+    ...         raise RuntimeError("killed mid-write")
+    ... except RuntimeError:
+    ...     pass
+    >>> path.read_text(), sorted(p.name for p in Path(tmp.name).iterdir())  # old content, no temp file left
+    ('complete or not at all\n', ['notes.txt'])
+    >>> tmp.cleanup()
     """
     if mode not in _MODES:
         raise ValueError(f"atomic_write: mode must be one of {_MODES}, got {mode!r}")
@@ -148,6 +166,16 @@ def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
     -------
     list of Path
         The files removed.
+
+    Examples
+    --------
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "notes.txt"
+    >>> stale = Path(tmp.name) / ".notes.txt.999999999.abc.tmp"  # left by a process that no longer exists
+    >>> _ = stale.write_text("partial")
+    >>> [p.name for p in remove_stale_temps(path)], stale.exists()
+    (['.notes.txt.999999999.abc.tmp'], False)
+    >>> tmp.cleanup()
     """
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
@@ -181,6 +209,15 @@ def exclusive_lock(path: str | os.PathLike[str]) -> Iterator[None]:
     others wait, then find it done. Waiting has no time limit and happens outside any collective of
     ``torch.distributed`` (whose barriers time out after 30 minutes). The lock is released when the
     block ends or the process dies. POSIX only; elsewhere (Windows) the block runs unlocked.
+
+    Examples
+    --------
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> lock = Path(tmp.name) / "store.lock"
+    >>> with exclusive_lock(lock):  # other processes taking this lock wait here
+    ...     lock.exists()
+    True
+    >>> tmp.cleanup()
     """
     try:
         import fcntl

@@ -64,6 +64,13 @@ def resample(y: np.ndarray, sr_from: int, sr_to: int) -> np.ndarray:
     Returns
     -------
     (ceil(N * sr_to / sr_from),) or (..., C) float32
+
+    Examples
+    --------
+    >>> y = np.sin(2 * np.pi * 5 * np.arange(48000) / 48000)  # 1 s of 5 Hz at 48 kHz
+    >>> z = resample(y, 48000, 16000)
+    >>> z.shape, z.dtype
+    ((16000,), dtype('float32'))
     """
     from scipy.signal import resample_poly
 
@@ -104,6 +111,12 @@ class AudioInfo(NamedTuple):
     declared_frames : int or None
         Frames the RIFF ``data`` chunk declares (``None`` when not a WAV or not stated);
         more than ``frames`` means a truncated file.
+
+    Examples
+    --------
+    >>> info = AudioInfo(frames=16000, samplerate=16000, channels=1, declared_frames=16000)
+    >>> info.frames / info.samplerate  # seconds
+    1.0
     """
 
     frames: int
@@ -195,6 +208,16 @@ def audio_info(path: str | os.PathLike[str]) -> AudioInfo:
         Bytes that are not audio, an undecodable header, a rate outside
         :data:`RATE_RANGE`, more than :data:`MAX_CHANNELS` channels, no samples, or
         more frames than the file size can hold.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "tone.wav"
+    >>> write_wav(path, np.zeros((8000, 2)), 16000)
+    >>> audio_info(path)
+    AudioInfo(frames=8000, samplerate=16000, channels=2, declared_frames=8000)
+    >>> tmp.cleanup()
     """
     p = Path(path)
     return _checked_info(p, *_audio_source(p))
@@ -230,6 +253,17 @@ def read_audio(
         the checks of :func:`audio_info` (checked before any sample is decoded), or
         libsndfile cannot decode them. A truncated WAV (fewer samples than its
         ``data`` chunk declares) is read with a :class:`FormatWarning`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "tone.wav"
+    >>> write_wav(path, np.full(32000, 0.5), 32000)  # 1 s at 32 kHz
+    >>> y, sr = read_audio(path)  # resampled to 16 kHz, mono
+    >>> y.shape, sr, round(float(y[8000]), 3)
+    ((16000,), 16000, 0.5)
+    >>> tmp.cleanup()
     """
     import soundfile as sf
 
@@ -270,6 +304,18 @@ def write_wav(path: str | os.PathLike[str], y: np.ndarray, sr: int, subtype: str
         Rate in Hz.
     subtype : str
         libsndfile subtype: ``"PCM_16"`` (default), ``"PCM_24"``, ``"PCM_32"``, ``"FLOAT"``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "ramp.wav.gz"  # gzipped
+    >>> y = np.linspace(-1, 1, 101)
+    >>> write_wav(path, y, 16000)
+    >>> back, sr = read_audio(path, sr=None)
+    >>> sr, bool(np.abs(back - y).max() <= 1 / 2**15)  # PCM_16: within one quantisation step
+    (16000, True)
+    >>> tmp.cleanup()
     """
     import soundfile as sf
 

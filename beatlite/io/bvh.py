@@ -98,6 +98,13 @@ def parse_frame_time(text: str) -> float:
     ------
     ValueError
         If ``text`` is not a positive finite number.
+
+    Examples
+    --------
+    >>> parse_frame_time("0.008333"), parse_frame_time("0.066667")
+    (120.0, 15.0)
+    >>> parse_frame_time("0.0333667000333667")  # 1 / 29.97 as printed
+    29.97
     """
     try:
         dec = Decimal(text.strip())
@@ -132,6 +139,13 @@ def format_frame_time(fps: float) -> str:
     ``format_frame_time(15) == "0.066667"``. Exact for integer rates and for
     rates with at most 9 decimals (29.97, 23.976); any other rate reads back
     within a few ulps.
+
+    Examples
+    --------
+    >>> format_frame_time(120), format_frame_time(15)
+    ('0.008333', '0.066667')
+    >>> parse_frame_time(format_frame_time(29.97))
+    29.97
     """
     fps = float(fps)
     if not math.isfinite(fps) or fps <= 0:
@@ -530,6 +544,18 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
     ------
     FormatError
         If the header is malformed (naming the line).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.bvh"
+    >>> write_bvh(path, Motion(beat_skeleton(), np.zeros((4, 228)), fps=120))
+    >>> skeleton, n_frames, frame_time = read_bvh_header(path)
+    >>> skeleton.n_joints, n_frames, frame_time
+    (75, 4, 0.008333)
+    >>> tmp.cleanup()
     """
     p = Path(path)
     f, head = _open_bvh(p)
@@ -604,7 +630,17 @@ def _settle_rate(
 
 
 def convert_units(skeleton: Skeleton, channels: np.ndarray, factor: float) -> tuple[Skeleton, np.ndarray]:
-    """Scale offsets, End Sites and position channels by ``factor`` (e.g. 100 for metres -> cm)."""
+    """Scale offsets, End Sites and position channels by ``factor`` (e.g. 100 for metres -> cm).
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> arm = Skeleton(("Root", "Hand"), [-1, 0], [[0, 0, 0], [0.3, 0, 0]],
+    ...                (("Xposition", "Yposition", "Zposition"), ()))
+    >>> cm, channels = convert_units(arm, np.array([[1.0, 0.5, 0.0]]), 100)  # metres -> cm
+    >>> cm.offsets[1], channels
+    (array([30.,  0.,  0.]), array([[100.,  50.,   0.]]))
+    """
     if factor == 1.0:
         return skeleton, channels
     cols = [
@@ -823,6 +859,19 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion, *, precision: int = 
         rounded to ``precision`` decimals read back bit-identical.
         ``Frame Time`` is written with :func:`format_frame_time`, so
         ``read_bvh`` recovers ``motion.fps`` exactly.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.bvh.gz"
+    >>> channels = np.round(np.random.default_rng(0).uniform(-90, 90, (3, 228)), 6)
+    >>> write_bvh(path, Motion(beat_skeleton(), channels, fps=15))
+    >>> back = read_bvh(path)
+    >>> back.fps, bool(np.array_equal(back.channels, channels))  # values rounded to 6 decimals read back exactly
+    (15.0, True)
+    >>> tmp.cleanup()
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"write_bvh: motion must be a Motion, got {type(motion).__name__}")

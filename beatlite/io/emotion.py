@@ -26,7 +26,14 @@ N_EMOTIONS = 8
 
 
 class EmotionSegment(NamedTuple):
-    """One emotion span: a label ``name``, times in seconds and the class ``emotion`` in 0..7."""
+    """One emotion span: a label ``name``, times in seconds and the class ``emotion`` in 0..7.
+
+    Examples
+    --------
+    >>> seg = EmotionSegment("happiness", 0.0, 2.5, 2.5, 1)
+    >>> seg.name, seg.end - seg.start, seg.emotion
+    ('happiness', 2.5, 1)
+    """
 
     name: str
     start: float
@@ -36,7 +43,7 @@ class EmotionSegment(NamedTuple):
 
 
 def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
-    """Read a BEAT emotion ``.csv`` file (``.gz`` transparent).
+    r"""Read a BEAT emotion ``.csv`` file (``.gz`` transparent).
 
     Returns
     -------
@@ -50,6 +57,16 @@ def read_emotion(path: str | os.PathLike[str]) -> list[EmotionSegment]:
         negative time, ``start > end`` or a class that is not a whole number in 0..7,
         naming the line and the field. Rows whose ``duration`` is not
         ``end - start`` give one :class:`FormatWarning`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.csv"
+    >>> _ = path.write_text("neutral,0.0,14.8,14.8,0\n")
+    >>> read_emotion(path)
+    [EmotionSegment(name='neutral', start=0.0, end=14.8, duration=14.8, emotion=0)]
+    >>> tmp.cleanup()
     """
     p = Path(path)
     out: list[EmotionSegment] = []
@@ -103,6 +120,12 @@ def emotion_to_frames(
     Returns
     -------
     (T,) int64
+
+    Examples
+    --------
+    >>> segments = [EmotionSegment("happiness", 0.2, 0.4, 0.2, 1)]
+    >>> emotion_to_frames(segments, n_frames=6, fps=10)  # frames at 0.0, 0.1, ..., 0.5 s
+    array([0, 0, 1, 1, 1, 0])
     """
     starts = np.array([s.start for s in segments], dtype=np.float64)
     ends = np.array([s.end for s in segments], dtype=np.float64)
@@ -111,7 +134,19 @@ def emotion_to_frames(
 
 
 def write_emotion(path: str | os.PathLike[str], segments: Sequence[EmotionSegment]) -> None:
-    """Write segments as a BEAT emotion ``.csv`` (atomic)."""
+    """Write segments as a BEAT emotion ``.csv`` (atomic).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.csv"
+    >>> segments = [EmotionSegment("neutral", 0.0, 1.5, 1.5, 0), EmotionSegment("anger", 1.5, 3.0, 1.5, 3)]
+    >>> write_emotion(path, segments)
+    >>> read_emotion(path) == segments
+    True
+    >>> tmp.cleanup()
+    """
     lines = []
     for i, s in enumerate(segments):
         seg = EmotionSegment(*s)

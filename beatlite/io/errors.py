@@ -27,6 +27,14 @@ class FormatError(ValueError):
         1-based column (token) number.
     field : str, optional
         Name of the field (JSON key, CSV column, ...).
+
+    Examples
+    --------
+    >>> err = FormatError("take.bvh", "'abc' is not a number", line=433, column=17)
+    >>> str(err)
+    "take.bvh, line 433, column 17: 'abc' is not a number"
+    >>> isinstance(err, ValueError)
+    True
     """
 
     def __init__(
@@ -66,12 +74,37 @@ class FormatWarning(UserWarning):
     """A file is readable but inconsistent (truncated audio, annotation times that disagree, ...).
 
     The message names the file and what was assumed.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warnings.warn("take.wav: truncated, 100 of 200 frames", FormatWarning)
+    >>> caught[0].category.__name__, issubclass(FormatWarning, UserWarning)
+    ('FormatWarning', True)
     """
 
 
 class BVHWarning(FormatWarning):
-    """A BVH file is readable but inconsistent, e.g. ``Frames: 100`` above 99 motion rows."""
+    """A BVH file is readable but inconsistent, e.g. ``Frames: 100`` above 99 motion rows.
+
+    Examples
+    --------
+    >>> issubclass(BVHWarning, FormatWarning)
+    True
+    """
 
 
 class AlignmentWarning(UserWarning):
-    """The modalities of a take have different durations and were truncated to the shortest."""
+    """The modalities of a take have different durations and were truncated to the shortest.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warnings.warn("audio 14.8 s, motion 14.6 s: truncated to 14.6 s", AlignmentWarning)
+    >>> caught[0].category.__name__, issubclass(AlignmentWarning, UserWarning)
+    ('AlignmentWarning', True)
+    """

@@ -69,6 +69,12 @@ class Facial:
         Time stamp of each frame, strictly increasing.
     fps : float
         Frame rate estimated from ``times`` (:func:`estimate_fps`).
+
+    Examples
+    --------
+    >>> face = Facial(("jawOpen",), np.zeros((3, 1), np.float32), np.array([0.0, 1 / 60, 2 / 60]), 60.0)
+    >>> face.weights.shape, face.fps
+    ((3, 1), 60.0)
     """
 
     names: tuple[str, ...]
@@ -94,6 +100,13 @@ def estimate_fps(times: np.ndarray, default: float = DEFAULT_FPS) -> float:
         Increasing time stamps.
     default : float
         Returned when there are fewer than two frames.
+
+    Examples
+    --------
+    >>> estimate_fps(np.arange(10) / 60.0)
+    60.0
+    >>> estimate_fps(np.arange(10) * 0.0401)  # within 1 % of 25: snapped
+    25.0
     """
     t = np.asarray(times, dtype=np.float64)
     if t.ndim != 1:
@@ -186,6 +199,16 @@ def select_blendshapes(
         If a name of ``names`` is missing (naming it). Extra names (``tongueOut``) are
         dropped, and a different column order is reordered, each with one
         :class:`FormatWarning`.
+
+    Examples
+    --------
+    >>> face = Facial(("mouthClose", "jawOpen"), np.array([[0.1, 0.9]], np.float32), np.zeros(1), 60.0)
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     picked = select_blendshapes(face, ["jawOpen", "mouthClose"])
+    >>> picked.names, picked.weights, len(caught)  # reordered by name, with one FormatWarning
+    (('jawOpen', 'mouthClose'), array([[0.9, 0.1]], dtype=float32), 1)
     """
     wanted = tuple(names)
     where = {n: i for i, n in enumerate(facial.names)}
@@ -237,6 +260,17 @@ def read_facial(path: str | os.PathLike[str], *, names: Sequence[str] | None = N
         names, a frame whose weight count differs from the number of names, a weight
         or time that is not a finite number (strings and booleans included), or time
         stamps that do not increase (each naming the frame index).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.json.gz"
+    >>> write_facial(path, ARKIT_51, np.full((120, 51), 0.25), fps=60)
+    >>> face = read_facial(path)
+    >>> face.weights.shape, face.fps, float(face.weights[0, 0]), round(float(face.times[-1]), 6)
+    ((120, 51), 60.0, 0.25, 1.983333)
+    >>> tmp.cleanup()
     """
     p = Path(path)
     doc = _parse_json(p)
@@ -287,6 +321,18 @@ def write_facial(
         Frame rate; frame ``i`` gets ``time = i / fps`` unless ``times`` is given.
     times : (T,) float, optional
         Explicit increasing time stamps in seconds (written rounded to 6 decimals).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.json"
+    >>> weights = np.round(np.random.default_rng(0).uniform(0, 1, (5, 2)), 6)
+    >>> write_facial(path, ["jawOpen", "mouthClose"], weights, fps=30)
+    >>> face = read_facial(path)
+    >>> face.names, bool(np.array_equal(face.weights, weights.astype(np.float32))), face.fps
+    (('jawOpen', 'mouthClose'), True, 30.0)
+    >>> tmp.cleanup()
     """
     names = [str(n) for n in names]
     w = np.asarray(weights, dtype=np.float64)

@@ -25,6 +25,13 @@ class Motion:
         centimetres, rotations in degrees, Euler order per joint as in the file).
     fps : float
         Frames per second.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> motion = Motion(beat_skeleton(), np.zeros((30, 228)), fps=15)
+    >>> motion.n_frames, motion.duration
+    (30, 2.0)
     """
 
     skeleton: Skeleton

@@ -72,6 +72,11 @@ def emotion_of(sequence: int, conversation: bool = False) -> int:
     """Emotion class implied by a speech sequence id (docs/reference_code.md#take-names): 1-64 neutral, 65-72 happiness, ...
 
     Conversation is always neutral (0); ids 0 and 1-64 are neutral.
+
+    Examples
+    --------
+    >>> emotion_of(1), emotion_of(65), emotion_of(65, conversation=True)  # neutral, happiness, conversation
+    (0, 1, 0)
     """
     if conversation:
         return 0
@@ -101,6 +106,11 @@ def split_of(speaker_id: int, conversation: bool, sequence: int, half: str | Non
         ``"train"``, ``"val"``, ``"test"``; ``"test+val"`` for a whole 1-h-speaker
         sequence that BEAT cuts into ``_a`` (test) and ``_b`` (val) halves;
         ``"none"`` for a sequence no split table lists.
+
+    Examples
+    --------
+    >>> split_of(2, False, 1), split_of(2, False, 66)
+    ('test', 'train')
     """
     if speaker_id in FOUR_HOUR_SPEAKERS:
         return _four_hour_conversation(sequence) if conversation else _four_hour_speech(sequence)
@@ -178,6 +188,12 @@ class TakeName:
         ``EMOTIONS[emotion]``.
     split : str
         One of :data:`SPLITS` (see :func:`split_of`).
+
+    Examples
+    --------
+    >>> name = parse_take_name("2_scott_0_65_65")
+    >>> name.speaker, name.language, name.conversation, name.emotion_name, name.split
+    ('scott', 'english', False, 'happiness', 'test')
     """
 
     speaker_id: int
@@ -250,6 +266,14 @@ def parse_take_name(name: str | os.PathLike[str]) -> TakeName:
     FormatError
         Naming the field that is wrong (``speaker_id``, ``speaker``,
         ``session_type``, ``start``, ``end``, ``half``).
+
+    Examples
+    --------
+    >>> name = parse_take_name("data/2_scott_0_1_1.bvh.gz")
+    >>> name.speaker_id, name.speaker, name.session_type, name.start, name.end, name.half
+    (2, 'scott', 0, 1, 1, None)
+    >>> name.language, name.conversation, name.emotion_name, name.split
+    ('english', False, 'neutral', 'test')
     """
     stem = split_take_file(name)[0]
     parts = stem.split("_")

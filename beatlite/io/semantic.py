@@ -28,7 +28,14 @@ _FIELDS = ("type", "start", "end", "duration", "score")
 
 
 class SemanticSegment(NamedTuple):
-    """One annotated gesture: ``type`` (e.g. ``"01_beat_align"``), times in seconds, score in [0, 1]."""
+    """One annotated gesture: ``type`` (e.g. ``"01_beat_align"``), times in seconds, score in [0, 1].
+
+    Examples
+    --------
+    >>> seg = SemanticSegment("02_deictic_l", 0.734, 2.315, 1.581, 0.3, "my")
+    >>> seg.type, seg.score, seg.keywords
+    ('02_deictic_l', 0.3, 'my')
+    """
 
     type: str
     start: float
@@ -39,7 +46,17 @@ class SemanticSegment(NamedTuple):
 
 
 def parse_number(path: Path, token: str, line: int, field: str) -> float:
-    """``float(token)``, or a :class:`FormatError` naming ``line`` and ``field`` (also for NaN/inf)."""
+    """``float(token)``, or a :class:`FormatError` naming ``line`` and ``field`` (also for NaN/inf).
+
+    Examples
+    --------
+    >>> parse_number(Path("take.txt"), "0.75", 3, "score")
+    0.75
+    >>> parse_number(Path("take.txt"), "abc", 3, "score")
+    Traceback (most recent call last):
+        ...
+    beatlite.io.errors.FormatError: take.txt, line 3, field 'score': 'abc' is not a number
+    """
     try:
         value = float(token)
     except ValueError:
@@ -54,7 +71,15 @@ DURATION_TOLERANCE = 0.01
 
 
 def check_times(path: Path, line: int, start: float, end: float, duration: float) -> str | None:
-    """Raise for negative or reversed times; return a note when ``duration != end - start``."""
+    """Raise for negative or reversed times; return a note when ``duration != end - start``.
+
+    Examples
+    --------
+    >>> check_times(Path("take.txt"), 2, 1.0, 2.0, 1.0) is None  # consistent: no note
+    True
+    >>> check_times(Path("take.txt"), 2, 1.0, 2.0, 1.5) is not None  # duration disagrees: a note for warn_durations
+    True
+    """
     if start < 0 or end < 0:
         raise FormatError(path, f"negative time: start {start}, end {end}", line=line, field="start")
     if start > end:
@@ -65,7 +90,17 @@ def check_times(path: Path, line: int, start: float, end: float, duration: float
 
 
 def warn_durations(path: Path, notes: list[str]) -> None:
-    """One :class:`FormatWarning` for the rows whose duration disagrees with their times."""
+    """One :class:`FormatWarning` for the rows whose duration disagrees with their times.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_durations(Path("take.txt"), ["line 2: duration 1.5 != end - start 1.0"])
+    >>> len(caught), caught[0].category.__name__
+    (1, 'FormatWarning')
+    """
     if notes:
         warnings.warn(
             f"{path}: {len(notes)} rows have a duration that is not end - start, e.g. {notes[0]}; "
@@ -76,7 +111,7 @@ def warn_durations(path: Path, notes: list[str]) -> None:
 
 
 def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
-    """Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
+    r"""Read a BEAT semantic ``.txt`` file (``.gz`` transparent).
 
     Parameters
     ----------
@@ -95,6 +130,17 @@ def read_semantic(path: str | os.PathLike[str]) -> list[SemanticSegment]:
         Fewer than 5 fields, a non-numeric time/score, a negative time, ``start > end``
         or a score outside [0, 1], naming the line and the field. Rows whose
         ``duration`` is not ``end - start`` give one :class:`FormatWarning`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.txt"
+    >>> _ = path.write_text("00_nogesture\t0.0\t0.734\t0.734\t0.0\n"
+    ...                     "02_deictic_l\t0.734\t2.315\t1.581\t0.3\tmy\n")
+    >>> [(s.type, s.start, s.score, s.keywords) for s in read_semantic(path)]
+    [('00_nogesture', 0.0, 0.0, ''), ('02_deictic_l', 0.734, 0.3, 'my')]
+    >>> tmp.cleanup()
     """
     p = Path(path)
     out: list[SemanticSegment] = []
@@ -151,6 +197,12 @@ def segments_to_frames(
     Returns
     -------
     (T,) array of ``dtype``
+
+    Examples
+    --------
+    >>> segments_to_frames(np.array([0.1, 0.25]), np.array([0.3, 0.5]), np.array([1.0, 2.0]),
+    ...                    n_frames=6, fps=10, default=0.0, dtype=np.float32)  # the first segment wins at 0.3 s
+    array([0., 1., 1., 1., 2., 2.], dtype=float32)
     """
     if isinstance(n_frames, bool) or not isinstance(n_frames, int | np.integer) or n_frames < 0:
         raise ValueError(f"n_frames must be a non-negative integer, got {n_frames!r}")
@@ -181,6 +233,12 @@ def semantic_to_frames(segments: Sequence[SemanticSegment], n_frames: int, fps: 
     -------
     (T,) float32
         Scores in [0, 1] (closed intervals; the first segment wins on overlap, as BEAT's loop does).
+
+    Examples
+    --------
+    >>> segments = [SemanticSegment("02_deictic_l", 0.1, 0.3, 0.2, 0.5)]
+    >>> semantic_to_frames(segments, n_frames=5, fps=10)  # frames at 0.0 .. 0.4 s
+    array([0. , 0.5, 0.5, 0.5, 0. ], dtype=float32)
     """
     starts = np.array([s.start for s in segments], dtype=np.float64)
     ends = np.array([s.end for s in segments], dtype=np.float64)
@@ -193,7 +251,20 @@ def _fmt(value: float) -> str:
 
 
 def write_semantic(path: str | os.PathLike[str], segments: Sequence[SemanticSegment]) -> None:
-    """Write segments as a BEAT semantic ``.txt`` (TAB-separated, atomic; keywords omitted when empty)."""
+    """Write segments as a BEAT semantic ``.txt`` (TAB-separated, atomic; keywords omitted when empty).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.txt"
+    >>> segments = [SemanticSegment("00_nogesture", 0.0, 0.5, 0.5, 0.0),
+    ...             SemanticSegment("02_deictic_l", 0.5, 1.0, 0.5, 0.3, "my")]
+    >>> write_semantic(path, segments)
+    >>> read_semantic(path) == segments
+    True
+    >>> tmp.cleanup()
+    """
     lines = []
     for i, s in enumerate(segments):
         seg = SemanticSegment(*s)

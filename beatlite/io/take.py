@@ -116,6 +116,15 @@ class Take:
         Parsed name (None for a name that is not BEAT's pattern).
     paths : dict str -> Path
         The files read, by extension.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> take = load_take(repo_root() / "data_samples" / "2_scott_0_1_1")
+    >>> take.name, take.fps, take.n_frames, take.motion.channels.shape, take.face.shape
+    ('2_scott_0_1_1', 15.0, 222, (222, 228), (222, 51))
+    >>> take.audio.shape == (take.n_frames * take.sr // 15,)  # cut to the motion: 222 / 15 s at 16 kHz
+    True
     """
 
     name: str
@@ -154,7 +163,15 @@ class Take:
 
 def take_stem(path_or_stem: str | os.PathLike[str]) -> Path:
     """``data/2_scott_0_1_1.bvh.gz`` -> ``data/2_scott_0_1_1`` (:func:`beatlite.io.names.split_take_file`: the
-    BEAT extension dropped; other dots are part of the stem, as the index reads it)."""
+    BEAT extension dropped; other dots are part of the stem, as the index reads it).
+
+    Examples
+    --------
+    >>> take_stem("data/2_scott_0_1_1.bvh.gz").as_posix()
+    'data/2_scott_0_1_1'
+    >>> take_stem("data/2_scott_0_1_1.v2.bvh").as_posix()
+    'data/2_scott_0_1_1.v2'
+    """
     from beatlite.io.names import split_take_file
 
     p = Path(path_or_stem)
@@ -202,6 +219,16 @@ def resample_frames(
     -------
     (T', D) array of ``values.dtype``
         ``T'`` = number of output times inside the source span.
+
+    Examples
+    --------
+    >>> values = np.arange(8.0)[:, None]  # (T, 1) at 120 fps
+    >>> resample_frames(values, 120, 30)[:, 0]  # every 4th frame
+    array([0., 4.])
+    >>> resample_frames(values, 120, 30, shift=1)[:, 0]  # BEAT's phase: from frame 1
+    array([1., 5.])
+    >>> resample_frames(np.array([[170.0], [-170.0]]), 10, 20, angle_columns=np.array([0]))[:, 0]  # the short arc
+    array([ 170.,  180., -170.])
     """
     v = np.asarray(values)
     if v.ndim != 2:
@@ -221,7 +248,15 @@ def resample_frames(
 
 
 def rotation_columns(motion: Motion) -> np.ndarray:
-    """(K,) int64: the columns of ``motion.channels`` that hold rotations (degrees), for :func:`resample_frames`."""
+    """(K,) int64: the columns of ``motion.channels`` that hold rotations (degrees), for :func:`resample_frames`.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> columns = rotation_columns(Motion(beat_skeleton(), np.zeros((1, 228)), fps=15))
+    >>> columns.shape, columns[:3].tolist()  # all but the three root position channels
+    ((225,), [3, 4, 5])
+    """
     cols = [
         int(start) + k
         for start, chans in zip(motion.skeleton.channel_starts, motion.skeleton.channels)
@@ -245,6 +280,13 @@ def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Pa
     ------
     FileNotFoundError
         If there is no ``.bvh`` / ``.bvh.gz`` for the stem.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> stem, files = take_files(repo_root() / "data_samples" / "2_scott_0_1_1.wav")
+    >>> stem.name, list(files), files[".bvh"].name
+    ('2_scott_0_1_1', ['.bvh', '.wav', '.json', '.TextGrid', '.txt', '.csv'], '2_scott_0_1_1.bvh.gz')
     """
     stem = take_stem(stem_or_path)
     paths = {".bvh": resolve(stem, ".bvh")}
@@ -255,7 +297,15 @@ def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Pa
 
 
 def read_take_words(path: str | os.PathLike[str]) -> WordIntervals:
-    """The words of a take's TextGrid: tier ``"words"`` (MFA), else tier 0 as BEAT's loader does."""
+    """The words of a take's TextGrid: tier ``"words"`` (MFA), else tier 0 as BEAT's loader does.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> words = read_take_words(repo_root() / "data_samples" / "2_scott_0_1_1.TextGrid")
+    >>> words.words[:3], float(words.starts[0]) < float(words.ends[0])
+    (('my', 'idea', 'is'), True)
+    """
     try:
         return read_words(path, tier="words")
     except FormatError as exc:
@@ -268,6 +318,13 @@ def reference_duration(durations: dict[str, float], half: str | None = None) -> 
     """The duration the motion should match: the audio's, else the face's, else the TextGrid's.
 
     The TextGrid of an ``_a``/``_b`` half spans the whole sequence (docs/reference_code.md#textgrid), so it is not used then.
+
+    Examples
+    --------
+    >>> reference_duration({"audio": 14.8, "face": 14.7, "text": 15.0})  # the audio's
+    14.8
+    >>> reference_duration({"text": 62.0}, half="a") is None  # a half's TextGrid spans both halves
+    True
     """
     for modality in ("audio", "face", "text"):
         if modality in durations and not (modality == "text" and half):
@@ -321,6 +378,22 @@ def read_take_motion(
     Returns
     -------
     Motion
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.bvh"
+    >>> from beatlite.io.bvh import write_bvh
+    >>> write_bvh(path, Motion(beat_skeleton(), np.zeros((240, 228)), fps=24))  # a wrong Frame Time
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     motion = read_take_motion(path, reference_s=2.0)  # the audio lasts 2 s: the rows are 120 fps
+    >>> motion.fps, motion.n_frames, [w.category.__name__ for w in caught]
+    (120.0, 240, ['BVHWarning'])
+    >>> tmp.cleanup()
     """
     p = Path(path)
     if bvh_fps is not None:
@@ -441,6 +514,13 @@ def load_take(
         If there is no ``.bvh`` / ``.bvh.gz`` for the stem.
     FormatError
         From the reader of a malformed file.
+
+    Examples
+    --------
+    >>> from beatlite.paths import repo_root
+    >>> take = load_take(repo_root() / "data_samples" / "2_scott_0_1_1", fps=15)
+    >>> take.n_frames, take.semantic.shape, take.emotion.shape, take.info.split
+    (222, (222,), (222,), 'test')
     """
     fps = _check_load_args(fps, phase)
     stem, paths = take_files(stem_or_path)

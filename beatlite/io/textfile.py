@@ -22,7 +22,18 @@ LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 
 
 def is_gzip(path: str | os.PathLike[str]) -> bool:
-    """True when the file starts with the gzip magic bytes ``1f 8b`` (whatever its name)."""
+    """True when the file starts with the gzip magic bytes ``1f 8b`` (whatever its name).
+
+    Examples
+    --------
+    >>> import gzip, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "no_suffix"
+    >>> _ = path.write_bytes(gzip.compress(b"hello"))
+    >>> is_gzip(path), read_bytes(path)  # recognised by its magic bytes, whatever its name
+    (True, b'hello')
+    >>> tmp.cleanup()
+    """
     with open(path, "rb") as f:
         return f.read(2) == GZIP_MAGIC
 
@@ -78,10 +89,21 @@ class _CheckedGzip(gzip.GzipFile):
 
 
 def open_binary(path: str | os.PathLike[str]) -> IO[bytes]:
-    """Open ``path`` for binary reading, decompressing gzip transparently.
+    r"""Open ``path`` for binary reading, decompressing gzip transparently.
 
     Gzip is recognised by its magic bytes, so a ``.gz`` file and a gzipped
     file without the suffix both work. Corrupt gzip data raises :class:`FormatError`.
+
+    Examples
+    --------
+    >>> import gzip, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.txt.gz"
+    >>> _ = path.write_bytes(gzip.compress(b"abc\n"))
+    >>> with open_binary(path) as f:
+    ...     f.read()
+    b'abc\n'
+    >>> tmp.cleanup()
     """
     p = Path(path)
     if is_gzip(p):
@@ -90,7 +112,18 @@ def open_binary(path: str | os.PathLike[str]) -> IO[bytes]:
 
 
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
-    """The whole (decompressed) content of ``path`` as bytes."""
+    r"""The whole (decompressed) content of ``path`` as bytes.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "plain.txt"
+    >>> _ = path.write_bytes(b"\x00\x01")
+    >>> read_bytes(path)
+    b'\x00\x01'
+    >>> tmp.cleanup()
+    """
     p = Path(path)
     with open_binary(p) as f:
         try:
@@ -110,16 +143,31 @@ BOMS: tuple[tuple[bytes, str], ...] = (
 
 
 def bom_encoding(head: bytes) -> str | None:
-    """The encoding a byte-order mark at the start of ``head`` announces (``None`` without one)."""
+    r"""The encoding a byte-order mark at the start of ``head`` announces (``None`` without one).
+
+    Examples
+    --------
+    >>> bom_encoding(b"\xef\xbb\xbfxmin"), bom_encoding(b"\xff\xfex\x00"), bom_encoding(b"xmin")
+    ('utf-8-sig', 'utf-16', None)
+    """
     return next((enc for bom, enc in BOMS if head.startswith(bom)), None)
 
 
 def decode_text(data: bytes, path: str | os.PathLike[str] | None, encoding: str = "utf-8") -> str:
-    """Decode ``data``; a byte that is not valid ``encoding`` raises :class:`FormatError` naming its line.
+    r"""Decode ``data``; a byte that is not valid ``encoding`` raises :class:`FormatError` naming its line.
 
     For ``encoding="utf-8"`` (the default) or ``"auto"`` a byte-order mark decides:
     UTF-8, UTF-16 (as Praat writes them) or UTF-32 files with a BOM are all read,
     and the BOM is dropped.
+
+    Examples
+    --------
+    >>> decode_text("File type".encode("utf-16"), None)  # Praat's UTF-16 with its BOM
+    'File type'
+    >>> decode_text(b"ok\n\xff\n", "take.txt")
+    Traceback (most recent call last):
+        ...
+    beatlite.io.errors.FormatError: take.txt, line 2: ...
     """
     if encoding == "auto" or encoding.lower().replace("_", "-") == "utf-8":
         encoding = bom_encoding(data[:4]) or "utf-8-sig"
@@ -135,7 +183,7 @@ def decode_text(data: bytes, path: str | os.PathLike[str] | None, encoding: str 
 
 
 def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
-    """The whole text of ``path`` (``.gz`` transparent), universal newlines (CRLF becomes LF).
+    r"""The whole text of ``path`` (``.gz`` transparent), universal newlines (CRLF becomes LF).
 
     Parameters
     ----------
@@ -147,7 +195,17 @@ def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
     Returns
     -------
     str
-        The text with ``\\r\\n`` and ``\\r`` turned into ``\\n`` and any BOM removed.
+        The text with ``\r\n`` and ``\r`` turned into ``\n`` and any BOM removed.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.TextGrid"
+    >>> _ = path.write_bytes(b"\xef\xbb\xbfa\r\nb\rc\n")
+    >>> read_text(path)  # BOM dropped, newlines universal
+    'a\nb\nc\n'
+    >>> tmp.cleanup()
     """
     text = decode_text(read_bytes(path), path, encoding)
     if "\r" in text:
@@ -156,10 +214,21 @@ def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
 
 
 def open_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> IO[str]:
-    """Open ``path`` as a text stream (``.gz`` transparent, universal newlines).
+    r"""Open ``path`` as a text stream (``.gz`` transparent, universal newlines).
 
     Decoding errors surface as ``UnicodeDecodeError`` while reading; use
     :func:`read_text` to get a :class:`FormatError` that names the line.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.txt"
+    >>> _ = path.write_bytes(b"one\r\ntwo\r\n")
+    >>> with open_text(path) as f:
+    ...     f.readlines()
+    ['one\n', 'two\n']
+    >>> tmp.cleanup()
     """
     if encoding.lower().replace("_", "-") == "utf-8":
         encoding = "utf-8-sig"
@@ -187,6 +256,16 @@ def resolve(path_or_stem: str | os.PathLike[str], ext: str) -> Path:
     ------
     FileNotFoundError
         Naming every path tried.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> _ = (Path(tmp.name) / "take.bvh.gz").write_bytes(b"")
+    >>> _ = (Path(tmp.name) / "take.textgrid").write_bytes(b"")
+    >>> resolve(Path(tmp.name) / "take", ".bvh").name, resolve(Path(tmp.name) / "take", "TextGrid").name
+    ('take.bvh.gz', 'take.textgrid')
+    >>> tmp.cleanup()
     """
     if not ext.startswith("."):
         ext = "." + ext
@@ -227,10 +306,17 @@ _MAGIC: tuple[tuple[bytes, str | object], ...] = (
 
 
 def describe_bytes(head: bytes) -> str:
-    """A short human description of what the first bytes of a file look like.
+    r"""A short human description of what the first bytes of a file look like.
 
     Used in error messages: ``"an empty file"``, ``"a Git-LFS pointer (run
     `git lfs pull`)"``, ``"MP3 audio"``, ``"an HTML page"``, ``"binary data"`` ...
+
+    Examples
+    --------
+    >>> describe_bytes(b""), describe_bytes(b"<!DOCTYPE html><html>")
+    ('an empty file', 'an HTML page (a download that returned a web page?)')
+    >>> describe_bytes(b"version https://git-lfs.github.com/spec/v1\n")
+    'a Git-LFS pointer text, not the file content (run `git lfs pull`)'
     """
     if not head:
         return "an empty file"

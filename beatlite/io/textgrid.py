@@ -65,6 +65,11 @@ class Interval(NamedTuple):
     """One TextGrid interval: ``[start, end]`` in seconds with its mark (``""`` = silence).
 
     Points of a ``TextTier`` are read as zero-length intervals (``start == end``).
+
+    Examples
+    --------
+    >>> Interval(0.0, 0.5, "hello")
+    Interval(start=0.0, end=0.5, text='hello')
     """
 
     start: float
@@ -84,6 +89,12 @@ class WordIntervals:
         The marks.
     xmax : float or None
         End of the tier (seconds); the tier covers ``[0, xmax]`` (silences included).
+
+    Examples
+    --------
+    >>> words = WordIntervals(np.array([0.1, 0.6]), np.array([0.4, 0.9]), ("hello", "world"), xmax=1.0)
+    >>> words.words, (words.ends - words.starts).round(6).tolist()
+    (('hello', 'world'), [0.3, 0.3])
     """
 
     starts: np.ndarray
@@ -242,6 +253,17 @@ def read_textgrid_tiers(
     FormatError
         Malformed file, infinite times, ``xmin > xmax``, unsorted or overlapping
         intervals. An interval outside ``[xmin, xmax]`` gives a :class:`FormatWarning`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.TextGrid"
+    >>> write_textgrid(path, {"words": [Interval(0.2, 0.5, "hi")]}, 1.0)
+    >>> xmin, xmax, tiers = read_textgrid_tiers(path)
+    >>> xmin, xmax, [(name, cls, len(intervals)) for name, cls, intervals in tiers]  # gaps filled with ""
+    (0.0, 1.0, [('words', 'IntervalTier', 3)])
+    >>> tmp.cleanup()
     """
     p = Path(path)
     text = read_text(p, encoding="auto")
@@ -318,6 +340,19 @@ def read_textgrid(path: str | os.PathLike[str]) -> dict[str, list[Interval]]:
     FormatError
         Malformed file, or intervals that are unsorted/overlapping (naming the
         tier, the 1-based interval index and the line).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.TextGrid"
+    >>> write_textgrid(path, {"words": [Interval(0.2, 0.5, "hi")]}, 1.0)
+    >>> for interval in read_textgrid(path)["words"]:  # gaps filled with "" (silence)
+    ...     print(interval)
+    Interval(start=0.0, end=0.2, text='')
+    Interval(start=0.2, end=0.5, text='hi')
+    Interval(start=0.5, end=1.0, text='')
+    >>> tmp.cleanup()
     """
     _, _, tiers = read_textgrid_tiers(path)
     out: dict[str, list[Interval]] = {}
@@ -344,6 +379,17 @@ def read_words(path: str | os.PathLike[str], tier: str | int = "words") -> WordI
     -------
     WordIntervals
         Marks that are not blank, with their start/end seconds and the tier's ``xmax``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.TextGrid"
+    >>> write_textgrid(path, {"words": [Interval(0.2, 0.5, "hi"), Interval(0.6, 0.9, "there")]}, 1.0)
+    >>> words = read_words(path)  # silences dropped
+    >>> words.words, words.starts.tolist(), words.xmax
+    (('hi', 'there'), [0.2, 0.6], 1.0)
+    >>> tmp.cleanup()
     """
     p = Path(path)
     _, xmax, tiers = read_textgrid_tiers(p)
@@ -434,6 +480,12 @@ def words_to_frames(
     -------
     (T,) int64
         Word ids.
+
+    Examples
+    --------
+    >>> words = WordIntervals(np.array([0.1]), np.array([0.3]), ("hi",), xmax=0.5)
+    >>> words_to_frames(words, n_frames=5, fps=10, vocab={"hi": 7})  # frames at 0.0 .. 0.4 s; end excluded
+    array([0, 7, 7, 0, 0])
     """
     if rule not in RULES:
         raise ValueError(f"words_to_frames: rule must be one of {RULES}, got {rule!r}")
@@ -534,6 +586,21 @@ def write_textgrid(
         End of the TextGrid in seconds (an ``int`` is written without decimals, like MFA's ``62``).
     xmin : float
         Start, default 0.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.TextGrid"
+    >>> write_textgrid(path, {"words": [Interval(0.25, 0.5, "hi")]}, 1)
+    >>> print(path.read_text()[:60])
+    File type = "ooTextFile"
+    Object class = "TextGrid"
+    <BLANKLINE>
+    xmin = 0
+    >>> read_words(path).words
+    ('hi',)
+    >>> tmp.cleanup()
     """
     if not np.isfinite(xmax) or xmax < xmin:
         raise ValueError(f"write_textgrid: xmax must be >= xmin ({xmin}), got {xmax!r}")

@@ -65,6 +65,13 @@ class BeatAlignVariant:
     window : (start, end) seconds or None
         Score only this part of each take (beat times relative to ``start``); the reference
         uses (10, 500).
+
+    Examples
+    --------
+    >>> VARIANTS["beatlite"].motion_kind, VARIANTS["beatlite"].order
+    ('positions', 2)
+    >>> BeatAlignVariant(motion_kind="euler", window=(10, 500)).window
+    (10, 500)
     """
 
     motion_kind: str = "positions"
@@ -207,6 +214,14 @@ def motion_beat_times(
     -------
     list of (K_j,) float64
         Beat times ``index / fps`` per joint (positions) or triplet (Euler).
+
+    Examples
+    --------
+    >>> frames = np.arange(60)
+    >>> motion = np.zeros((60, 1, 3))
+    >>> motion[:, 0, 0] = 10 * np.cos(np.pi * frames / 12)  # (T, J, 3) cm, turns every 12 frames
+    >>> [t.round(6).tolist() for t in motion_beat_times(motion, 15)]  # the turns: frames 12, 24, 36, 48
+    [[0.8, 1.6, 2.4, 3.2]]
     """
     return _variant(variant).motion_beats(motion, positive(fps, "fps"))
 
@@ -285,6 +300,15 @@ def emage_audio_beats(
     Returns
     -------
     (A,) float64 seconds.
+
+    Examples
+    --------
+    >>> sr = 16000
+    >>> audio = np.zeros(6 * sr, dtype=np.float32)
+    >>> audio[[5 * sr // 2, 7 * sr // 2]] = 1.0  # clicks at 2.5 s and 3.5 s
+    >>> beats = emage_audio_beats(audio, sr, n_frames=90, fps=15)  # 6 s of motion, 2 s skipped at each end
+    >>> beats.round(3).tolist()  # relative to 2 s, in hops of 32 ms; librosa's peak picking marks a click twice
+    [0.512, 0.544, 1.504, 1.536]
     """
     y = as_array(audio, "audio", ndim=1, dtype=np.float32)[: int(sr / positive(fps, "fps") * n_frames)]
     offset = int(_emage_frames(fps, EMAGE_ORDER_S, skip_s)[1] * sr / fps)
@@ -328,6 +352,18 @@ def emage_beat_align(
     Returns
     -------
     float in [0, 1]; NaN when no take is longer than ``2 skip_s`` with audio beats.
+
+    Examples
+    --------
+    >>> fps, frames = 15, np.arange(90)
+    >>> positions = np.zeros((90, 1, 3))
+    >>> positions[:, 0, 0] = 10 * np.cos(np.pi * frames / 12)  # (T, J, 3) cm, turns every 12 frames
+    >>> mean_speed = np.array([np.abs(np.gradient(positions[:, 0, 0])).mean() * fps])
+    >>> # scored frames 30..59 (2 s skipped): motion beats at frames 36 and 48, i.e. 0.4 and 1.2 s after the skip
+    >>> emage_beat_align([np.array([0.4, 1.2])], [positions], fps, mean_speed)
+    1.0
+    >>> round(emage_beat_align([np.array([0.8, 1.6])], [positions], fps, mean_speed), 4)  # 0.4 s off: exp(-0.16 / 0.18)
+    0.4111
     """
     fps = positive(fps, "fps")
     order, skip = _emage_frames(fps, order_s, skip_s)

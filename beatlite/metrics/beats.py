@@ -70,6 +70,14 @@ def audio_beats(
     -------
     (A,) float64
         Increasing onset times in seconds from the first sample.
+
+    Examples
+    --------
+    >>> sr = 16000
+    >>> audio = np.zeros(3 * sr, dtype=np.float32)
+    >>> audio[[sr // 2, 3 * sr // 2]] = 1.0  # clicks at 0.5 s and 1.5 s
+    >>> audio_beats(audio, sr).round(1).tolist()  # to the nearest hop of 512 samples (32 ms)
+    [0.5, 1.5]
     """
     import librosa
     from scipy import sparse
@@ -120,6 +128,12 @@ def stft_magnitude(
     Returns
     -------
     (1 + n_fft // 2, 1 + N // hop_length) float32 magnitudes.
+
+    Examples
+    --------
+    >>> y = np.zeros(16000, dtype=np.float32)
+    >>> stft_magnitude(y).shape  # (1 + 2048 // 2, 1 + 16000 // 512)
+    (1025, 32)
     """
     import scipy.fft
     from scipy.signal import get_window
@@ -159,6 +173,13 @@ def position_speed(positions: np.ndarray, fps: float) -> np.ndarray:
     Returns
     -------
     (T, J) float64, centimetres per second.
+
+    Examples
+    --------
+    >>> positions = np.zeros((4, 1, 3))
+    >>> positions[:, 0, 0] = [0.0, 1.0, 2.0, 4.0]  # cm
+    >>> position_speed(positions, fps=10)[:, 0]  # cm/s
+    array([10., 10., 15., 20.])
     """
     p = as_array(positions, "positions", ndim=3, last=3)
     if p.shape[0] < 2:
@@ -184,6 +205,14 @@ def euler_speed(channels: np.ndarray, columns: np.ndarray | list[int], fps: floa
     -------
     (T - 1, K) float64, degrees per second; sample ``t`` lies between frames t and t+1 and,
     as in the reference, is timed at ``t / fps``.
+
+    Examples
+    --------
+    >>> channels = np.zeros((3, 6))
+    >>> channels[:, 3] = [0.0, 3.0, 7.0]  # x rotation of the second triplet, degrees
+    >>> euler_speed(channels, [3, 4, 5], fps=10)  # (T - 1, K) degrees per second
+    array([[30.],
+           [40.]])
     """
     x = as_array(channels, "channels", ndim=2)
     cols = np.asarray(columns, dtype=np.int64).ravel()
@@ -212,6 +241,11 @@ def local_minima(curve: np.ndarray, order: int = 2) -> np.ndarray:
     Returns
     -------
     (K,) int64 increasing indices.
+
+    Examples
+    --------
+    >>> local_minima(np.array([3.0, 2, 1, 2, 3, 2, 0, 2, 3]), order=2)
+    array([2, 6])
     """
     x = np.asarray(curve, dtype=np.float64)
     if x.ndim != 1:
@@ -244,6 +278,15 @@ def append_palm_normals(directions: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T, 44, 3) float64
+
+    Examples
+    --------
+    >>> directions = np.zeros((1, 42, 3))
+    >>> directions[:, [11, 28]] = [1, 0, 0]
+    >>> directions[:, [17, 34]] = [0, 1, 0]
+    >>> out = append_palm_normals(directions)
+    >>> out.shape, out[0, 42:].tolist()
+    ((1, 44, 3), [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
     """
     from beatlite.skeleton.ted import palm_normals
 
@@ -267,6 +310,12 @@ def included_angles(directions: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T, P) float64 in [0, 1] (units of pi radians).
+
+    Examples
+    --------
+    >>> directions = np.array([[[1.0, 0, 0], [0, 2, 0], [-1, 0, 0]]])
+    >>> included_angles(directions, np.array([[0, 1], [0, 2]]))  # 90 and 180 degrees, in units of pi
+    array([[0.5, 1. ]])
     """
     d = as_array(directions, "directions", ndim=3, last=3)
     pr = np.asarray(pairs, dtype=np.int64)
@@ -296,6 +345,15 @@ def mean_angle_change(directions: list[np.ndarray] | np.ndarray, pairs: np.ndarr
     Returns
     -------
     (P,) float64, units of pi radians per frame.
+
+    Examples
+    --------
+    >>> angle = np.array([0.0, 0.5, 0.5, 1.5]) * np.pi / 4  # (T,) radians of the second vector
+    >>> directions = np.zeros((4, 2, 3))
+    >>> directions[:, 0] = [1, 0, 0]
+    >>> directions[:, 1, 0], directions[:, 1, 1] = np.cos(angle), np.sin(angle)
+    >>> mean_angle_change(directions, np.array([[0, 1]])).round(6)  # (0.5 + 0 + 1) / 4 / 3 in units of pi
+    array([0.125])
     """
     items = directions if isinstance(directions, (list, tuple)) else [directions]
     total, count = None, 0
@@ -393,6 +451,15 @@ def angle_change_curve(
     Returns
     -------
     (T,) float64, dimensionless (1 = a typical frame).
+
+    Examples
+    --------
+    >>> angle = np.array([0.0, 0.5, 0.5, 1.5]) * np.pi / 4
+    >>> directions = np.zeros((4, 2, 3))
+    >>> directions[:, 0] = [1, 0, 0]
+    >>> directions[:, 1, 0], directions[:, 1, 1] = np.cos(angle), np.sin(angle)
+    >>> angle_change_curve(directions, np.array([[0, 1]]), np.array([0.125])).round(6)  # change / MAAC
+    array([0., 1., 0., 2.])
     """
     pr, ca = drop_rigid_pairs(pairs, change_angle, rtol=rigid_rtol)
     th = included_angles(directions, pr)
@@ -417,6 +484,12 @@ def angle_change_beats(curve: np.ndarray, fps: float, *, threshold: float = 0.03
     Returns
     -------
     (K,) float64 beat times in seconds, ``t / fps``.
+
+    Examples
+    --------
+    >>> curve = np.array([0.0, 1.0, 1.0, 0.2, 1.0, 1.0, 0.99, 1.0, 1.0])
+    >>> angle_change_beats(curve, fps=15)  # frame 3 (a clear drop); frame 6 drops by only 0.01
+    array([0.2])
     """
     c = np.asarray(curve, dtype=np.float64)
     if c.ndim != 1:
@@ -441,6 +514,11 @@ def nearest_distance(query: np.ndarray, reference: np.ndarray) -> np.ndarray:
     Returns
     -------
     (Q,) float64 seconds; ``inf`` everywhere when ``reference`` is empty.
+
+    Examples
+    --------
+    >>> nearest_distance(np.array([0.1, 0.9, 2.0]), np.array([1.0, 0.0])).round(6)
+    array([0.1, 0.1, 1. ])
     """
     q = np.asarray(query, dtype=np.float64).ravel()
     r = np.sort(np.asarray(reference, dtype=np.float64).ravel())
@@ -463,6 +541,13 @@ def gaussian_alignment(query: np.ndarray, reference: np.ndarray, sigma: float) -
     Returns
     -------
     float in [0, 1] (0 when ``reference`` is empty), NaN for an empty ``query``.
+
+    Examples
+    --------
+    >>> round(gaussian_alignment(np.array([1.0, 2.0]), np.array([1.0, 2.3]), sigma=0.3), 4)  # (1 + exp(-0.5)) / 2
+    0.8033
+    >>> gaussian_alignment(np.array([1.0]), np.array([]), sigma=0.3)
+    0.0
     """
     s = positive(sigma, "sigma")
     q = np.asarray(query, dtype=np.float64).ravel()
@@ -485,6 +570,14 @@ def alignment_score(
     Returns
     -------
     float in [0, 1]; NaN when the query set is empty.
+
+    Examples
+    --------
+    >>> audio, motion = np.array([1.0, 2.0]), np.array([1.0, 2.3, 5.0])
+    >>> round(alignment_score(audio, motion, 0.3), 4)  # the extra motion beat at 5 s is ignored
+    0.8033
+    >>> round(alignment_score(audio, motion, 0.3, "motion_to_audio"), 4)  # (1 + exp(-0.5) + ~0) / 3
+    0.5355
     """
     if direction == "audio_to_motion":
         return gaussian_alignment(audio_times, motion_times, sigma)

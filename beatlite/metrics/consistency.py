@@ -46,6 +46,12 @@ def default_angle_pairs() -> np.ndarray:
     """HA2G's 41 angle pairs over the 44 vectors (42 bones + 2 palm normals), (41, 2) int64.
 
     Taken from ``beatlite.skeleton.ted.ANGLE_PAIRS``.
+
+    Examples
+    --------
+    >>> pairs = default_angle_pairs()
+    >>> pairs.shape, int(pairs.max()) < 44
+    ((41, 2), True)
     """
     from beatlite.skeleton.ted import ANGLE_PAIRS
 
@@ -76,6 +82,13 @@ class BCVariant:
     rigid_rtol : float
         Angle pairs whose MAAC is at most ``rigid_rtol`` times the largest are rigid and left out
         (:func:`beatlite.metrics.beats.drop_rigid_pairs`); 0 keeps every moving pair.
+
+    Examples
+    --------
+    >>> VARIANTS["ha2g"].clip_length, VARIANTS["ha2g"].clip_stride
+    (34, 10)
+    >>> BCVariant(threshold=0.05).palm_normals
+    True
     """
 
     threshold: float = 0.03
@@ -126,6 +139,13 @@ def prepare_directions(
     Returns
     -------
     (T, 42 or 44, 3) float64 unit vectors.
+
+    Examples
+    --------
+    >>> directions = np.tile([0.0, 2.0, 0.0], (5, 42, 1))  # (T, 42, 3), not unit
+    >>> out = prepare_directions(directions)
+    >>> out.shape, np.allclose(out[:, :42], [0, 1, 0])  # renormalised, two palm normals appended
+    ((5, 44, 3), True)
     """
     d = as_array(directions, "directions", ndim=(2, 3))
     if d.ndim == 2:
@@ -294,6 +314,15 @@ def clip_audio_beats(
     Returns
     -------
     list of (A_c,) float64, one per clip.
+
+    Examples
+    --------
+    >>> sr = 16000
+    >>> audio = np.zeros(4 * sr, dtype=np.float32)
+    >>> audio[[sr, 3 * sr]] = 1.0  # clicks at 1 s and 3 s
+    >>> clips = clip_audio_beats(audio, sr, n_frames=60)  # 34-frame clips every 10 frames: starts 0, 10, 20
+    >>> len(clips), [c.round(1).tolist() for c in clips]  # relative to each clip's start (0, 2/3, 4/3 s)
+    (3, [[1.0], [0.4], [1.7]])
     """
     v = VARIANTS.get(variant) if isinstance(variant, str) else variant
     if not isinstance(v, BCVariant) or v.clip_length is None:

@@ -68,6 +68,12 @@ class ExtractorConfig:
     velocity_weight, velocity_loss : float, "mse" or "l1"
         Weight and kind of the frame-difference term: BEAT's AE uses ``0.1 * MSE`` (docs/reference_code.md#fgd-autoencoder),
         HA2G's MotionAE ``1 * L1`` (docs/reference_code.md#ha2g-feature-extractor).
+
+    Examples
+    --------
+    >>> config = ExtractorConfig(input_dim=126)
+    >>> config.latent_dim, config.channels, config.velocity_loss
+    (32, 32, 'mse')
     """
 
     input_dim: int
@@ -82,7 +88,15 @@ class ExtractorConfig:
 
 
 class MotionAutoencoder(nn.Module):
-    """Convolutional autoencoder of (B, 34, D) windows; ``encode`` gives (B, L) features."""
+    """Convolutional autoencoder of (B, 34, D) windows; ``encode`` gives (B, L) features.
+
+    Examples
+    --------
+    >>> model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8)).eval()
+    >>> x = torch.zeros(2, 34, 6)
+    >>> tuple(model.encode(x).shape), tuple(model(x).shape)
+    ((2, 4), (2, 34, 6))
+    """
 
     def __init__(self, config: ExtractorConfig) -> None:
         super().__init__()
@@ -124,7 +138,15 @@ class MotionAutoencoder(nn.Module):
 def autoencoder_loss(
     recon: torch.Tensor, target: torch.Tensor, velocity_weight: float = 0.1, velocity_loss: str = "mse"
 ) -> torch.Tensor:
-    """``mean|x^ - x| + w * mean((diff_t x^ - diff_t x)^2)`` (or ``mean|...|`` for ``"l1"``) on (B, T, D)."""
+    """``mean|x^ - x| + w * mean((diff_t x^ - diff_t x)^2)`` (or ``mean|...|`` for ``"l1"``) on (B, T, D).
+
+    Examples
+    --------
+    >>> target = torch.zeros(1, 3, 1)
+    >>> recon = torch.tensor([[[1.0], [1.0], [3.0]]])  # |error| mean 5/3; frame differences (0, 2) vs (0, 0)
+    >>> round(float(autoencoder_loss(recon, target, velocity_weight=0.1)), 6)  # 5/3 + 0.1 * (0 + 4) / 2
+    1.866667
+    """
     vel = torch.diff(recon, dim=1) - torch.diff(target, dim=1)
     if velocity_loss == "mse":
         term = vel.pow(2).mean()
@@ -147,6 +169,14 @@ class FeatureExtractor:
         ``"dirvec"`` or ``"pose"`` (what the windows must be).
     meta : dict
         Everything else stored in the checkpoint (fingerprint, training history...).
+
+    Examples
+    --------
+    >>> extractor = load_extractor("dirvec")  # the shipped checkpoint
+    >>> extractor.space, extractor.latent_dim
+    ('dirvec', 32)
+    >>> extractor(np.zeros((3, 34, 126), dtype=np.float32)).shape
+    (3, 32)
     """
 
     def __init__(
@@ -191,6 +221,12 @@ class WindowSource:
     A view (:class:`~beatlite.data.store.StoreWindows` or :class:`~beatlite.data.windows.Windows`)
     is read ``key`` by ``key`` in batches (``view.batch(idx, keys=(key,))``), so training from the
     window store holds one batch in memory, whatever the corpus size. An array is indexed directly.
+
+    Examples
+    --------
+    >>> source = WindowSource(np.arange(2 * 34 * 3, dtype=np.float32).reshape(2, 34, 3))
+    >>> len(source), source.get(np.array([1])).shape
+    (2, (1, 34, 3))
     """
 
     def __init__(self, windows: Any, key: str | None = None) -> None:
@@ -259,6 +295,14 @@ def train_autoencoder(
     model : MotionAutoencoder (eval mode)
     info : dict
         ``mean``/``std`` (D,) input normalisation, ``history`` of per-epoch losses, ``seconds``.
+
+    Examples
+    --------
+    >>> windows = np.random.default_rng(0).normal(size=(16, 34, 6)).astype(np.float32)
+    >>> config = ExtractorConfig(input_dim=6, latent_dim=4, channels=8, epochs=2, batch_size=8)
+    >>> model, info = train_autoencoder(windows, config, log=False)
+    >>> info["mean"].shape, len(info["history"])
+    ((6,), 2)
     """
     from beatlite.paths import n_threads
 
@@ -354,6 +398,19 @@ def save_extractor(
     """Write the checkpoint atomically: config, weights, input normalisation, fingerprint, history.
 
     Only tensors and plain Python values are stored, so it loads with ``weights_only=True``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8)).eval()
+    >>> info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}  # as train_autoencoder returns it
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = save_extractor(f"{tmp}/ae.pt", model, info, space="dirvec", meta={})
+    ...     extractor = load_extractor("dirvec", path)
+    >>> windows = np.random.default_rng(0).normal(size=(5, 34, 6)).astype(np.float32)
+    >>> features = extractor(windows)  # (N, L); the same as the saved model's
+    >>> features.shape, np.allclose(features, model.encode(torch.from_numpy(windows)).detach().numpy(), atol=1e-6)
+    ((5, 4), True)
     """
     from beatlite.io.atomic import atomic_write
 
@@ -395,6 +452,12 @@ def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> Fea
         The checkpoint does not exist (train it with ``python -m beatlite.metrics.extractor train``).
     ValueError
         The file is not a beatlite FGD extractor checkpoint.
+
+    Examples
+    --------
+    >>> extractor = load_extractor("pose")  # checkpoints/fgd_euler141.pt
+    >>> extractor(np.zeros((2, 34, 141), dtype=np.float32)).shape
+    (2, 32)
     """
     from beatlite.paths import checkpoints_dir
 
@@ -464,7 +527,17 @@ def _info_command(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m beatlite.metrics.extractor {train,info} ...``"""
+    """``python -m beatlite.metrics.extractor {train,info} ...``
+
+    Examples
+    --------
+    >>> import contextlib, io
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     code = main(["info", "--space", "dirvec"])
+    >>> code, "space dirvec" in out.getvalue()
+    (0, True)
+    """
     parser = argparse.ArgumentParser(
         prog="python -m beatlite.metrics.extractor", description=__doc__.split("\n")[0]
     )

@@ -44,6 +44,15 @@ def fit_gaussian(features: np.ndarray, name: str = "features") -> tuple[np.ndarr
         ``mean_i x_i``.
     sigma : (D, D) float64
         ``sum_i (x_i - mu)(x_i - mu)^T / (N - 1)`` (as ``np.cov(features, rowvar=False)``).
+
+    Examples
+    --------
+    >>> mu, sigma = fit_gaussian(np.array([[0.0, 1.0], [2.0, 1.0], [4.0, 1.0]]))
+    >>> mu
+    array([2., 1.])
+    >>> sigma
+    array([[4., 0.],
+           [0., 0.]])
     """
     x = as_array(features, name, ndim=2)
     n = x.shape[0]

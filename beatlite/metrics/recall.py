@@ -119,7 +119,19 @@ def srgr_per_frame(
     generated: np.ndarray, ground_truth: np.ndarray, semantic: np.ndarray, *, variant: str = "paper",
     delta: float | None = None,
 ) -> np.ndarray:  # fmt: skip
-    """Per-frame terms ``w_t (1/J) sum_j hit_{t,j}`` of one take, (T,) float64; their mean is SRGR."""
+    """Per-frame terms ``w_t (1/J) sum_j hit_{t,j}`` of one take, (T,) float64; their mean is SRGR.
+
+    Examples
+    --------
+    >>> truth = np.zeros((3, 2, 3))
+    >>> generated = truth.copy()
+    >>> generated[1, 0, 0] = 50.0  # one of two joints misses in frame 1
+    >>> terms = srgr_per_frame(generated, truth, np.array([1.0, 1.0, 0.5]))
+    >>> terms
+    array([1. , 0.5, 0.5])
+    >>> round(float(terms.mean()), 6) == round(srgr(generated, truth, np.array([1.0, 1.0, 0.5])), 6)
+    True
+    """
     hits, weights = _hits(generated, ground_truth, semantic, variant, delta)
     return weights * hits.mean(axis=1)
 

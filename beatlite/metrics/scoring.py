@@ -56,6 +56,12 @@ class Takes:
     euler_features : (N, F) float, optional
         Features of the same windows of the Euler channels by an autoencoder trained on them
         (BEAT's FGD space: ``"FGD (BEAT AE)"``).
+
+    Examples
+    --------
+    >>> takes = Takes(positions=[np.zeros((4, 2, 3)), np.zeros((6, 2, 3))])
+    >>> len(takes.positions), takes.directions is None
+    (2, True)
     """
 
     positions: list[np.ndarray]
@@ -91,6 +97,12 @@ class GroundTruth:
     onsets : dict of str -> list
         Per-take onsets of the variants that detect their own (``"BeatAlign (reference)"``: one array per
         take; ``"BC (ha2g)"``: per take one array per 34-frame clip), filled on first use.
+
+    Examples
+    --------
+    >>> truth = GroundTruth(Takes(positions=[np.zeros((4, 2, 3))]), semantic=[np.full(4, 0.5)])
+    >>> truth.fps, truth.sr, truth.beats() is None  # no audio, no beats
+    (15, 16000, True)
     """
 
     takes: Takes
@@ -145,6 +157,14 @@ class Metric:
         One line for a table caption: the variant and its parameters.
     source : str
         Where the variant comes from (paper, code, section) and what it differs in.
+
+    Examples
+    --------
+    >>> def mean_height(positions, fps):
+    ...     return float(np.mean([p[..., 1].mean() for p in positions]))
+    >>> metric = Metric("Height", "demo", None, None, mean_height, "mean joint height, cm")
+    >>> metric.needs  # from the parameter names (needs_of)
+    ('positions',)
     """
 
     name: str
@@ -166,7 +186,14 @@ ARROWS: dict[bool | None, str] = {True: " ↑", False: " ↓", None: ""}
 
 @dataclass(frozen=True)
 class MetricResult:
-    """One metric value with the definition that produced it (a :class:`Metric`'s fields)."""
+    """One metric value with the definition that produced it (a :class:`Metric`'s fields).
+
+    Examples
+    --------
+    >>> result = MetricResult("MPJPE", "MPJPE", 1.5, "positions", higher_is_better=False)
+    >>> result.key, result.value
+    ('MPJPE', 1.5)
+    """
 
     key: str
     name: str
@@ -178,7 +205,15 @@ class MetricResult:
 
 @dataclass
 class Evaluation:
-    """The results of :func:`evaluate`: ``results`` plus ``skipped`` ``{metric key: reason}``."""
+    """The results of :func:`evaluate`: ``results`` plus ``skipped`` ``{metric key: reason}``.
+
+    Examples
+    --------
+    >>> truth = GroundTruth(Takes(positions=[np.zeros((4, 2, 3))]))
+    >>> ev = evaluate(Takes(positions=[np.ones((4, 2, 3))]), truth, metrics=("MPJPE", "SRGR"))
+    >>> round(ev.get("MPJPE").value, 6), list(ev.skipped)  # sqrt(3) cm; no semantic scores for SRGR
+    (1.732051, ['SRGR'])
+    """
 
     results: list[MetricResult]
     skipped: dict[str, str] = field(default_factory=dict)
@@ -227,6 +262,13 @@ def evaluate(
     Returns
     -------
     Evaluation
+
+    Examples
+    --------
+    >>> truth = GroundTruth(Takes(positions=[np.zeros((4, 2, 3))]))
+    >>> generated = Takes(positions=[np.zeros((4, 2, 3))])
+    >>> evaluate(generated, truth, metrics=("MPJPE", "PCK")).values()  # a perfect prediction
+    {'MPJPE': 0.0, 'PCK': 1.0}
     """
     _check_pairing(generated, truth)
     results, skipped = [], {}
@@ -245,7 +287,13 @@ def evaluate(
 
 def describe(keys: Sequence[str], *, sources: bool = False) -> str:
     """Caption lines ``- <key>: <variant and parameters>`` for the columns of a table (``sources``: each
-    followed by where the variant comes from)."""
+    followed by where the variant comes from).
+
+    Examples
+    --------
+    >>> print(describe(["MPJPE"]))
+    - **MPJPE**: mean per-joint position error, cm, frame-weighted over takes
+    """
     return "\n".join(
         f"- **{key}**: {METRICS[key].describe}" + (f" [{METRICS[key].source}]" if sources else "")
         for key in keys
@@ -324,7 +372,15 @@ def bind_inputs(fn: Callable[..., float]) -> Callable[[Takes, GroundTruth, int],
 def needs_of(fn: Callable[..., float]) -> tuple[str, ...]:
     """The :class:`Metric` ``needs`` of a function :func:`bind_inputs` binds by name: its parameters that
     name an input which may be missing (``truth_positions`` reads as ``positions``; ``fps``, ``sr`` and
-    ``seed`` are always there)."""
+    ``seed`` are always there).
+
+    Examples
+    --------
+    >>> def recall(positions, truth_positions, semantic, fps):
+    ...     return 0.0
+    >>> needs_of(recall)  # fps is always there; truth_positions reads as positions
+    ('positions', 'semantic')
+    """
     if bind_inputs(fn) is fn:
         raise ValueError(f"{getattr(fn, '__name__', fn)!r} does not name its inputs; give needs explicitly")
     names = [p for p in inspect.signature(fn).parameters if p in INPUTS and p not in ("fps", "sr", "seed")]
@@ -338,6 +394,16 @@ def register_metric(key: str, metric: Metric) -> None:
     ------
     ValueError
         ``key`` is already a metric, or ``metric.compute`` reads an input its ``needs`` does not list.
+
+    Examples
+    --------
+    >>> def mean_height(positions):
+    ...     return float(np.mean([p[..., 1].mean() for p in positions]))
+    >>> register_metric("Height (demo)", Metric("Height", "demo", None, None, mean_height, "mean joint height"))
+    >>> truth = GroundTruth(Takes(positions=[np.zeros((4, 2, 3))]))
+    >>> evaluate(Takes(positions=[np.ones((4, 2, 3))]), truth, metrics=["Height (demo)"]).values()
+    {'Height (demo)': 1.0}
+    >>> del METRICS["Height (demo)"]  # keep the registry as shipped
     """
     if key in METRICS:
         raise ValueError(f"{key!r} is already a metric ({METRICS[key].describe})")

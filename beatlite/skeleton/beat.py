@@ -131,6 +131,14 @@ def beat_skeleton() -> Skeleton:
         ``n_joints == 75``, ``n_channels == 228``, 13 End Sites (HeadEnd, ten finger ``*4``
         tips, two ``*ToeBaseEnd``). Hips: ``Xposition Yposition Zposition Xrotation Yrotation
         Zrotation``; every other joint ``Xrotation Yrotation Zrotation``.
+
+    Examples
+    --------
+    >>> skel = beat_skeleton()
+    >>> skel.n_joints, skel.n_channels, len(skel.end_sites)
+    (75, 228, 13)
+    >>> skel.names[0], skel.channels[0][:3]
+    ('Hips', ('Xposition', 'Yposition', 'Zposition'))
     """
     names = [row[0] for row in _TABLE]
     index = {n: i for i, n in enumerate(names)}
@@ -214,6 +222,12 @@ def subset_columns(skeleton: Skeleton, subset_name: str) -> np.ndarray:
         For each of the K joints in subset order, the columns of its three rotation channels
         in file order (``X, Y, Z`` for BEAT). ``motion.channels[:, cols]`` is the subset's
         (T, 3K) Euler-degree array, e.g. the 141-d CaMN pose for ``"spine_neck_141"``.
+
+    Examples
+    --------
+    >>> cols = subset_columns(beat_skeleton(), "spine_neck_141")
+    >>> cols.shape  # 47 joints, 3 rotation channels each
+    (141,)
     """
     names = _subset_names(subset_name)
     if not isinstance(skeleton, Skeleton):
@@ -247,6 +261,14 @@ def expand_subset(
     Returns
     -------
     (T, C) float64 (C = 228 for BEAT); (1, C) for 1-D ``values``.
+
+    Examples
+    --------
+    >>> rows = expand_subset(np.ones((2, 141)), "spine_neck_141")
+    >>> rows.shape
+    (2, 228)
+    >>> int(rows.sum())  # the 141 subset channels are 1, every other channel 0
+    282
     """
     skel = beat_skeleton() if skeleton is None else skeleton
     cols = subset_columns(skel, subset_name)
@@ -296,6 +318,13 @@ def camn_assemble(body27: np.ndarray, hands114: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 141) array in ``JOINT_SUBSETS["spine_neck_141"]`` order (dtype of the inputs' result type).
+
+    Examples
+    --------
+    >>> body, hands = np.zeros(27), np.ones(114)
+    >>> pose = camn_assemble(body, hands)
+    >>> pose.shape, int(pose[:18].sum()), int(pose[18:75].sum())
+    ((141,), 0, 57)
     """
     body = _check_last(body27, 27, "body27")
     hands = _check_last(hands114, 114, "hands114")
@@ -315,6 +344,15 @@ def camn_split(pose141: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     -------
     body27 : (..., 27) array
     hands114 : (..., 114) array
+
+    Examples
+    --------
+    >>> pose = np.arange(141.0)
+    >>> body, hands = camn_split(pose)
+    >>> body.shape, hands.shape
+    ((27,), (114,))
+    >>> bool(np.array_equal(camn_assemble(body, hands), pose))
+    True
     """
     x = _check_last(pose141, 141, "pose141")
     body = np.concatenate([x[..., 0:18], x[..., 75:84]], axis=-1)

@@ -51,6 +51,15 @@ class Skeleton:
         A joint may have 0, 3 or 6 channels.
     end_sites : dict int -> (3,) float64
         ``End Site`` offsets keyed by the index of the joint that owns them.
+
+    Examples
+    --------
+    >>> arm = Skeleton(("Shoulder", "Elbow"), [-1, 0], [[0, 0, 0], [30, 0, 0]],
+    ...                (("Zrotation", "Xrotation", "Yrotation"),) * 2)
+    >>> arm.n_joints, arm.n_channels
+    (2, 6)
+    >>> arm.parents
+    array([-1,  0])
     """
 
     names: tuple[str, ...]

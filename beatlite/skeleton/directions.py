@@ -24,7 +24,16 @@ def _as_bones(bones: np.ndarray) -> np.ndarray:
 
 
 def skeleton_bones(skeleton: Skeleton) -> np.ndarray:
-    """(J - 1, 2) int64 ``(parent, child)`` pairs of every non-root joint, in joint order."""
+    """(J - 1, 2) int64 ``(parent, child)`` pairs of every non-root joint, in joint order.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> chain = Skeleton(("A", "B", "C"), [-1, 0, 1], np.zeros((3, 3)), (("Xrotation",),) * 3)
+    >>> skeleton_bones(chain)
+    array([[0, 1],
+           [1, 2]])
+    """
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
     child = np.arange(1, skeleton.n_joints, dtype=np.int64)
@@ -48,6 +57,13 @@ def positions_to_directions(
     Returns
     -------
     (..., B, 3) float64 unit vectors.
+
+    Examples
+    --------
+    >>> positions = np.array([[0.0, 0, 0], [0, 2, 0], [3, 2, 0]])
+    >>> positions_to_directions(positions, np.array([[0, 1], [1, 2]]))
+    array([[0., 1., 0.],
+           [1., 0., 0.]])
     """
     pos = np.asarray(positions, dtype=np.float64)
     b = _as_bones(bones)
@@ -95,6 +111,14 @@ def directions_to_positions(
     Returns
     -------
     (..., J, 3) float64 with ``J = bones.max() + 1``.
+
+    Examples
+    --------
+    >>> dirs = np.array([[0.0, 1, 0], [1, 0, 0]])
+    >>> directions_to_positions(dirs, np.array([[0, 1], [1, 2]]), np.array([2.0, 3.0]), np.zeros(3))
+    array([[0., 0., 0.],
+           [0., 2., 0.],
+           [3., 2., 0.]])
     """
     b = _as_bones(bones)
     n_bones = b.shape[0]

@@ -184,6 +184,19 @@ def local_rotations(skeleton: Skeleton, channels: np.ndarray) -> np.ndarray:
     -------
     (T, J, 3, 3) float64
         Identity for joints without rotation channels.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> zxy = ("Zrotation", "Xrotation", "Yrotation")
+    >>> arm = Skeleton(("Shoulder", "Elbow"), [-1, 0], [[0, 0, 0], [30, 0, 0]], (zxy, ()))
+    >>> rot = local_rotations(arm, np.array([[90.0, 0, 0]]))
+    >>> rot.shape
+    (1, 2, 3, 3)
+    >>> rot[0, 0].round(6) + 0.0  # 90 degrees about z
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
     """
     ch = _check_inputs(skeleton, channels)
     groups, no_rotation = _order_groups(skeleton)
@@ -220,6 +233,17 @@ def global_transforms(
         World orientation of each joint's frame (``v_world = R @ v_joint``).
     positions : (T, J, 3) float64, centimetres
         World position of each joint.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> zxy = ("Zrotation", "Xrotation", "Yrotation")
+    >>> arm = Skeleton(("Shoulder", "Elbow"), [-1, 0], [[0, 0, 0], [30, 0, 0]], (zxy, ()))
+    >>> rotations, positions = global_transforms(arm, np.array([[90.0, 0, 0]]))
+    >>> rotations.shape, positions.shape
+    ((1, 2, 3, 3), (1, 2, 3))
+    >>> positions[0, 1].round(6) + 0.0  # the elbow swung from +x to +y
+    array([ 0., 30.,  0.])
     """
     ch = _check_inputs(skeleton, channels, position_mode)
     n_frames, n_joints = ch.shape[0], skeleton.n_joints
@@ -309,6 +333,15 @@ def rest_pose(skeleton: Skeleton, *, end_sites: bool = False) -> np.ndarray:
     Returns
     -------
     (J, 3) float64, centimetres; (J + E, 3) with ``end_sites=True``.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.core import Skeleton
+    >>> chain = Skeleton(("A", "B", "C"), [-1, 0, 1], [[0, 0, 0], [0, 10, 0], [5, 0, 0]], (("Xrotation",),) * 3)
+    >>> rest_pose(chain)
+    array([[ 0.,  0.,  0.],
+           [ 0., 10.,  0.],
+           [ 5., 10.,  0.]])
     """
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")

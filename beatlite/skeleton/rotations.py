@@ -151,6 +151,14 @@ def euler_entries(a: np.ndarray, b: np.ndarray, c: np.ndarray, order: str) -> np
     Returns
     -------
     (3, 3, *shape) float64 with ``out[r, col]`` the matrix entry ``R[r, col]``.
+
+    Examples
+    --------
+    >>> m = euler_entries(np.zeros(4), np.zeros(4), np.full(4, np.pi / 2), "XYZ")
+    >>> m.shape  # component-major: (3, 3, *shape)
+    (3, 3, 4)
+    >>> np.allclose(np.moveaxis(m, (0, 1), (-2, -1)), euler_to_matrix([0, 0, 90], "XYZ"))
+    True
     """
     intrinsic, extrinsic = _parse_order(order)
     a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
@@ -181,6 +189,15 @@ def euler_to_matrix(angles: np.ndarray, order: str, degrees: bool = True) -> np.
     Returns
     -------
     (..., 3, 3) float64
+
+    Examples
+    --------
+    >>> euler_to_matrix([90, 0, 0], "ZXY").round(6) + 0.0  # 90 degrees about z
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    >>> euler_to_matrix(np.zeros((5, 2, 3)), "ZXY").shape
+    (5, 2, 3, 3)
     """
     angles = _as_float_array(angles, "angles", (3,))
     _parse_order(order)
@@ -209,6 +226,12 @@ def matrix_to_euler(matrix: np.ndarray, order: str, degrees: bool = True) -> np.
     Returns
     -------
     (..., 3) float64
+
+    Examples
+    --------
+    >>> angles = np.array([30.0, -45.0, 60.0])
+    >>> matrix_to_euler(euler_to_matrix(angles, "ZXY"), "ZXY").round(6)
+    array([ 30., -45.,  60.])
     """
     m = _as_float_array(matrix, "matrix", (3, 3))
     intrinsic, extrinsic = _parse_order(order)
@@ -245,6 +268,11 @@ def unwrap_degrees(angles: np.ndarray, axis: int = 0) -> np.ndarray:
     Returns
     -------
     float64 array of the same shape, degrees; consecutive values differ by at most 180°.
+
+    Examples
+    --------
+    >>> unwrap_degrees(np.array([170.0, -170.0, -150.0]))
+    array([170., 190., 210.])
     """
     arr = np.asarray(angles, dtype=np.float64)
     if arr.ndim == 0:
@@ -264,6 +292,14 @@ def quat_to_matrix(quat: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 3, 3) float64
+
+    Examples
+    --------
+    >>> half = np.sqrt(0.5)
+    >>> quat_to_matrix([half, 0, 0, half]).round(6) + 0.0  # 90 degrees about z
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
     """
     q = _as_float_array(quat, "quat", (4,))
     norm = np.linalg.norm(q, axis=-1, keepdims=True)
@@ -296,6 +332,13 @@ def matrix_to_quat(matrix: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 4) float64
+
+    Examples
+    --------
+    >>> matrix_to_quat(np.eye(3))
+    array([1., 0., 0., 0.])
+    >>> matrix_to_quat(euler_to_matrix([180, 0, 0], "ZXY")).round(6) + 0.0  # 180 degrees about z
+    array([0., 0., 0., 1.])
     """
     m = _as_float_array(matrix, "matrix", (3, 3))
     m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
@@ -333,6 +376,13 @@ def axis_angle_to_matrix(rotvec: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 3, 3) float64
+
+    Examples
+    --------
+    >>> axis_angle_to_matrix([0, 0, np.pi / 2]).round(6) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
     """
     v = _as_float_array(rotvec, "rotvec", (3,))
     theta = np.linalg.norm(v, axis=-1)
@@ -358,6 +408,12 @@ def matrix_to_axis_angle(matrix: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 3) float64
+
+    Examples
+    --------
+    >>> rotvec = np.array([0.1, -0.2, 0.3])
+    >>> np.allclose(matrix_to_axis_angle(axis_angle_to_matrix(rotvec)), rotvec)
+    True
     """
     q = matrix_to_quat(matrix)
     vnorm = np.linalg.norm(q[..., 1:], axis=-1)
@@ -379,6 +435,11 @@ def matrix_to_6d(matrix: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 6) float64, ``[R[:, 0], R[:, 1]]``
+
+    Examples
+    --------
+    >>> matrix_to_6d(np.eye(3))
+    array([1., 0., 0., 0., 1., 0.])
     """
     m = _as_float_array(matrix, "matrix", (3, 3))
     return np.concatenate([m[..., :, 0], m[..., :, 1]], axis=-1)
@@ -396,6 +457,13 @@ def sixd_to_matrix(sixd: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 3, 3) float64 with columns ``b1, b2, b1 × b2``.
+
+    Examples
+    --------
+    >>> sixd_to_matrix([2.0, 0, 0, 1, 1, 0])  # columns normalised and made orthogonal
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
     """
     d = _as_float_array(sixd, "sixd", (6,))
     a1, a2 = d[..., :3], d[..., 3:]

@@ -245,6 +245,15 @@ def palm_normals(dirs: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 2, 3) float64 unit vectors ``[left, right]`` (zero where the two vectors are parallel).
+
+    Examples
+    --------
+    >>> dirs = np.zeros((42, 3))
+    >>> dirs[[11, 28]] = [1, 0, 0]  # wrist -> pinky along x
+    >>> dirs[[17, 34]] = [0, 1, 0]  # wrist -> thumb along y
+    >>> palm_normals(dirs)
+    array([[0., 0., 1.],
+           [0., 0., 1.]])
     """
     d = _check_dirs(dirs)
     left = np.cross(d[..., _v("left_wrist", "left_pinky1"), :], d[..., _v("left_wrist", "left_thumb1"), :])
@@ -265,6 +274,17 @@ def pair_angles(dirs: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 41) float64 radians (HA2G divides them by π).
+
+    Examples
+    --------
+    >>> dirs = np.tile([1.0, 0, 0], (42, 1))
+    >>> dirs[17] = [0, 1, 0]  # palm normals exist: left pinky (x) and thumb (y) are not parallel
+    >>> dirs[34] = [0, 1, 0]
+    >>> angles = pair_angles(dirs)
+    >>> angles.shape, ANGLE_PAIRS[0], float(angles[0])  # bones 0 and 1 are parallel
+    ((41,), (0, 1), 0.0)
+    >>> ANGLE_PAIRS[12], round(float(angles[12]), 6)  # bone 17 (along y) against bone 18 (along x): pi / 2
+    ((17, 18), 1.570796)
     """
     d = _unit(_check_dirs(dirs))
     vecs = np.concatenate([d, palm_normals(d)], axis=-2)
@@ -317,6 +337,13 @@ def beat_to_ted43(
     Returns
     -------
     (T, 43, 3) float64, centimetres, in :data:`TED43_JOINTS` order.
+
+    Examples
+    --------
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> positions = beat_to_ted43(beat_skeleton(), np.zeros((2, 228)))
+    >>> positions.shape  # (T, 43, 3), cm
+    (2, 43, 3)
     """
     names, pos, rotations = _source_positions(source, channels, rotations, skeleton)
     _check_ted_joints(names)
@@ -387,6 +414,12 @@ def euler_to_directions(euler: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T, 42, 3) float64 unit vectors (the construction of ``build_windows``' ``"dirvec"``).
+
+    Examples
+    --------
+    >>> dirs = euler_to_directions(np.zeros((2, 141)))
+    >>> dirs.shape, np.allclose(np.linalg.norm(dirs, axis=-1), 1.0)
+    ((2, 42, 3), True)
     """
     euler = np.asarray(euler, dtype=np.float64)
     if euler.ndim != 2 or euler.shape[1] != 141:
@@ -406,6 +439,14 @@ def channels_to_directions(channels: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T, 42, 3) float64 unit vectors: forward kinematics -> ``beat_to_ted43`` -> bone directions.
+
+    Examples
+    --------
+    >>> dirs = channels_to_directions(np.zeros((3, 228)))
+    >>> dirs.shape, np.allclose(np.linalg.norm(dirs, axis=-1), 1.0)
+    ((3, 42, 3), True)
+    >>> np.allclose(dirs, euler_to_directions(np.zeros((3, 141))))  # rest pose either way
+    True
     """
     positions = forward_kinematics(beat_skeleton(), np.asarray(channels, dtype=np.float64))
     return positions_to_directions(beat_to_ted43(positions), np.asarray(TED_BONES))
@@ -415,6 +456,17 @@ def directions_to_ted_positions(directions: np.ndarray, lengths: np.ndarray | No
     """(T, 42, 3) unit directions -> (T, 43, 3) cm TED-43 positions, root at the origin.
 
     ``lengths`` (42,) cm default to :func:`rest_bone_lengths` (the common positions space).
+
+    Examples
+    --------
+    >>> dirs = euler_to_directions(np.zeros((1, 141)))
+    >>> positions = directions_to_ted_positions(dirs)
+    >>> positions.shape, positions[0, 0].tolist()  # root at the origin
+    ((1, 43, 3), [0.0, 0.0, 0.0])
+    >>> parent, child = np.asarray(TED_BONES).T
+    >>> lengths = np.linalg.norm(positions[0, child] - positions[0, parent], axis=-1)
+    >>> np.allclose(lengths, rest_bone_lengths())
+    True
     """
     lengths = rest_bone_lengths() if lengths is None else lengths
     return directions_to_positions(directions, np.asarray(TED_BONES), lengths, np.zeros(3))
