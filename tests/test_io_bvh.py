@@ -159,9 +159,23 @@ def test_read_header_only(tmp_path: Path) -> None:
         read_bvh(p)
 
 
-def test_zero_frames(tmp_path: Path) -> None:
-    m = read_bvh(write(tmp_path, small_bvh(frames="0", rows=[])))
-    assert m.channels.shape == (0, 12)
+def test_zero_frames_are_a_format_error_but_the_header_reads(tmp_path: Path) -> None:
+    """An empty MOTION block is no motion (it was read as a (0, C) take); the skeleton alone still reads."""
+    path = write(tmp_path, small_bvh(frames="0", rows=[]))
+    with pytest.raises(FormatError, match="no motion") as info:
+        read_bvh(path)
+    assert info.value.field == "Frames"
+    assert read_bvh_header(path)[1] == 0
+
+
+def test_a_joint_with_two_end_sites_is_a_format_error(tmp_path: Path) -> None:
+    """A Skeleton holds one End Site per joint: the second silently replaced the first."""
+    text = small_bvh(frames="1", rows=["0 " * 12])
+    site = "End Site\n{\nOFFSET 0 1 0\n}\n"
+    i = text.index("End Site")
+    doubled = text[:i] + site + text[i:]
+    with pytest.raises(FormatError, match="second End Site"):
+        read_bvh(write(tmp_path, doubled))
 
 
 # ----------------------------------------------------------------------------- real files

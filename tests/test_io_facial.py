@@ -146,3 +146,25 @@ def test_load_take_face_is_51_wide_by_name(tmp_path: Path) -> None:
     np.testing.assert_allclose(take.face, _weights(n, ARKIT_51)[::4], rtol=1e-6)  # 60 -> 15 fps
     raw = load_take(stem, blendshapes=None)  # the file's own columns
     assert raw.face is not None and raw.face.shape == (30, 52)
+
+
+def test_an_empty_track_is_an_error_and_a_hole_in_the_time_stamps_warns_with_its_size(tmp_path: Path) -> None:
+    """A 10 s hole was read silently as a uniform 60 fps track; an empty track was accepted."""
+    import warnings
+
+    write_facial(tmp_path / "empty.json", ARKIT_51, np.zeros((0, 51)), fps=60)
+    with pytest.raises(FormatError, match="no frames"):
+        read_facial(tmp_path / "empty.json")
+    times = np.concatenate([np.arange(120) / 60, 12.0 + np.arange(120) / 60])  # 2 s, a 10 s hole, 2 s
+    write_facial(tmp_path / "hole.json", ARKIT_51, np.full((240, 51), 0.5), fps=60, times=times)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        face = read_facial(tmp_path / "hole.json")
+    messages = [str(w.message) for w in caught if issubclass(w.category, FormatWarning)]
+    assert face.fps == 60 and len(messages) == 1, messages
+    gap = times[120] - times[119]  # 10.0167 s between frames 119 and 120: 10 s of frames missing
+    assert f"{gap:.3f} s after frame 119" in messages[0] and f"{gap - 1 / 60:.3f} s early" in messages[0]
+    write_facial(tmp_path / "even.json", ARKIT_51, np.full((240, 51), 0.5), fps=60)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a regular track: no warning
+        read_facial(tmp_path / "even.json")

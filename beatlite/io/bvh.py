@@ -268,6 +268,8 @@ def _parse_end_site(tokens: _Tokens, joints: _Joints, j: int) -> None:
     tokens.expect("{")
     tokens.expect("OFFSET")
     what = f"End Site OFFSET of {joints.names[j]!r}"
+    if j in joints.end_sites:  # a Skeleton holds one End Site per joint: a second would replace the first
+        raise FormatError(tokens.path, f"joint {joints.names[j]!r} has a second End Site", line=site_line)
     joints.end_sites[j] = np.array([tokens.number(what) for _ in range(3)])
     tokens.expect("}")
 
@@ -774,6 +776,10 @@ def read_bvh(
         file_fps = None
     channels = _parse_motion(data, skeleton.n_channels, n_header + 1, p)
     n_rows = channels.shape[0]
+    if n_rows == 0:
+        raise FormatError(
+            p, f"no motion: the MOTION block has no rows ('Frames: {n_declared}')", field="Frames"
+        )
     if strict and n_rows != n_declared:
         raise FormatError(p, f"'Frames: {n_declared}' but the MOTION block has {n_rows} rows", field="Frames")
     rate = _settle_rate(p, n_declared, file_fps, n_rows, fps)

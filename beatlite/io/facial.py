@@ -275,6 +275,8 @@ def read_facial(path: str | os.PathLike[str], *, names: Sequence[str] | None = N
     p = Path(path)
     doc = _parse_json(p)
     frames, k = doc["frames"], len(doc["names"])
+    if not frames:
+        raise FormatError(p, "no frames: an empty facial track", field="frames")
     times = np.empty(len(frames), dtype=np.float64)
     weights = np.empty((len(frames), k), dtype=np.float32)
     for i, frame in enumerate(frames):
@@ -295,8 +297,31 @@ def read_facial(path: str | os.PathLike[str], *, names: Sequence[str] | None = N
         raise FormatError(
             p, f"frame times imply {fps:g} fps, outside {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}", field="frames"
         )
+    _warn_on_holes(p, times, fps)
     facial = Facial(names=tuple(doc["names"]), weights=weights, times=times, fps=fps)
     return facial if names is None else select_blendshapes(facial, names, path=p)
+
+
+#: A step between time stamps longer than this many frame periods is a hole in the track.
+HOLE_PERIODS = 1.5
+
+
+def _warn_on_holes(path: Path, times: np.ndarray, fps: float) -> None:
+    """One :class:`FormatWarning` naming the largest gap when the time stamps skip frames: the weights are used
+    as a uniform ``fps`` track (``Facial.weights[i]`` at ``i / fps``), so frames after a hole come early."""
+    steps = np.diff(times)
+    holes = np.flatnonzero(steps > HOLE_PERIODS / fps)
+    if holes.size:
+        i = int(holes[np.argmax(steps[holes])])
+        missing = float(np.sum(steps[holes]) - holes.size / fps)
+        warnings.warn(
+            FormatWarning(
+                f"{path}: {holes.size} hole(s) in the time stamps at {fps:g} fps, the largest {steps[i]:.3f} s "
+                f"after frame {i} ({times[i]:.3f} s); read as a uniform track, frames after the holes are "
+                f"{missing:.3f} s early (resample by `times` to keep them in place)"
+            ),
+            stacklevel=3,
+        )
 
 
 def write_facial(
