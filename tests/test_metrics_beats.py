@@ -459,3 +459,35 @@ def test_audio_beats_librosa_peak_picking_equals_onset_detect():
     y = AUDIO + np.random.default_rng(1).normal(scale=0.003, size=AUDIO.shape).astype(np.float32)
     ref = librosa.onset.onset_detect(y=y, sr=SR, units="time")
     np.testing.assert_allclose(audio_beats(y, SR, peak_pick="librosa"), ref, atol=1e-9)
+
+
+WORKER = """
+import numpy as np
+from beatlite.metrics.beats import audio_beats
+y = (0.1 * np.sin(np.arange(32000) * 0.05) * (np.arange(32000) % 8000 < 800)).astype(np.float32)
+print(len(audio_beats(y, 16000, peak_pick="librosa", backtrack="rms")), len(audio_beats(y, 16000)))
+"""
+
+
+@pytest.mark.slow
+def test_workers_started_after_warm_up_detect_onsets_from_a_fresh_numba_cache(tmp_path):
+    """Fresh processes compiling librosa's numba code at once can corrupt numba's cache (numba#10128): warm_up
+    compiles it once in the parent; three workers started together on that cache then all detect onsets."""
+    import os
+    import subprocess
+    import sys
+
+    env = {
+        **os.environ,
+        "NUMBA_CACHE_DIR": str(tmp_path / "numba"),
+    }  # an empty cache, as in a fresh environment
+    warm = subprocess.run([sys.executable, "-c", "from beatlite.metrics.beats import warm_up; warm_up()"],
+                          env=env, capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert warm.returncode == 0, warm.stderr
+    assert any((tmp_path / "numba").rglob("*.nbi")), "warm_up left no compiled code in the cache"
+    workers = [subprocess.Popen([sys.executable, "-c", WORKER], env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True) for _ in range(3)]  # fmt: skip
+    outs = [w.communicate(timeout=600) for w in workers]
+    for w, (_, err) in zip(workers, outs, strict=True):
+        assert w.returncode == 0, err[-3000:]
+    assert len({out for out, _ in outs}) == 1  # the same onsets in every worker

@@ -110,6 +110,31 @@ def audio_beats(
     return np.asarray(frames, dtype=np.float64) * hop_length / pick_sr
 
 
+_WARM: list[bool] = []
+
+
+def warm_up() -> None:
+    """Compile, once per process, the numba functions of librosa that :func:`audio_beats` runs (onset strength,
+    both peak pickers, both backtracks).
+
+    Call it before starting worker processes that detect onsets (``retrain-all --jobs``): numba keeps
+    compiled code in an on-disk cache, and several fresh processes compiling the same functions at once can
+    corrupt it (numba#10128, librosa#1998: every later ``onset_detect`` then segfaults). Compiled here
+    first, the workers only read the cache. About 20 s in a fresh environment, instant afterwards.
+
+    Examples
+    --------
+    >>> warm_up()  # later calls return at once
+    """
+    if _WARM:
+        return
+    y = (0.1 * np.sin(np.arange(16000) * 0.05) * (np.arange(16000) % 4000 < 400)).astype(np.float32)
+    for pick in ("beatlite", "librosa"):
+        for backtrack in (None, "rms", "onset"):
+            audio_beats(y, 16000, peak_pick=pick, backtrack=backtrack)
+    _WARM.append(True)
+
+
 def stft_magnitude(
     y: np.ndarray, *, n_fft: int = 2048, hop_length: int = 512, chunk: int = 2048
 ) -> np.ndarray:

@@ -38,6 +38,7 @@ from beatlite import models, paths
 from beatlite.data.index import index_folder
 from beatlite.data.store import build_store
 from beatlite.data.vocab import build_vocab, take_sentences, word_vectors
+from beatlite.metrics.beats import warm_up
 from beatlite.models import build_model, model_class, presets
 from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
 from beatlite.train.config import TrainConfig
@@ -497,6 +498,7 @@ def retrain_many(
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    warm_up()  # librosa's numba code compiled here once, not by the workers at once (a corrupted cache)
     with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
         futures = [
             pool.submit(_retrain_in_worker, name, seed, None if out is None else str(out), epochs)
