@@ -516,3 +516,29 @@ def test_a_save_killed_midway_leaves_no_temp_file_after_the_next_save(windows, t
     save_checkpoint(tmp_path / "c.pt", {"format": "beatlite-checkpoint/1", "model": {}, "state": {}})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.pt"]
     assert load_checkpoint(tmp_path / "c.pt")["state"] == {}
+
+
+def test_convert_legacy_needs_trust_and_writes_a_plain_copy(windows, tmp_path):
+    import pathlib
+
+    from beatlite.io import FormatError
+    from beatlite.train.checkpoint import convert_legacy, load_checkpoint
+
+    train, _ = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "t.pt"))
+    data = load_checkpoint(tmp_path / "t.pt")
+    legacy = {
+        **data,
+        "meta": {**data["meta"], "source": pathlib.PurePosixPath("/data/beat")},
+    }  # a pickled object
+    torch.save(legacy, tmp_path / "legacy.pt")
+    with pytest.raises(FormatError, match="convert_legacy"):
+        load_checkpoint(tmp_path / "legacy.pt")
+    with pytest.raises(PermissionError, match="trust=True"):
+        convert_legacy(tmp_path / "legacy.pt", tmp_path / "plain.pt")
+    convert_legacy(tmp_path / "legacy.pt", tmp_path / "plain.pt", trust=True)
+    plain = load_checkpoint(tmp_path / "plain.pt")
+    assert plain["meta"]["source"] == "/data/beat"
+    assert all(torch.equal(v, data["state"][k]) for k, v in plain["state"].items())
+    model, _ = load_model(tmp_path / "plain.pt")
+    assert all(torch.equal(v, data["state"][k]) for k, v in model.state_dict().items())

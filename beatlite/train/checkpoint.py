@@ -112,7 +112,9 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         ]
         reason = lines[0] if lines else type(exc).__name__
         raise FormatError(
-            path, f"not a plain torch checkpoint (tensors and plain values only): {reason}"
+            path,
+            f"not a plain torch checkpoint (tensors and plain values only): {reason}; if you trust where the "
+            "file comes from, beatlite.train.checkpoint.convert_legacy(path, new_path, trust=True) rewrites it",
         ) from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise FormatError(path, f"not a beatlite checkpoint (missing format {FORMAT!r})", field="format")
@@ -197,3 +199,42 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
             for k, v in keep["state"].items()
         }
     return save_checkpoint(dst, keep)
+
+
+def convert_legacy(src: str | Path, dst: str | Path, *, trust: bool = False) -> Path:
+    """Rewrite a checkpoint that only the full (code-running) unpickler can read as a plain one.
+
+    For a file of a source you trust, made by an older beatlite or another tool that pickled objects
+    (numpy arrays of other dtypes, ``pathlib`` paths, ...): it is loaded with ``weights_only=False``,
+    which runs whatever code the file holds, so ``trust=True`` must be passed explicitly. The copy keeps
+    tensors and plain values only (numpy arrays become tensors, other objects their ``str``) and then
+    loads with :func:`load_checkpoint`.
+
+    Raises
+    ------
+    PermissionError
+        ``trust`` is not True.
+    """
+    if trust is not True:
+        raise PermissionError(
+            f"convert_legacy({src}): loading it runs any code it holds; pass trust=True only for a file you trust"
+        )
+    data = torch.load(Path(src), map_location="cpu", weights_only=False)  # the explicit opt-in above
+    save_checkpoint(dst, _plain(data))
+    load_checkpoint(dst)  # the copy reads without running code
+    return Path(dst)
+
+
+def _plain(value: Any) -> Any:
+    """Tensors, numbers, strings, None, and dicts/lists/tuples of them; numpy arrays as tensors, the rest as str."""
+    if torch.is_tensor(value) or value is None or isinstance(value, bool | int | float | str):
+        return value
+    if isinstance(value, np.ndarray):
+        return torch.from_numpy(np.array(value))
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {k if isinstance(k, int | str) else str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_plain(v) for v in value)
+    return str(value)
