@@ -313,3 +313,38 @@ def test_one_stem_rule_and_a_foreign_skeleton_make_takes_unusable_with_a_reason(
     assert take_stem(tmp_path / "2_scott_0_1_1.v2.bvh").name == "2_scott_0_1_1.v2"  # the index's stem
     foreign = idx["2_scott_0_9_9"]
     assert not foreign.usable and any("not BEAT's skeleton" in p and "Spine" in p for p in foreign.problems)
+
+
+def test_usable_means_the_window_features_build_on_random_broken_takes(tmp_path: Path) -> None:
+    """A property, on seeded random takes (a renamed joint, a dot in the name, motion cut short): every take the
+    index calls usable builds its window features (what build_store runs), every other take says why."""
+    from test_data_windows import write_take
+
+    from beatlite.data.windows import take_features
+    from beatlite.skeleton.beat import beat_skeleton
+
+    rng = np.random.default_rng(25)
+    joints = beat_skeleton().names[1:]
+    for i in range(12):
+        stem = f"2_scott_0_{i + 1}_{i + 1}" + (".v2" if rng.random() < 0.2 else "")
+        write_take(tmp_path, stem, int(rng.integers(40, 90)))
+        bvh = tmp_path / f"{stem}.bvh"
+        if (
+            rng.random() < 0.5
+        ):  # rename one joint (a leg joint leaves the take usable, a spine or hand joint not)
+            name = str(rng.choice(joints))
+            bvh.write_text(bvh.read_text().replace(f"JOINT {name}\n", f"JOINT {name}_x\n"))
+        if rng.random() < 0.2:  # cut the motion to a third: the durations disagree
+            lines = bvh.read_text().splitlines()
+            motion = lines.index("MOTION")
+            rows = lines[motion + 3 :]
+            lines[motion + 1] = f"Frames: {len(rows) // 3}"
+            bvh.write_text("\n".join(lines[: motion + 3] + rows[: len(rows) // 3]) + "\n")
+    index = index_folder(tmp_path, cache=False)
+    usable = [r for r in index if r.usable]
+    assert 0 < len(usable) < len(index)  # the draw has both kinds
+    for record in index:
+        if record.usable:
+            take_features(record, mel=False)  # raises if "usable" lied
+        else:
+            assert record.problems, record.stem
