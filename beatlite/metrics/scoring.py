@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -157,6 +158,11 @@ class Metric:
         One line for a table caption: the variant and its parameters.
     source : str
         Where the variant comes from (paper, code, section) and what it differs in.
+    bounds : (float, float)
+        The values the metric can take (``(0, 1)`` for a fraction; default unbounded).
+    perfect : float or None
+        Its value when the system is the ground truth itself, where that is a constant (FGD 0, PCK 1);
+        None where it depends on the data (SRGR, BeatAlign, BC: the ground truth's own value).
 
     Examples
     --------
@@ -174,6 +180,8 @@ class Metric:
     compute: Callable[[Takes, GroundTruth, int], float]
     describe: str
     source: str = ""
+    bounds: tuple[float, float] = (-math.inf, math.inf)
+    perfect: float | None = None
 
     def __post_init__(self) -> None:
         if self.needs is None:
@@ -634,5 +642,24 @@ def _metrics() -> dict[str, Metric]:
     }  # fmt: skip
 
 
-METRICS: dict[str, Metric] = _metrics()
+#: The values each built-in metric can take, by name (``SRGR (reference)``, weighted by score / 0.165, can exceed 1).
+BOUNDS: dict[str, tuple[float, float]] = {
+    "FGD": (0.0, math.inf), "SRGR": (0.0, 1.0), "BeatAlign": (0.0, 1.0), "BC": (0.0, 1.0),
+    "Diversity": (0.0, math.inf), "L1div": (0.0, math.inf), "PCK": (0.0, 1.0), "MPJPE": (0.0, math.inf),
+    "Acceleration": (0.0, math.inf), "Jerk": (0.0, math.inf), "Speed Hellinger": (0.0, 1.0),
+}  # fmt: skip
+#: Built-in metrics whose value for the ground truth itself is a constant, by name.
+PERFECT: dict[str, float] = {"FGD": 0.0, "PCK": 1.0, "MPJPE": 0.0, "Speed Hellinger": 0.0}
+
+
+def _with_bounds(metrics: dict[str, Metric]) -> dict[str, Metric]:
+    """The built-in metrics with their :data:`BOUNDS` and :data:`PERFECT` values."""
+    out = {}
+    for key, m in metrics.items():
+        bounds = (0.0, math.inf) if key == "SRGR (reference)" else BOUNDS.get(m.name, m.bounds)
+        out[key] = dataclasses.replace(m, bounds=bounds, perfect=PERFECT.get(m.name))
+    return out
+
+
+METRICS: dict[str, Metric] = _with_bounds(_metrics())
 """Every metric a table can show, by key (``"<name>"`` or ``"<name> (<variant>)"``)."""
