@@ -11,18 +11,6 @@ the same way as the built-in ones (``tests/test_metrics_contract.py`` runs it ov
   ``bounds`` and, when the metric declares ``perfect``, is strictly worse than it;
 - a declared ``perfect`` value sits at the better end of the bounds (``higher_is_better`` says which end).
 
-Examples
---------
->>> from beatlite.metrics.scoring import METRICS
->>> check_metric("PCK", METRICS["PCK"], truth_value=1.0, degraded_value=0.4)
->>> check_metric("PCK", METRICS["PCK"], truth_value=1.0, degraded_value=1.2)
-Traceback (most recent call last):
-    ...
-AssertionError: PCK: degraded value 1.2 outside its bounds (0.0, 1.0)
->>> check_metric("MPJPE", METRICS["MPJPE"], truth_value=0.0, degraded_value=0.0)
-Traceback (most recent call last):
-    ...
-AssertionError: MPJPE: the degraded system scores 0.0, as good as perfect 0.0
 """
 
 from __future__ import annotations
@@ -50,6 +38,19 @@ def check_metric(key: str, metric: Metric, *, truth_value: float, degraded_value
     ------
     AssertionError
         Naming the key and the rule it breaks.
+
+    Examples
+    --------
+    >>> from beatlite.metrics.scoring import METRICS
+    >>> check_metric("PCK", METRICS["PCK"], truth_value=1.0, degraded_value=0.4)
+    >>> check_metric("PCK", METRICS["PCK"], truth_value=1.0, degraded_value=1.2)
+    Traceback (most recent call last):
+        ...
+    AssertionError: PCK: degraded value 1.2 outside its bounds (0.0, 1.0)
+    >>> check_metric("MPJPE", METRICS["MPJPE"], truth_value=0.0, degraded_value=0.0)
+    Traceback (most recent call last):
+        ...
+    AssertionError: MPJPE: the degraded system scores 0.0, as good as perfect 0.0
     """
     _require(metric.describe.strip(), f"{key}: no describe line (what a table caption prints)")
     _require(metric.source.strip(), f"{key}: no source (paper, code or section of the variant)")
