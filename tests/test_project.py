@@ -104,6 +104,33 @@ def test_notebook_is_stripped(path):
     assert not dirty, f"{path.name}: cells {dirty} carry outputs; strip them before committing"
 
 
+def _checks_in_teaching_cells(path: Path) -> list[str]:
+    """``assert`` statements and ``np.testing.assert_*`` calls in code cells not tagged ``check`` or ``solution``."""
+    nb = json.loads(path.read_text())
+    found = []
+    for i, cell in enumerate(nb["cells"]):
+        tags = cell.get("metadata", {}).get("tags", [])
+        if cell["cell_type"] != "code" or {"check", "solution"} & set(tags):
+            continue
+        src = "".join(cell["source"])
+        src = "\n".join(line for line in src.splitlines() if not line.lstrip().startswith(("%", "!")))
+        for node in ast.walk(ast.parse(src)):
+            is_call = isinstance(node, ast.Call) and ".testing.assert_" in ast.unparse(node.func)
+            if isinstance(node, ast.Assert) or is_call:
+                found.append(f"cell {i} line {node.lineno}")
+    return found
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_checks_sit_in_check_cells(path):
+    """Teaching cells hold no assertion: each sits in a cell tagged ``check`` after the cell it checks.
+
+    A lecture can hide the ``check`` cells; nbval and ``make run`` still execute them (docs/teaching.md).
+    """
+    found = _checks_in_teaching_cells(path)
+    assert not found, f"{path.name}: move these assertions to a cell tagged `check`: {found}"
+
+
 def _notebook_imports(path: Path) -> set[str]:
     nb = json.loads(path.read_text())
     names: set[str] = set()
