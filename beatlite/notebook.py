@@ -36,6 +36,9 @@ def require(version: str) -> None:
         )
 
 
+_require_version = require  # setup()'s argument of the same name shadows the function
+
+
 def interactive() -> bool:
     """True in a live Jupyter kernel that may show widgets.
 
@@ -95,16 +98,21 @@ def _inline_figures() -> None:
         shell.run_line_magic("matplotlib", "inline")
 
 
-def setup(seed: int = 0, *, verbose: bool = True) -> dict[str, str]:
+def setup(seed: int = 0, *, require: str | None = None, verbose: bool = True) -> dict[str, str]:
     """Prepare a notebook: seed numpy/random (and torch if it is imported), set torch threads.
 
-    Inside Jupyter it also switches matplotlib to inline figures, so executed
-    notebooks keep their figures even when the environment says ``MPLBACKEND=Agg``.
+    The one call of every notebook's first cell, after its imports (so that ``torch``, when the
+    notebook imports it, is seeded and gets ``BEATLITE_THREADS`` threads). Inside Jupyter it also
+    switches matplotlib to inline figures (no ``%matplotlib inline`` needed), so executed notebooks
+    keep their figures even when the environment says ``MPLBACKEND=Agg``.
 
     Parameters
     ----------
     seed : int
         Seed for ``random``, ``numpy`` and, when already imported, ``torch``.
+    require : str, optional
+        The oldest beatlite the notebook runs with (e.g. ``"0.1"``): :func:`require` raises
+        ``RuntimeError`` before anything else when the installed one is older.
     verbose : bool
         Print a one-line summary.
 
@@ -112,8 +120,21 @@ def setup(seed: int = 0, *, verbose: bool = True) -> dict[str, str]:
     -------
     dict
         ``version``, ``mode``, ``data``, ``threads``, ``python``.
+
+    Examples
+    --------
+    >>> info = setup(seed=0, require="0.1", verbose=False)
+    >>> sorted(info)
+    ['data', 'mode', 'python', 'threads', 'version']
+    >>> setup(require="99.0")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    RuntimeError: these notebooks need beatlite >= 99.0, installed is ...
     """
     import sys
+
+    if require is not None:
+        _require_version(require)
 
     random.seed(seed)
     np.random.seed(seed)  # noqa: NPY002 - legacy global seed for student code that uses np.random.*

@@ -228,3 +228,18 @@ def test_speaker_split_table_default_columns_are_the_splits_present() -> None:
     lines = speaker_split_table(idx).splitlines()
     assert lines[0] == "| speaker | train takes | none takes | train min | none min |"
     assert lines[-1] == "| **all** | 1 | 1 | 1.0 | 2.0 |"
+
+
+# ------------------------------------------------------------------ notebook.setup
+def test_setup_checks_the_version_before_seeding() -> None:
+    """``setup(require=...)`` replaces a notebook's separate ``notebook.require`` line: it refuses first."""
+    from beatlite import notebook
+
+    np.random.seed(5)  # noqa: NPY002 - setup seeds the legacy global state
+    state = np.random.get_state()[1].copy()  # noqa: NPY002
+    with pytest.raises(RuntimeError, match=r"beatlite >= 99\.0"):
+        notebook.setup(seed=0, require="99.0", verbose=False)
+    assert np.array_equal(np.random.get_state()[1], state)  # noqa: NPY002 - refused before seeding
+    info = notebook.setup(seed=0, require="0.1", verbose=False)
+    assert info == notebook.setup(seed=0, verbose=False)
+    assert np.random.rand() == np.random.RandomState(0).rand()  # noqa: NPY002

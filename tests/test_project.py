@@ -104,6 +104,66 @@ def test_notebook_is_stripped(path):
     assert not dirty, f"{path.name}: cells {dirty} carry outputs; strip them before committing"
 
 
+def _checks_in_teaching_cells(path: Path) -> list[str]:
+    """``assert`` statements and ``np.testing.assert_*`` calls in code cells not tagged ``check`` or ``solution``."""
+    nb = json.loads(path.read_text())
+    found = []
+    for i, cell in enumerate(nb["cells"]):
+        tags = cell.get("metadata", {}).get("tags", [])
+        if cell["cell_type"] != "code" or {"check", "solution"} & set(tags):
+            continue
+        src = "".join(cell["source"])
+        src = "\n".join(line for line in src.splitlines() if not line.lstrip().startswith(("%", "!")))
+        for node in ast.walk(ast.parse(src)):
+            is_call = isinstance(node, ast.Call) and ".testing.assert_" in ast.unparse(node.func)
+            if isinstance(node, ast.Assert) or is_call:
+                found.append(f"cell {i} line {node.lineno}")
+    return found
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_checks_sit_in_check_cells(path):
+    """Teaching cells hold no assertion: each sits in a cell tagged ``check`` after the cell it checks.
+
+    A lecture can hide the ``check`` cells; nbval and ``make run`` still execute them (docs/teaching.md).
+    """
+    found = _checks_in_teaching_cells(path)
+    assert not found, f"{path.name}: move these assertions to a cell tagged `check`: {found}"
+
+
+def _figure_saves_not_via_save_figure(path: Path) -> list[str]:
+    """Figure saves other than ``bl.viz.save_figure(fig, ...)``: ``savefig``, ``out=`` to a plot function, aliases."""
+    nb = json.loads(path.read_text())
+    found = []
+    for i, cell in enumerate(nb["cells"]):
+        if cell["cell_type"] != "code":
+            continue
+        src = "".join(cell["source"])
+        src = "\n".join(line for line in src.splitlines() if not line.lstrip().startswith(("%", "!")))
+        for node in ast.walk(ast.parse(src)):
+            if not isinstance(node, ast.Call):
+                continue
+            func = ast.unparse(node.func)
+            if func.endswith(("savefig", "save_figure")) and func != "bl.viz.save_figure":
+                found.append(f"cell {i}: {func}(...)")
+            for k in node.keywords:  # a plot function's own out= argument
+                if k.arg == "out" and (
+                    "figures_dir" in ast.unparse(k.value) or "FIGURES" in ast.unparse(k.value)
+                ):
+                    found.append(f"cell {i}: {func}(out=...)")
+    return found
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_figures_are_saved_one_way(path):
+    """Every notebook figure is written by ``bl.viz.save_figure(fig, bl.report.figures_dir() / "NN_name")``.
+
+    ``make run`` collects them in ``build/figures/`` as ``NN_name.png`` and ``NN_name.svg`` (docs/teaching.md).
+    """
+    found = _figure_saves_not_via_save_figure(path)
+    assert not found, f"{path.name}: save figures with bl.viz.save_figure: {found}"
+
+
 def _notebook_imports(path: Path) -> set[str]:
     nb = json.loads(path.read_text())
     names: set[str] = set()
