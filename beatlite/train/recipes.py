@@ -150,7 +150,7 @@ is flat within noise after epoch 16 (seed 2021: best 3.19 at epoch 22 of 30)."""
 HA2G_LR = 2e-3
 """HA2G's learning rate: at 1e-3 its validation FGD was still falling steeply at epoch 30 (seed 2021:
 6.6 at epoch 24, 3.71 at 29; test FGD 5.45); at 2e-3 the same seed reached 2.57 (test 3.52)."""
-DIFFGESTURE_EPOCHS = 25
+DIFFGESTURE_EPOCHS = 40
 """Epochs of the DiffGesture checkpoint (about 21 steps of 32 windows each on ``data_samples/``)."""
 DIFFGESTURE_LR = 1e-3
 """DiffGesture's learning rate. ``select_best`` is off: scoring an epoch by validation FGD samples every
