@@ -1,4 +1,4 @@
-"""Gesture models (CaMN, HA2G and baselines), built by name; torch is imported lazily.
+"""Gesture models (CaMN, HA2G, DiffGesture and baselines), built by name; torch is imported lazily.
 
 Usage (skipped by the doctests: building a network is covered by ``tests/test_models_*.py``):
 
@@ -21,6 +21,7 @@ name                 class                                                    re
 ``seq2seq``          :class:`beatlite.models.seq2seq.Seq2Seq`                 euler141
 ``a2g``              :class:`beatlite.models.a2g.A2G`                         euler141
 ``joint_embedding``  :class:`beatlite.models.joint_embedding.JointEmbedding`  euler141
+``diffgesture``      :class:`beatlite.models.diffgesture.DiffGesture`         dirvec126
 ===================  =======================================================  ==============
 
 The table lists the built-in registry :data:`MODELS` (``tests/test_models_contract.py`` checks it);
@@ -47,6 +48,7 @@ MODELS: dict[str, tuple[str, str] | type[GestureModel]] = {
     "seq2seq": ("beatlite.models.seq2seq", "Seq2Seq"),
     "a2g": ("beatlite.models.a2g", "A2G"),
     "joint_embedding": ("beatlite.models.joint_embedding", "JointEmbedding"),
+    "diffgesture": ("beatlite.models.diffgesture", "DiffGesture"),
 }
 """Registry: model name -> (module, class name), imported on first use, or a registered class."""
 
