@@ -690,13 +690,9 @@ def index_folder(
 
     Examples
     --------
-    >>> import shutil, tempfile
-    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> index.stems, [r.split for r in index], all(r.usable for r in index)
     (['2_scott_0_1_1', '2_scott_0_9_9'], ['test', 'train'], True)

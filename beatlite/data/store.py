@@ -367,13 +367,10 @@ class StoreTake:
 
     Examples
     --------
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> store = build_store(index, Path(tmp.name) / "store")
     >>> take = store.take("2_scott_0_1_1")
@@ -446,13 +443,10 @@ class WindowStore:
 
     Examples
     --------
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> store = build_store(index, Path(tmp.name) / "store")
     >>> len(store), store.n_frames("test")
@@ -594,13 +588,10 @@ class StoreWindows:
 
     Examples
     --------
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
     >>> len(windows)  # 34-frame windows every 10 frames of a 222-frame take
@@ -977,13 +968,10 @@ def build_store(
 
     Examples
     --------
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> store = build_store(index, Path(tmp.name) / "store")
     >>> [t.stem for t in store.takes], len(store.vocab) > 4

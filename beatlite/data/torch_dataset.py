@@ -59,13 +59,10 @@ class WindowDataset(Dataset):
     Examples
     --------
     >>> from beatlite.data.store import build_store
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
     >>> dataset = WindowDataset(windows, keys=("pose", "word"))
@@ -141,13 +138,10 @@ def window_loader(
     Examples
     --------
     >>> from beatlite.data.store import build_store
-    >>> import shutil, tempfile
     >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> windows = build_store(index, Path(tmp.name) / "store").windows("test")
     >>> loader = window_loader(windows, batch_size=8, keys=("pose",))

@@ -356,13 +356,9 @@ class Windows:
 
     Examples
     --------
-    >>> import shutil, tempfile
-    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> windows = build_windows(index, split="test", cache=False)  # statistics from the train take
     >>> len(windows), windows["pose"].shape, windows["dirvec"].shape
@@ -627,13 +623,9 @@ def build_windows(
 
     Examples
     --------
-    >>> import shutil, tempfile
-    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
     >>> from beatlite.data.index import index_folder
-    >>> from beatlite.paths import repo_root
-    >>> tmp = tempfile.TemporaryDirectory()
-    >>> for p in (repo_root() / "data_samples").glob("2_scott_0_[19]_[19].*"):  # a test and a train take
-    ...     _ = shutil.copy(p, tmp.name)
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
     >>> index = index_folder(tmp.name, cache=False)
     >>> takes = build_windows(index, split="test", whole_takes=True, cache=False)
     >>> len(takes), takes["pose"][0].shape  # one 222-frame take

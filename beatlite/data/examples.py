@@ -1,0 +1,38 @@
+"""Small example corpora for docstring Examples and quick experiments (as ``librosa.ex`` gives example audio).
+
+:func:`example_corpus` copies a few takes of the shipped ``data_samples/`` into a temporary folder, so an Example
+can index, window or build a store without writing into the repository.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+
+from beatlite.paths import repo_root
+
+#: The default takes: test take ``2_scott_0_1_1`` (222 frames) and train take ``2_scott_0_9_9``.
+DEFAULT_PATTERN = "2_scott_0_[19]_[19]"
+
+
+def example_corpus(pattern: str = DEFAULT_PATTERN) -> tempfile.TemporaryDirectory:
+    """A temporary copy of the ``data_samples/`` takes whose stems match the glob ``pattern``.
+
+    Returns
+    -------
+    tempfile.TemporaryDirectory
+        ``.name`` is the folder (every file of each matching take: ``.bvh.gz``, ``.wav``, ``.json.gz``, ...);
+        ``.cleanup()`` removes it (so does the end of the process).
+
+    Examples
+    --------
+    >>> tmp = example_corpus()
+    >>> from pathlib import Path
+    >>> sorted(p.name for p in Path(tmp.name).glob("*.wav"))
+    ['2_scott_0_1_1.wav', '2_scott_0_9_9.wav']
+    >>> tmp.cleanup()
+    """
+    tmp = tempfile.TemporaryDirectory(prefix="beatlite_example_")
+    for path in sorted((repo_root() / "data_samples").glob(f"{pattern}.*")):
+        shutil.copy(path, tmp.name)
+    return tmp
