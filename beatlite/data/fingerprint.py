@@ -187,6 +187,15 @@ def takes_fingerprint(records: Iterable[TakeRecord], params: Mapping[str, Any]) 
     return h.hexdigest()
 
 
+def vocab_hash(vocab: Iterable[str]) -> str:
+    """sha256 (64 hex digits) of a vocabulary's words in id order (``Vocab.itos``).
+
+    >>> vocab_hash(["<pad>", "hello"]) == vocab_hash(["<pad>", "hello"]) != vocab_hash(["hello", "<pad>"])
+    True
+    """
+    return hashlib.sha256("\n".join(vocab).encode()).hexdigest()
+
+
 def windows_fingerprint(
     take_fingerprints: Iterable[str], *, split: str | None, length: int, stride: int, vocab: Iterable[str]
 ) -> str:
@@ -209,8 +218,9 @@ def windows_fingerprint(
     >>> len(a), a == windows_fingerprint(["ab" * 32], split="test", length=34, stride=5, vocab=["<pad>", "hello"])
     (16, False)
     """
-    vocab_hash = hashlib.sha256("\n".join(vocab).encode()).hexdigest()
-    h = _params_hash({"split": split, "length": int(length), "stride": int(stride), "vocab": vocab_hash})
+    h = _params_hash(
+        {"split": split, "length": int(length), "stride": int(stride), "vocab": vocab_hash(vocab)}
+    )
     for fp in take_fingerprints:
         h.update(f"{fp}\n".encode())
     return h.hexdigest()[:16]

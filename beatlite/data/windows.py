@@ -724,10 +724,6 @@ def _windows_fingerprint(
     return windows_fingerprint(takes, split=params["split"], length=length, stride=stride, vocab=vocab.itos)
 
 
-def _vocab_hash(vocab: Vocab) -> str:
-    return hashlib.sha256("\n".join(vocab.itos).encode()).hexdigest()
-
-
 def _windows_cache_path(
     records: Sequence[TakeRecord],
     params: dict[str, Any],
@@ -738,11 +734,12 @@ def _windows_cache_path(
     folder = _cache_folder(cache)
     if folder is None:
         return None
-    vocab_hash = _vocab_hash(vocab)
+    from beatlite.data.fingerprint import vocab_hash
+
     stats_hash = hashlib.sha256(
         b"".join(a.tobytes() for a in (stats.pose.mean, stats.pose.std, stats.dirvec.mean))
     ).hexdigest()
-    fp = _fingerprint(records, {**params, "vocab": vocab_hash, "stats": stats_hash})
+    fp = _fingerprint(records, {**params, "vocab": vocab_hash(vocab.itos), "stats": stats_hash})
     return folder / f"windows_{params['split']}_{'takes' if params['whole_takes'] else 'win'}_{fp[:20]}.npz"
 
 

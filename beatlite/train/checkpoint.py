@@ -53,17 +53,27 @@ def _numpy_array_globals() -> list[Any]:
 NUMPY_ARRAY_GLOBALS = _numpy_array_globals()
 
 
-def _tensors_for_numpy(value: Any) -> Any:
-    """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones."""
+def _tensors_for_numpy(value: Any, other: Any = None) -> Any:
+    """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones;
+    anything else that is not a tensor or a plain value, and dict keys that are not int or str, go through
+    ``other`` (default: kept as they are)."""
     if isinstance(value, np.ndarray):
         return torch.from_numpy(np.array(value))
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, Mapping):
-        return {k: _tensors_for_numpy(v) for k, v in value.items()}
+        key = (lambda k: k) if other is None else (lambda k: k if isinstance(k, int | str) else other(k))
+        return {key(k): _tensors_for_numpy(v, other) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return type(value)(_tensors_for_numpy(v) for v in value)
-    return value
+        return type(value)(_tensors_for_numpy(v, other) for v in value)
+    if (
+        other is None
+        or torch.is_tensor(value)
+        or value is None
+        or isinstance(value, bool | int | float | str)
+    ):
+        return value
+    return other(value)
 
 
 def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
@@ -220,21 +230,8 @@ def convert_legacy(src: str | Path, dst: str | Path, *, trust: bool = False) -> 
             f"convert_legacy({src}): loading it runs any code it holds; pass trust=True only for a file you trust"
         )
     data = torch.load(Path(src), map_location="cpu", weights_only=False)  # the explicit opt-in above
-    save_checkpoint(dst, _plain(data))
+    save_checkpoint(
+        dst, _tensors_for_numpy(data, other=str)
+    )  # tensors and plain values; other objects as str
     load_checkpoint(dst)  # the copy reads without running code
     return Path(dst)
-
-
-def _plain(value: Any) -> Any:
-    """Tensors, numbers, strings, None, and dicts/lists/tuples of them; numpy arrays as tensors, the rest as str."""
-    if torch.is_tensor(value) or value is None or isinstance(value, bool | int | float | str):
-        return value
-    if isinstance(value, np.ndarray):
-        return torch.from_numpy(np.array(value))
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Mapping):
-        return {k if isinstance(k, int | str) else str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return type(value)(_plain(v) for v in value)
-    return str(value)
