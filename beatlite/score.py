@@ -10,7 +10,12 @@ take (matched by stem, everything before the first dot):
                        holds the 47 joints of ``spine_neck_141`` (the others at rest). Only the rotations
                        are read (and the root position): they are applied to beatlite's BEAT skeleton, as the
                        in-library evaluation of Euler models does.
-``{stem}.npz``         BEAT2's SMPL-X parameters: refused with one line (the SMPL-X body model is not shipped).
+``{stem}.npz``         BEAT2's SMPL-X parameters (:func:`beatlite.io.smplx.read_smplx`: ``poses``, ``trans``,
+                       ``mocap_frame_rate``), retargeted to BEAT's skeleton
+                       (:func:`beatlite.skeleton.smplx.smplx_to_beat`, the approximate rest skeleton) and
+                       then read as a BVH is. Scored against a BEAT2 folder (``--data`` holding
+                       ``smplxflame_30/``, ``wave16k/``, ``textgrid/``, ``train_test_split.csv``), whose
+                       takes are retargeted the same way, or against BEAT.
 ``{stem}.npy``         ``(T, 42, 3)`` TED-43 unit bone directions (HA2G's vector order,
                        :data:`beatlite.skeleton.ted.TED_BONES`), ``(T, 126)`` the same flattened, or
                        ``(T, 141)`` ``spine_neck_141`` Euler degrees (CaMN's output, BEAT's channel order).
@@ -214,17 +219,31 @@ def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
 def _bvh_prediction(path: Path) -> Prediction:
     """A BVH file -> directions and Euler channels at 15 fps (see :func:`beat_channels`)."""
     from beatlite.io import read_bvh
+
+    motion = read_bvh(path)
+    return _channels_prediction(beat_channels(motion, path), motion.fps, "bvh")
+
+
+def _smplx_prediction(path: Path) -> Prediction:
+    """A BEAT2 ``.npz`` -> BEAT's skeleton (:func:`beatlite.skeleton.smplx.smplx_to_beat`) -> as a BVH."""
+    from beatlite.io.smplx import read_smplx
+
+    motion = read_smplx(path)
+    return _channels_prediction(motion.to_beat().channels, motion.fps, "npz smplx -> BEAT skeleton,")  # type: ignore[attr-defined]
+
+
+def _channels_prediction(channels: np.ndarray, fps: float, form: str) -> Prediction:
+    """BEAT-skeleton rows at ``fps`` -> directions and Euler channels at 15 fps."""
     from beatlite.io.motion import Motion
     from beatlite.io.take import resample_frames, rotation_columns
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
     from beatlite.skeleton.ted import channels_to_directions
 
-    motion = read_bvh(path)
-    channels = beat_channels(motion, path)
-    form = f"bvh {motion.fps:g} fps"
-    if motion.fps != FPS:
-        cols = rotation_columns(Motion(beat_skeleton(), channels[:1], motion.fps))
-        channels = resample_frames(channels, motion.fps, FPS, angle_columns=cols)
+    form = f"{form} {fps:g} fps"
+    motion = Motion(beat_skeleton(), channels[:1], fps)
+    if fps != FPS:
+        cols = rotation_columns(motion)
+        channels = resample_frames(channels, fps, FPS, angle_columns=cols)
         form += f" -> {FPS:g} fps"
     euler = channels[:, subset_columns(beat_skeleton(), "spine_neck_141")]
     return Prediction(channels_to_directions(channels), euler, form)
@@ -288,7 +307,7 @@ def _unit_directions(d: np.ndarray, path: Path) -> np.ndarray:
 
 
 def read_prediction(path: str | Path) -> Prediction:
-    """One prediction file (``.bvh``, ``.bvh.gz`` or ``.npy``, see the module docstring) at 15 fps.
+    """One prediction file (``.bvh``, ``.bvh.gz``, ``.npy`` or BEAT2's ``.npz``, see the module docstring) at 15 fps.
 
     Raises
     ------
@@ -302,11 +321,8 @@ def read_prediction(path: str | Path) -> Prediction:
         return _bvh_prediction(p)
     if p.name.endswith(".npy"):
         return _npy_prediction(p)
-    if p.name.endswith(".npz"):  # matched so that it is named, not silently ignored
-        raise FormatError(
-            p, "BEAT2's SMPL-X .npz needs the SMPL-X body model, which beatlite does not ship: write BEAT-skeleton "
-            "BVH or TED-43 direction .npy files instead",
-        )  # fmt: skip
+    if p.name.endswith(".npz"):
+        return _smplx_prediction(p)
     raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
 
 

@@ -85,7 +85,7 @@ def test_problem_takes_are_flagged_not_crashing(corpus: Path) -> None:
     problems = idx.problems()
     assert set(problems) == {"2_scott_0_11_11", "hello_world", "2_scott_0_12_12", "2_scott_0_13_13"}
     wav_only = idx["2_scott_0_11_11"]
-    assert any("missing motion (.bvh)" in p for p in wav_only.problems)
+    assert any("missing motion (.bvh or .npz)" in p for p in wav_only.problems)
     assert not wav_only.usable and wav_only.has("audio") and not wav_only.has("motion")
     bad_name = idx["hello_world"]
     assert bad_name.speaker_id is None and bad_name.split is None

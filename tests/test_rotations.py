@@ -171,3 +171,47 @@ def test_input_validation_messages():
         sixd_to_matrix(np.zeros((2, 5)))
     with pytest.raises(TypeError, match="numeric"):
         axis_angle_to_matrix("abc")
+
+
+def _geodesic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angle (rad) of a^T b, from both its sine and cosine parts (exact near 0 and near pi)."""
+    d = np.swapaxes(a, -1, -2) @ b
+    sin = np.linalg.norm(
+        np.stack([d[..., 2, 1] - d[..., 1, 2], d[..., 0, 2] - d[..., 2, 0], d[..., 1, 0] - d[..., 0, 1]], -1),
+        axis=-1,
+    )
+    return np.arctan2(sin / 2, (np.trace(d, axis1=-2, axis2=-1) - 1) / 2)
+
+
+def _hard_rotations(rng, n=100_000):
+    """10^5 rotations: uniform ones, plus the edge cases (identity, 1e-12..1e-4 rad, pi and pi - 1e-9..1e-5 about
+    random axes and the coordinate axes, Euler gimbal lock at +-90 degrees in the middle angle)."""
+    axes = rng.normal(size=(2000, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    axes[:3] = np.eye(3)
+    tiny = np.logspace(-12, -4, 1000)
+    near_pi = np.pi - np.concatenate([[0.0], np.logspace(-9, -5, 999)])
+    edge = np.concatenate([axes[:1000] * tiny[:, None], axes[1000:] * near_pi[:, None], np.zeros((1, 3))])
+    gimbal = np.radians(rng.uniform(-180, 180, size=(1000, 3)))
+    gimbal[:, 1] = np.radians(rng.choice([-90.0, 90.0], size=1000) + rng.normal(scale=1e-7, size=1000))
+    uniform = Rotation.random(n - len(edge) - len(gimbal), random_state=rng.integers(1 << 31)).as_rotvec()
+    mats = axis_angle_to_matrix(np.concatenate([uniform, edge]))
+    return np.concatenate([mats, euler_to_matrix(gimbal, "XYZ", degrees=False)])
+
+
+def test_every_representation_round_trips_below_a_microradian_on_hard_rotations(rng):
+    mats = _hard_rotations(rng)
+    assert mats.shape == (100_000, 3, 3)
+    trips = {
+        "axis-angle": axis_angle_to_matrix(matrix_to_axis_angle(mats)),
+        "quaternion": quat_to_matrix(matrix_to_quat(mats)),
+        "6d": sixd_to_matrix(matrix_to_6d(mats)),
+        **{f"euler {o}": euler_to_matrix(matrix_to_euler(mats, o), o) for o in ALL_ORDERS},
+    }
+    for name, back in trips.items():
+        assert _geodesic(mats, back).max() < 1e-6, name
+    # and against scipy (its axis-angle and quaternion of the same matrices, up to the quaternion's sign)
+    np.testing.assert_allclose(axis_angle_to_matrix(Rotation.from_matrix(mats).as_rotvec()), mats, atol=1e-9)
+    ours = matrix_to_quat(mats)
+    theirs = Rotation.from_matrix(mats).as_quat(scalar_first=True)
+    assert _geodesic(quat_to_matrix(ours), quat_to_matrix(theirs)).max() < 1e-6

@@ -36,3 +36,29 @@ def example_corpus(pattern: str = DEFAULT_PATTERN) -> tempfile.TemporaryDirector
     for path in sorted((repo_root() / "data_samples").glob(f"{pattern}.*")):
         shutil.copy(path, tmp.name)
     return tmp
+
+
+def example_beat2_corpus(pattern: str = DEFAULT_PATTERN) -> tempfile.TemporaryDirectory:
+    """The takes of :func:`example_corpus` in BEAT2's layout (:func:`beatlite.data.beat2.write_beat2_folder`).
+
+    Returns
+    -------
+    tempfile.TemporaryDirectory
+        ``.name`` is a BEAT2 root: ``smplxflame_30/{stem}.npz`` (30 fps SMPL-X retargeted from the BVH; zero
+        ``betas`` and ``expressions``), ``wave16k/``, ``textgrid/``, ``train_test_split.csv``.
+
+    Examples
+    --------
+    >>> tmp = example_beat2_corpus()
+    >>> from pathlib import Path
+    >>> (Path(tmp.name) / "train_test_split.csv").read_text().splitlines()
+    ['id,type', '2_scott_0_1_1,test', '2_scott_0_9_9,train']
+    >>> tmp.cleanup()
+    """
+    from beatlite.data.beat2 import write_beat2_folder
+
+    src = example_corpus(pattern)
+    tmp = tempfile.TemporaryDirectory(prefix="beatlite_beat2_")
+    write_beat2_folder(src.name, tmp.name)
+    src.cleanup()
+    return tmp

@@ -3,8 +3,10 @@
 A *take* is every file sharing one stem, e.g. ``2_scott_0_1_1.bvh``, ``.wav``,
 ``.json``, ``.TextGrid``, ``.txt`` and ``.csv`` (each possibly ``.gz``, detected
 from the bytes as the readers do). The index works on real BEAT's layout
-(``{speaker_id}/{stem}.*``, also nested as ``beat_english_v0.2.1/2/...``) and on a
-flat folder.
+(``{speaker_id}/{stem}.*``, also nested as ``beat_english_v0.2.1/2/...``), on a
+flat folder, and on BEAT2's (``smplxflame_30/{stem}.npz``, ``wave16k/``, ``textgrid/``; the splits from its
+``train_test_split.csv``, :func:`beatlite.io.smplx.read_beat2_split`). :attr:`TakeRecord.format` says which
+format each take is in.
 
 Every file is checked by the code :func:`beatlite.io.load_take` runs: the BVH is
 read (rows included) at the frame rate loading will use
@@ -49,6 +51,7 @@ MODALITIES: dict[str, str] = {
     "textgrid": "text",
     "txt": "semantic",
     "csv": "emotion",
+    "npz": "motion",  # BEAT2's SMPL-X parameters (beatlite.io.smplx)
 }
 #: Modalities without which a take cannot be used for training.
 REQUIRED = ("motion", "audio")
@@ -85,7 +88,8 @@ class TakeRecord:
     emotion_name : str or None
         ``"neutral"``, ``"happiness"``, ...
     split : str or None
-        ``"train"``, ``"val"``, ``"test"`` (BEAT's rule) or ``None``.
+        ``"train"``, ``"val"``, ``"test"`` (BEAT's rule) or ``None``; for a take listed in a BEAT2
+        ``train_test_split.csv`` at the indexed root, its ``type`` there (also ``"additional"``).
     files : dict str -> Path
         Modality (``"motion"``, ``"audio"``, ``"face"``, ``"text"``, ``"semantic"``,
         ``"emotion"``) -> file path.
@@ -123,6 +127,12 @@ class TakeRecord:
     durations: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
     bvh_fps: float | None = None
+
+    @property
+    def format(self) -> str:
+        """``"beat2"`` when the motion is BEAT2's SMPL-X ``.npz``, else ``"beat"``."""
+        motion = self.files.get("motion")
+        return "beat2" if motion is not None and motion.name.endswith(".npz") else "beat"
 
     @property
     def duration(self) -> float:
@@ -183,9 +193,10 @@ class TakeRecord:
             "emotion": self.emotion,
             "emotion_name": self.emotion_name,
             "split": self.split,
+            "format": self.format,
             "duration": round(self.duration, 3),
         }
-        for modality in MODALITIES.values():
+        for modality in dict.fromkeys(MODALITIES.values()):
             row[f"has_{modality}"] = modality in self.files
         for modality in TIMED:
             value = self.durations.get(modality)
@@ -334,7 +345,11 @@ class TakeIndex:
                 "problems",
             ]
             for row in rows:
-                row["files"] = " ".join(ext for ext, m in MODALITIES.items() if row[f"has_{m}"])
+                row["files"] = " ".join(
+                    ("npz" if m == "motion" and row["format"] == "beat2" else ext)
+                    for ext, m in MODALITIES.items()
+                    if ext != "npz" and row[f"has_{m}"]
+                )
         columns = list(columns)
         if rows and not all(c in rows[0] for c in columns):
             missing = [c for c in columns if c not in rows[0]]
@@ -494,7 +509,7 @@ def _scan(root: Path, recursive: bool) -> dict[str, dict[str, list[Path]]]:
     for folder, names in walker:
         for name in names:
             stem, ext = split_take_file(name)
-            if ext is None or name.startswith("."):
+            if ext is None or name.startswith(".") or name == "train_test_split.csv":  # BEAT2's split list
                 continue
             found.setdefault(stem, {}).setdefault(MODALITIES[ext], []).append(folder / name)
     for by_modality in found.values():
@@ -534,8 +549,10 @@ def _list_files(record: TakeRecord, files: dict[str, list[Path]]) -> None:
             others = ", ".join(str(p) for p in paths[1:])
             record.problems.append(f"duplicate {modality} files: using {paths[0]}, ignoring {others}")
     for ext, modality in MODALITIES.items():
+        if ext == "npz" or (modality == "face" and record.format == "beat2"):  # BEAT2's face is in its .npz
+            continue
         if modality not in record.files:
-            shown = "TextGrid" if ext == "textgrid" else ext
+            shown = "TextGrid" if ext == "textgrid" else ("bvh or .npz" if ext == "bvh" else ext)
             record.problems.append(f"missing {modality} (.{shown}) file")
 
 
@@ -549,6 +566,9 @@ def _check_motion(record: TakeRecord, bvh_fps: float | None) -> None:
     motion = read_take_motion(path, bvh_fps=bvh_fps, reference_s=reference)
     record.durations["motion"] = motion.duration
     _check_skeleton(motion)
+    if record.format == "beat2":  # the .npz states its rate
+        record.bvh_fps = None if bvh_fps is None else motion.fps
+        return
     header_fps = parse_frame_time(repr(read_bvh_header(path)[2]))
     if bvh_fps is not None or motion.fps != header_fps:
         record.bvh_fps = motion.fps
@@ -715,8 +735,22 @@ def index_folder(
         ]
     else:
         records = _index_with_cache(root, recursive, found, overrides, workers)
+    _beat2_splits(root, records)
     records.sort(key=_sort_key)
     return TakeIndex(records, root)
+
+
+def _beat2_splits(root: Path, records: list[TakeRecord]) -> None:
+    """Splits from BEAT2's ``train_test_split.csv`` at ``root`` (if there is one), over the name rule's."""
+    from beatlite.io.smplx import read_beat2_split
+
+    path = root / "train_test_split.csv"
+    if not path.is_file():
+        return
+    listed = read_beat2_split(path)
+    for record in records:
+        if record.stem in listed:
+            record.split = listed[record.stem]
 
 
 def _index_with_cache(

@@ -225,15 +225,17 @@ def _int_field(path: str, text: str, field: str) -> int:
     return int(text)
 
 
-#: A take's file name: its stem, then one of BEAT's extensions (any case), optionally ``.gz``.
-TAKE_FILE = re.compile(r"^(?P<stem>.+)\.(?P<ext>bvh|wav|json|textgrid|txt|csv)(?P<gz>\.gz)?$", re.IGNORECASE)
+#: A take's file name: its stem, then one of BEAT's extensions or BEAT2's ``npz`` (any case), optionally ``.gz``.
+TAKE_FILE = re.compile(
+    r"^(?P<stem>.+)\.(?P<ext>bvh|wav|json|textgrid|txt|csv|npz)(?P<gz>\.gz)?$", re.IGNORECASE
+)
 
 
 def split_take_file(name: str | os.PathLike[str]) -> tuple[str, str | None]:
     """The one stem rule of beatlite (index, ``load_take``, names): ``(stem, extension)`` of a file name.
 
-    The stem is everything before a BEAT extension (``bvh wav json TextGrid txt csv``, optionally ``.gz``),
-    dots included; a name without one is all stem (a stem given as such).
+    The stem is everything before a BEAT extension (``bvh wav json TextGrid txt csv``, optionally ``.gz``,
+    or BEAT2's ``npz``), dots included; a name without one is all stem (a stem given as such).
 
     Examples
     --------

@@ -6,6 +6,11 @@ face), ``.TextGrid[.gz]`` (words), ``.txt`` (semantic) and ``.csv``
 (emotion). :func:`load_take` reads those present and resamples motion and
 face to one frame rate (default 15 fps).
 
+A BEAT2 take (:mod:`beatlite.io.smplx`) is ``smplxflame_30/{stem}.npz`` (30 fps SMPL-X, read as a motion on
+BEAT's skeleton by :func:`beatlite.skeleton.smplx.smplx_to_beat`) with ``wave16k/{stem}.wav`` and
+``textgrid/{stem}.TextGrid`` in the sibling folders (or beside it); its FLAME expressions become
+:attr:`Take.expressions` (BEAT2 has no ARKit face, so ``face`` is None). :attr:`Take.format` says which.
+
 Resampling phase
 ----------------
 - ``phase="start"``: output frame ``i`` is the source at ``t = i / fps``. For an
@@ -73,11 +78,14 @@ __all__ = [
     "clip_take",
     "PHASES",
     "TAKE_EXTENSIONS",
+    "BEAT2_FOLDERS",
     "RATE_GAP_S",
 ]
 
 PHASES = ("start", "beat")
 TAKE_EXTENSIONS = (".bvh", ".wav", ".json", ".TextGrid", ".txt", ".csv")
+#: Where a BEAT2 take's other files live, relative to its ``smplxflame_30/`` folder (docs/data.md#beat2).
+BEAT2_FOLDERS = {".wav": "wave16k", ".TextGrid": "textgrid"}
 #: Seconds by which motion may differ from the other modalities before its frame rate is questioned
 #: (the dataset index's ``MAX_DURATION_GAP``).
 RATE_GAP_S = 1.0
@@ -115,7 +123,9 @@ class Take:
     info : TakeName or None
         Parsed name (None for a name that is not BEAT's pattern).
     paths : dict str -> Path
-        The files read, by extension.
+        The files read, by extension (``".bvh"`` or, for BEAT2, ``".npz"``).
+    expressions : (T, E) float32 or None
+        BEAT2's FLAME expression coefficients resampled to ``fps`` (None for BEAT).
 
     Examples
     --------
@@ -141,6 +151,12 @@ class Take:
     emotion_segments: list[EmotionSegment] = field(default_factory=list)
     info: TakeName | None = None
     paths: dict[str, Path] = field(default_factory=dict)
+    expressions: np.ndarray | None = None
+
+    @property
+    def format(self) -> str:
+        """``"beat2"`` for a take read from BEAT2's SMPL-X ``.npz``, else ``"beat"`` (BVH)."""
+        return "beat2" if ".npz" in self.paths else "beat"
 
     @property
     def n_frames(self) -> int:
@@ -276,10 +292,13 @@ def _optional(stem: Path, ext: str) -> Path | None:
 def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Path]]:
     """The stem of a take and its files by extension (:data:`TAKE_EXTENSIONS`, plain or ``.gz``).
 
+    The motion is the ``.bvh`` / ``.bvh.gz``, else (BEAT2) the ``.npz``; a BEAT2 take's audio and TextGrid are
+    looked for beside it, then in :data:`BEAT2_FOLDERS` next to its folder.
+
     Raises
     ------
     FileNotFoundError
-        If there is no ``.bvh`` / ``.bvh.gz`` for the stem.
+        If there is neither a ``.bvh`` / ``.bvh.gz`` nor an ``.npz`` for the stem.
 
     Examples
     --------
@@ -289,6 +308,18 @@ def take_files(stem_or_path: str | os.PathLike[str]) -> tuple[Path, dict[str, Pa
     ('2_scott_0_1_1', ['.bvh', '.wav', '.json', '.TextGrid', '.txt', '.csv'], '2_scott_0_1_1.bvh.gz')
     """
     stem = take_stem(stem_or_path)
+    npz = stem.with_name(stem.name + ".npz")
+    if str(stem_or_path).endswith(".npz") or (npz.is_file() and _optional(stem, ".bvh") is None):
+        if not npz.is_file():
+            raise FileNotFoundError(f"no file {npz}")
+        paths = {".npz": npz}
+        for ext in TAKE_EXTENSIONS[1:]:
+            found = _optional(stem, ext)
+            if found is None and ext in BEAT2_FOLDERS:
+                found = _optional(stem.parent.parent / BEAT2_FOLDERS[ext] / stem.name, ext)
+            if found is not None:
+                paths[ext] = found
+        return stem, paths
     paths = {".bvh": resolve(stem, ".bvh")}
     for ext in TAKE_EXTENSIONS[1:]:
         if (found := _optional(stem, ext)) is not None:
@@ -366,7 +397,7 @@ def read_take_motion(
     Parameters
     ----------
     path : str or PathLike
-        The ``.bvh`` / ``.bvh.gz``.
+        The ``.bvh`` / ``.bvh.gz``, or a BEAT2 ``.npz`` (retargeted to BEAT's skeleton at the file's rate).
     bvh_fps : float, optional
         The rate of the rows, an override: nothing is inferred.
     reference_s : float, optional
@@ -396,6 +427,11 @@ def read_take_motion(
     >>> tmp.cleanup()
     """
     p = Path(path)
+    if p.name.endswith(".npz"):  # BEAT2: the file states its rate; bvh_fps still overrides it
+        from beatlite.io.smplx import read_smplx
+
+        beat = read_smplx(p).to_beat()
+        return beat if bvh_fps is None else Motion(beat.skeleton, beat.channels, bvh_fps)  # type: ignore[attr-defined]
     if bvh_fps is not None:
         return read_bvh(p, fps=bvh_fps)
     motion = read_bvh(p)
@@ -540,7 +576,18 @@ def load_take(
     except FormatError:
         info = None
     reference = reference_duration(durations, info.half if info is not None else None)
-    source = read_take_motion(paths[".bvh"], bvh_fps=bvh_fps, reference_s=reference)
+    expressions = None
+    if ".npz" in paths:
+        from beatlite.io.smplx import read_smplx
+
+        smplx = read_smplx(paths[".npz"])
+        rate = smplx.fps if bvh_fps is None else float(bvh_fps)
+        beat = smplx.to_beat()
+        source = Motion(beat.skeleton, beat.channels, rate)  # type: ignore[attr-defined]
+        if smplx.expressions is not None:
+            expressions = resample_frames(smplx.expressions, rate, fps, shift=0).astype(np.float32)
+    else:
+        source = read_take_motion(paths[".bvh"], bvh_fps=bvh_fps, reference_s=reference)
     motion, audio, face = _align(stem.name, source, audio, int(audio_sr), facial, fps, phase)
     return Take(
         name=stem.name,
@@ -553,6 +600,7 @@ def load_take(
         words=words,
         info=info,
         paths=paths,
+        expressions=None if expressions is None else expressions[: motion.n_frames],
         **_annotations(paths, info, motion.n_frames, fps),  # type: ignore[arg-type]
     )
 

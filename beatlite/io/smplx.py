@@ -1,0 +1,331 @@
+"""BEAT2's SMPL-X motion files (``.npz``) and its split list (``train_test_split.csv``).
+
+One ``.npz`` per take, as PantoMatrix's ``beat_format_save`` writes them (Liu et al., EMAGE, CVPR 2024):
+
+=====================  ==========================  ==================================================
+key                    shape, dtype                meaning
+=====================  ==========================  ==================================================
+``poses``              (T, 165) float32            axis-angle (radians) of the 55 SMPL-X joints
+                                                   (:data:`beatlite.skeleton.smplx.SMPLX_JOINTS`),
+                                                   each relative to its parent
+``trans``              (T, 3) float32              root translation, metres
+``betas``              (300,) float32              body shape (the SMPL-X model turns it into a mesh)
+``expressions``        (T, 100) float32            FLAME face expression coefficients
+``model``              str                         ``"smplx2020"``
+``gender``             str                         ``"neutral"``
+``mocap_frame_rate``   int                         30
+=====================  ==========================  ==================================================
+
+:func:`read_smplx` reads one with ``allow_pickle=False``; every problem (not an npz, a Git-LFS pointer, a
+pickled object array, a missing key, a wrong shape, a non-finite value, an unbounded decompression) is one
+:class:`~beatlite.io.errors.FormatError` naming the file and the key. ``poses``, ``trans`` and
+``mocap_frame_rate`` are required (a prediction file needs no more); ``betas`` and ``expressions`` may be absent.
+:func:`write_smplx` writes the same layout atomically.
+
+A BEAT2 folder (``beat_english_v2.0.0/``) holds ``smplxflame_30/{take}.npz``, ``wave16k/{take}.wav``,
+``textgrid/{take}.TextGrid`` and ``train_test_split.csv`` (:func:`read_beat2_split`); :func:`beatlite.io.load_take`
+and :func:`beatlite.data.index_folder` read it (the motion retargeted to BEAT's skeleton,
+:func:`beatlite.skeleton.smplx.smplx_to_beat`).
+
+Taught in ``notebooks/01_beat_formats.ipynb`` (BEAT and BEAT2 side by side).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from beatlite.io.errors import FormatError
+from beatlite.io.textfile import GZIP_MAX_RATIO, describe_bytes
+
+__all__ = ["BEAT2_SPLITS", "SMPLXMotion", "read_beat2_split", "read_smplx", "write_smplx"]
+
+#: The ``type`` values of BEAT2's ``train_test_split.csv``.
+BEAT2_SPLITS = ("train", "val", "test", "additional")
+
+_MAX_MEMBER_BYTES = 4 * 2**30  # one array of a 76 h take set at 30 fps is < 200 MB; more is not a BEAT2 file
+_STRINGS = ("model", "gender")
+
+
+@dataclasses.dataclass
+class SMPLXMotion:
+    """One SMPL-X motion: BEAT2's ``.npz`` in memory.
+
+    Attributes
+    ----------
+    poses : (T, 55, 3) float64
+        Axis-angle rotations in radians, each joint relative to its parent
+        (:data:`beatlite.skeleton.smplx.SMPLX_JOINTS` order).
+    trans : (T, 3) float64, metres
+    fps : float
+    betas : (B,) float64 or None
+    expressions : (T, E) float64 or None
+    model, gender : str
+        As the file says (``"smplx2020"``, ``"neutral"`` in BEAT2); ``""`` if absent.
+
+    Examples
+    --------
+    >>> m = SMPLXMotion(np.zeros((30, 55, 3)), np.zeros((30, 3)), fps=30)
+    >>> m.n_frames, m.duration, m.to_beat().channels.shape
+    (30, 1.0, (30, 228))
+    """
+
+    poses: np.ndarray
+    trans: np.ndarray
+    fps: float
+    betas: np.ndarray | None = None
+    expressions: np.ndarray | None = None
+    model: str = ""
+    gender: str = ""
+
+    def __post_init__(self) -> None:
+        self.poses = np.asarray(self.poses, dtype=np.float64).reshape(-1, 55, 3)
+        self.trans = np.asarray(self.trans, dtype=np.float64).reshape(-1, 3)
+        if self.trans.shape[0] != self.poses.shape[0]:
+            raise ValueError(f"SMPLXMotion: {self.poses.shape[0]} poses but {self.trans.shape[0]} trans rows")
+        if not (np.isfinite(self.fps) and self.fps > 0):
+            raise ValueError(f"SMPLXMotion: fps must be positive, got {self.fps}")
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames T."""
+        return int(self.poses.shape[0])
+
+    @property
+    def duration(self) -> float:
+        """``T / fps`` seconds."""
+        return self.n_frames / self.fps
+
+    def positions(self, rest: object | None = None) -> np.ndarray:
+        """(T, 55, 3) float64 metres: :func:`beatlite.skeleton.smplx.smplx_forward_kinematics`."""
+        from beatlite.skeleton.smplx import smplx_forward_kinematics
+
+        return smplx_forward_kinematics(self.poses, self.trans, rest)  # type: ignore[arg-type]
+
+    def to_beat(self, rest: object | None = None) -> object:
+        """The motion on BEAT's skeleton (:func:`beatlite.skeleton.smplx.smplx_to_beat`), a ``Motion``."""
+        from beatlite.skeleton.smplx import smplx_to_beat
+
+        return smplx_to_beat(self.poses, self.trans, self.fps, rest)  # type: ignore[arg-type]
+
+
+def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
+    """The ``.npy`` members of an npz, checked for size before anything is decompressed."""
+    with open(path, "rb") as f:
+        head = f.read(64)
+    if not head.startswith(b"PK\x03\x04"):
+        raise FormatError(path, f"not an .npz file (a ZIP archive of .npy arrays): {describe_bytes(head)}")
+    try:
+        with zipfile.ZipFile(path) as z:
+            infos = {i.filename.removesuffix(".npy"): i for i in z.infolist()}
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise FormatError(path, f"a damaged ZIP archive ({exc})") from None
+    for key, info in infos.items():
+        ratio = info.file_size / max(info.compress_size, 1)
+        if info.file_size > _MAX_MEMBER_BYTES or (info.file_size > 64 * 2**20 and ratio > GZIP_MAX_RATIO):
+            raise FormatError(
+                path,
+                f"{info.file_size} bytes uncompressed ({ratio:.0f} x the stored size): refused",
+                field=key,
+            )
+    return infos
+
+
+def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:
+    try:
+        value = z[key]
+    except ValueError as exc:  # "Object arrays cannot be loaded when allow_pickle=False"
+        if "allow_pickle" in str(exc) or "pickle" in str(exc):
+            raise FormatError(
+                path, "a pickled object array (never loaded: it could run code)", field=key
+            ) from None
+        raise FormatError(path, f"not a readable array ({exc})", field=key) from None
+    except (OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise FormatError(path, f"not a readable array ({exc})", field=key) from None
+    return value
+
+
+def _numeric(path: Path, key: str, value: np.ndarray, shape: str, ok: bool) -> np.ndarray:
+    if value.dtype.kind not in "fiu" or not ok:
+        raise FormatError(path, f"expected {shape} numbers, got {value.shape} {value.dtype}", field=key)
+    value = value.astype(np.float64)
+    if not np.isfinite(value).all():
+        bad = np.argwhere(~np.isfinite(value))[0].tolist()
+        raise FormatError(path, f"non-finite value at index {bad}", field=key)
+    return value
+
+
+def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
+    """Read a BEAT2 SMPL-X ``.npz`` (see the module docstring for its keys).
+
+    Parameters
+    ----------
+    path : str or PathLike
+
+    Returns
+    -------
+    SMPLXMotion
+        ``poses`` reshaped to (T, 55, 3), everything float64.
+
+    Raises
+    ------
+    FormatError
+        Naming the file and the key.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "2_scott_0_1_1.npz"
+    >>> write_smplx(path, SMPLXMotion(np.zeros((60, 55, 3)), np.zeros((60, 3)), fps=30, betas=np.zeros(300)))
+    >>> m = read_smplx(path)
+    >>> m.poses.shape, m.fps, m.betas.shape, m.model
+    ((60, 55, 3), 30.0, (300,), 'smplx2020')
+    >>> _ = path.write_text("version https://git-lfs.github.com/spec/v1\\noid sha256:0\\nsize 1\\n")
+    >>> read_smplx(path)
+    Traceback (most recent call last):
+    ...
+    beatlite.io.errors.FormatError: ...: not an .npz file (a ZIP archive of .npy arrays): a Git-LFS pointer text, not the file content (run `git lfs pull`)
+    >>> tmp.cleanup()
+    """
+    p = Path(path)
+    infos = _members(p)
+    for key in ("poses", "trans", "mocap_frame_rate"):
+        if key not in infos:
+            raise FormatError(p, f"no {key!r} array (keys: {', '.join(sorted(infos)) or 'none'})", field=key)
+    try:
+        z = np.load(p, allow_pickle=False)
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise FormatError(p, f"not a readable npz ({exc})") from None
+    with z:
+        raw = {key: _array(z, p, key) for key in infos}
+    poses = raw["poses"]
+    n = poses.shape[0] if poses.ndim else 0
+    poses = _numeric(p, "poses", poses, "(T, 165)", poses.ndim in (2, 3) and n >= 1
+                     and poses.shape[1:] in ((165,), (55, 3)))  # fmt: skip
+    trans = _numeric(p, "trans", raw["trans"], f"({n}, 3)", raw["trans"].shape == (n, 3))
+    rate = raw["mocap_frame_rate"]
+    fps = float(_numeric(p, "mocap_frame_rate", rate, "a positive scalar", rate.size == 1).ravel()[0])
+    if fps <= 0:
+        raise FormatError(p, f"frame rate {fps:g} is not positive", field="mocap_frame_rate")
+    betas = expressions = None
+    if "betas" in raw:
+        b = raw["betas"]
+        betas = _numeric(p, "betas", b, "(B,) or (T, B)", b.ndim in (1, 2) and b.size > 0)
+        if betas.ndim == 2:  # per-frame copies of one shape
+            if not np.allclose(betas, betas[:1]):
+                raise FormatError(
+                    p, "per-frame betas differ between frames (one body shape expected)", field="betas"
+                )
+            betas = betas[0]
+    if "expressions" in raw:
+        e = raw["expressions"]
+        expressions = _numeric(p, "expressions", e, f"({n}, E)", e.ndim == 2 and e.shape[0] == n)
+    strings = {}
+    for key in _STRINGS:
+        value = raw.get(key, np.array(""))
+        if value.dtype.kind not in "US" or value.size != 1:
+            raise FormatError(p, f"expected a string, got {value.shape} {value.dtype}", field=key)
+        strings[key] = str(value.ravel()[0].decode() if value.dtype.kind == "S" else value.ravel()[0])
+    return SMPLXMotion(poses.reshape(n, 55, 3), trans, fps, betas, expressions, **strings)
+
+
+def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
+    """Write ``motion`` as BEAT2 does (float32 arrays, ``poses`` as (T, 165), the model and gender strings).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        Destination ``.npz``, written atomically (:func:`beatlite.io.atomic.atomic_write`).
+    motion : SMPLXMotion
+        ``betas`` default ``zeros(300)``, ``expressions`` default ``zeros((T, 100))``, ``model`` default
+        ``"smplx2020"``, ``gender`` default ``"neutral"`` (BEAT2's values).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "take.npz"
+    >>> write_smplx(path, SMPLXMotion(np.zeros((2, 55, 3)), np.ones((2, 3)), fps=30))
+    >>> with np.load(path) as z:
+    ...     sorted(z.files), z["poses"].shape, z["poses"].dtype, int(z["mocap_frame_rate"])
+    (['betas', 'expressions', 'gender', 'mocap_frame_rate', 'model', 'poses', 'trans'], (2, 165), dtype('float32'), 30)
+    >>> tmp.cleanup()
+    """
+    from beatlite.io.atomic import atomic_write
+
+    n = motion.n_frames
+    arrays = {
+        "betas": np.zeros(300) if motion.betas is None else motion.betas,
+        "poses": motion.poses.reshape(n, 165),
+        "expressions": np.zeros((n, 100)) if motion.expressions is None else motion.expressions,
+        "trans": motion.trans,
+    }
+    buffer = io.BytesIO()
+    np.savez(
+        buffer,
+        **{k: np.asarray(v, dtype=np.float32) for k, v in arrays.items()},
+        model=np.array(motion.model or "smplx2020"),
+        gender=np.array(motion.gender or "neutral"),
+        mocap_frame_rate=np.array(int(motion.fps) if float(motion.fps).is_integer() else motion.fps),
+    )
+    with atomic_write(path, "wb") as f:
+        f.write(buffer.getvalue())
+
+
+def read_beat2_split(path: str | os.PathLike[str]) -> dict[str, str]:
+    """BEAT2's ``train_test_split.csv``: take -> ``"train"``, ``"val"``, ``"test"`` or ``"additional"``.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        A CSV with a header naming the columns ``id`` and ``type`` (others ignored).
+
+    Returns
+    -------
+    dict str -> str
+
+    Raises
+    ------
+    FormatError
+        Missing columns, an unknown type, or a take listed twice (naming the line).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "train_test_split.csv"
+    >>> _ = path.write_text("id,type\\n2_scott_0_1_1,test\\n2_scott_0_2_2,train\\n")
+    >>> read_beat2_split(path)
+    {'2_scott_0_1_1': 'test', '2_scott_0_2_2': 'train'}
+    >>> tmp.cleanup()
+    """
+    from beatlite.io.textfile import read_text
+
+    p = Path(path)
+    rows = csv.reader(read_text(p).splitlines())
+    header = [h.strip() for h in next(rows, [])]
+    if "id" not in header or "type" not in header:
+        raise FormatError(p, f"the header must name the columns id and type, got {header}", line=1)
+    i, t = header.index("id"), header.index("type")
+    out: dict[str, str] = {}
+    for line, row in enumerate(rows, start=2):
+        if not any(c.strip() for c in row):
+            continue
+        if len(row) <= max(i, t):
+            raise FormatError(p, f"{len(row)} columns, the header has {len(header)}", line=line)
+        take, kind = row[i].strip(), row[t].strip()
+        if kind not in BEAT2_SPLITS:
+            raise FormatError(
+                p, f"type {kind!r} is not one of {', '.join(BEAT2_SPLITS)}", line=line, field="type"
+            )
+        if take in out:
+            raise FormatError(p, f"take {take} is listed twice", line=line, field="id")
+        out[take] = kind
+    return out

@@ -1,0 +1,353 @@
+"""BEAT2 / SMPL-X: the .npz reader and writer, forward kinematics, retargeting to and from BEAT, BEAT2 folders."""
+
+from __future__ import annotations
+
+import io
+import shutil
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beatlite.io import FormatError, load_take
+from beatlite.io.smplx import SMPLXMotion, read_beat2_split, read_smplx, write_smplx
+from beatlite.paths import repo_root
+from beatlite.skeleton.rotations import axis_angle_to_matrix
+from beatlite.skeleton.smplx import (
+    BEAT_COUNTERPARTS,
+    SMPLX_JOINTS,
+    SMPLX_PARENTS,
+    angular_speed,
+    approximate_rest,
+    beat_to_smplx,
+    bone_direction_errors,
+    rest_from_model,
+    smplx_forward_kinematics,
+    smplx_to_beat,
+)
+
+SAMPLES = repo_root() / "data_samples"
+
+
+def _beat2_like(n: int = 40, seed: int = 0) -> dict[str, np.ndarray]:
+    """The arrays of a BEAT2 file as PantoMatrix's beat_format_save writes them (keys, dtypes, shapes)."""
+    rng = np.random.default_rng(seed)
+    return {
+        "betas": rng.normal(size=300).astype(np.float32),
+        "poses": rng.normal(scale=0.3, size=(n, 165)).astype(np.float32),
+        "expressions": rng.normal(size=(n, 100)).astype(np.float32),
+        "trans": rng.normal(scale=0.1, size=(n, 3)).astype(np.float32),
+        "model": np.array("smplx2020"),
+        "gender": np.array("neutral"),
+        "mocap_frame_rate": np.array(30),
+    }
+
+
+def _save(path: Path, arrays: dict, **kw) -> Path:
+    np.savez(path, **arrays, **kw)
+    return path
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angle in radians between rotation matrices (robust near 0 and pi)."""
+    d = np.swapaxes(a, -1, -2) @ b
+    cos = (np.trace(d, axis1=-2, axis2=-1) - 1) / 2
+    sin = np.linalg.norm(np.stack([d[..., 2, 1] - d[..., 1, 2], d[..., 0, 2] - d[..., 2, 0],
+                                   d[..., 1, 0] - d[..., 0, 1]], -1), axis=-1) / 2  # fmt: skip
+    return np.arctan2(sin, cos)
+
+
+# --------------------------------------------------------------------------------------------- reading
+def test_read_smplx_reads_a_file_written_like_beat2s(tmp_path):
+    arrays = _beat2_like()
+    m = read_smplx(_save(tmp_path / "2_scott_0_1_1.npz", arrays))
+    assert m.poses.shape == (40, 55, 3) and m.fps == 30.0 and (m.model, m.gender) == ("smplx2020", "neutral")
+    np.testing.assert_array_equal(m.poses.reshape(40, 165), arrays["poses"].astype(np.float64))
+    np.testing.assert_array_equal(m.trans, arrays["trans"].astype(np.float64))
+    np.testing.assert_array_equal(m.betas, arrays["betas"].astype(np.float64))
+    assert m.expressions.shape == (40, 100)
+
+
+def test_write_then_read_round_trips_in_float32(tmp_path):
+    a = _beat2_like(seed=1)
+    motion = SMPLXMotion(a["poses"].reshape(-1, 55, 3), a["trans"], 30, a["betas"], a["expressions"])
+    write_smplx(tmp_path / "t.npz", motion)
+    back = read_smplx(tmp_path / "t.npz")
+    np.testing.assert_array_equal(back.poses, motion.poses)  # float32 values survive exactly
+    with np.load(tmp_path / "t.npz") as z:
+        assert set(z.files) == set(a) and all(z[k].dtype == a[k].dtype for k in ("poses", "trans", "betas"))
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+def _malformed(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    """Ten malformed files (and what each error must name)."""
+    a = _beat2_like(n=10)
+    out = {}
+    p = tmp_path / "lfs.npz"
+    p.write_text("version https://git-lfs.github.com/spec/v1\noid sha256:ab\nsize 12\n")
+    out["lfs pointer"] = (p, "Git-LFS")
+    p = tmp_path / "text.npz"
+    p.write_text("poses,trans\n1,2\n")
+    out["a csv named .npz"] = (p, "not an .npz")
+    out["no poses"] = (_save(tmp_path / "nop.npz", {k: v for k, v in a.items() if k != "poses"}), "'poses'")
+    out["no frame rate"] = (
+        _save(tmp_path / "nofps.npz", {k: v for k, v in a.items() if k != "mocap_frame_rate"}),
+        "mocap_frame_rate",
+    )
+    out["164 columns"] = (_save(tmp_path / "w.npz", {**a, "poses": a["poses"][:, :164]}), "field 'poses'")
+    nan = a["trans"].copy()
+    nan[3, 1] = np.nan
+    out["NaN in trans"] = (
+        _save(tmp_path / "nan.npz", {**a, "trans": nan}),
+        "non-finite value at index [3, 1]",
+    )
+    obj = np.empty(2, dtype=object)
+    obj[:] = [{"x": 1}, None]
+    out["pickled object array"] = (_save(tmp_path / "obj.npz", {**a, "betas": obj}), "pickled object array")
+    out["trans of another length"] = (
+        _save(tmp_path / "len.npz", {**a, "trans": a["trans"][:-1]}),
+        "field 'trans'",
+    )
+    out["zero frame rate"] = (
+        _save(tmp_path / "zero.npz", {**a, "mocap_frame_rate": np.array(0)}),
+        "not positive",
+    )
+    good = _save(tmp_path / "good.npz", a).read_bytes()
+    p = tmp_path / "cut.npz"
+    p.write_bytes(good[: len(good) // 2])
+    out["truncated download"] = (p, "cut.npz")
+    return out
+
+
+def test_read_smplx_gives_one_format_error_per_malformed_file(tmp_path):
+    cases = _malformed(tmp_path)
+    assert len(cases) == 10
+    for name, (path, expected) in cases.items():
+        with pytest.raises(FormatError) as err:
+            read_smplx(path)
+        message = str(err.value)
+        assert path.name in message and expected in message, (name, message)
+        assert "\n" not in message, (name, message)
+
+
+def test_read_smplx_refuses_a_decompression_bomb_before_decompressing(tmp_path):
+    path = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        buf = io.BytesIO()
+        np.lib.format.write_array(buf, np.zeros((100_000, 165)))  # 132 MB of zeros, ~130 kB stored
+        z.writestr("poses.npy", buf.getvalue())
+    with pytest.raises(FormatError, match="field 'poses'.*refused"):
+        read_smplx(path)
+
+
+def test_read_beat2_split_names_the_bad_line(tmp_path):
+    path = tmp_path / "train_test_split.csv"
+    path.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_2_2,holdout\n")
+    with pytest.raises(FormatError, match="line 3.*holdout"):
+        read_beat2_split(path)
+    path.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_1_1,train\n")
+    with pytest.raises(FormatError, match="line 3.*twice"):
+        read_beat2_split(path)
+
+
+# ------------------------------------------------------------------------------------------ kinematics
+def test_topology_is_smplx_kintree():
+    assert len(SMPLX_JOINTS) == 55 and all(SMPLX_PARENTS[j] < j for j in range(1, 55))
+    named = dict(zip(SMPLX_JOINTS, SMPLX_PARENTS, strict=True))
+    assert SMPLX_JOINTS[named["left_wrist"]] == "left_elbow" and SMPLX_JOINTS[named["jaw"]] == "head"
+    assert (
+        SMPLX_JOINTS[named["right_thumb3"]] == "right_thumb2"
+        and SMPLX_JOINTS[named["right_index1"]] == "right_wrist"
+    )
+
+
+def test_forward_kinematics_by_hand():
+    rest = approximate_rest()
+    poses = np.zeros((1, 55, 3))
+    e, w = SMPLX_JOINTS.index("left_elbow"), SMPLX_JOINTS.index("left_wrist")
+    poses[0, SMPLX_JOINTS.index("left_shoulder")] = [
+        0,
+        0,
+        np.pi / 2,
+    ]  # the whole left arm turns 90 deg about Z
+    x = smplx_forward_kinematics(poses, np.array([[1.0, 2.0, 3.0]]))
+    forearm = rest.joints[w] - rest.joints[e]  # along +X at rest
+    np.testing.assert_allclose(x[0, w] - x[0, e], [-forearm[1], forearm[0], forearm[2]], atol=1e-12)
+    np.testing.assert_allclose(x[0, 0], rest.joints[0] + [1.0, 2.0, 3.0])
+
+
+def _fake_model(path: Path, rng: np.random.Generator) -> Path:
+    """A random SMPL-X model file with the keys and shapes the smplx package reads (V = 10000 vertices)."""
+    v = 10000
+    reg = rng.random((55, v)) * (rng.random((55, v)) < 0.002)
+    reg[:, 0] += 1e-3
+    reg /= reg.sum(1, keepdims=True)
+    kintree = np.stack([np.where(SMPLX_PARENTS < 0, 2**32 - 1, SMPLX_PARENTS), np.arange(55)]).astype(
+        np.int64
+    )
+    np.savez(
+        path, v_template=rng.normal(size=(v, 3)), shapedirs=rng.normal(scale=1e-3, size=(v, 3, 400)).astype(np.float32),
+        posedirs=np.zeros((v, 3, 486), np.float32), J_regressor=reg, kintree_table=kintree,
+        weights=np.full((v, 55), 1 / 55), f=rng.integers(0, v, size=(200, 3)),
+        hands_componentsl=np.eye(45), hands_componentsr=np.eye(45),
+        hands_meanl=rng.normal(scale=0.2, size=45), hands_meanr=rng.normal(scale=0.2, size=45),
+        lmk_faces_idx=np.zeros(51, np.int64), lmk_bary_coords=np.full((51, 3), 1 / 3),
+        dynamic_lmk_faces_idx=np.zeros((79, 17), np.int64), dynamic_lmk_bary_coords=np.full((79, 17, 3), 1 / 3),
+    )  # fmt: skip
+    return path
+
+
+@pytest.mark.slow
+def test_forward_kinematics_equals_the_smplx_package_on_a_fake_model(tmp_path):
+    smplx = pytest.importorskip("smplx", reason="the optional smplx package (pip install beatlite[smplx])")
+    torch = pytest.importorskip("torch")
+    rng = np.random.default_rng(3)
+    model_path = _fake_model(tmp_path / "SMPLX_NEUTRAL.npz", rng)
+    betas, expr = rng.normal(size=(1, 10)), rng.normal(size=(1, 10))
+    poses, trans = rng.normal(scale=0.4, size=(4, 55, 3)), rng.normal(size=(4, 3))
+    model = smplx.SMPLX(str(model_path), num_betas=10, num_expression_coeffs=10, use_pca=False,
+                        flat_hand_mean=False, batch_size=4)  # fmt: skip
+    t = lambda x: torch.as_tensor(np.asarray(x), dtype=torch.float32)  # noqa: E731
+    out = model(
+        betas=t(np.repeat(betas, 4, 0)), expression=t(np.repeat(expr, 4, 0)), transl=t(trans),
+        global_orient=t(poses[:, 0]), body_pose=t(poses[:, 1:22].reshape(4, -1)), jaw_pose=t(poses[:, 22]),
+        leye_pose=t(poses[:, 23]), reye_pose=t(poses[:, 24]), left_hand_pose=t(poses[:, 25:40].reshape(4, -1)),
+        right_hand_pose=t(poses[:, 40:55].reshape(4, -1)), return_verts=False,
+    )  # fmt: skip
+    rest = rest_from_model(model_path, betas[0], expr[0])
+    ours = smplx_forward_kinematics(poses, trans, rest)
+    scale = float(np.abs(ours).max())
+    # float32 in the package: its error grows with the chain depth (~20 products), ~1e-6 relative each
+    np.testing.assert_allclose(out.joints[:, :55].numpy(), ours, atol=1e-5 * scale)
+
+
+def test_rest_from_model_refuses_bad_files(tmp_path):
+    p = tmp_path / "SMPLX_NEUTRAL.npz"
+    np.savez(p, v_template=np.zeros((5, 3)))
+    with pytest.raises(FormatError, match="no shapedirs"):
+        rest_from_model(p)
+    obj = np.empty(1, dtype=object)
+    np.savez(p, v_template=obj, shapedirs=obj, J_regressor=obj, kintree_table=obj)
+    with pytest.raises(FormatError, match="pickles"):
+        rest_from_model(p)
+
+
+def test_angular_speed_is_the_rotation_between_frames():
+    rng = np.random.default_rng(0)
+    poses = rng.normal(size=(5, 55, 3))
+    r = axis_angle_to_matrix(poses)
+    np.testing.assert_allclose(angular_speed(poses, 30.0), _angle(r[:-1], r[1:]) * 30.0, atol=1e-9)
+
+
+# ------------------------------------------------------------------------------------------ retargeting
+def _unmapped_beat_joints() -> set[str]:
+    from beatlite.skeleton.beat import beat_skeleton
+
+    return set(beat_skeleton().names) - set(BEAT_COUNTERPARTS.values())
+
+
+def test_beat_to_smplx_points_every_aligned_bone_exactly_and_bounds_the_rest():
+    take = load_take(SAMPLES / "2_scott_0_1_1", fps=30)
+    poses, trans = beat_to_smplx(take.motion)
+    errors = bone_direction_errors(take.motion, poses, trans)
+    print({k: round(float(v.max()), 2) for k, v in errors.items() if v.max() > 1e-6})
+    exact = {"pelvis->spine1", "spine3->neck", "left_wrist->left_middle1", "right_wrist->right_middle1"}
+    for bone, e in errors.items():
+        parent = bone.split("->")[0]
+        single = parent not in ("pelvis", "spine3", "left_wrist", "right_wrist")
+        if single or bone in exact:
+            assert e.max() < 1e-6, bone  # the aligned bone of each joint: exact by construction
+        else:
+            assert e.max() < 10.0, bone  # the other children of pelvis, spine3 and wrists
+    # the pelvis lands on BEAT's Hips
+    np.testing.assert_allclose(trans * 100, take.motion.positions()[:, 0], atol=1e-9)
+
+
+def test_bvh_to_smplx_to_bvh_round_trip_bone_directions():
+    take = load_take(SAMPLES / "2_scott_0_1_1", fps=30)
+    back = smplx_to_beat(*beat_to_smplx(take.motion), fps=30)
+    a, b = take.motion.positions(), back.positions()
+    sk = take.motion.skeleton
+    worst = {}
+    for k in range(1, sk.n_joints):
+        p = sk.parents[k]
+        u, v = a[:, k] - a[:, p], b[:, k] - b[:, p]
+        angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.sum(u * v, -1))  # exact near 0
+        worst[f"{sk.names[p]}->{sk.names[k]}"] = float(np.degrees(angle).max())
+    print("round trip, worst bone errors in degrees:", {k: round(v, 2) for k, v in worst.items() if v > 1e-6})
+    unmapped = _unmapped_beat_joints()
+    for bone, e in worst.items():
+        parent, child = bone.split("->")
+        if parent in unmapped or child in unmapped:  # a folded joint's own rotation is lost
+            assert e < 10.0, bone
+        else:
+            assert e < 1e-6, bone
+    np.testing.assert_allclose(a[:, 0], b[:, 0], atol=1e-9)
+
+
+def test_smplx_to_bvh_to_smplx_recovers_every_mapped_rotation():
+    rng = np.random.default_rng(5)
+    poses = rng.normal(scale=0.3, size=(20, 55, 3))
+    trans = rng.normal(scale=0.2, size=(20, 3))
+    back, trans2 = beat_to_smplx(smplx_to_beat(poses, trans, fps=30))
+    mapped = [j for j, n in enumerate(SMPLX_JOINTS) if n in BEAT_COUNTERPARTS]
+    err = _angle(axis_angle_to_matrix(poses[:, mapped]), axis_angle_to_matrix(back[:, mapped]))
+    assert err.max() < 1e-7
+    np.testing.assert_allclose(trans2, trans, atol=1e-12)
+    assert np.abs(back[:, [22, 23, 24]]).max() == 0.0  # jaw and eyes: BEAT has no such joints
+
+
+# ----------------------------------------------------------------------------------------- BEAT2 folders
+@pytest.fixture(scope="module")
+def beat2_folder(tmp_path_factory):
+    from beatlite.data.beat2 import write_beat2_folder
+    from beatlite.data.examples import example_corpus
+
+    src = example_corpus()
+    dst = tmp_path_factory.mktemp("beat2") / "beat_english_v2.0.0"
+    write_beat2_folder(src.name, dst)
+    src.cleanup()
+    return dst
+
+
+def test_index_and_load_a_beat2_folder(beat2_folder):
+    from beatlite.data.index import index_folder
+
+    (beat2_folder / "train_test_split.csv").write_text(
+        "id,type\n2_scott_0_1_1,test\n2_scott_0_9_9,additional\n"
+    )
+    index = index_folder(beat2_folder, cache=False)
+    assert index.stems == ["2_scott_0_1_1", "2_scott_0_9_9"]
+    assert [r.format for r in index] == ["beat2", "beat2"] and [r.split for r in index] == [
+        "test",
+        "additional",
+    ]
+    assert all(r.usable for r in index) and not any("face" in p for r in index for p in r.problems)
+    take = load_take(index[0].path("motion"))
+    beat = load_take(SAMPLES / "2_scott_0_1_1")
+    assert (
+        take.format == "beat2"
+        and take.n_frames == beat.n_frames
+        and take.expressions.shape == (beat.n_frames, 100)
+    )
+    np.testing.assert_array_equal(take.audio, beat.audio)
+    assert take.words.words == beat.words.words
+    # the body (no fingers) is where BEAT puts it, up to the folded Spine1 and Neck1: a chain of two 11 cm bones
+    # bent by theta is 22 (1 - cos(theta / 2)) cm shorter than straight, < 0.05 cm for the sample's bends (< 4 deg)
+    names = [n for n in BEAT_COUNTERPARTS.values() if "Hand" not in n or n.endswith("Hand")]
+    cols = [beat.motion.skeleton.index(n) for n in names]
+    np.testing.assert_allclose(take.positions()[:, cols], beat.positions()[:, cols], atol=0.05)
+
+
+@pytest.mark.slow
+def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
+    from beatlite.score import read_prediction, score_folder
+
+    (beat2_folder / "train_test_split.csv").write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_9_9,train\n")
+    shutil.copy(beat2_folder / "smplxflame_30" / "2_scott_0_1_1.npz", tmp_path)
+    assert read_prediction(tmp_path / "2_scott_0_1_1.npz").form.startswith("npz smplx")
+    result = score_folder(tmp_path, beat2_folder, metrics=["FGD", "MPJPE", "BC (emage)"])
+    values = result.evaluation.values()
+    assert values["FGD"] < 1e-6 and values["MPJPE"] < 1e-4
+    assert values["BC (emage)"] == pytest.approx(result.truth.values()["BC (emage)"], abs=1e-9)
