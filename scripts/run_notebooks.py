@@ -208,8 +208,9 @@ def _instructor_sheet():
         "instructor_sheet", Path(__file__).with_name("instructor_sheet.py")
     )
     module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault("instructor_sheet", module)  # dataclasses look their module up there
     spec.loader.exec_module(module)
-    return module
+    return sys.modules["instructor_sheet"]
 
 
 def main(argv: list[str] | None = None) -> int:
