@@ -13,9 +13,25 @@ shape, the kind of dtype (integer, float, bool), or the first differing element
 (index, both values, how many elements differ). It never prints whole arrays.
 
 "Why?" questions get feedback too: :func:`choice` checks a multiple-choice answer
-against a key that does not show the answer (:func:`answer_key` makes it), and
-:func:`predict` compares a number the student predicted with the value the next
-lines measure.
+against a key that does not show the answer, and :func:`predict` compares a number
+the student predicted with the value the next lines measure, within exactly the
+tolerance the cell gives.
+
+How the keys of :func:`choice` hide the answer: a key is the first 12 hex digits of
+``sha256(salt | question | answer)``, and the salt is the course's, not the
+student's: it is never printed or passed in a notebook cell, and :func:`answer_key`
+does not know it (the salt is its required third argument). So the options and the
+key in a student's cell do not give the answer away, neither read nor recomputed
+with ``answer_key(question, option)``. The instructor makes a key with
+``python scripts/instructor_sheet.py --key QUESTION ANSWER``, and
+``scripts/instructor_sheet.py`` (run by ``make run``) writes every exercise's solution,
+choice and "why?" answer to ``build/instructor/``. This keeps answers out of sight,
+not secret: the salt is in this module (``_SALT``), ``notebooks/`` holds the
+solutions, and trying every option with :func:`choice` is always possible; a
+student who does that learns less, not more. A key that depends on the data (the
+answer changes with the corpus) is made in the library by the function that poses
+the question (e.g. :func:`beatlite.models.ha2g_losses.costliest_pair_question`),
+never by a computation in the student's cell.
 
 Examples
 --------
@@ -185,16 +201,41 @@ def check(
     return True
 
 
-def answer_key(name: str, answer: Any) -> str:
-    """The 12-hex-digit key of ``answer`` to question ``name``, for :func:`choice` (hides the answer).
+#: The course's salt for :func:`choice` keys (see the module docstring: it keeps answers out of sight, not secret).
+_SALT = "beatlite-course-2026|b7c1f0e2"
+
+
+def answer_key(name: str, answer: Any, salt: str) -> str:
+    """The 12-hex-digit key of ``answer`` to question ``name`` under ``salt``, for :func:`choice`.
+
+    A notebook's key is made with the course's salt (instructors: ``scripts/instructor_sheet.py --key``), which
+    no notebook cell shows, so a key cannot be recomputed from the question and its options alone. Answers
+    are compared stripped and case-insensitive.
 
     Examples
     --------
-    >>> answer_key("05 indicator bit", "B")
-    '8a650c6856e1'
+    >>> answer_key("05 indicator bit", "B", salt="my class")
+    '68d0c02f0849'
+    >>> answer_key("05 indicator bit", " b ", salt="my class") == answer_key("05 indicator bit", "B", salt="my class")
+    True
+    >>> answer_key("05 indicator bit", "b", salt="another class")
+    '6d8ebe3a62a0'
     """
-    text = f"beatlite-exercise|{name}|{str(answer).strip().lower()}"
+    text = f"{salt}|beatlite-exercise|{name}|{str(answer).strip().lower()}"
     return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def course_key(name: str, answer: Any) -> str:
+    """:func:`answer_key` with the course's salt: for the library functions that pose a question on measured data.
+
+    Not for notebook cells (a call in a student's cell would show the answer it is given).
+
+    Examples
+    --------
+    >>> course_key("seed bit", "b") == answer_key("seed bit", "b", _SALT) != answer_key("seed bit", "b", "")
+    True
+    """
+    return answer_key(name, answer, _SALT)
 
 
 def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint: str = "") -> bool | None:
@@ -209,7 +250,8 @@ def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint
     options : mapping
         Choice -> statement, printed while unanswered.
     key : str
-        ``answer_key(name, correct_choice)``: the check never shows the right choice.
+        ``answer_key(name, correct_choice, salt)`` with the course's salt (:func:`course_key`); the cell holds
+        only the key, so it never shows the right choice.
     hint : str
         Printed after a wrong choice; it should point at the evidence, not at the answer.
 
@@ -221,12 +263,16 @@ def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint
     Examples
     --------
     >>> options = {"a": "it trains faster", "b": "a seed pose can be all zeros"}
-    >>> choice("seed bit", "a", options, answer_key("seed bit", "b"), hint="What does a 0 input mean?")
+    >>> key = course_key("seed bit", "b")  # instructors: scripts/instructor_sheet.py --key "seed bit" b
+    >>> choice("seed bit", "a", options, key, hint="What does a 0 input mean?")
     [exercise] seed bit: a is not the best answer. What does a 0 input mean?
     False
+    >>> choice("seed bit", "b", options, key)
+    [exercise] seed bit: b is right ✓
+    True
     """
     valid = {str(k).strip().lower(): k for k in options}
-    if not any(answer_key(name, k) == key for k in valid):
+    if not any(course_key(name, k) == key for k in valid):
         raise ValueError(f"choice {name!r}: the key {key!r} matches none of the options {list(options)}")
     if answer is None:
         lines = [f"[exercise] {name}: not answered yet; set the answer to one of:"]
@@ -236,7 +282,7 @@ def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint
     if str(answer).strip().lower() not in valid:
         print(f"[exercise] {name}: {answer!r} is not one of the options {list(options)}")
         return False
-    if answer_key(name, answer) == key:
+    if course_key(name, answer) == key:
         print(f"[exercise] {name}: {answer} is right ✓")
         return True
     print(f"[exercise] {name}: {answer} is not the best answer. {hint}".rstrip())
@@ -244,7 +290,13 @@ def choice(name: str, answer: Any, options: Mapping[str, str], key: str, *, hint
 
 
 def predict(
-    name: str, guess: float | None, actual: float, *, rtol: float = 0.1, atol: float = 0.0, unit: str = ""
+    name: str,
+    guess: float | None,
+    actual: float,
+    *,
+    rtol: float | None = None,
+    atol: float | None = None,
+    unit: str = "",
 ) -> bool | None:
     """Compare a numeric prediction, written down before running the code, with the measured value.
 
@@ -255,24 +307,40 @@ def predict(
     guess : float or None
         The student's prediction; ``None`` while not made.
     actual : float
-        The value the notebook measured.
-    rtol, atol : float
-        The prediction counts as right when ``|guess - actual| <= atol + rtol * |actual|``.
+        The value the notebook measured (same unit as ``guess``).
+    rtol, atol : float or None
+        The prediction counts as right when ``|guess - actual| <= atol + rtol * |actual|``. A tolerance given
+        is the whole tolerance: when only one of the two is given the other is 0; when neither is given,
+        ``rtol=0.1`` (within 10 %) and ``atol=0``.
     unit : str
         Unit printed after the numbers.
 
     Returns
     -------
     bool or None
-        True (within tolerance), False (outside; the message says how far and in which direction),
-        None (no prediction made: the measured value is not shown, so the student can still predict).
+        True (within tolerance), False (outside; the message says how far, in which direction, and the
+        tolerance), None (no prediction made: the measured value is not shown, so the student can still predict).
 
     Examples
     --------
-    >>> predict("mel frames per 34-pose window", 68, 70, rtol=0.05)  # 70: notebook 03
+    >>> predict("mel frames per 34-pose window", 68, 70, rtol=0.05)  # 70: notebook 03; 5 % of 70 = 3.5
     [exercise] mel frames per 34-pose window: predicted 68, measured 70 ✓
     True
+
+    Only the tolerance given counts: ``atol=5`` is 5 samples, with no 10 % of 36,545 (3,654.5 samples) added:
+
+    >>> predict("audio for 35 frames", 36266, 36545, atol=5, unit="samples")  # 36266 samples give 34 frames
+    [exercise] audio for 35 frames: predicted 36266 samples, measured 36545 samples: too low, 0.99x the measured value (within ±5 samples counts as right)
+    False
+    >>> predict("audio for 35 frames", 36545, 36545, atol=5, unit="samples")
+    [exercise] audio for 35 frames: predicted 36545 samples, measured 36545 samples ✓
+    True
     """
+    if rtol is None and atol is None:
+        rtol, atol = 0.1, 0.0
+    rtol, atol = float(rtol or 0.0), float(atol or 0.0)
+    if rtol < 0 or atol < 0:
+        raise ValueError(f"predict {name!r}: tolerances must be >= 0, got rtol={rtol}, atol={atol}")
     if guess is None:
         print(f"[exercise] {name}: write your prediction first (the measured value is printed afterwards)")
         return None

@@ -7,6 +7,8 @@ Writes, for each ``notebooks/NN_name.ipynb``:
   :func:`export_html`);
 - the tables the notebook saved with :func:`beatlite.report.save_table` (``build/tables/``);
 - ``build/student/NN_name.ipynb``: the student copy, without the cells tagged ``solution``;
+- ``build/instructor/``: the answer sheet of the exercises, from the ``solution`` cells
+  (``scripts/instructor_sheet.py``);
 - ``build/results.md``: per-notebook status and wall time, then every table.
 
 Exit status is non-zero when any notebook fails (the others still run). The notebooks run with
@@ -198,6 +200,19 @@ def write_student_copy(path: Path, out_dir: Path) -> None:
     nbformat.write(nb, out_dir / path.name)
 
 
+def _instructor_sheet():
+    """``scripts/instructor_sheet.py`` as a module (the scripts folder is not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "instructor_sheet", Path(__file__).with_name("instructor_sheet.py")
+    )
+    module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault("instructor_sheet", module)  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return sys.modules["instructor_sheet"]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -228,6 +243,7 @@ def main(argv: list[str] | None = None) -> int:
         rows.append((path.stem, ok, seconds, message))
         print(f"[run] {path.name}: {'ok' if ok else 'FAILED'} in {seconds:.1f} s {message}", flush=True)
     total = time.perf_counter() - total
+    _instructor_sheet().write_sheets(out / "instructor", [p.resolve() for p in paths])
 
     lines = [
         "# beatlite results",

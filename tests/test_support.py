@@ -113,8 +113,8 @@ def test_exercise_tolerance_and_nan_and_errors(capsys):
 
 def test_exercise_choice_hides_the_answer_and_checks_it(capsys):
     options = {"a": "it is faster", "b": "a z-scored pose can be all zeros", "c": "the paper says so"}
-    key = exercise.answer_key("bit", "B")
-    assert key == exercise.answer_key("bit", " b ") and key != exercise.answer_key("bit", "a")
+    key = exercise.course_key("bit", "B")
+    assert key == exercise.course_key("bit", " b ") and key != exercise.course_key("bit", "a")
     assert exercise.choice("bit", None, options, key) is None
     assert "c: the paper says so" in capsys.readouterr().out
     assert exercise.choice("bit", "a", options, key, hint="What does a 0 input mean?") is False
@@ -122,7 +122,21 @@ def test_exercise_choice_hides_the_answer_and_checks_it(capsys):
     assert exercise.choice("bit", "d", options, key) is False
     assert exercise.choice("bit", "B", options, key) is True
     with pytest.raises(ValueError, match="matches none"):
-        exercise.choice("bit", "a", options, exercise.answer_key("other question", "b"))
+        exercise.choice("bit", "a", options, exercise.course_key("other question", "b"))
+
+
+def test_exercise_choice_key_is_not_derivable_from_the_options():
+    """No salt a student can see (none, the empty one, the question's name) makes the course's key."""
+    import hashlib
+
+    key = exercise.course_key("bit", "b")
+    for salt in ("", "bit", "beatlite", "beatlite-exercise"):
+        assert exercise.answer_key("bit", "b", salt) != key
+    # the key's recipe, derived here from hashlib: sha256 of "salt|beatlite-exercise|question|answer"
+    text = f"{exercise._SALT}|beatlite-exercise|bit|b"
+    assert key == hashlib.sha256(text.encode()).hexdigest()[:12]
+    with pytest.raises(TypeError):
+        exercise.answer_key("bit", "b")  # the salt is not optional
 
 
 def test_exercise_predict(capsys):
@@ -133,6 +147,25 @@ def test_exercise_predict(capsys):
     assert "too low, 0.4x the measured value" in capsys.readouterr().out
     assert exercise.predict("lag", 0.2, 0.0, atol=0.05, unit="s") is False
     assert "too high" in capsys.readouterr().out
+
+
+def test_exercise_predict_tolerance_given_is_the_tolerance(capsys):
+    # notebook 05 (issue 27): measured 36545 samples; the old hidden rtol=0.1 accepted anything within 4,194.5
+    assert exercise.predict("n", 36266, 36545, atol=540) is True  # 279 <= 540: atol alone
+    assert exercise.predict("n", 36004, 36545, atol=540) is False  # 541 > 540 (the old rule: 4194.5)
+    assert "within ±540 counts" in capsys.readouterr().out
+    assert exercise.predict("n", 33500, 36545, atol=540) is False
+    assert exercise.predict("n", 36266, 36545, atol=5) is False
+    # rtol alone: no atol added; 10 % of 50 = 5
+    assert exercise.predict("x", 55.0, 50.0, rtol=0.1) is True
+    assert exercise.predict("x", 55.01, 50.0, rtol=0.1) is False
+    assert exercise.predict("x", 0.01, 0.0, rtol=0.5) is False  # |actual| = 0: rtol gives no slack
+    # both given: they add up; neither: within 10 %
+    assert exercise.predict("x", 56.0, 50.0, rtol=0.1, atol=1.0) is True
+    assert exercise.predict("x", 56.01, 50.0, rtol=0.1, atol=1.0) is False
+    assert exercise.predict("x", 109.9, 100.0) is True and exercise.predict("x", 110.1, 100.0) is False
+    with pytest.raises(ValueError, match=">= 0"):
+        exercise.predict("x", 1.0, 1.0, atol=-1.0)
 
 
 class ZMQInteractiveShell:  # what IPython's get_ipython() returns in a Jupyter kernel (by class name)

@@ -271,6 +271,67 @@ def physical_constraint_loss(angles: torch.Tensor, mean: torch.Tensor, var: torc
     return z.reshape(-1, mean.shape[0]).mean(dim=0).sum()
 
 
+def costliest_pair_question(
+    angles: np.ndarray, mean: np.ndarray, var: np.ndarray, *, k: int = 4, name: str = "costliest pair"
+) -> tuple[dict[str, str], str]:
+    """Notebook 06's "which pair costs the most?" question on measured angles: its options and its key.
+
+    Each pair's term of :func:`physical_constraint_loss` is ``mean_t (theta_p - mu_p)^2 / (2 sigma_p^2)``; the
+    options are the ``k`` costliest pairs in pair order, lettered a, b, ...; the key is the course's key
+    (:func:`beatlite.exercise.course_key`) of the costliest one's letter. Computed here, not in the student's
+    cell, so the cell shows neither the costs nor the answer.
+
+    Parameters
+    ----------
+    angles : (..., P) array, units of pi (P = 41: :data:`beatlite.skeleton.ted.ANGLE_PAIRS`)
+    mean, var : (P,) arrays, the angle statistics of the model (units of pi, pi^2)
+    k : int
+        Number of options (the k costliest pairs).
+    name : str
+        The question's name, part of the key.
+
+    Returns
+    -------
+    options : dict
+        Letter -> ``"vector vs vector"`` (:data:`beatlite.skeleton.ted.TED_VECTOR_NAMES`).
+    key : str
+        For :func:`beatlite.exercise.choice`.
+
+    Examples
+    --------
+    >>> from beatlite.exercise import course_key
+    >>> from beatlite.skeleton.ted import ANGLE_PAIRS, TED_VECTOR_NAMES
+    >>> mean, var = np.full(41, 0.5), np.full(41, 0.01)
+    >>> angles = np.full((10, 41), 0.5)
+    >>> angles[:, [3, 9, 20, 30]] += [0.1, 0.3, 0.2, 0.05]  # pair 9 costs 0.3^2 / 0.02 = 4.5, the most
+    >>> options, key = costliest_pair_question(angles, mean, var)
+    >>> list(options)
+    ['a', 'b', 'c', 'd']
+    >>> options["b"] == " vs ".join(TED_VECTOR_NAMES[v] for v in ANGLE_PAIRS[9])
+    True
+    >>> key == course_key("costliest pair", "b")
+    True
+    """
+    from beatlite.exercise import course_key
+    from beatlite.skeleton.ted import ANGLE_PAIRS, TED_VECTOR_NAMES
+
+    mean, var = np.asarray(mean, dtype=np.float64), np.asarray(var, dtype=np.float64)
+    a = np.asarray(angles, dtype=np.float64)
+    if a.shape[-1] != mean.shape[0] or mean.shape != var.shape or mean.shape[0] != len(ANGLE_PAIRS):
+        raise ValueError(
+            f"angles (..., {len(ANGLE_PAIRS)}), mean and var must agree on P, got {a.shape}, {mean.shape}, {var.shape}"
+        )
+    if not 1 <= k <= min(26, len(mean)):
+        raise ValueError(f"k must be in 1..{min(26, len(mean))}, got {k}")
+    per_pair = ((a - mean) ** 2 / (2.0 * var)).reshape(-1, len(mean)).mean(axis=0)
+    shown = sorted(int(p) for p in np.argsort(per_pair, kind="stable")[-k:])
+    letters = "abcdefghijklmnopqrstuvwxyz"[:k]
+    options = {
+        letter: " vs ".join(TED_VECTOR_NAMES[v] for v in ANGLE_PAIRS[p]) for letter, p in zip(letters, shown)
+    }
+    return options, course_key(name, letters[shown.index(int(np.argmax(per_pair)))])
+
+
 @dataclass(frozen=True)
 class AngleStatistics:
     """Training-set statistics of the bone angles (units of pi radians).
