@@ -351,3 +351,30 @@ def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
     values = result.evaluation.values()
     assert values["FGD"] < 1e-6 and values["MPJPE"] < 1e-4
     assert values["BC (emage)"] == pytest.approx(result.truth.values()["BC (emage)"], abs=1e-9)
+
+
+# ------------------------------------------------------------------------------------------ conversion
+def test_convert_command_round_trip_and_one_line_errors(tmp_path, capsys):
+    from beatlite.convert import main
+    from beatlite.io import read_bvh
+
+    src = SAMPLES / "2_scott_0_1_1.bvh.gz"
+    assert main([str(src), str(tmp_path / "t.npz")]) == 0
+    out = capsys.readouterr().out
+    assert "left_wrist->left_pinky1" in out and "jaw, left_eye_smplhf, right_eye_smplhf" in out
+    smplx = read_smplx(tmp_path / "t.npz")
+    assert (
+        smplx.fps == 30.0 and smplx.n_frames == 2 * load_take(SAMPLES / "2_scott_0_1_1").n_frames
+    )  # 15 fps take
+    assert main([str(tmp_path / "t.npz"), str(tmp_path / "back.bvh")]) == 0
+    back = read_bvh(tmp_path / "back.bvh")
+    np.testing.assert_allclose(back.channels, smplx.to_beat().channels, atol=1e-6)  # 6 decimals in the file
+    assert main([str(tmp_path / "t.npz"), str(tmp_path / "own.bvh"), "--skeleton", "smplx"]) == 0
+    own = read_bvh(tmp_path / "own.bvh")
+    from beatlite.skeleton.smplx import DEPTH_FIRST
+
+    np.testing.assert_allclose(own.positions(), 100 * smplx.positions()[:, DEPTH_FIRST], atol=1e-3)
+    capsys.readouterr()
+    assert main([str(SAMPLES / "2_scott_0_1_1.wav"), str(tmp_path / "x.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:") and "2_scott_0_1_1.wav" in err[0]

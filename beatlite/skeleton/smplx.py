@@ -42,6 +42,7 @@ from beatlite.skeleton.rotations import axis_angle_to_matrix, matrix_to_6d, matr
 
 __all__ = [
     "BEAT_COUNTERPARTS",
+    "DEPTH_FIRST",
     "SMPLX_JOINTS",
     "SMPLX_N_JOINTS",
     "SMPLX_PARENTS",
@@ -54,6 +55,7 @@ __all__ = [
     "rest_from_model",
     "rot6d_features",
     "smplx_forward_kinematics",
+    "smplx_skeleton_motion",
     "smplx_to_beat",
 ]
 
@@ -78,6 +80,19 @@ _fill = np.flatnonzero(SMPLX_PARENTS == -2)
 SMPLX_PARENTS[_fill] = _fill - 1  # a finger's 2nd and 3rd joints hang from the joint before them
 SMPLX_PARENTS.setflags(write=False)
 """(55,) int64: each joint's parent (the SMPL-X ``kintree_table``), ``-1`` for the pelvis."""
+
+
+def _depth_first() -> np.ndarray:
+    order, stack = [], [0]
+    while stack:
+        j = stack.pop()
+        order.append(j)
+        stack.extend(reversed(np.flatnonzero(SMPLX_PARENTS == j).tolist()))
+    return np.array(order, dtype=np.int64)
+
+
+DEPTH_FIRST: np.ndarray = _depth_first()
+"""(55,) int64: SMPL-X's joints in depth-first order (children in index order), the order a BVH file needs."""
 
 _BEAT_FINGER = {"index": "Index", "middle": "Middle", "pinky": "Pinky", "ring": "Ring", "thumb": "Thumb"}
 BEAT_COUNTERPARTS: dict[str, str] = {
@@ -142,9 +157,15 @@ class SMPLXRest:
 
     def skeleton(self) -> Skeleton:
         """A BVH :class:`~beatlite.skeleton.core.Skeleton` of this body (offsets in cm, ``XYZ`` Euler channels,
-        root position channels), for :func:`beatlite.io.write_bvh` (e.g. to open an SMPL-X motion in Blender)."""
+        root position channels), for :func:`beatlite.io.write_bvh` (e.g. to open an SMPL-X motion in Blender).
+
+        Its joints are in depth-first order, as BVH requires (``skeleton.names[k]`` is
+        ``SMPLX_JOINTS[DEPTH_FIRST[k]]``), not in SMPL-X's order."""
+        inverse = np.argsort(DEPTH_FIRST)
+        parents = np.array([-1 if p < 0 else inverse[p] for p in SMPLX_PARENTS[DEPTH_FIRST]], dtype=np.int64)
         channels = ((*POSITION_CHANNELS, *ROTATION_CHANNELS),) + (ROTATION_CHANNELS,) * (SMPLX_N_JOINTS - 1)
-        return Skeleton(SMPLX_JOINTS, SMPLX_PARENTS.copy(), 100.0 * self.offsets(), channels)
+        names = tuple(SMPLX_JOINTS[j] for j in DEPTH_FIRST)
+        return Skeleton(names, parents, 100.0 * self.offsets()[DEPTH_FIRST], channels)
 
 
 def _beat_rest_m(beat: Skeleton | None = None) -> tuple[Skeleton, np.ndarray]:
@@ -536,6 +557,51 @@ def smplx_to_beat(poses: np.ndarray, trans: np.ndarray, fps: float, rest: SMPLXR
     hips = 100.0 * (np.asarray(trans, dtype=np.float64) + rest.joints[0])
     channels[:, beat.position_channel_indices(0)] = hips
     return Motion(beat, channels, fps)
+
+
+def smplx_skeleton_motion(
+    poses: np.ndarray, trans: np.ndarray, fps: float, rest: SMPLXRest | None = None
+) -> object:
+    """An SMPL-X motion as BVH rows of its own skeleton (:meth:`SMPLXRest.skeleton`): no retargeting, e.g. to open
+    a BEAT2 file in Blender (PantoMatrix#83, #178) with :func:`beatlite.io.write_bvh`.
+
+    Parameters
+    ----------
+    poses : (T, 55, 3) float, axis-angle radians
+    trans : (T, 3) float, metres
+    fps : float
+    rest : SMPLXRest, optional
+        Default :func:`approximate_rest`.
+
+    Returns
+    -------
+    Motion
+        ``XYZ`` Euler degrees per joint (continuous over time), the pelvis position in cm, joints in
+        :data:`DEPTH_FIRST` order; its forward kinematics equals ``100 * smplx_forward_kinematics(...)[:, DEPTH_FIRST]``.
+
+    Examples
+    --------
+    >>> poses = np.random.default_rng(0).normal(scale=0.3, size=(3, 55, 3))
+    >>> motion = smplx_skeleton_motion(poses, np.zeros((3, 3)), fps=30)
+    >>> x = 100 * smplx_forward_kinematics(poses)[:, DEPTH_FIRST]  # the BVH's joints are in depth-first order
+    >>> motion.channels.shape, bool(np.allclose(motion.positions(), x))
+    ((3, 168), True)
+    """
+    from beatlite.io.motion import Motion
+    from beatlite.skeleton.rotations import matrix_to_euler
+    from beatlite.synth.motion import continuous_euler
+
+    rest = approximate_rest() if rest is None else rest
+    local = _full_local(poses, rest)
+    skeleton = rest.skeleton()
+    channels = np.zeros((local.shape[0], skeleton.n_channels))
+    channels[:, skeleton.position_channel_indices(0)] = 100.0 * (
+        np.asarray(trans, np.float64) + rest.joints[0]
+    )
+    for k, j in enumerate(DEPTH_FIRST):
+        euler = matrix_to_euler(local[:, j], "XYZ", degrees=True)
+        channels[:, skeleton.rotation_channel_indices(k)] = continuous_euler(euler)
+    return Motion(skeleton, channels, fps)
 
 
 def bone_direction_errors(motion: object, poses: np.ndarray, trans: np.ndarray, rest: SMPLXRest | None = None

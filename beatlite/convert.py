@@ -1,0 +1,179 @@
+"""Move motion between BEAT and BEAT2: ``python -m beatlite.convert SRC DST``.
+
+=====================================  ==================================================================
+``SRC -> DST``                         what happens
+=====================================  ==================================================================
+``take.bvh[.gz] -> take.npz``          BEAT's skeleton resampled to ``--fps`` (default 30, BEAT2's rate) and
+                                       retargeted to SMPL-X (:func:`beatlite.skeleton.smplx.beat_to_smplx`);
+                                       the bone-direction errors are reported
+``take.npz -> take.bvh``               BEAT2 retargeted to BEAT's skeleton (:func:`~beatlite.skeleton.smplx
+                                       .smplx_to_beat`); ``--skeleton smplx`` writes SMPL-X's own skeleton
+                                       instead (no retargeting: to open BEAT2 files in Blender)
+``BEAT folder -> BEAT2 folder``        :func:`beatlite.data.beat2.write_beat2_folder`
+=====================================  ==================================================================
+
+``--model SMPLX_NEUTRAL.npz`` (and the file's ``betas``) gives the body's rest skeleton
+(:func:`~beatlite.skeleton.smplx.rest_from_model`); without it beatlite's approximation is used
+(:func:`~beatlite.skeleton.smplx.approximate_rest`). Every file is written atomically; a bad input is one
+``error:`` line and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["convert", "main"]
+
+
+def _rest(model: str | Path | None, betas: np.ndarray | None = None) -> Any:
+    from beatlite.skeleton.smplx import approximate_rest, rest_from_model
+
+    return approximate_rest() if model is None else rest_from_model(model, betas)
+
+
+def _is_bvh(path: Path) -> bool:
+    return path.name.endswith((".bvh", ".bvh.gz"))
+
+
+def convert(
+    src: str | Path,
+    dst: str | Path,
+    *,
+    fps: float = 30.0,
+    skeleton: str = "beat",
+    model: str | Path | None = None,
+) -> dict[str, Any]:
+    """Convert one file or a folder (see the module docstring) and say what was lost.
+
+    Parameters
+    ----------
+    src, dst : str or Path
+        ``.bvh``/``.bvh.gz`` <-> ``.npz``, or a BEAT folder -> a BEAT2 folder.
+    fps : float
+        Frame rate of a written ``.npz`` (the BVH is resampled; rotations along the shorter arc).
+    skeleton : {"beat", "smplx"}
+        The skeleton of a written ``.bvh``.
+    model : str or Path, optional
+        An SMPL-X model ``.npz`` for the rest skeleton.
+
+    Returns
+    -------
+    dict
+        ``{"frames", "fps", "bone_errors_deg": {bone: (mean, max)}, "no_counterpart": [...]}`` for BVH -> npz
+        (the SMPL-X joints without a BEAT joint), ``{"frames", "fps"}`` for npz -> BVH, ``{"takes": [...]}`` for
+        a folder.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from beatlite.paths import repo_root
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> report = convert(repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz", Path(tmp.name) / "t.npz")
+    >>> report["frames"], report["fps"], report["no_counterpart"]
+    (444, 30.0, ['jaw', 'left_eye_smplhf', 'right_eye_smplhf'])
+    >>> max(m for _, m in report["bone_errors_deg"].values()) < 5  # the wrists' other children, in degrees
+    True
+    >>> convert(Path(tmp.name) / "t.npz", Path(tmp.name) / "t.bvh")
+    {'frames': 444, 'fps': 30.0}
+    >>> tmp.cleanup()
+    """
+    from beatlite.io import FormatError, read_bvh, write_bvh
+    from beatlite.io.motion import Motion
+    from beatlite.io.smplx import SMPLXMotion, read_smplx, write_smplx
+    from beatlite.io.take import resample_frames, rotation_columns
+    from beatlite.score import beat_channels
+    from beatlite.skeleton.beat import beat_skeleton
+    from beatlite.skeleton.smplx import (
+        BEAT_COUNTERPARTS,
+        SMPLX_JOINTS,
+        beat_to_smplx,
+        bone_direction_errors,
+        smplx_skeleton_motion,
+        smplx_to_beat,
+    )
+
+    src, dst = Path(src), Path(dst)
+    if skeleton not in ("beat", "smplx"):
+        raise ValueError(f"convert: skeleton must be 'beat' or 'smplx', got {skeleton!r}")
+    if src.is_dir():
+        from beatlite.data.beat2 import write_beat2_folder
+
+        return {"takes": write_beat2_folder(src, dst, rest=_rest(model))}
+    if _is_bvh(src) and dst.suffix == ".npz":
+        source = read_bvh(src)
+        channels = beat_channels(source, src)
+        motion = Motion(beat_skeleton(), channels, source.fps)
+        if source.fps != fps:
+            cols = rotation_columns(motion)
+            motion = Motion(
+                beat_skeleton(), resample_frames(channels, source.fps, fps, angle_columns=cols), fps
+            )
+        rest = _rest(model)
+        poses, trans = beat_to_smplx(motion, rest)
+        write_smplx(dst, SMPLXMotion(poses, trans, fps, betas=np.zeros(300)))
+        errors = bone_direction_errors(motion, poses, trans, rest)
+        return {
+            "frames": motion.n_frames,
+            "fps": float(fps),
+            "bone_errors_deg": {k: (float(v.mean()), float(v.max())) for k, v in errors.items()},
+            "no_counterpart": [n for n in SMPLX_JOINTS if n not in BEAT_COUNTERPARTS],
+        }
+    if src.suffix == ".npz" and _is_bvh(dst):
+        smplx = read_smplx(src)
+        rest = _rest(model, smplx.betas if model is not None else None)
+        if skeleton == "smplx":
+            out = smplx_skeleton_motion(smplx.poses, smplx.trans, smplx.fps, rest)
+        else:
+            out = smplx_to_beat(smplx.poses, smplx.trans, smplx.fps, rest)
+        write_bvh(dst, out)  # type: ignore[arg-type]
+        return {"frames": smplx.n_frames, "fps": smplx.fps}
+    raise FormatError(
+        src, f"cannot convert {src.name} to {dst.name}: give .bvh -> .npz, .npz -> .bvh, or two folders"
+    )
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m beatlite.convert", description=__doc__.split("\n")[0])
+    p.add_argument("src", help="a .bvh[.gz], a BEAT2 .npz, or a BEAT folder")
+    p.add_argument("dst", help="a .npz, a .bvh, or the BEAT2 folder to write")
+    p.add_argument("--fps", type=float, default=30.0, help="frame rate of a written .npz (default 30)")
+    p.add_argument("--skeleton", choices=("beat", "smplx"), default="beat", help="skeleton of a written .bvh")
+    p.add_argument(
+        "--model", help="an SMPL-X model .npz for the rest skeleton (default: beatlite's approximation)"
+    )
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: 0 on success, 2 when the input cannot be converted (one ``error:`` line)."""
+    from beatlite.io import FormatError
+
+    args = _parser().parse_args(argv)
+    try:
+        report = convert(args.src, args.dst, fps=args.fps, skeleton=args.skeleton, model=args.model)
+    except (FormatError, FileNotFoundError, ValueError) as exc:
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    if "takes" in report:
+        print(f"{len(report['takes'])} takes written to {args.dst}")
+    else:
+        print(f"{args.dst}: {report['frames']} frames at {report['fps']:g} fps")
+    if "bone_errors_deg" in report:
+        worst = sorted(report["bone_errors_deg"].items(), key=lambda kv: -kv[1][1])[:5]
+        print("bone-direction error after retargeting (degrees, mean / max over frames), the five largest:")
+        for bone, (mean, top) in worst:
+            print(f"  {bone:32s} {mean:6.2f} / {top:6.2f}")
+        print(
+            f"SMPL-X joints without a BEAT counterpart (left at rest): {', '.join(report['no_counterpart'])}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
