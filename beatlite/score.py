@@ -443,6 +443,11 @@ class ScoreResult:
                 if i.get("euler_extractor_sha256")
                 else ""
             )
+            + (
+                f", 6D autoencoder sha256 {i['rot6d_extractor_sha256']}"
+                if i.get("rot6d_extractor_sha256")
+                else ""
+            )
             + f"; beatlite {i['beatlite_version']}.",
         ]
         if i.get("bootstrap"):
@@ -684,8 +689,11 @@ def _score(
     torch.set_num_threads(n_threads())
     extractor = _extractor(extractor_path)
     euler_ae = load_extractor("pose") if "FGD (BEAT AE)" in keys else None
-    truth = test.ground_truth(extractor, euler_ae)
-    generated = directions_takes(directions, test, extractor, euler=euler, euler_extractor=euler_ae)
+    rot6d_ae = load_extractor("rot6d") if "FGD (rot6d)" in keys else None
+    truth = test.ground_truth(extractor, euler_ae, rot6d_ae)
+    generated = directions_takes(
+        directions, test, extractor, euler=euler, euler_extractor=euler_ae, rot6d_extractor=rot6d_ae
+    )
     evaluation = evaluate(generated, truth, metrics=keys, seed=seed)
     own = evaluate(truth.takes, truth, metrics=keys, seed=seed)
     scored = [r.key for r in evaluation.results]
@@ -702,6 +710,7 @@ def _score(
         "extractor": extractor.meta["path"],
         "extractor_sha256": _file_sha(extractor.meta["path"]),
         "euler_extractor_sha256": None if euler_ae is None else _file_sha(euler_ae.meta["path"]),
+        "rot6d_extractor_sha256": None if rot6d_ae is None else _file_sha(rot6d_ae.meta["path"]),
         "beatlite_version": beatlite.__version__,
         "bootstrap": int(bootstrap),
         "seed": int(seed),
@@ -814,6 +823,7 @@ def _draw(takes: Any, idx: np.ndarray, bounds: np.ndarray) -> Any:
         euler=_pick(takes.euler, idx),
         features=None if takes.features is None else takes.features[rows],
         euler_features=None if takes.euler_features is None else takes.euler_features[rows],
+        rot6d_features=None if takes.rot6d_features is None else takes.rot6d_features[rows],
     )
 
 

@@ -19,15 +19,17 @@ def values() -> dict[str, tuple[float, float]]:
     from beatlite.train.testset import directions_takes, load_test_set
 
     test = load_test_set()
-    extractor, euler_extractor = load_extractor("dirvec"), load_extractor("pose")
-    truth = test.ground_truth(extractor, euler_extractor)
+    extractor, euler_extractor, rot6d_extractor = (load_extractor(s) for s in ("dirvec", "pose", "rot6d"))
+    truth = test.ground_truth(extractor, euler_extractor, rot6d_extractor)
     rng = np.random.default_rng(0)
     noisy = []
     for d in test.gt_directions:  # 0.3 rad of noise per bone direction, re-normalised
         n = d + 0.3 * rng.standard_normal(d.shape)
         noisy.append(n / np.linalg.norm(n, axis=-1, keepdims=True))
     euler = [e + rng.normal(0, 10.0, e.shape) for e in test.gt_euler]  # 10 degrees of noise
-    degraded = directions_takes(noisy, test, extractor, euler=euler, euler_extractor=euler_extractor)
+    degraded = directions_takes(
+        noisy, test, extractor, euler=euler, euler_extractor=euler_extractor, rot6d_extractor=rot6d_extractor
+    )
     gt, bad = evaluate(truth.takes, truth), evaluate(degraded, truth)
     assert not gt.skipped and not bad.skipped, (gt.skipped, bad.skipped)  # every metric is scored here
     return {key: (gt.values()[key], bad.values()[key]) for key in METRICS}

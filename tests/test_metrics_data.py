@@ -151,13 +151,18 @@ def split_windows(data_samples):
     )
 
 
-@pytest.mark.parametrize("space", ["dirvec", "pose"])
+@pytest.mark.parametrize("space", ["dirvec", "pose", "rot6d"])
 def test_shipped_extractor_matches_the_corpus_and_ranks_broken_motion_worse(space, split_windows):
-    from beatlite.metrics.extractor import SPACES, load_extractor
+    from beatlite.metrics.extractor import SPACES, load_extractor, space_input
 
     train, val, test = split_windows
     key = SPACES[space][0]
-    ex = load_extractor(space)
+    loaded = load_extractor(space)
+
+    def ex(windows):  # rot6d: the raw Euler windows as 6D rotations first
+        return loaded(np.asarray(space_input(windows, space), np.float32))
+
+    ex.meta = loaded.meta
     # files (content) + parameters: the same on every machine (float bytes are not: other CPUs, builds)
     assert ex.meta["data_fingerprint"] == train.fingerprint, (
         f"checkpoint is stale: retrain with `python -m beatlite.metrics.extractor train --space {space}`"

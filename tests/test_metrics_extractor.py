@@ -95,7 +95,7 @@ def test_command_line_help():
     assert out.returncode == 0 and "--space" in out.stdout
 
 
-@pytest.mark.parametrize("space, dim", [("dirvec", 126), ("pose", 141)])
+@pytest.mark.parametrize("space, dim", [("dirvec", 126), ("pose", 141), ("rot6d", 282)])
 def test_shipped_checkpoint(space, dim):
     from beatlite.metrics.extractor import SPACES
 

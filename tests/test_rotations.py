@@ -10,6 +10,7 @@ from beatlite.skeleton.rotations import (
     EULER_ORDERS,
     axis_angle_to_matrix,
     euler_entries,
+    euler_to_6d,
     euler_to_matrix,
     matrix_to_6d,
     matrix_to_axis_angle,
@@ -215,3 +216,17 @@ def test_every_representation_round_trips_below_a_microradian_on_hard_rotations(
     ours = matrix_to_quat(mats)
     theirs = Rotation.from_matrix(mats).as_quat(scalar_first=True)
     assert _geodesic(quat_to_matrix(ours), quat_to_matrix(theirs)).max() < 1e-6
+
+
+def test_euler_to_6d_is_the_6d_of_each_triplet(rng):
+    angles = rng.uniform(-180, 180, size=(5, 141))
+    six = euler_to_6d(angles)
+    assert six.shape == (5, 282)
+    by_hand = matrix_to_6d(euler_to_matrix(angles.reshape(5, 47, 3), "XYZ")).reshape(5, 282)
+    np.testing.assert_array_equal(six, by_hand)
+    # continuity: a joint turning through 180 degrees jumps in Euler angles, not in 6D
+    track = np.array([[0.0, 0.0, 179.0], [0.0, 0.0, -179.0]])
+    assert np.abs(np.diff(track, axis=0)).max() == 358.0
+    assert np.abs(np.diff(euler_to_6d(track), axis=0)).max() < np.radians(2.0) + 1e-12
+    with pytest.raises(ValueError, match="triplets"):
+        euler_to_6d(np.zeros((2, 4)))

@@ -352,7 +352,9 @@ def test_an_extractor_of_another_space_is_refused(truth_files, test_set):
         score_folder(truth_files, test=test_set, metrics=["FGD"], extractor=path)
 
 
-def test_a_too_short_prediction_and_a_smplx_npz_are_refused_one_line_each(truth_files, test_set, tmp_path):
+def test_a_too_short_prediction_and_an_incomplete_smplx_npz_are_refused_one_line_each(
+    truth_files, test_set, tmp_path
+):
     folder = tmp_path / "pred"
     shutil.copytree(truth_files, folder)
     short, smplx = test_set.takes[0], test_set.takes[1]
@@ -365,7 +367,7 @@ def test_a_too_short_prediction_and_a_smplx_npz_are_refused_one_line_each(truth_
     lines = info.value.lines
     assert len(lines) == 2 and all("\n" not in line for line in lines), lines
     assert any(short in line and "20 frames" in line and "34-frame window" in line for line in lines), lines
-    assert any(f"{smplx}.npz" in line and "SMPL-X" in line for line in lines), lines
+    assert any(f"{smplx}.npz" in line and "no 'trans' array" in line for line in lines), lines
 
 
 def test_emage_audio_beats_leave_out_two_seconds_at_both_ends():

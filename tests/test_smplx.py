@@ -347,9 +347,10 @@ def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
     (beat2_folder / "train_test_split.csv").write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_9_9,train\n")
     shutil.copy(beat2_folder / "smplxflame_30" / "2_scott_0_1_1.npz", tmp_path)
     assert read_prediction(tmp_path / "2_scott_0_1_1.npz").form.startswith("npz smplx")
-    result = score_folder(tmp_path, beat2_folder, metrics=["FGD", "MPJPE", "BC (emage)"])
+    result = score_folder(tmp_path, beat2_folder, metrics=["FGD", "FGD (rot6d)", "MPJPE", "BC (emage)"])
     values = result.evaluation.values()
-    assert values["FGD"] < 1e-6 and values["MPJPE"] < 1e-4
+    assert values["FGD"] < 1e-6 and values["FGD (rot6d)"] < 1e-6 and values["MPJPE"] < 1e-4
+    assert "6D autoencoder sha256" in result.to_markdown()
     assert values["BC (emage)"] == pytest.approx(result.truth.values()["BC (emage)"], abs=1e-9)
 
 

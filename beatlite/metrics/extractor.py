@@ -18,7 +18,7 @@ encoder output; beatlite does the same at a laptop scale:
   2.4 and 11.9 with w = 10).
 - input normalisation: per-channel mean/std of the training windows, stored in the checkpoint.
 
-Train with ``python -m beatlite.metrics.extractor train [--space dirvec|pose]`` (one thread,
+Train with ``python -m beatlite.metrics.extractor train [--space dirvec|pose|rot6d]`` (one thread,
 deterministic with ``--seed``); the shipped checkpoints are ``checkpoints/fgd_dirvec.pt``
 (TED-43 direction vectors, 126-d, the common evaluation space) and
 ``checkpoints/fgd_euler141.pt`` (z-scored Euler angles, 141-d, BEAT's space).
@@ -45,11 +45,18 @@ from beatlite.constants import WINDOW_LENGTH
 
 FORMAT = "beatlite-fgd-extractor/1"
 #: Window key of ``beatlite.data.windows`` for each extractor space, and the shipped file name.
-SPACES = {"dirvec": ("dirvec", "fgd_dirvec.pt"), "pose": ("pose", "fgd_euler141.pt")}
+SPACES = {
+    "dirvec": ("dirvec", "fgd_dirvec.pt"),
+    "pose": ("pose", "fgd_euler141.pt"),
+    "rot6d": ("pose_raw", "fgd_rot6d.pt"),
+}
+#: Spaces whose windows are computed from their key's values: "rot6d" = the 6D rotation of each of the 47 joints of
+#: the raw Euler degrees (:func:`beatlite.skeleton.rotations.euler_to_6d`, 282-d; EMAGE's FGD space is rot6d).
+SPACE_INPUTS = {"rot6d": "euler_to_6d"}
 #: Weight of the velocity MSE per space. BEAT's 0.1 (docs/reference_code.md#fgd-autoencoder) for "pose"; for "dirvec" 0.1 leaves
 #: the encoder blind to timing (FGD of frame-shuffled test windows 0.9x that of held-out real
 #: windows on data_samples), 10 makes it see it (2.4x) — measured, see the module docstring.
-VELOCITY_WEIGHT = {"dirvec": 10.0, "pose": 0.1}
+VELOCITY_WEIGHT = {"dirvec": 10.0, "pose": 0.1, "rot6d": 10.0}  # rot6d: unit-vector columns, as dirvec
 
 
 @dataclass(frozen=True)
@@ -166,7 +173,7 @@ class FeatureExtractor:
     mean, std : (D,) float32
         Input normalisation applied before encoding.
     space : str
-        ``"dirvec"`` or ``"pose"`` (what the windows must be).
+        ``"dirvec"``, ``"pose"`` or ``"rot6d"`` (what the windows must be: :data:`SPACES`, :func:`space_input`).
     meta : dict
         Everything else stored in the checkpoint (fingerprint, training history...).
 
@@ -215,6 +222,21 @@ class FeatureExtractor:
 
 
 # ----------------------------------------------------------------------------- training
+def space_input(values: np.ndarray, space: str | None) -> np.ndarray:
+    """The extractor input of ``space`` from its window key's values (unchanged but for :data:`SPACE_INPUTS`).
+
+    Examples
+    --------
+    >>> space_input(np.zeros((2, 34, 141)), "rot6d").shape  # 47 Euler triplets -> 47 6D rotations
+    (2, 34, 282)
+    """
+    if space not in SPACE_INPUTS:
+        return values
+    from beatlite.skeleton import rotations
+
+    return getattr(rotations, SPACE_INPUTS[space])(values)
+
+
 class WindowSource:
     """The (N, 34, D) float32 training windows of an extractor, from an array or a window view.
 
@@ -229,10 +251,11 @@ class WindowSource:
     (2, (1, 34, 3))
     """
 
-    def __init__(self, windows: Any, key: str | None = None) -> None:
+    def __init__(self, windows: Any, key: str | None = None, space: str | None = None) -> None:
         self.view = None if key is None else windows
         self.array = np.asarray(windows, dtype=np.float32) if key is None else None
         self.key = key
+        self.space = space
         n, shape = (
             (len(windows), self.get(np.arange(min(1, len(windows))))[0].shape) if len(windows) else (0, ())
         )
@@ -242,10 +265,11 @@ class WindowSource:
         return self.n
 
     def get(self, idx: np.ndarray) -> np.ndarray:
-        """Windows ``idx``: (len(idx), 34, D) float32."""
+        """Windows ``idx``: (len(idx), 34, D) float32 (of a view: its ``key``, then :func:`space_input`)."""
         if self.view is None:
             return self.array[idx]
-        return np.asarray(self.view.batch(np.asarray(idx), keys=(self.key,))[self.key], np.float32)
+        values = self.view.batch(np.asarray(idx), keys=(self.key,))[self.key]
+        return np.asarray(space_input(values, self.space), np.float32)
 
     def moments(self, chunk: int = 4096) -> tuple[np.ndarray, np.ndarray]:
         """Per-channel mean and std (floored at 1e-3), (D,) float32: of the array as numpy computes
@@ -273,6 +297,7 @@ def train_autoencoder(
     *,
     val_windows: Any = None,
     key: str | None = None,
+    space: str | None = None,
     log: bool = True,
 ) -> tuple[MotionAutoencoder, dict[str, Any]]:
     """Train the autoencoder on (N, 34, D) windows, deterministically (one thread by default).
@@ -286,7 +311,9 @@ def train_autoencoder(
     val_windows : (M, 34, D) float array or a view with ``key``, optional
         Held-out windows whose loss is reported.
     key : str, optional
-        The batch key of a view (``"dirvec"`` or ``"pose"``); None for arrays.
+        The batch key of a view (``"dirvec"``, ``"pose"`` or ``"pose_raw"``); None for arrays.
+    space : str, optional
+        The extractor space: a view's windows pass through :func:`space_input` (``"rot6d"``: Euler -> 6D).
     log : bool
         Print one line per 10 epochs.
 
@@ -306,12 +333,12 @@ def train_autoencoder(
     """
     from beatlite.paths import n_threads
 
-    w = WindowSource(windows, key)
+    w = WindowSource(windows, key, space)
     if len(w) and w.shape != (WINDOW_LENGTH, config.input_dim):
         raise ValueError(f"windows must be (N, {WINDOW_LENGTH}, {config.input_dim}), got (N, *{w.shape})")
     if len(w) < 2:
         raise ValueError(f"need at least 2 training windows, got {len(w)}")
-    val = None if val_windows is None else WindowSource(val_windows, key)
+    val = None if val_windows is None else WindowSource(val_windows, key, space)
     torch.set_num_threads(n_threads())
     torch.manual_seed(config.seed)
     was_deterministic = torch.are_deterministic_algorithms_enabled()
@@ -493,13 +520,13 @@ def _train_command(args: argparse.Namespace) -> int:
     except ValueError:
         val = None
     config = ExtractorConfig(
-        input_dim=WindowSource(train, key).shape[1], latent_dim=args.latent, channels=args.channels,
+        input_dim=WindowSource(train, key, args.space).shape[1], latent_dim=args.latent, channels=args.channels,
         epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
         velocity_weight=VELOCITY_WEIGHT[args.space] if args.velocity_weight is None else args.velocity_weight,
         velocity_loss=args.velocity_loss,
     )  # fmt: skip
     print(f"training the {args.space} FGD autoencoder on {len(train)} windows from {root}", flush=True)
-    model, info = train_autoencoder(train, config, val_windows=val, key=key)
+    model, info = train_autoencoder(train, config, val_windows=val, key=key, space=args.space)
     meta = {
         "data_fingerprint": train.fingerprint,  # files + parameters: the same on every machine
         "n_windows": int(len(train)),

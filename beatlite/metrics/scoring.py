@@ -57,6 +57,8 @@ class Takes:
     euler_features : (N, F) float, optional
         Features of the same windows of the Euler channels by an autoencoder trained on them
         (BEAT's FGD space: ``"FGD (BEAT AE)"``).
+    rot6d_features : (N, F) float, optional
+        Features of the same windows as 6D rotations of the 47 joints (EMAGE's kind of FGD space: ``"FGD (rot6d)"``).
 
     Examples
     --------
@@ -70,6 +72,7 @@ class Takes:
     euler: list[np.ndarray] | None = None
     features: np.ndarray | None = None
     euler_features: np.ndarray | None = None
+    rot6d_features: np.ndarray | None = None
 
 
 @dataclass(eq=False)
@@ -310,7 +313,14 @@ def describe(keys: Sequence[str], *, sources: bool = False) -> str:
 
 #: Generated per take (a list in take order, or an (N, F) array of window features): the system's under
 #: these names, the ground truth's as ``truth_<name>``.
-TAKE_INPUTS: tuple[str, ...] = ("positions", "directions", "euler", "features", "euler_features")
+TAKE_INPUTS: tuple[str, ...] = (
+    "positions",
+    "directions",
+    "euler",
+    "features",
+    "euler_features",
+    "rot6d_features",
+)
 #: Every parameter name :func:`bind_inputs` fills: :data:`TAKE_INPUTS`, their ``truth_`` twins, the
 #: :class:`GroundTruth` fields (``beats``: :meth:`GroundTruth.beats`) and ``seed``.
 INPUTS: tuple[str, ...] = (
@@ -423,7 +433,7 @@ def register_metric(key: str, metric: Metric) -> None:
 
 
 def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:
-    if need in ("positions", "directions", "euler", "features", "euler_features"):
+    if need in TAKE_INPUTS:
         return getattr(gen, need) is not None and getattr(truth.takes, need) is not None
     if need == "beats":
         return truth.beats() is not None
@@ -452,6 +462,12 @@ def _fgd_euler(g: Takes, t: GroundTruth, seed: int) -> float:
     from beatlite.metrics.frechet import fgd
 
     return fgd(g.euler_features, t.takes.euler_features)
+
+
+def _fgd_rot6d(g: Takes, t: GroundTruth, seed: int) -> float:
+    from beatlite.metrics.frechet import fgd
+
+    return fgd(g.rot6d_features, t.takes.rot6d_features)
 
 
 def _srgr_paper(g: Takes, t: GroundTruth, seed: int) -> float:
@@ -584,6 +600,10 @@ def _metrics() -> dict[str, Metric]:
                                 f"the same on {win} of the 141 z-scored Euler channels, features of an "
                                 "autoencoder trained on them (BEAT's space; Euler models only)",
                     source="BEAT's code: features of an autoencoder on the 141 Euler channels (docs/reference_code.md#fgd-autoencoder); here beatlite's own such autoencoder, not BEAT's weights"),
+        "FGD (rot6d)": Metric("FGD", "rot6d", False, ("rot6d_features",), _fgd_rot6d,
+                              f"the same on {win} of the 6D rotations of the 47 spine_neck_141 joints (282-d), "
+                              "features of an autoencoder trained on them",
+                    source="EMAGE (Liu et al., CVPR 2024) and BEAT2 compute FGD on 6D rotations (Zhou et al., CVPR 2019) with an autoencoder of their own; here beatlite's autoencoder on the 47 upper-body BEAT joints (checkpoints/fgd_rot6d.pt), not EMAGE's weights or joint set"),
         "SRGR": Metric("SRGR", "paper", True, ("positions", "semantic"), _srgr_paper,
                        "BEAT eq. 11 on joint positions, δ = 10 cm, ground-truth semantic scores",
                     source='BEAT (Liu et al., ECCV 2022) eq. 11: PCK weighted by semantic scores, here on TED-43 positions with δ = 10 cm'),

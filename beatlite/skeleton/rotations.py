@@ -27,6 +27,7 @@ __all__ = [
     "EULER_ORDERS",
     "axis_angle_to_matrix",
     "euler_entries",
+    "euler_to_6d",
     "euler_to_matrix",
     "matrix_to_6d",
     "matrix_to_axis_angle",
@@ -443,6 +444,34 @@ def matrix_to_6d(matrix: np.ndarray) -> np.ndarray:
     """
     m = _as_float_array(matrix, "matrix", (3, 3))
     return np.concatenate([m[..., :, 0], m[..., :, 1]], axis=-1)
+
+
+def euler_to_6d(angles: np.ndarray, order: str = "XYZ", degrees: bool = True) -> np.ndarray:
+    """The 6D representation of each Euler triplet of a row (e.g. BEAT's 141 channels -> 282).
+
+    Parameters
+    ----------
+    angles : (..., 3K) float
+        K Euler triplets per row, each in ``order`` (BEAT's ``XYZ`` intrinsic by default).
+    order : str
+    degrees : bool
+
+    Returns
+    -------
+    (..., 6K) float64
+        Per triplet :func:`matrix_to_6d` of :func:`euler_to_matrix`: continuous in the rotation, unlike the angles.
+
+    Examples
+    --------
+    >>> euler_to_6d([0.0, 0, 0, 0, 0, 90]).round(6) + 0.0  # the identity, then 90 degrees about Z
+    array([ 1.,  0.,  0.,  0.,  1.,  0.,  0.,  1.,  0., -1.,  0.,  0.])
+    """
+    a = _as_float_array(angles, "angles", ())
+    if a.ndim == 0 or a.shape[-1] % 3:
+        raise ValueError(f"angles: the last axis must hold Euler triplets (3K values), got {a.shape}")
+    triplets = a.reshape(a.shape[:-1] + (a.shape[-1] // 3, 3))
+    six = matrix_to_6d(euler_to_matrix(triplets, order, degrees=degrees))
+    return six.reshape(a.shape[:-1] + (-1,))
 
 
 def sixd_to_matrix(sixd: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ ablations) from the ``data_samples/`` (``$BEATLITE_DATA``) train split with its 
 ``BEATLITE_THREADS`` threads, writing the full training checkpoint to ``build/train/<name>.pt``,
 a float16 inference copy to ``checkpoints/<name>.pt`` and the training times to
 ``build/train/times.json``. Without ``--only`` it then retrains the FGD extractors
-(``python -m beatlite.metrics.extractor train --space dirvec`` and ``--space pose``).
+(``python -m beatlite.metrics.extractor train --space dirvec``, ``--space pose`` and ``--space rot6d``).
 
 ``results [--out STEM] [--only NAME ...]`` evaluates every shipped checkpoint on the
 test split (:func:`beatlite.train.evaluation.evaluate_models`) and writes
@@ -152,7 +152,7 @@ def _retrain_all_command(args: argparse.Namespace) -> int:
     runs = [(name, recorded_shipped_seed(name) if args.seed is None else args.seed, None) for name in names]
     retrain_many(runs, jobs=args.jobs, epochs=args.epochs, on_done=report)
     if not args.skip_extractor and not args.only:
-        for space in ("dirvec", "pose"):
+        for space in ("dirvec", "pose", "rot6d"):
             cmd = [sys.executable, "-m", "beatlite.metrics.extractor", "train", "--space", space]
             subprocess.run(cmd, check=True)
     return 0

@@ -100,12 +100,16 @@ class EvaluationSet:
             self.audio_beats = [audio_beats(y, SR) for y in self.audio]
         return self.audio_beats
 
-    def ground_truth(self, extractor: Any, euler_extractor: Any = None) -> GroundTruth:
+    def ground_truth(
+        self, extractor: Any, euler_extractor: Any = None, rot6d_extractor: Any = None
+    ) -> GroundTruth:
         """The :class:`~beatlite.metrics.scoring.GroundTruth` every row is scored against
-        (``euler_extractor``: the Euler autoencoder of ``"FGD (BEAT AE)"``, optional)."""
+        (``euler_extractor``: the Euler autoencoder of ``"FGD (BEAT AE)"``; ``rot6d_extractor``: the 6D one of
+        ``"FGD (rot6d)"``; both optional)."""
         takes = directions_takes(
-            self.gt_directions, self, extractor, euler=self.gt_euler, euler_extractor=euler_extractor
-        )
+            self.gt_directions, self, extractor, euler=self.gt_euler, euler_extractor=euler_extractor,
+            rot6d_extractor=rot6d_extractor,
+        )  # fmt: skip
         return GroundTruth(
             takes,
             semantic=self.semantic,
@@ -376,6 +380,17 @@ def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any)
     return _window_features(euler, "euler141", test, extractor)
 
 
+def rot6d_features(euler: list[np.ndarray], extractor: Any) -> np.ndarray:
+    """(N, F) float64 features of the 34-frame windows (stride 10) of the 6D rotations of the Euler channels
+    (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself)."""
+    from beatlite.skeleton.rotations import euler_to_6d
+
+    windows = sliding_windows([euler_to_6d(x) for x in euler])
+    if not len(windows):
+        raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
+    return np.asarray(extractor(windows.astype(np.float32)), np.float64)
+
+
 def _window_features(
     takes: list[np.ndarray], representation: str, test: EvaluationSet, extractor: Any
 ) -> np.ndarray:
@@ -394,9 +409,11 @@ def directions_takes(
     *,
     euler: list[np.ndarray] | None = None,
     euler_extractor: Any = None,
+    rot6d_extractor: Any = None,
 ) -> Takes:
     """A row's :class:`~beatlite.metrics.scoring.Takes`: TED-43 positions, directions, features (+ Euler,
-    + the Euler autoencoder's features when both ``euler`` and ``euler_extractor`` are given)."""
+    + the Euler autoencoder's features when both ``euler`` and ``euler_extractor`` are given, + the 6D
+    autoencoder's with ``euler`` and ``rot6d_extractor``)."""
     if len(directions) != len(test.takes):
         raise ValueError(f"directions has {len(directions)} takes, the test set {len(test.takes)}")
     for i, (d, s) in enumerate(zip(directions, test.streams, strict=True)):
@@ -410,6 +427,9 @@ def directions_takes(
         euler_features=None
         if euler is None or euler_extractor is None
         else euler_features(euler, test, euler_extractor),
+        rot6d_features=None
+        if euler is None or rot6d_extractor is None
+        else rot6d_features(euler, rot6d_extractor),
     )
 
 
