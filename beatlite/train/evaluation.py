@@ -286,7 +286,8 @@ def evaluate_models(
         the reference variants ``"SRGR (reference)"``, ``"BC (ha2g)"`` for a like-for-like table).
     euler_extractor : callable, optional
         (N, 34, 141) -> (N, F) features of z-scored Euler windows for ``"FGD (BEAT AE)"``; default
-        ``load_extractor("pose")``, loaded only when that column is asked for.
+        ``load_extractor("pose")``, loaded only when that column is asked for (as ``load_extractor("rot6d")`` for
+        ``"FGD (rot6d)"``).
 
     Returns
     -------
@@ -307,8 +308,9 @@ def evaluate_models(
     euler_ae = None
     if "FGD (BEAT AE)" in columns:
         euler_ae = load_extractor("pose") if euler_extractor is None else euler_extractor
-    truth = test.ground_truth(extractor, euler_ae)
-    scoring = {"columns": columns, "seed": seed, "euler_extractor": euler_ae}
+    rot6d_ae = load_extractor("rot6d") if "FGD (rot6d)" in columns else None
+    truth = test.ground_truth(extractor, euler_ae, rot6d_ae)
+    scoring = {"columns": columns, "seed": seed, "euler_extractor": euler_ae, "rot6d_extractor": rot6d_ae}
     rows: list[ResultRow] = []
     if ground_truth:
         for label, dirs in ((GROUND_TRUTH, test.gt_directions), (GROUND_TRUTH_141, test.gt_directions_141)):

@@ -443,9 +443,17 @@ def score_directions(
     columns: Sequence[str],
     seed: int = 0,
     euler_extractor: Any = None,
+    rot6d_extractor: Any = None,
 ) -> dict[str, float]:
     """The metrics of ``columns`` for one row's per-take directions (T, 42, 3) (NaN where undefined)."""
-    takes = directions_takes(directions, test, extractor, euler=euler, euler_extractor=euler_extractor)
+    takes = directions_takes(
+        directions,
+        test,
+        extractor,
+        euler=euler,
+        euler_extractor=euler_extractor,
+        rot6d_extractor=rot6d_extractor,
+    )
     values = evaluate(takes, truth, metrics=columns, seed=seed).values()
     return {key: values[key] for key in columns}
 
