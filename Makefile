@@ -42,13 +42,14 @@ run: $(STAMP) $(INTERACTIVE) system-deps
 	$(VPY) scripts/run_notebooks.py --out build
 
 ## JupyterLab on working copies of the notebooks in build/lab/ (copied from LAB_FROM once; delete a copy to get a
-## fresh one). notebooks/ keeps the solutions and stays clean, and BEATLITE_BUILD=build/lab keeps the figures,
-## tables and caches of interactive work away from `make run`'s build/. Students: `make lab LAB_FROM=build/student`.
+## fresh one; copies that hold solutions are replaced by student copies, the old ones kept in build/lab/backup/:
+## scripts/lab_copies.py). notebooks/ keeps the solutions and stays clean, and BEATLITE_BUILD=build/lab keeps the
+## figures, tables and caches of interactive work away from `make run`'s build/. Students: `make lab LAB_FROM=build/student`.
 LAB      ?= build/lab
 LAB_FROM ?= notebooks
 lab: $(INTERACTIVE) system-deps
 	@mkdir -p $(LAB)
-	@for nb in $(LAB_FROM)/[0-9][0-9]_*.ipynb; do test -e $(LAB)/$$(basename $$nb) || cp $$nb $(LAB)/; done
+	@$(VPY) scripts/lab_copies.py $(LAB_FROM) $(LAB)
 	BEATLITE_BUILD=$(abspath $(LAB)) BEATLITE_INTERACTIVE=on $(VPY) -m jupyter lab --notebook-dir=$(LAB) \
 		$(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
