@@ -71,6 +71,15 @@ WRONG: dict[tuple[str, str], list[str]] = {
         "    return np.where(k >= 0, ids[np.maximum(k, 0)], 0).astype(np.int64)"
     ],
     ("01", "beat_decimate"): ["def beat_decimate(channels, ratio):\n    return channels[::ratio]"],  # phase 0
+    ("01", "rodrigues"): [  # the sine term flipped (the inverse rotation); K of v, not of the unit axis
+        "def rodrigues(rotvec):\n    v = np.asarray(rotvec, dtype=float)\n    theta = np.linalg.norm(v)\n"
+        "    if theta < 1e-12:\n        return np.eye(3)\n    x, y, z = v / theta\n"
+        "    K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])\n"
+        "    return np.eye(3) - np.sin(theta) * K + (1 - np.cos(theta)) * K @ K",
+        "def rodrigues(rotvec):\n    x, y, z = np.asarray(rotvec, dtype=float)\n    theta = np.linalg.norm([x, y, z])\n"
+        "    K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])\n"
+        "    return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K",
+    ],
     ("02", "joint_speed"): [  # cm per frame, not per second
         "def joint_speed(positions, fps):\n    p = np.asarray(positions, dtype=float)\n"
         "    if len(p) < 2:\n        return np.zeros(len(p))\n"
@@ -178,7 +187,7 @@ def _all_exercises():
 def test_every_notebook_has_exercises_with_solutions():
     found = _all_exercises()
     assert {p.name for p, _ in found} == {p.name for p in NOTEBOOKS}
-    assert len(found) == 28 and sum(len(ex.calls) for _, ex in found) == 31  # counted in the notebooks
+    assert len(found) == 29 and sum(len(ex.calls) for _, ex in found) == 32  # counted in the notebooks
     for path, ex in found:
         assert ex.stubs and ex.solutions, f"{path.name} {ex.title}: needs a stub cell and a solution cell"
         assert ex.names, f"{path.name} {ex.title}: no stub (raise NotImplementedError / answer = None)"
@@ -225,7 +234,7 @@ def test_instructor_sheet_has_every_answer(tmp_path):
     assert "Answer (why): each pair costs about 0.5" in (tmp_path / "06_ha2g.md").read_text()
     assert "left_out = (1 - 1 / K) ** K" in (tmp_path / "09_scoring.md").read_text()
     answers = (tmp_path / "answers.md").read_text()
-    assert answers.count("\n## Exercise") == 28 and "no solution cell" not in answers
+    assert answers.count("\n## Exercise") == 29 and "no solution cell" not in answers
 
 
 # ----------------------------------------------------------------------------- running the checks

@@ -27,7 +27,8 @@ A BEAT2 folder (``beat_english_v2.0.0/``) holds ``smplxflame_30/{take}.npz``, ``
 and :func:`beatlite.data.index_folder` read it (the motion retargeted to BEAT's skeleton,
 :func:`beatlite.skeleton.smplx.smplx_to_beat`).
 
-Taught in ``notebooks/01_beat_formats.ipynb`` (BEAT and BEAT2 side by side).
+Taught in notebooks/01_beat_formats.ipynb, section 12 (BEAT and BEAT2 side by side: 12.1-12.2 the file and its
+165 numbers, 12.4 the face).
 """
 
 from __future__ import annotations

@@ -16,7 +16,8 @@ Conventions
 - **6D** (Zhou et al., CVPR 2019) is the first two *columns* of the matrix, ``(..., 6)`` =
   ``[R[:, 0], R[:, 1]]``; :func:`sixd_to_matrix` re-orthonormalises with Gram-Schmidt.
 
-Taught in notebooks/01_beat_formats.ipynb, section 4 (Euler angles: many numbers for one rotation).
+Taught in notebooks/01_beat_formats.ipynb, sections 4 (Euler angles: many numbers for one rotation) and 12.1-12.3
+(axis-angle, and why rot6d), and its Exercise 4 (axis-angle to a matrix).
 """
 
 from __future__ import annotations

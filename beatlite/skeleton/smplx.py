@@ -26,7 +26,8 @@ world rotation. :func:`bone_direction_errors` measures what is lost, in degrees 
 
 Coordinates are shared: Y up, the body facing +Z, its left side at +X (BEAT's and SMPL-X's convention).
 
-Taught in ``notebooks/01_beat_formats.ipynb`` (BEAT and BEAT2 side by side).
+Taught in notebooks/01_beat_formats.ipynb, section 12 (BEAT and BEAT2 side by side: 12.2 the 55 joints, 12.3 rot6d,
+12.5 the rest skeleton, 12.6 retargeting and its bone-direction errors).
 """
 
 from __future__ import annotations
