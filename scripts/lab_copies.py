@@ -42,7 +42,9 @@ def refresh(source: Path, lab: Path, *, stamp: str | None = None) -> list[str]:
             backup.parent.mkdir(exist_ok=True)
             shutil.move(copy, backup)
             shutil.copyfile(nb, copy)
-            done.append(f"replaced {nb.name} (it held the solutions; the old copy is {backup.relative_to(lab)})")
+            done.append(
+                f"replaced {nb.name} (it held the solutions; the old copy is {backup.relative_to(lab)})"
+            )
     return done
 
 
