@@ -154,6 +154,10 @@ class Claim:
         ``"indistinguishable"`` when ``delta ± 2 se`` covers 0; ``"unknown"`` when ``se`` is NaN.
     seeds : (int, int)
         Finite values of each row (1 for a ground-truth row).
+    against_data : bool
+        ``reference`` is a row recorded once (the ground truth) and the metric has no perfect value (SRGR,
+        BeatAlign, BC: the data's own value is the target, more is not closer to it): the sentence then says
+        "above"/"below" rather than "better"/"worse" (the verdict keeps the metric's direction).
     """
 
     row: str
@@ -166,6 +170,7 @@ class Claim:
     se: float
     verdict: str
     seeds: tuple[int, int]
+    against_data: bool = False
 
     @property
     def holds(self) -> bool:
@@ -183,6 +188,9 @@ class Claim:
             means = f"means {a} vs {b} over {n} seeds"
         else:  # a row recorded once is a ground-truth row: not a draw
             means = f"mean {a} over {n} seeds vs " + (f"{b} (one value)" if m == 1 else f"{b} over {m} seeds")
+        if self.verdict in ("better", "worse") and self.against_data:
+            side = "above" if self.delta > 0 else "below"
+            return f"{self.row} is {side} {self.reference} on {self.metric} by {d} ± {e} (2 SE; {means})."
         if self.verdict in ("better", "worse"):
             return (
                 f"{self.row} is {self.verdict} than {self.reference} on {self.metric} ({direction} is better) "
@@ -246,6 +254,13 @@ def claim(record: Any, row: str, reference: str, metric: str) -> Claim:
     ('worse', 4.3, 0.35)
     >>> print(c)
     B is worse than Ground truth on FGD (lower is better) by 4.30 ± 0.35 (2 SE; 24.8 SE from 0; mean 4.30 over 3 seeds vs 0.00 (one value)).
+
+    Against the ground truth on a metric whose target is the data's own value (BeatAlign, BC, SRGR), a
+    difference is "above"/"below", not "better"/"worse":
+
+    >>> record.values["Ground truth"]["BC"], record.values["A"]["BC"] = [0.66], [0.77, 0.78, 0.76]
+    >>> print(claim(record, "A", "Ground truth", "BC"))
+    A is above Ground truth on BC by 0.110 ± 0.012 (2 SE; mean 0.770 over 3 seeds vs 0.660 (one value)).
     """
     from beatlite.metrics.scoring import METRICS
 
@@ -266,7 +281,10 @@ def claim(record: Any, row: str, reference: str, metric: str) -> Claim:
         verdict = "better" if (delta > 0) == higher else "worse"
     mean_a = float(np.mean(a)) if len(a) else math.nan
     mean_b = float(np.mean(b)) if len(b) else math.nan
-    return Claim(row, reference, metric, higher, mean_a, mean_b, delta, se, verdict, (len(a), len(b)))
+    against_data = len(record.values[reference][metric]) == 1 and METRICS[metric].perfect is None
+    return Claim(
+        row, reference, metric, higher, mean_a, mean_b, delta, se, verdict, (len(a), len(b)), against_data
+    )
 
 
 def claims(record: Any, pairs: Iterable[tuple[str, str]], metric: str) -> list[Claim]:

@@ -152,3 +152,16 @@ def test_row_descriptions_come_from_the_registries():
     assert "Reads: text." in describe_row("seq2seq_tiny")
     assert "audio" not in describe_row("camn_tiny_no_audio").split("Reads:")[1].split(".")[0]
     assert describe_rows(["s2g_tiny", "a2g_tiny"]).count("\n- ") == 1
+
+
+def test_claim_against_the_ground_truth_says_above_or_below_where_the_data_is_the_target():
+    """BC above the ground truth's is not "better": the sentence says above; FGD against it stays better/worse."""
+    record = _record()
+    record.values["Ground truth"]["BC"], record.values["A"]["BC"] = [0.66], [0.77, 0.78, 0.76]
+    above = claim(record, "A", "Ground truth", "BC")
+    assert above.verdict == "better" and above.against_data
+    assert str(above).startswith("A is above Ground truth on BC by 0.110 ± ")
+    record.values["A"]["BC"] = [0.55, 0.56, 0.54]
+    assert str(claim(record, "A", "Ground truth", "BC")).startswith("A is below Ground truth on BC")
+    fgd = claim(record, "A", "Ground truth", "FGD")  # FGD 0 is perfect: worse is worse
+    assert not fgd.against_data and str(fgd).startswith("A is worse than Ground truth on FGD")
