@@ -309,6 +309,48 @@ def paper_rows(
     return found
 
 
+SPEECH_INPUTS: dict[str, str] = {
+    "audio": "audio (waveform)", "mel": "audio (mel spectrogram)", "word": "text",
+    "speaker": "speaker ID", "emotion": "emotion", "face": "face",
+}  # fmt: skip
+"""The batch keys that carry the speech and its speaker, as :func:`describe_row` names them (the seed pose,
+``pose``/``dirvec``, is left out: every model reads it)."""
+
+
+def describe_row(name: str) -> str:
+    """One line on recipe ``name``'s row, generated from the registries (never written by hand).
+
+    The row label, the model class's one-line summary (:data:`beatlite.models.MODELS`), the speech inputs
+    its ``tiny`` config reads (:meth:`~beatlite.models.base.GestureModel.keys_for`, named by
+    :data:`SPEECH_INPUTS`) and the published rows it stands for (:attr:`Recipe.paper_rows`).
+
+    Examples
+    --------
+    >>> print(describe_row("s2g_tiny"))
+    **S2G-style** (`s2g_tiny`): Audio-only convolutional generator in the style of Speech2Gesture. Reads: audio (mel spectrogram). Stands for: BEAT Table 4 "S2G", HA2G Table 1 "Speech2Gesture".
+    >>> print(describe_row("mean_pose"))
+    **Mean pose** (`mean_pose`): Frozen mean pose: `forward` returns the training mean (z-scored units) on every frame. Reads: no speech input.
+    """
+    import re
+
+    from beatlite.models.base import config_from_preset
+
+    recipe = RECIPES[name]
+    cls = model_class(recipe.model)
+    summary = (cls.__doc__ or cls.__name__).strip().splitlines()[0]
+    summary = re.sub(r"\s*\((see the )?module docstring\)", "", summary).rstrip(".").replace("``", "`") + "."
+    config = config_from_preset(cls.config_class, presets(recipe.model), "tiny", **recipe.overrides)
+    reads = [SPEECH_INPUTS[k] for k in cls.keys_for(config) if k in SPEECH_INPUTS]
+    text = f"**{recipe.label}** (`{name}`): {summary} Reads: {', '.join(reads) or 'no speech input'}."
+    rows = [f'{r.paper} {r.table} "{r.row}"' for r in recipe.paper_rows if r.row is not None]
+    return text + (f" Stands for: {', '.join(rows)}." if rows else "")
+
+
+def describe_rows(names: Sequence[str]) -> str:
+    """:func:`describe_row` of each recipe of ``names`` as a Markdown list (one ``- `` line each)."""
+    return "\n".join(f"- {describe_row(n)}" for n in names)
+
+
 @dataclasses.dataclass
 class TrainingData:
     """What every recipe trains on (built once by :func:`training_data`): the window store's train and
