@@ -41,13 +41,17 @@ def header_times(path: Path) -> dict:
     """``lecture`` minutes and ``run`` time (text) of a header; ``full``: (epochs, s per epoch, extra s) or None."""
     text = _header(path).split("**Reproduces:**")[0]
     m = TIME.search(text)
-    assert m, f"{path.name}: the header has no '**Estimated time:** lecture ~N min; running it takes ...' line"
+    assert m, (
+        f"{path.name}: the header has no '**Estimated time:** lecture ~N min; running it takes ...' line"
+    )
     full = FULL.search(text)
     numbers = None
     if full:
         part = full.group(1)
         epochs, per_epoch, extra = EPOCHS.search(part), PER_EPOCH.search(part), EXTRA.search(part)
-        assert epochs and per_epoch and extra, f"{path.name}: the full-mode sentence lacks epochs, s/epoch or extra"
+        assert epochs and per_epoch and extra, (
+            f"{path.name}: the full-mode sentence lacks epochs, s/epoch or extra"
+        )
         numbers = (int(epochs.group(1)), float(per_epoch.group(1)), int(extra.group(1)))
     return {"lecture": int(m.group(1)), "run": _norm(m.group(2)), "full": numbers}
 
@@ -101,13 +105,17 @@ def test_plan_total_is_the_sum_of_the_headers():
     assert set(plan) - {"**total**"} == {p.name[:2] for p in NOTEBOOKS}, "one plan row per notebook"
     total = sum(header_times(p)["lecture"] for p in NOTEBOOKS)
     assert plan["**total**"]["lecture"] == f"**{total} min**"
-    assert f"about {total} minutes of lecture" in GUIDE.read_text(), "the guide's first paragraph states the total"
+    assert f"about {total} minutes of lecture" in GUIDE.read_text(), (
+        "the guide's first paragraph states the total"
+    )
 
 
 def test_full_mode_table_matches_the_headers():
     headers = {p.name[:2]: header_times(p)["full"] for p in NOTEBOOKS}
     expected = {k: v for k, v in headers.items() if v is not None}
-    assert set(expected) == {"05", "06", "07"}, f"notebooks whose header describes full mode: {sorted(expected)}"
+    assert set(expected) == {"05", "06", "07"}, (
+        f"notebooks whose header describes full mode: {sorted(expected)}"
+    )
     assert guide_full_mode() == expected
 
 
@@ -115,7 +123,9 @@ def test_the_lecture_series_splits_the_plan_minutes():
     """Every lecture of the minute-by-minute plan adds up to its notebooks' header minutes."""
     text = GUIDE.read_text()
     lectures = re.findall(r"^### Lecture (\d): notebooks? ([\d, and]+) \((\d+) min\)", text, re.M)
-    assert len(lectures) >= 4, "the guide plans each lecture under '### Lecture N: notebooks AA and BB (M min)'"
+    assert len(lectures) >= 4, (
+        "the guide plans each lecture under '### Lecture N: notebooks AA and BB (M min)'"
+    )
     minutes = {p.name[:2]: header_times(p)["lecture"] for p in NOTEBOOKS}
     covered = []
     for number, names, total in lectures:
@@ -124,8 +134,12 @@ def test_the_lecture_series_splits_the_plan_minutes():
         assert sum(minutes[n] for n in nbs) == int(total), f"lecture {number}: {nbs} add up to {total} min?"
         block = text.split(f"### Lecture {number}:", 1)[1].split("\n### ", 1)[0]
         spans = [(int(a), int(b)) for a, b in re.findall(r"^\| (\d+)–(\d+) \|", block, re.M)]
-        assert spans and spans[0][0] == 0 and spans[-1][1] == int(total), f"lecture {number}: minutes 0–{total}"
-        assert all(b0 == a1 for (_, b0), (a1, _) in zip(spans, spans[1:])), f"lecture {number}: gaps or overlaps"
+        assert spans and spans[0][0] == 0 and spans[-1][1] == int(total), (
+            f"lecture {number}: minutes 0–{total}"
+        )
+        assert all(b0 == a1 for (_, b0), (a1, _) in zip(spans, spans[1:])), (
+            f"lecture {number}: gaps or overlaps"
+        )
     assert sorted(covered) == sorted(minutes), "every notebook is in exactly one lecture"
 
 
