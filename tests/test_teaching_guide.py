@@ -172,3 +172,25 @@ def test_quoted_progress_bar_is_what_fit_prints():
         entry = {"train": {main: float(keys[main]), "total": 9.0}, "val": {main: float(keys[f"val_{main}"])}}
         shown = ", ".join(f"{k}={v}" for k, v in _shown_losses(entry).items())
         assert shown == postfix
+
+
+def test_guide_calls_name_real_parameters():
+    """Every backticked ``name(params)`` of the guide that resolves to one beatlite function names only its
+    parameters (the check of ``docs/architecture.md``, with the notebooks' ``bl.`` prefix dropped)."""
+    pytest.importorskip("torch")
+    from tests.test_docs_signatures import _index, documented_calls, missing_parameters, resolve
+
+    index = _index()
+    fenced = re.compile(r"^ *```.*?^ *```", re.S | re.M)  # shell commands and printed output, not calls
+    text = fenced.sub("", GUIDE.read_text())
+    text = text.replace("`bl.", "`").replace(" bl.", " ")
+    checked, wrong = 0, []
+    for package, name, names, _ in documented_calls(text):
+        obj = resolve(name, package, index)
+        if obj is None or not names:
+            continue
+        checked += 1
+        if bad := missing_parameters(obj, names):
+            wrong.append(f"{name}({', '.join(names)}): {obj.__module__}.{obj.__qualname__} has no {bad}")
+    assert checked >= 4, checked
+    assert not wrong, "docs/teaching.md names parameters the code does not have:\n" + "\n".join(wrong)
