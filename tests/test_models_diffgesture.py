@@ -87,7 +87,7 @@ def test_an_oracle_denoiser_makes_ddpm_and_ddim_recover_the_clean_window(dtype: 
 @pytest.mark.parametrize("sampler", ["ddpm", "ddim"])
 def test_the_model_samples_the_clean_window_with_an_oracle_network(sampler: str, monkeypatch) -> None:  # noqa: ANN001
     """Through ``generate`` (guidance, seeding, float32): the network replaced by the oracle."""
-    model, batch = _model(diffusion_steps=500), _batch()
+    model, batch = _model(diffusion_steps=500, prediction="eps", x_scale=1.0), _batch()
     x0 = 0.3 * torch.randn(3, 34, 126, generator=torch.Generator().manual_seed(2))
     oracle = _oracle(x0)
     monkeypatch.setattr(model, "denoise", lambda x, t, cond: oracle(x, int(t[0])))
@@ -95,9 +95,25 @@ def test_the_model_samples_the_clean_window_with_an_oracle_network(sampler: str,
     assert got.dtype == torch.float32 and (got - x0).abs().max() < 1e-5
 
 
+@pytest.mark.parametrize("sampler", ["ddpm", "ddim"])
+def test_an_x0_predicting_oracle_on_scaled_windows_samples_the_clean_window(
+    sampler: str, monkeypatch
+) -> None:  # noqa: ANN001
+    """``prediction="x0"``, ``x_scale=3``: a network that returns the (scaled) clean window gives it back."""
+    model, batch = _model(prediction="x0", x_scale=3.0), _batch()
+    x0 = 0.3 * torch.randn(3, 34, 126, generator=torch.Generator().manual_seed(2))
+    monkeypatch.setattr(model, "denoise", lambda x, t, cond: 3.0 * x0.repeat(x.shape[0] // 3, 1, 1))
+    got = model.generate(batch, sampler=sampler, guidance_scale=1.15)
+    assert (got - x0).abs().max() < 1e-5
+    # clipping the estimate at +-0.6 (diffused units): DDIM's last step returns the clipped window exactly
+    model.config.clip_x0 = 0.6
+    got = model.generate(batch, sampler="ddim", guidance_scale=1.15)
+    assert (got - (3.0 * x0).clamp(-0.6, 0.6) / 3.0).abs().max() < 1e-5
+
+
 def test_the_training_pass_noises_and_denoises_consistently(monkeypatch) -> None:  # noqa: ANN001
     """With the oracle as the network, the loss is 0 and the predicted clean window is the target."""
-    model, batch = _model(), _batch()
+    model, batch = _model(prediction="eps", x_scale=1.0), _batch()
     x0 = batch["dirvec"].double()
     ab = torch.as_tensor(_alpha_bars(500, 1e-4, 0.02))
 
@@ -113,9 +129,35 @@ def test_the_training_pass_noises_and_denoises_consistently(monkeypatch) -> None
     assert out["t"].min() >= 1 and out["t"].max() <= 500
 
 
+def test_the_x0_training_pass_regresses_the_scaled_clean_window(monkeypatch) -> None:  # noqa: ANN001
+    model, batch = _model(prediction="x0", x_scale=3.0), _batch()
+    monkeypatch.setattr(model, "denoise", lambda x, t, cond: 3.0 * batch["dirvec"])
+    model.train()
+    out = model(batch)
+    assert model.losses(batch, out, epoch=0)["total"] < 1e-12 and set(model.losses(batch, out, epoch=0)) == {
+        "x0",
+        "total",
+    }
+    assert (out["pose"] - batch["dirvec"]).abs().max() < 1e-6
+    # the noise it implies is the noise that was added (x_t = sqrt(abar) 3 x0 + sqrt(1 - abar) noise)
+    assert (out["eps"] - out["noise"]).abs().max() < 1e-3
+
+
+@torch.no_grad()
+def test_x0_guidance_combines_the_clean_window_estimates() -> None:
+    model, batch = _model(prediction="x0", x_scale=3.0), _batch()
+    cond = model.condition(batch)
+    x = torch.randn(3, 34, 126, generator=torch.Generator().manual_seed(3))
+    t = torch.full((3,), 123)
+    x0_u = model.denoise(x, t, model.null_condition.expand_as(cond))
+    x0_c = model.denoise(x, t, cond)
+    want = model.schedule.predict_eps(x, t, x0_u + 2.0 * (x0_c - x0_u))
+    assert torch.allclose(model.guided_eps(x, 123, cond, 2.0), want, atol=1e-4)
+
+
 @torch.no_grad()
 def test_guidance_scale_0_is_the_unconditional_and_1_the_conditional_prediction() -> None:
-    model, batch = _model(), _batch()
+    model, batch = _model(prediction="eps", x_scale=1.0), _batch()
     cond = model.condition(batch)
     x = torch.randn(3, 34, 126, generator=torch.Generator().manual_seed(3))
     t = torch.full((3,), 123)

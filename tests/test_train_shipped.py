@@ -15,12 +15,13 @@ def _missing() -> list[str]:
     return [name for name in NEEDED if not (checkpoints_dir() / f"{name}.pt").is_file()]
 
 
-def test_checkpoints_total_at_most_20_mb():
+def test_checkpoints_total_at_most_24_mib():
+    """The clone stays small: 24 MiB (20 before the DiffGesture row's 2.5 MB and the 6D FGD extractor)."""
     files = list(checkpoints_dir().glob("*.pt"))
     if not files:
         pytest.skip("no shipped checkpoints")
     total = sum(f.stat().st_size for f in files)
-    assert total <= 20 * 1024 * 1024, f"checkpoints/ holds {total / 2**20:.1f} MiB > 20 MiB"
+    assert total <= 24 * 1024 * 1024, f"checkpoints/ holds {total / 2**20:.1f} MiB > 24 MiB"
 
 
 def test_shipped_checkpoints_are_float16_inference_copies():

@@ -151,11 +151,11 @@ is flat within noise after epoch 16 (seed 2021: best 3.19 at epoch 22 of 30)."""
 HA2G_LR = 2e-3
 """HA2G's learning rate: at 1e-3 its validation FGD was still falling steeply at epoch 30 (seed 2021:
 6.6 at epoch 24, 3.71 at 29; test FGD 5.45); at 2e-3 the same seed reached 2.57 (test 3.52)."""
-DIFFGESTURE_EPOCHS = 40
-"""Epochs of the DiffGesture checkpoint (about 21 steps of 32 windows each on ``data_samples/``). Seed 2021,
-2 threads on a shared 2-core machine: 178 s, noise MSE 0.051 (validation 0.047). Its samples are still far
-from the data (test FGD about 2000 with DDIM 50 steps, 860 with DDPM; sample std 1.6 against 0.33): the
-denoiser's error at large t, amplified 1 / sqrt(abar_t) = 12 times in the clean-window estimate, dominates."""
+DIFFGESTURE_EPOCHS = 60
+"""Epochs of the DiffGesture checkpoint (about 21 steps of 32 windows each on ``data_samples/``). Seed 2021, one
+thread on a shared 2-core machine: 268 s. Test FGD 4.4 with the tiny preset's DDIM 25 steps (4.6 with 10, 5.3 with
+100, 10.2 with DDPM's 500; 7.2 after 40 epochs). The paper's epsilon-prediction on unscaled directions sampled far
+from the data with this budget (test FGD 2174 after 40 epochs): see :mod:`beatlite.models.diffgesture`."""
 DIFFGESTURE_LR = 1e-3
 """DiffGesture's learning rate. ``select_best`` is off: scoring an epoch by validation FGD samples every
 validation window (DDIM, two network passes per step for the guidance), which costs about as much as the epoch."""
