@@ -433,3 +433,27 @@ def test_generated_euler_of_the_mean_pose_is_its_mean_and_directions_are_refused
 
     with pytest.raises(ValueError, match="not Euler"):
         generated_euler(Still(), test_set)
+
+
+class _SeedEcho(torch.nn.Module):
+    """A direction model whose every generated frame is its first seed frame: the output reveals its seed."""
+
+    representation, target_key, input_keys, pose_dim, n_pre = "dirvec126", "dirvec", ("dirvec",), 126, 4
+
+    def generate(self, batch):
+        return batch["dirvec"][:, :1].expand(-1, 34, -1).clone()
+
+
+def test_the_per_clip_protocol_seeds_every_clip_with_its_own_ground_truth(test_set):
+    from beatlite.train.testset import clip_test_set, generate_takes
+
+    clips = clip_test_set(test_set)
+    starts = [(k, s) for k, t in enumerate(LENGTHS) for s in range(0, t - 33, 10)]
+    assert clips.takes == [f"{test_set.takes[k]}@{s}" for k, s in starts]
+    assert all(len(d) == 34 for d in clips.gt_directions) and len(clips.audio[0]) == int(34 / 15 * 16000)
+    directions, _ = generate_takes(_SeedEcho(), clips, None)
+    for (k, s), d in zip(starts, directions, strict=True):  # clip k@s: every frame is the take's frame s
+        np.testing.assert_allclose(d, np.broadcast_to(test_set.gt_directions[k][s], d.shape), atol=1e-6)
+    whole, _ = generate_takes(_SeedEcho(), test_set, None)  # whole takes: the first seed carries on
+    np.testing.assert_allclose(whole[0][40], test_set.gt_directions[0][0], atol=1e-6)
+    assert np.abs(test_set.gt_directions[0][40] - test_set.gt_directions[0][0]).max() > 1e-3
