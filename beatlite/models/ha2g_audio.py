@@ -19,6 +19,10 @@ exactly 34 time steps (70 -> 35 -> 34, 70 -> 18 -> 36 -> 34, 70 -> 9 -> 36 -> 34
 The style coordinator turns a speaker's style input into softmax weights over the
 three audio levels for each body level (paper eq. 3).
 
+Differs from HA2G's code in the layer order only (docs/reference_code.md#ha2g-audio): the code's stem and
+first convolution of each block run convolution -> ReLU -> BatchNorm (here convolution -> BatchNorm -> ReLU, the
+stem unbiased), and its three streams add ReLU and BatchNorm after their convolution (here none).
+
 Taught in notebooks/06_ha2g.ipynb, sections 3 (the hierarchical audio learner) and 5 (the style coordinator).
 """
 
