@@ -32,6 +32,7 @@ from beatlite.metrics.beats import audio_beats, mean_angle_change, position_spee
 from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 from beatlite.metrics.frechet import fgd
 from beatlite.metrics.scoring import GroundTruth, Takes, evaluate
+from beatlite.skeleton.rotations import euler_to_6d
 from beatlite.skeleton.ted import directions_to_ted_positions, euler_to_directions
 
 # torch stays lazy (beatlite.train.generation and .checkpoint, beatlite.metrics.extractor import it): this
@@ -447,8 +448,6 @@ def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any)
 def rot6d_features(euler: list[np.ndarray], extractor: Any) -> np.ndarray:
     """(N, F) float64 features of the 34-frame windows (stride 10) of the 6D rotations of the Euler channels
     (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself)."""
-    from beatlite.skeleton.rotations import euler_to_6d
-
     windows = sliding_windows([euler_to_6d(x) for x in euler])
     if not len(windows):
         raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
