@@ -381,14 +381,10 @@ def _draws(record: Any, row: str, metric: str) -> tuple[np.ndarray, float]:
 
 
 def _fmt(value: float, metric: str) -> str:
-    """A mean as the tables print it (2 decimals for FGD/Diversity/L1div, 3 for the rest)."""
-    from beatlite.metrics.scoring import METRICS
+    """A mean as the tables print it (:func:`beatlite.train.evaluation.fmt_metric`)."""
+    from beatlite.train.evaluation import fmt_metric
 
-    if not math.isfinite(value):
-        return "—"
-    if METRICS[metric].name in ("FGD", "Diversity", "L1div"):
-        return f"{value:.2f}" if abs(value) < 100 else f"{value:.1f}"
-    return f"{value:.3f}"
+    return fmt_metric(value, metric)
 
 
 def _decimals(two_se: float, metric: str) -> int:
