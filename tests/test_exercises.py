@@ -175,6 +175,18 @@ WRONG: dict[tuple[str, str], list[str]] = {
     ("09", "take_interval"): [  # a 90 % interval
         "def take_interval(per_take, n, seed):\n    rng = np.random.default_rng(seed)\n    x = np.asarray(per_take, dtype=float)\n"
         "    means = [x[rng.integers(len(x), size=len(x))].mean() for _ in range(n)]\n    return np.percentile(means, [5, 95])"
+    ],    ("10", "ddim_step"): [  # the re-noising term left out (the clean estimate, only rescaled)
+        "def ddim_step(x_t, eps, t, prev):\n    a_t, a_p = float(schedule.alpha_bars[t]), float(schedule.alpha_bars[prev])\n"
+        "    return np.sqrt(a_p) * (x_t - np.sqrt(1 - a_t) * eps) / np.sqrt(a_t)",
+        # the one-step alphas of t and prev where their products belong
+        "def ddim_step(x_t, eps, t, prev):\n    a_t, a_p = float(schedule.alphas[t]), float(schedule.alphas[prev])\n"
+        "    x0 = (x_t - np.sqrt(1 - a_t) * eps) / np.sqrt(a_t)\n    return np.sqrt(a_p) * x0 + np.sqrt(1 - a_p) * eps",
+    ],
+    ("10", "snr_at"): [  # alpha_t / beta_t: one step's ratio, not the product's
+        "def snr_at(steps, beta_1, beta_T, t):\n    b = np.linspace(beta_1, beta_T, steps)[t - 1]\n    return float((1 - b) / b)",
+        # the amplitude ratio sqrt(abar / (1 - abar))
+        "def snr_at(steps, beta_1, beta_T, t):\n    ab = np.prod(1 - np.linspace(beta_1, beta_T, steps)[:t])\n"
+        "    return float(np.sqrt(ab / (1 - ab)))",
     ],
 }
 
@@ -187,7 +199,7 @@ def _all_exercises():
 def test_every_notebook_has_exercises_with_solutions():
     found = _all_exercises()
     assert {p.name for p, _ in found} == {p.name for p in NOTEBOOKS}
-    assert len(found) == 29 and sum(len(ex.calls) for _, ex in found) == 32  # counted in the notebooks
+    assert len(found) == 31 and sum(len(ex.calls) for _, ex in found) == 34  # counted in the notebooks
     for path, ex in found:
         assert ex.stubs and ex.solutions, f"{path.name} {ex.title}: needs a stub cell and a solution cell"
         assert ex.names, f"{path.name} {ex.title}: no stub (raise NotImplementedError / answer = None)"
@@ -234,7 +246,7 @@ def test_instructor_sheet_has_every_answer(tmp_path):
     assert "Answer (why): each pair costs about 0.5" in (tmp_path / "06_ha2g.md").read_text()
     assert "left_out = (1 - 1 / K) ** K" in (tmp_path / "09_scoring.md").read_text()
     answers = (tmp_path / "answers.md").read_text()
-    assert answers.count("\n## Exercise") == 29 and "no solution cell" not in answers
+    assert answers.count("\n## Exercise") == 31 and "no solution cell" not in answers
 
 
 # ----------------------------------------------------------------------------- running the checks

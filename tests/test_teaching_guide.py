@@ -1,7 +1,7 @@
 """docs/teaching.md agrees with the notebooks: its numbers come from the notebooks' header cells.
 
 Each notebook's first cell says ``**Estimated time:** lecture ~N min; running it takes RUN on 2 CPU cores``, and
-notebooks 05-07 add what ``full`` mode trains live (epochs, seconds per epoch, the extra wall time). The guide's
+notebooks 05-07 and 10 add what ``full`` mode trains live (epochs, seconds per epoch, the extra wall time). The guide's
 lecture plan and its full-mode table repeat these numbers; a header changed without the guide (or the other way
 round) fails here. Notebook 00's map names every notebook, and the guide quotes the progress bar as
 ``beatlite.train`` formats it.
@@ -113,7 +113,7 @@ def test_plan_total_is_the_sum_of_the_headers():
 def test_full_mode_table_matches_the_headers():
     headers = {p.name[:2]: header_times(p)["full"] for p in NOTEBOOKS}
     expected = {k: v for k, v in headers.items() if v is not None}
-    assert set(expected) == {"05", "06", "07"}, (
+    assert set(expected) == {"05", "06", "07", "10"}, (
         f"notebooks whose header describes full mode: {sorted(expected)}"
     )
     assert guide_full_mode() == expected
