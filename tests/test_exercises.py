@@ -175,7 +175,8 @@ WRONG: dict[tuple[str, str], list[str]] = {
     ("09", "take_interval"): [  # a 90 % interval
         "def take_interval(per_take, n, seed):\n    rng = np.random.default_rng(seed)\n    x = np.asarray(per_take, dtype=float)\n"
         "    means = [x[rng.integers(len(x), size=len(x))].mean() for _ in range(n)]\n    return np.percentile(means, [5, 95])"
-    ],    ("10", "ddim_step"): [  # the re-noising term left out (the clean estimate, only rescaled)
+    ],
+    ("10", "ddim_step"): [  # the re-noising term left out (the clean estimate, only rescaled)
         "def ddim_step(x_t, eps, t, prev):\n    a_t, a_p = float(schedule.alpha_bars[t]), float(schedule.alpha_bars[prev])\n"
         "    return np.sqrt(a_p) * (x_t - np.sqrt(1 - a_t) * eps) / np.sqrt(a_t)",
         # the one-step alphas of t and prev where their products belong
