@@ -615,7 +615,7 @@ def _metrics() -> dict[str, Metric]:
                     source="BEAT (Liu et al., ECCV 2022) §6.3 / supplement §D; beatlite's clean reading on joint positions (docs/reference_code.md#beatalign-reference)"),
         "BeatAlign (reference)": Metric("BeatAlign", "reference", True, ("euler", "audio"), _beat_align_reference,
                                         "BEAT's code: Euler speed of columns 36:39, 10-500 s, RMS backtrack, "
-                                        "times at 22050 Hz",
+                                        "times at 22050 Hz; onsets by the installed librosa (BEAT pins 0.8.0)",
                     source="BEAT's code utils/metric.py (docs/reference_code.md#beatalign-reference): one Euler triplet (a finger joint), 10-500 s, RMS backtracking, times at 22050 Hz"),
         "BC (emage)": Metric("BC", "emage", True, ("positions", "audio", "mean_speed"), _bc_emage,
                              "EMAGE/BEAT2's 'BC': BEAT's BeatAlign on positions (neck, shoulders, elbows, wrists, "
