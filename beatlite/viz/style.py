@@ -64,7 +64,10 @@ NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
 )
 
 #: Colours of systems without a named colour (baselines, new models): never grey, blue or orange.
-OTHER_SYSTEM_COLOURS: tuple[str, ...] = ("#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+OTHER_SYSTEM_COLOURS: tuple[str, ...] = (
+    "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",  # tab10 without the named systems' colours
+    "#393b79", "#637939", "#843c39", "#7b4173",  # tab20b's darkest: distinct, and readable as text on white
+)  # fmt: skip
 
 #: Smallest width in pixels of a saved figure, an animation or a GIF ("slide size").
 SLIDE_WIDTH_PX = 960
@@ -184,7 +187,7 @@ def system_colour(label: str, index: int = 0) -> str:
         first word that names a known system decides (case-insensitive).
     index : int
         Position of the system in the figure, used for other names:
-        ``OTHER_SYSTEM_COLOURS[index % 6]``, so a baseline never takes the colour of
+        ``OTHER_SYSTEM_COLOURS[index % 10]``, so a baseline never takes the colour of
         ground truth, CaMN or HA2G.
 
     Returns
