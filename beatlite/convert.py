@@ -83,20 +83,7 @@ def convert(
     {'frames': 444, 'fps': 30.0}
     >>> tmp.cleanup()
     """
-    from beatlite.io import FormatError, read_bvh, write_bvh
-    from beatlite.io.motion import Motion
-    from beatlite.io.smplx import SMPLXMotion, read_smplx, write_smplx
-    from beatlite.io.take import resample_frames, rotation_columns
-    from beatlite.score import beat_channels
-    from beatlite.skeleton.beat import beat_skeleton
-    from beatlite.skeleton.smplx import (
-        BEAT_COUNTERPARTS,
-        SMPLX_JOINTS,
-        beat_to_smplx,
-        bone_direction_errors,
-        smplx_skeleton_motion,
-        smplx_to_beat,
-    )
+    from beatlite.io import FormatError
 
     src, dst = Path(src), Path(dst)
     if skeleton not in ("beat", "smplx"):
@@ -106,36 +93,51 @@ def convert(
 
         return {"takes": write_beat2_folder(src, dst, rest=_rest(model))}
     if _is_bvh(src) and dst.suffix == ".npz":
-        source = read_bvh(src)
-        channels = beat_channels(source, src)
-        motion = Motion(beat_skeleton(), channels, source.fps)
-        if source.fps != fps:
-            cols = rotation_columns(motion)
-            motion = Motion(
-                beat_skeleton(), resample_frames(channels, source.fps, fps, angle_columns=cols), fps
-            )
-        rest = _rest(model)
-        poses, trans = beat_to_smplx(motion, rest)
-        write_smplx(dst, SMPLXMotion(poses, trans, fps, betas=np.zeros(300)))
-        errors = bone_direction_errors(motion, poses, trans, rest)
-        return {
-            "frames": motion.n_frames,
-            "fps": float(fps),
-            "bone_errors_deg": {k: (float(v.mean()), float(v.max())) for k, v in errors.items()},
-            "no_counterpart": [n for n in SMPLX_JOINTS if n not in BEAT_COUNTERPARTS],
-        }
+        return _bvh_to_npz(src, dst, fps, _rest(model))
     if src.suffix == ".npz" and _is_bvh(dst):
-        smplx = read_smplx(src)
-        rest = _rest(model, smplx.betas if model is not None else None)
-        if skeleton == "smplx":
-            out = smplx_skeleton_motion(smplx.poses, smplx.trans, smplx.fps, rest)
-        else:
-            out = smplx_to_beat(smplx.poses, smplx.trans, smplx.fps, rest)
-        write_bvh(dst, out)  # type: ignore[arg-type]
-        return {"frames": smplx.n_frames, "fps": smplx.fps}
+        return _npz_to_bvh(src, dst, skeleton, model)
     raise FormatError(
         src, f"cannot convert {src.name} to {dst.name}: give .bvh -> .npz, .npz -> .bvh, or two folders"
     )
+
+
+def _bvh_to_npz(src: Path, dst: Path, fps: float, rest: Any) -> dict[str, Any]:
+    """BEAT BVH -> BEAT2 ``.npz`` at ``fps``, with the bone-direction errors of the retargeting."""
+    from beatlite.io import read_bvh
+    from beatlite.io.motion import Motion
+    from beatlite.io.smplx import SMPLXMotion, write_smplx
+    from beatlite.io.take import resample_frames, rotation_columns
+    from beatlite.score import beat_channels
+    from beatlite.skeleton.beat import beat_skeleton
+    from beatlite.skeleton.smplx import BEAT_COUNTERPARTS, SMPLX_JOINTS, beat_to_smplx, bone_direction_errors
+
+    source = read_bvh(src)
+    motion = Motion(beat_skeleton(), beat_channels(source, src), source.fps)
+    if source.fps != fps:
+        channels = resample_frames(motion.channels, source.fps, fps, angle_columns=rotation_columns(motion))
+        motion = Motion(motion.skeleton, channels, fps)
+    poses, trans = beat_to_smplx(motion, rest)
+    write_smplx(dst, SMPLXMotion(poses, trans, fps, betas=np.zeros(300)))
+    errors = bone_direction_errors(motion, poses, trans, rest)
+    return {
+        "frames": motion.n_frames,
+        "fps": float(fps),
+        "bone_errors_deg": {k: (float(v.mean()), float(v.max())) for k, v in errors.items()},
+        "no_counterpart": [n for n in SMPLX_JOINTS if n not in BEAT_COUNTERPARTS],
+    }
+
+
+def _npz_to_bvh(src: Path, dst: Path, skeleton: str, model: str | Path | None) -> dict[str, Any]:
+    """BEAT2 ``.npz`` -> BVH of BEAT's skeleton (retargeted) or of SMPL-X's own (``skeleton="smplx"``)."""
+    from beatlite.io import write_bvh
+    from beatlite.io.smplx import read_smplx
+    from beatlite.skeleton.smplx import smplx_skeleton_motion, smplx_to_beat
+
+    smplx = read_smplx(src)
+    rest = _rest(model, smplx.betas if model is not None else None)
+    to_bvh = smplx_skeleton_motion if skeleton == "smplx" else smplx_to_beat
+    write_bvh(dst, to_bvh(smplx.poses, smplx.trans, smplx.fps, rest))  # type: ignore[arg-type]
+    return {"frames": smplx.n_frames, "fps": smplx.fps}
 
 
 def _parser() -> argparse.ArgumentParser:

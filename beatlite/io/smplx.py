@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import io
 import os
 import zipfile
 from pathlib import Path
@@ -268,16 +267,14 @@ def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
         "expressions": np.zeros((n, 100)) if motion.expressions is None else motion.expressions,
         "trans": motion.trans,
     }
-    buffer = io.BytesIO()
-    np.savez(
-        buffer,
-        **{k: np.asarray(v, dtype=np.float32) for k, v in arrays.items()},
-        model=np.array(motion.model or "smplx2020"),
-        gender=np.array(motion.gender or "neutral"),
-        mocap_frame_rate=np.array(int(motion.fps) if float(motion.fps).is_integer() else motion.fps),
-    )
-    with atomic_write(path, "wb") as f:
-        f.write(buffer.getvalue())
+    with atomic_write(path, "wb") as f:  # np.savez writes its ZIP straight into the temporary file
+        np.savez(
+            f,
+            **{k: np.asarray(v, dtype=np.float32) for k, v in arrays.items()},
+            model=np.array(motion.model or "smplx2020"),
+            gender=np.array(motion.gender or "neutral"),
+            mocap_frame_rate=np.array(int(motion.fps) if float(motion.fps).is_integer() else motion.fps),
+        )
 
 
 def read_beat2_split(path: str | os.PathLike[str]) -> dict[str, str]:

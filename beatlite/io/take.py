@@ -428,10 +428,7 @@ def read_take_motion(
     """
     p = Path(path)
     if p.name.endswith(".npz"):  # BEAT2: the file states its rate; bvh_fps still overrides it
-        from beatlite.io.smplx import read_smplx
-
-        beat = read_smplx(p).to_beat()
-        return beat if bvh_fps is None else Motion(beat.skeleton, beat.channels, bvh_fps)  # type: ignore[attr-defined]
+        return _beat2_motion(p, bvh_fps)[0]
     if bvh_fps is not None:
         return read_bvh(p, fps=bvh_fps)
     motion = read_bvh(p)
@@ -448,6 +445,17 @@ def read_take_motion(
         stacklevel=2,
     )
     return Motion(motion.skeleton, motion.channels, rate)
+
+
+def _beat2_motion(path: Path, bvh_fps: float | None) -> tuple[Motion, np.ndarray | None]:
+    """A BEAT2 ``.npz`` as a motion on BEAT's skeleton at its rate (``bvh_fps`` overrides it), and its FLAME
+    expressions (None without) at the same rate."""
+    from beatlite.io.smplx import read_smplx
+
+    smplx = read_smplx(path)
+    beat = smplx.to_beat()
+    rate = smplx.fps if bvh_fps is None else float(bvh_fps)
+    return Motion(beat.skeleton, beat.channels, rate), smplx.expressions  # type: ignore[attr-defined]
 
 
 def _check_load_args(fps: float, phase: str) -> float:
@@ -578,14 +586,9 @@ def load_take(
     reference = reference_duration(durations, info.half if info is not None else None)
     expressions = None
     if ".npz" in paths:
-        from beatlite.io.smplx import read_smplx
-
-        smplx = read_smplx(paths[".npz"])
-        rate = smplx.fps if bvh_fps is None else float(bvh_fps)
-        beat = smplx.to_beat()
-        source = Motion(beat.skeleton, beat.channels, rate)  # type: ignore[attr-defined]
-        if smplx.expressions is not None:
-            expressions = resample_frames(smplx.expressions, rate, fps, shift=0).astype(np.float32)
+        source, flame = _beat2_motion(paths[".npz"], bvh_fps)
+        if flame is not None:
+            expressions = resample_frames(flame, source.fps, fps, shift=0).astype(np.float32)
     else:
         source = read_take_motion(paths[".bvh"], bvh_fps=bvh_fps, reference_s=reference)
     motion, audio, face = _align(stem.name, source, audio, int(audio_sr), facial, fps, phase)

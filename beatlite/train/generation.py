@@ -80,30 +80,41 @@ def _zero_padded(a: np.ndarray, start: int, length: int) -> np.ndarray:
     return part
 
 
-def unit_batch(
-    streams: Mapping[str, np.ndarray], start: int, keys: tuple[str, ...]
-) -> dict[str, torch.Tensor]:
-    """The one-window batch (B = 1) of the unit starting at frame ``start``.
+def unit_streams(streams: Mapping[str, np.ndarray], start: int, keys: Sequence[str]) -> dict[str, np.ndarray]:
+    """The unit starting at frame ``start`` of whole-take ``streams``, as numpy arrays of their own dtypes.
 
     Frame streams are sliced ``[start, start + 34)`` (edge-padded), audio samples
     ``[floor(start * 16000 / 15), + floor(34 / 15 * 16000))`` (zero-padded), mel frames
     ``[floor(a0 / 512), + 70)`` with ``a0`` the unit's first audio sample (edge-padded, as
     :mod:`beatlite.data.windows` slices the whole-take log-mel), ``speaker`` is copied.
     """
-    batch: dict[str, torch.Tensor] = {}
+    n_samples = int(np.floor(UNIT / FPS * SR))
+    out: dict[str, np.ndarray] = {}
     for key in keys:
         a = np.asarray(streams[key])
         if key == "speaker":
-            part = np.asarray(a, dtype=np.int64).reshape(1)
-            batch[key] = torch.from_numpy(part)
-            continue
-        if key == "audio":
-            part = _zero_padded(a, int(start * SR // FPS), int(np.floor(UNIT / FPS * SR)))
+            out[key] = a
+        elif key == "audio":
+            out[key] = _zero_padded(a, int(start * SR // FPS), n_samples)
         elif key == "mel":
-            hop = MEL_SETTINGS["hop_length"]
-            part = _unit_slice(a, int(start * SR // FPS) // hop, mel_frames(int(np.floor(UNIT / FPS * SR))))
+            out[key] = _unit_slice(
+                a, int(start * SR // FPS) // MEL_SETTINGS["hop_length"], mel_frames(n_samples)
+            )
         else:
-            part = _unit_slice(a, start, UNIT)
+            out[key] = _unit_slice(a, start, UNIT)
+    return out
+
+
+def unit_batch(
+    streams: Mapping[str, np.ndarray], start: int, keys: tuple[str, ...]
+) -> dict[str, torch.Tensor]:
+    """The one-window batch (B = 1) of the unit starting at frame ``start`` (:func:`unit_streams` as tensors:
+    integers as int64, the rest float32, ``speaker`` of shape (1,))."""
+    batch: dict[str, torch.Tensor] = {}
+    for key, part in unit_streams(streams, start, keys).items():
+        if key == "speaker":
+            batch[key] = torch.from_numpy(np.asarray(part, dtype=np.int64).reshape(1))
+            continue
         dtype = np.int64 if part.dtype.kind in "iu" else np.float32
         batch[key] = torch.from_numpy(np.ascontiguousarray(part.astype(dtype))[None])
     return batch

@@ -27,7 +27,7 @@ from beatlite.data.index import index_folder
 from beatlite.data.normalize import Normalizers
 from beatlite.data.store import build_store
 from beatlite.data.vocab import build_vocab
-from beatlite.data.windows import MEL_SETTINGS, mel_frames, sliding_windows
+from beatlite.data.windows import sliding_windows
 from beatlite.metrics.beats import audio_beats, mean_angle_change, position_speed
 from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 from beatlite.metrics.frechet import fgd
@@ -181,15 +181,6 @@ def load_test_set(
     return test
 
 
-def _clip(a: np.ndarray, start: int, length: int, *, zeros: bool = False) -> np.ndarray:
-    """``a[start:start + length]``, padded at the end (zeros, or the last row repeated)."""
-    part = a[start : start + length]
-    if len(part) < length:
-        pad = np.zeros((length - len(part), *a.shape[1:]), a.dtype) if zeros or not len(part) else part[-1:]
-        part = np.concatenate([part, np.repeat(pad, length - len(part), axis=0) if len(pad) == 1 else pad])
-    return part
-
-
 def clip_test_set(test: EvaluationSet, *, stride: int = WINDOW_STRIDE) -> EvaluationSet:
     """HA2G's per-clip protocol: every 34-frame window (``stride`` apart) of every take becomes a take of its own.
 
@@ -208,32 +199,26 @@ def clip_test_set(test: EvaluationSet, *, stride: int = WINDOW_STRIDE) -> Evalua
     Returns
     -------
     EvaluationSet
-        Takes named ``{stem}@{start}``; streams cut as :func:`beatlite.train.generation.unit_batch` cuts a unit
-        (frames, the audio samples of the clip's 34 / 15 s, its 70 log-mel frames); the train statistics shared.
+        Takes named ``{stem}@{start}``; streams cut by :func:`beatlite.train.generation.unit_streams`, as a unit
+        of generation is (frames, the audio samples of the clip's 34 / 15 s, its 70 log-mel frames); the train
+        statistics shared.
     """
-    n_samples = int(np.floor(WINDOW_LENGTH / FPS * SR))
-    hop, n_mel = MEL_SETTINGS["hop_length"], mel_frames(int(np.floor(WINDOW_LENGTH / FPS * SR)))
+    from beatlite.train.generation import unit_streams
+
     clips: dict[str, list[Any]] = {
         k: [] for k in ("takes", "streams", "dirs", "dirs141", "euler", "sem", "audio")
     }
     for k, stem in enumerate(test.takes):
         n = test.gt_directions[k].shape[0]
         for s in range(0, n - WINDOW_LENGTH + 1, stride):
-            frames, a0 = slice(s, s + WINDOW_LENGTH), int(s * SR // FPS)
-            streams = {
-                key: (value if key == "speaker" else _clip(np.asarray(value), s, WINDOW_LENGTH))
-                for key, value in test.streams[k].items()
-                if key not in ("audio", "mel")
-            }
-            streams["audio"] = _clip(np.asarray(test.streams[k]["audio"]), a0, n_samples, zeros=True)
-            streams["mel"] = _clip(np.asarray(test.streams[k]["mel"]), a0 // hop, n_mel)
+            frames = slice(s, s + WINDOW_LENGTH)
             clips["takes"].append(f"{stem}@{s}")
-            clips["streams"].append(streams)
+            clips["streams"].append(unit_streams(test.streams[k], s, tuple(test.streams[k])))
             clips["dirs"].append(test.gt_directions[k][frames])
             clips["dirs141"].append(test.gt_directions_141[k][frames])
             clips["euler"].append(test.gt_euler[k][frames])
             clips["sem"].append(test.semantic[k][frames])
-            clips["audio"].append(_clip(test.audio[k], a0, n_samples, zeros=True))
+            clips["audio"].append(unit_streams({"audio": test.audio[k]}, s, ("audio",))["audio"])
     if not clips["takes"]:
         raise ValueError(f"clip_test_set: no take has {WINDOW_LENGTH} frames")
     out = dataclasses.replace(
