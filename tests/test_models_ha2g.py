@@ -166,6 +166,47 @@ def test_coarse_to_fine_level_k_reads_level_k_minus_1() -> None:
     torch.testing.assert_close(model(future)["pose"], after["pose"])
 
 
+# The levels' vectors as the reference's slices list them (docs/reference_code.md#ha2g-levels), in channel order.
+_LEVEL_VECTORS = (
+    [0, 1, 2, 37, 38, 39, 40, 41],
+    [0, 1, 2, 3, 20, 37, 38, 39, 40, 41],
+    [0, 1, 2, 3, 4, 20, 21, 37, 38, 39, 40, 41],
+    [*range(6), 8, 11, 14, 17, 20, 21, 22, 25, 28, 31, 34, *range(37, 42)],
+    [*range(7), 8, 9, 11, 12, 14, 15, 17, 18, *range(20, 24), 25, 26, 28, 29, 31, 32, 34, 35, *range(37, 42)],
+    list(range(42)),
+)
+
+
+def test_cascade_copies_every_shared_bone_into_its_own_channels() -> None:
+    # The reference copies the head bones 37-41 one channel off (docs/reference_code.md#ha2g-levels); beatlite
+    # must put each bone of level k-1's prediction in that bone's channels of level k's seed, new bones and the
+    # indicator 0 from frame n_pre on, and the ground-truth seed frames with indicator 1 before.
+    model = _model().eval()
+    seen: list[torch.Tensor] = []
+    hooks = [g.register_forward_hook(lambda m, args, out: seen.append(args[0])) for g in model.generators]
+    batch = fake_batch(2)
+    with torch.no_grad():
+        out = model(batch)
+    for h in hooks:
+        h.remove()
+    n_pre = model.n_pre
+    assert [s.shape[-1] for s in seen] == [3 * len(v) + 1 for v in _LEVEL_VECTORS]
+    for k in range(1, 6):
+        prev, cur, pre_seq = _LEVEL_VECTORS[k - 1], _LEVEL_VECTORS[k], seen[k]
+        pred = out[f"level{k - 1}"]
+        for i, bone in enumerate(cur):
+            got = pre_seq[:, n_pre:, 3 * i : 3 * i + 3]
+            if bone in prev:
+                j = prev.index(bone)
+                torch.testing.assert_close(got, pred[:, n_pre:, 3 * j : 3 * j + 3])
+            else:
+                assert torch.count_nonzero(got) == 0, f"level {k + 1}, new bone {bone}"
+            torch.testing.assert_close(
+                pre_seq[:, :n_pre, 3 * i : 3 * i + 3], batch["dirvec"][:, :n_pre, 3 * bone : 3 * bone + 3]
+            )
+        assert torch.all(pre_seq[:, n_pre:, -1] == 0) and torch.all(pre_seq[:, :n_pre, -1] == 1)
+
+
 def test_discriminator_shape_and_losses() -> None:
     d = HA2GDiscriminator(126, 16, 2, 34, 0.1)
     assert tuple(d(torch.randn(3, 34, 126)).shape) == (3, 1)
