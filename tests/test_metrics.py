@@ -240,6 +240,26 @@ def test_diversity_batch_pairing_quirk():
     assert diversity(batches, n_pairs=3, seed=7, batch_pairing=True) == pytest.approx(np.mean(rows))
 
 
+def test_diversity_ha2g_variant_pairs_batches_of_windows_in_test_order():
+    # 40 windows -> 2 batches of 16 (the last 8 dropped, as HA2G's drop_last loader); the permutation of 2 batches
+    # is either the identity (every row meets itself: 0) or the swap (row r of batch 0 with row r of batch 1).
+    from beatlite.metrics.scoring import DIVERSITY_BATCH
+
+    assert DIVERSITY_BATCH == 16
+    feats = np.zeros((40, 2))
+    feats[16:32] = [3.0, 4.0]  # batch 1 is 7 (L1) away from batch 0, row by row
+    takes = Takes(positions=[np.zeros((40, 2, 3))], features=feats)
+    for seed in range(6):
+        swap = np.random.default_rng(seed).permutation(2)[0] == 1
+        value = evaluate(takes, GroundTruth(takes), metrics=("Diversity (ha2g)",), seed=seed).get(
+            "Diversity (ha2g)"
+        )
+        assert value.value == (7.0 if swap else 0.0)
+    one_batch = Takes(positions=[np.zeros((31, 2, 3))], features=np.zeros((31, 2)))
+    skipped = evaluate(one_batch, GroundTruth(one_batch), metrics=("Diversity (ha2g)",)).skipped
+    assert skipped == {"Diversity (ha2g)": "needs at least 2 batches of 16 windows, got 31 windows"}
+
+
 def test_diversity_errors():
     with pytest.raises(ValueError, match="at least 2 clips"):
         diversity(np.ones((1, 3)))
@@ -289,6 +309,7 @@ def test_evaluate_ground_truth_against_itself():
     assert rep.get("PCK").value == 1.0
     assert rep.get("MPJPE").value == 0.0
     assert rep.skipped["BeatAlign"] == "needs beats" and rep.skipped["BC"].startswith("needs directions")
+    assert rep.skipped["Diversity (ha2g)"].startswith("needs at least 2 batches")  # 14 windows
     md = rep.to_markdown()
     assert md.splitlines()[0] == "| metric | variant | value | better | definition |"
     assert "| SRGR | paper |" in md and "skipped" in md
