@@ -309,6 +309,24 @@ def test_ablation_table_values_changes_and_paper_rows():
     assert lines[3].endswith("| 3 |")
 
 
+def test_ablation_table_shows_the_papers_value_of_a_metric_beside_our_variant():
+    # The paper reports "BC"; our column is the variant "BC (ha2g)": the paper's column is headed "paper BC" and
+    # holds the paper's BC; a variant's change gets the metric's 3 decimals.
+    from beatlite.train.seeds import SeedResults, ablation_table
+
+    rec = SeedResults(
+        {"Full": {"BC (ha2g)": [0.70, 0.72, 0.74]}, "A": {"BC (ha2g)": [0.60, 0.61, 0.62]}}, [1, 2, 3], {}
+    )
+    paper = {"full": {"BC": 0.727}, "a": {"BC": 0.651}}
+    lines = ablation_table(
+        rec, "Full", {"Full": "full", "A": "a"}, paper, metrics=("BC (ha2g)",), deltas=("BC (ha2g)",)
+    )
+    lines = lines.splitlines()
+    assert lines[0] == "| variant | paper row | paper BC ↑ | ours BC (ha2g) ↑ | Δ BC (ha2g) ± 2 SE | seeds |"
+    # -0.11, SE sqrt(0.02^2/3 + 0.01^2/3) = 0.0129 -> 2 SE 0.026: worse (BC is higher-is-better)
+    assert lines[3] == "| A | a | 0.651 | 0.610 ± 0.010 | -0.110 ± 0.026 worse | 3 |"
+
+
 def test_the_shipped_checkpoint_is_the_median_seed_and_the_replaced_one_is_kept(tmp_path, monkeypatch):
     pytest.importorskip("torch")
     from beatlite.train import checkpoint, seeds

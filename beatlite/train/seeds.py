@@ -420,20 +420,21 @@ def compare_rows(
     For an ablation study ``full`` is the full model and ``variants`` its ablations; for a
     benchmark ``full`` can be a baseline and ``variants`` the models compared with it.
     A difference counts (``"worse"``/``"better"`` than ``full``) only when it exceeds two standard
-    errors of the difference of the seed means (Welch); the direction uses :data:`COLUMNS` (FGD
-    lower is better, the others higher).
+    errors of the difference of the seed means (Welch); the direction is the metric's
+    (``METRICS[key].higher_is_better``: FGD lower is better, most others higher). ``metrics``: keys of
+    :data:`~beatlite.metrics.scoring.METRICS` that have a better direction.
 
     Returns
     -------
     list of Effect, variant-major.
     """
 
-    higher = {key: METRICS[key].higher_is_better for key in COLUMNS}
+    higher = {key: m.higher_is_better for key, m in METRICS.items() if m.higher_is_better is not None}
     effects = []
     for variant in variants:
         for metric in metrics:
             if metric not in higher:
-                raise ValueError(f"metric must be one of {list(COLUMNS)}, got {metric!r}")
+                raise ValueError(f"metric must be a key of METRICS with a better direction, got {metric!r}")
             delta, se = results.difference(variant, full, metric)
             if not math.isfinite(se):
                 verdict = "unknown"
@@ -732,7 +733,9 @@ def ablation_table(
     paper : mapping paper row -> metric -> value
         E.g. :data:`beatlite.train.evaluation.PAPER_BEAT_TABLE5`.
     metrics : sequence of str
-        Columns shown as values, for the paper (when it has them) and for us.
+        Columns shown as values, for us and for the paper: the paper's value of a variant key
+        (``"BC (ha2g)"``) is the one it reports under the key or the metric's name (``"BC"``), its column
+        headed by what the paper has (``"paper BC"``); the caption must say which variant the paper used.
     deltas : sequence of str
         Columns shown as changes vs ``full`` (:func:`compare_rows`: ``"+0.52 ± 0.31 worse"``; an undecided
         change says how many seeds would decide it).
@@ -763,21 +766,31 @@ def ablation_table(
     variants = [label for label in rows if label != full]
     by = {(e.variant, e.metric): e for e in compare_rows(record, full, variants, metrics=deltas)}
     heads = column_headers(metrics)
-    header = ["variant", "paper row", *[f"paper {h}" for h in heads], *[f"ours {h}" for h in heads]]
+    names = [METRICS[m].name if m in METRICS else m for m in metrics]  # a paper reports one variant per name
+    header = [
+        "variant",
+        "paper row",
+        *[f"paper {h}" for h in column_headers(names)],
+        *[f"ours {h}" for h in heads],
+    ]
     header += [f"Δ {m} ± 2 SE" for m in deltas] + ["seeds"]
     body = []
     for label, paper_row in rows.items():
         published = paper.get(paper_row, {}) if paper_row else {}
         cells = [label, paper_row or "—"]
-        cells += [fmt_metric(published.get(m, math.nan), m) for m in metrics]
+        cells += [fmt_metric(published.get(m, published.get(n, math.nan)), m) for m, n in zip(metrics, names)]
         cells += [record.cell(label, m) for m in metrics]
         cells += [
-            "" if label == full else by[label, m].cell(3 if m in ("SRGR", "BeatAlign", "BC") else 2)
-            for m in deltas
+            "" if label == full else by[label, m].cell(3 if n in ("SRGR", "BeatAlign", "BC") else 2)
+            for m, n in zip(deltas, [METRICS[m].name if m in METRICS else m for m in deltas])
         ]
         body.append([*cells, record.count(label, metrics[0])])
     for paper_row, reason in (absent or {}).items():
         published = paper.get(paper_row, {})
-        cells = ["—", paper_row, *[fmt_metric(published.get(m, math.nan), m) for m in metrics]]
+        cells = [
+            "—",
+            paper_row,
+            *[fmt_metric(published.get(m, published.get(n, math.nan)), m) for m, n in zip(metrics, names)],
+        ]
         body.append([*cells, f"not trained: {reason}", *[""] * (len(metrics) - 1 + len(deltas)), 0])
     return markdown_table(header, body)
