@@ -11,9 +11,13 @@ Per row:
 - **step windows/s** (and ms/step): the model's own training step, as ``fit`` takes it
   (``beatlite.train.training._Run.step``: forward, losses, discriminator step, backward, Adam, gradient
   clipping; adversarial epoch) on one batch already on the device: no data path.
-- **fit windows/s**: ``fit`` itself on a window store (``store.windows("train", keys=batch_keys)``), one
-  epoch of ``--fit-steps`` steps: the data path included. ``fit/step`` is their ratio (the named
-  alternative measured in the same run: what the data path costs).
+- **fit windows/s (loader)**: ``fit`` itself on a window store (``store.windows("train", keys=batch_keys)``),
+  one epoch of ``--fit-steps`` steps, batches read by the store's DataLoader and copied to the device: the data
+  path included. ``fit/step`` is their ratio (the named alternative measured in the same run: what the data
+  path costs).
+- **fit windows/s (resident)**: the same ``fit`` with ``data_on_device="always"``: the model's streams held on
+  the device (:class:`beatlite.data.resident.ResidentWindows`), every batch gathered there; ``resident/loader``
+  is its ratio to the loader route in the same run.
 - **GFLOP/window**: FLOPs of one training step divided by the batch size, counted with
   ``torch.utils.flop_counter.FlopCounterMode`` (matrix products and convolutions; the fused recurrent kernels
   that it does not know, oneDNN's ``mkldnn_rnn_layer`` and cuDNN's ``_cudnn_rnn``, are counted here as
@@ -156,6 +160,7 @@ class Row:
     step_wps: float | None = None
     step_ms: float | None = None
     fit_wps: float | None = None
+    fit_resident_wps: float | None = None
     peak_mib: float | None = None
     peak_fraction: float | None = None
     note: str = ""
@@ -239,41 +244,47 @@ def _peak(device: torch.device, dtype: torch.dtype) -> float:
 
 
 def measure_fit(row: Row, store_train: Any, steps: int) -> None:
-    """``fit``'s windows/s on the store view of the model's keys (one epoch of ``steps`` steps)."""
-    model = _model(row.model, row.preset, store_train, prepare=False)  # fit prepares it (timed)
-    keys = type(model).batch_keys(model.config)
-    view = store_train.store.windows("train", keys=keys, stats=store_train.normalizers)
-    n = min(len(view), steps * row.batch)
-    config = _config(row.device, row.precision, row.batch, epochs=1, windows_per_epoch=n)
-    start = time.perf_counter()
-    fit(model, view, config)
-    row.fit_wps = n / (time.perf_counter() - start)
+    """``fit``'s windows/s on the store view of the model's keys (one epoch of ``steps`` steps), by both routes
+    of a store view: batches read by the store's loader (``data_on_device="never"``) and gathered on the
+    device from resident streams (``"always"``, :class:`beatlite.data.resident.ResidentWindows`)."""
+    for mode, field in (("never", "fit_wps"), ("always", "fit_resident_wps")):
+        model = _model(row.model, row.preset, store_train, prepare=False)  # fit prepares it (timed)
+        keys = type(model).batch_keys(model.config)
+        view = store_train.store.windows("train", keys=keys, stats=store_train.normalizers)
+        n = min(len(view), steps * row.batch)
+        config = _config(
+            row.device, row.precision, row.batch, epochs=1, windows_per_epoch=n, data_on_device=mode
+        )
+        start = time.perf_counter()
+        fit(model, view, config)
+        setattr(row, field, n / (time.perf_counter() - start))
 
 
 # ---------------------------------------------------------------------------- table and command line
 COLUMNS = (
     ("model", "model"), ("preset", "preset"), ("device", "device"), ("precision", "precision"),
     ("batch", "batch"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
-    ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s"),
-    ("fit_ratio", "fit/step"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
+    ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s (loader)"),
+    ("fit_ratio", "fit/step"), ("fit_resident_wps", "fit windows/s (resident)"), ("resident_ratio", "resident/loader"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
 )  # fmt: skip
 
 
 def _cell(row: Row, field: str) -> str:
     if row.note and field not in ("model", "preset", "device", "precision", "batch"):
         return row.note
-    value = (
-        (row.fit_wps / row.step_wps if row.fit_wps and row.step_wps else None)
-        if field == "fit_ratio"
-        else getattr(row, field)
-    )
+    ratios = {"fit_ratio": (row.fit_wps, row.step_wps), "resident_ratio": (row.fit_resident_wps, row.fit_wps)}
+    if field in ratios:
+        a, b = ratios[field]
+        value = a / b if a and b else None
+    else:
+        value = getattr(row, field)
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-"
     if field == "params":
         return f"{value / 1e6:.2f}"
     if field == "peak_fraction":
         return f"{100 * value:.1f}"
-    if field in ("gflop_per_window", "fit_ratio"):
+    if field in ("gflop_per_window", "fit_ratio", "resident_ratio"):
         return f"{value:.3g}"
     return f"{value:,.0f}" if isinstance(value, float) else str(value)
 

@@ -84,6 +84,17 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
     f.add_argument("--checkpoint-every", type=int, help="also checkpoint every N steps inside an epoch")
     f.add_argument(
+        "--batch-size",
+        type=int,
+        help="windows per step (default: the recipe's); learning rates scale linearly",
+    )
+    f.add_argument(
+        "--data-on-device",
+        choices=("auto", "always", "never"),
+        default="auto",
+        help="hold the store's streams on the device, batches gathered there (auto: CUDA when they fit in half its free memory)",
+    )
+    f.add_argument(
         "--extractor-epochs",
         type=int,
         default=100,
@@ -190,6 +201,8 @@ def _fit_command(args: argparse.Namespace) -> int:
         device=args.device,
         extractor=extractor,
         checkpoint_every=args.checkpoint_every,
+        batch_size=args.batch_size,
+        data_on_device=args.data_on_device,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

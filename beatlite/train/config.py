@@ -12,6 +12,8 @@ from typing import Any
 
 LR_SCHEDULES = ("constant", "cosine")
 """Values of :attr:`TrainConfig.lr_schedule`."""
+DATA_ON_DEVICE = ("auto", "always", "never")
+"""Values of :attr:`TrainConfig.data_on_device`."""
 
 
 @dataclasses.dataclass
@@ -66,6 +68,12 @@ class TrainConfig:
     workers : int
         DataLoader worker processes that read the batches of a window store
         (:class:`beatlite.data.store.StoreWindows`); in-memory windows are indexed in the loop.
+    data_on_device : {"auto", "always", "never"}
+        For a window store view (train and validation windows): hold the streams the model reads on the
+        training device and gather every batch there (:class:`beatlite.data.resident.ResidentWindows`: no
+        disk read, host copy or DataLoader per step; the same batches to the bit). ``"auto"``: on CUDA when
+        they take at most half of its free memory (:func:`beatlite.data.resident.fits_on_device`), never on
+        the CPU, where the store's loader keeps the memory flat. In-memory windows are indexed in the loop.
     micro_batches : int
         Split every batch into this many micro-batches whose gradients are averaged before the step
         (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
@@ -93,6 +101,7 @@ class TrainConfig:
     micro_batches: int = 1
     workers: int = 0
     checkpoint_every: int | None = None
+    data_on_device: str = "auto"
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -110,6 +119,10 @@ class TrainConfig:
         if self.checkpoint_every is not None and self.checkpoint_every < 1:
             raise ValueError(
                 f"TrainConfig: checkpoint_every must be >= 1 or None, got {self.checkpoint_every}"
+            )
+        if self.data_on_device not in DATA_ON_DEVICE:
+            raise ValueError(
+                f"TrainConfig: data_on_device must be one of {DATA_ON_DEVICE}, got {self.data_on_device!r}"
             )
         if self.workers < 0:
             raise ValueError(f"TrainConfig: workers must be >= 0, got {self.workers}")

@@ -426,6 +426,8 @@ def retrain(
     device: str = "cpu",
     extractor: str | Path | None = None,
     checkpoint_every: int | None = None,
+    batch_size: int | None = None,
+    data_on_device: str = "auto",
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -454,6 +456,13 @@ def retrain(
         ``checkpoints/fgd_dirvec.pt``, trained on ``data_samples/``).
     checkpoint_every : int, optional
         :attr:`beatlite.train.TrainConfig.checkpoint_every` (mid-epoch checkpoints, resumable).
+    batch_size : int, optional
+        Windows per step instead of the recipe's (a GPU takes larger batches at about the same time per
+        step); the learning rates scale with it linearly (Goyal et al. 2017, "Accurate, large minibatch SGD"):
+        ``lr * batch_size / recipe.batch_size``, or the default ``5e-4 * batch_size / 256`` of a recipe without
+        its own ``lr``. Not the recipe the shipped numbers were measured with.
+    data_on_device : {"auto", "always", "never"}
+        :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
 
     Returns
     -------
@@ -471,10 +480,11 @@ def retrain(
         export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
     else:
         export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
+    batch = recipe.batch_size if batch_size is None else int(batch_size)
     config = TrainConfig(
         epochs=recipe.epochs if epochs is None else epochs,
-        batch_size=recipe.batch_size,
-        lr=recipe.lr,
+        batch_size=batch,
+        lr=None if recipe.lr is None else recipe.lr * batch / recipe.batch_size,
         lr_schedule=recipe.lr_schedule,
         seed=seed,
         checkpoint=full,
@@ -482,6 +492,7 @@ def retrain(
         progress=progress,
         device=device,
         checkpoint_every=checkpoint_every,
+        data_on_device=data_on_device,
     )
     score = None
     if recipe.select_best and config.epochs > 0:

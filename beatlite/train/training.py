@@ -17,6 +17,7 @@ import torch
 
 from beatlite import paths
 from beatlite.data.normalize import Normalizers
+from beatlite.data.resident import ResidentWindows, fits_on_device
 from beatlite.models.base import GestureModel
 from beatlite.notebook import progress
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
@@ -194,12 +195,17 @@ def evaluate_losses(
 ) -> dict[str, float]:
     """Mean of ``model.losses`` over ``windows`` in eval mode (weighted by batch size).
 
-    ``windows``: in-memory windows, or a window store view read batch by batch (only the model's keys).
+    ``windows``: in-memory windows, a window store view read batch by batch (only the model's keys), or
+    :class:`~beatlite.data.resident.ResidentWindows` on the model's device.
     """
-    store = windows if _is_store_view(windows) else None
-    arrays = None if store is not None else as_arrays(windows)
-    keys = _needed_keys(model, windows if store is not None else arrays, "evaluate_losses")
-    n = len(store) if store is not None else _n_windows(arrays, keys, "evaluate_losses")
+    if isinstance(windows, ResidentWindows):
+        keys = _needed_keys(model, dict.fromkeys(windows.keys), "evaluate_losses")
+        store, arrays, n = None, None, len(windows)
+    else:
+        store = windows if _is_store_view(windows) else None
+        arrays = None if store is not None else as_arrays(windows)
+        keys = _needed_keys(model, windows if store is not None else arrays, "evaluate_losses")
+        n = len(store) if store is not None else _n_windows(arrays, keys, "evaluate_losses")
     was_training = model.training
     model.eval()
     sums: dict[str, Any] = {}
@@ -207,8 +213,11 @@ def evaluate_losses(
     try:
         for start in range(0, n, batch_size):
             idx = np.arange(start, min(n, start + batch_size))
-            source = arrays if store is None else store.batch(idx, keys=keys)
-            batch = _batch(source, keys, idx if store is None else slice(None), device)
+            if isinstance(windows, ResidentWindows):
+                batch = windows.batch(torch.arange(start, start + len(idx), device=windows.device))
+            else:
+                source = arrays if store is None else store.batch(idx, keys=keys)
+                batch = _batch(source, keys, idx if store is None else slice(None), device)
             _accumulate(sums, model.losses(batch, model(batch), epoch=epoch), len(idx))
     finally:
         model.train(was_training)
@@ -279,6 +288,9 @@ def fit(
         if run.path is not None and run.path.is_file():
             run.resume()
     run.wrap()
+    data.hold(config.data_on_device, run.device)
+    if data.resident is not None and val_windows is not None and _is_store_view(val_windows):
+        val_windows = ResidentWindows(val_windows, data.keys, run.device)
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
         return run.result()
@@ -338,6 +350,14 @@ class _Data:
     n: int
     fingerprint: str
     store: Any = None
+    resident: ResidentWindows | None = None
+
+    def hold(self, mode: str, device: Any) -> None:
+        """Hold a store view's streams on ``device`` as ``TrainConfig.data_on_device`` says (``mode``)."""
+        if self.store is None or mode == "never":
+            return
+        if mode == "always" or fits_on_device(self.store, self.keys, device):
+            self.resident = ResidentWindows(self.store, self.keys, device)
 
     @classmethod
     def of(cls, model: GestureModel, windows: Any) -> _Data:
@@ -351,7 +371,7 @@ class _Data:
     def batches(self, steps: list[list[np.ndarray]], device: Any, workers: int) -> Any:
         """For every step, its micro-batches as (tensor dict, windows) on ``device``.
 
-        A window store is read by a ``torch.utils.data.DataLoader`` (``workers`` processes, pinned
+        Resident streams (:meth:`hold`) are gathered on the device; otherwise a window store is read by a ``torch.utils.data.DataLoader`` (``workers`` processes, pinned
         memory on CUDA) in exactly this order; in-memory arrays are indexed here. The loader draws its
         workers' base seed from its own generator, not torch's global one, which the models' dropout and
         sampling use: both routes then take the same steps.
@@ -359,6 +379,17 @@ class _Data:
         if self.store is None:
             for step in steps:
                 yield [(_batch(self.arrays, self.keys, m, device), len(m)) for m in step]
+            return
+        if self.resident is not None:  # the epoch's indices copied once, every batch gathered on the device
+            flat = [m for step in steps for m in step]
+            order = torch.from_numpy(np.concatenate(flat) if flat else np.zeros(0, np.int64)).to(device)
+            at = 0
+            for step in steps:
+                micro = []
+                for m in step:
+                    micro.append((self.resident.batch(order[at : at + len(m)]), len(m)))
+                    at += len(m)
+                yield micro
             return
         from torch.utils.data import DataLoader
 
