@@ -292,32 +292,44 @@ def _store_view(case: ModelCase, keys: tuple[str, ...]) -> Any:
     )  # fmt: skip
 
 
-def _fit_two_steps(case: ModelCase, windows: Any, *, amp: bool) -> tuple[Any, list[dict[str, Any]]]:
-    """A fresh model trained for two steps of 4 windows on ``windows`` (adversarial from the start)."""
+def _fit_two_steps(
+    case: ModelCase, windows: Any, *, amp: bool, on_device: str = "never"
+) -> tuple[Any, list[dict[str, Any]]]:
+    """A fresh model trained for two steps of 4 windows on ``windows`` (adversarial from the start);
+    ``on_device``: ``TrainConfig.data_on_device`` (a store view read by the loader, or held on the device)."""
     from beatlite.train import TrainConfig, fit
 
     model = case.build()
     config = TrainConfig(
-        epochs=1, batch_size=4, windows_per_epoch=8, seed=1, no_adv_epochs=0, progress=False, amp=amp
-    )
+        epochs=1, batch_size=4, windows_per_epoch=8, seed=1, no_adv_epochs=0, progress=False, amp=amp,
+        data_on_device=on_device,
+    )  # fmt: skip
     with CudaAutocastRules():
         history = fit(model, windows, config).history
     return model, history
 
 
 def check_store_training(case: ModelCase) -> None:
-    """Two steps from a store view of exactly ``batch_keys`` equal two steps from the same windows in memory
-    (same losses, weights and buffers, bit for bit), with finite losses."""
+    """Two steps from a store view of exactly ``batch_keys``, read by the loader and held on the device
+    (``data_on_device="always"``), equal two steps from the same windows in memory (same losses, weights and
+    buffers, bit for bit), with finite losses."""
     model = case.build()
     view = _store_view(case, type(model).batch_keys(model.config))
     stored, history = _fit_two_steps(case, view, amp=False)
     memory, reference = _fit_two_steps(case, case.reference, amp=False)
+    resident, held = _fit_two_steps(case, view, amp=False, on_device="always")
     _expect(len(history) == (1 if stored.trainable else 0), case, f"history has {len(history)} epochs")
     _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite losses {history}")
     _expect(history == reference, case, f"store route {history} != in-memory route {reference}")
-    a, b = stored.state_dict(), memory.state_dict()
+    _expect(held == reference, case, f"resident route {held} != in-memory route {reference}")
+    a, b, c = stored.state_dict(), memory.state_dict(), resident.state_dict()
     _expect(
         all(torch.equal(a[k], b[k]) for k in a), case, "store and in-memory training end with other weights"
+    )
+    _expect(
+        all(torch.equal(c[k], b[k]) for k in c),
+        case,
+        "resident and in-memory training end with other weights",
     )
     pose = _reset(stored).generate(case.batch(stored))
     _expect(torch.isfinite(pose).all(), case, "the model prepared from the store generates non-finite values")
