@@ -136,9 +136,10 @@ def colab_url(repo: str, notebook: str, branch: str = "main") -> str:
 def tag_slides(nb) -> int:
     """Give every cell without ``metadata.slideshow`` a slide type; return how many were tagged.
 
-    The header cell is the title slide, a ``## `` section starts a slide and a ``### `` one a subslide; the
-    Colab and import cells (setup), ``check`` cells (the lecture hides them) and ``solution`` cells (answers
-    stay off the screen) are skipped; every other cell continues its slide (``-``).
+    The header cell is the title slide, a ``## `` section starts a slide and a ``### `` one a subslide, as does
+    any other Markdown cell that follows a shown code cell (one idea per screen: text, code, output); the Colab
+    and import cells (setup), ``check`` cells (the lecture hides them) and ``solution`` cells (answers stay off
+    the screen) are skipped; every other cell continues its slide (``-``).
     """
     code = [i for i, c in enumerate(nb.cells) if c.cell_type == "code" and "colab" not in _tags(c)]
     tagged = 0
@@ -154,11 +155,21 @@ def tag_slides(nb) -> int:
             kind = "slide"
         elif cell.cell_type == "markdown" and text.startswith("### "):
             kind = "subslide"
+        elif cell.cell_type == "markdown" and _shown_code_before(nb.cells, i):
+            kind = "subslide"  # the next idea after a shown cell's output: below, not on the same screen
         else:
             kind = "-"
         cell.metadata["slideshow"] = {"slide_type": kind}
         tagged += 1
     return tagged
+
+
+def _shown_code_before(cells, i: int) -> bool:
+    """Whether the nearest cell before ``i`` that is shown on the slides is a code cell."""
+    for cell in reversed(cells[:i]):
+        if cell.metadata.get("slideshow", {}).get("slide_type") != "skip":
+            return cell.cell_type == "code"
+    return False
 
 
 def _tags(cell) -> list[str]:
@@ -194,11 +205,11 @@ def header(nb) -> dict:
     """Title, first goal and lecture minutes from the notebook's header cell (its first Markdown cell)."""
     text = next((c.source for c in nb.cells if c.cell_type == "markdown"), "")
     title = re.search(r"^#\s+(.+)$", text, re.M)
-    goal = re.search(r"\*\*Goals?\*\*\s*\n\s*[-*]\s+(.+)", text)
+    goal = re.search(r"\*\*Goals?\*\*\s*\n\s*[-*]\s+(.+?)(?=\n\s*[-*]\s|\n\s*\n|$)", text, re.S)
     minutes = re.search(r"lecture ~(\d+) min", text)
     return {
         "title": title[1].strip() if title else "",
-        "goal": goal[1].strip() if goal else "",
+        "goal": " ".join(goal[1].split()) if goal else "",
         "minutes": int(minutes[1]) if minutes else None,
     }
 
@@ -245,6 +256,8 @@ _SLIDES_CSS = """
 .reveal .slides > section, .reveal .slides > section > section { height: 100%; overflow-y: auto; }
 .reveal .jp-OutputArea-output img { max-height: 600px; width: auto; }
 .reveal .jp-RenderedHTMLCommon table { font-size: 16px; }
+.reveal .jp-InputArea-editor pre, .reveal .jp-OutputArea-output pre { white-space: pre-wrap; font-size: 16px; }
+.reveal .slide-number { left: 8px; right: auto; }
 """
 
 

@@ -216,6 +216,26 @@ def test_tag_slides_rules():
     assert kinds == ["slide", "skip", "skip", "slide", "-", "skip", "subslide", "slide", "skip"]
     nb.cells[4].metadata["slideshow"]["slide_type"] = "fragment"
     assert site.tag_slides(nb) == 0 and nb.cells[4].metadata["slideshow"]["slide_type"] == "fragment"
+    # text after a shown code cell goes below it; after a skipped one it continues the slide
+    more = new_notebook(
+        cells=[
+            new_markdown_cell("# T"),
+            new_code_cell("import x"),
+            new_markdown_cell("after the skipped setup"),
+            new_code_cell("f()"),
+            new_markdown_cell("after a shown cell"),
+            new_markdown_cell("text after text"),
+        ]
+    )
+    site.tag_slides(more)
+    assert [c.metadata["slideshow"]["slide_type"] for c in more.cells] == [
+        "slide",
+        "skip",
+        "-",
+        "-",
+        "subslide",
+        "-",
+    ]
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
