@@ -17,7 +17,7 @@ JOBS ?= 1
 # Recipes `make seeds` trains and records (default: all).
 ONLY ?=
 
-.PHONY: run test test-fast lint lab venv system-deps data checkpoints results seeds bench clean
+.PHONY: run test test-fast lint lab site venv system-deps data checkpoints results seeds bench clean
 
 venv: $(STAMP)
 
@@ -40,6 +40,19 @@ system-deps:
 ## The main job: execute every notebook in order on data_samples/ and write build/.
 run: $(STAMP) $(INTERACTIVE) system-deps
 	$(VPY) scripts/run_notebooks.py --out build
+
+## The course site in build/site/ (works from file://, offline): index.html (the course map), every notebook as an
+## offline page and as reveal.js slides, the guide, the figures, the student copies. Reuses the executed notebooks of
+## `make run` when current and runs the others. Colab links: `make site COLAB_REPO=owner/name` (or a GitHub origin).
+SITE_STAMP := $(VENV)/.beatlite-site
+COLAB_REPO ?=
+COLAB_BRANCH ?= main
+$(SITE_STAMP): $(STAMP)
+	$(VPY) -m pip install --quiet -e ".[notebooks,dev,site]"
+	@touch $(SITE_STAMP)
+
+site: $(SITE_STAMP) $(INTERACTIVE) system-deps
+	$(VPY) scripts/build_site.py --build build --branch $(COLAB_BRANCH) $(if $(COLAB_REPO),--colab-repo $(COLAB_REPO))
 
 ## JupyterLab on working copies of the notebooks in build/lab/ (copied from LAB_FROM once; delete a copy to get a
 ## fresh one; copies that hold solutions are replaced by student copies, the old ones kept in build/lab/backup/:

@@ -151,6 +151,15 @@ def export_html(nb) -> str:
     player's Font Awesome link is dropped and its icons are inline SVG. Widget state is not embedded (the
     notebooks run with ``BEATLITE_INTERACTIVE=off``, without widgets).
     """
+    body, _ = _offline_exporter().from_notebook_node(
+        offline_notebook(nb), resources={"offline_css": _offline_css()}
+    )
+    return body
+
+
+def offline_notebook(nb):
+    """A copy of ``nb`` without web references in its outputs: the animation player's Font Awesome link dropped
+    (the offline style sheet draws its icons) and no widget state."""
     nb = copy.deepcopy(nb)
     for cell in nb.cells:
         for output in cell.get("outputs", []):
@@ -159,8 +168,7 @@ def export_html(nb) -> str:
                 text = "".join(html) if isinstance(html, list) else html
                 output["data"]["text/html"] = _FONT_AWESOME_LINK.sub("", text)
     nb.metadata.pop("widgets", None)
-    body, _ = _offline_exporter().from_notebook_node(nb, resources={"offline_css": _offline_css()})
-    return body
+    return nb
 
 
 def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:

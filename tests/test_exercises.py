@@ -282,9 +282,13 @@ def _stores(src: str) -> set[str]:
 
 def _setup_cells(cells: list[dict], first: int, needed: set[str]) -> list[int]:
     """The code cells before ``first`` (not ``check``, not ``solution``) that define ``needed``, transitively,
-    and the first code cell (imports and ``notebook.setup``)."""
+    and the first code cell after the Colab cell (imports and ``notebook.setup``)."""
     chosen = []
-    code = [i for i in range(first) if cells[i]["cell_type"] == "code"]
+    code = [
+        i
+        for i in range(first)
+        if cells[i]["cell_type"] == "code" and "colab" not in cells[i].get("metadata", {}).get("tags", [])
+    ]
     for i in reversed(code):
         tags = cells[i].get("metadata", {}).get("tags", [])
         if {"check", "solution"} & set(tags):

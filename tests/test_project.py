@@ -68,7 +68,7 @@ def test_environment_yml_matches_pyproject():
         f"only in environment.yml: {sorted(set(conda_reqs) - set(pip_reqs))}, "
         f"different pins: {[k for k in pip_reqs if k in conda_reqs and pip_reqs[k] != conda_reqs[k]]}"
     )
-    assert pip_reqs["torch"] == "==2.13.0"
+    assert pip_reqs["torch"] == ">=2.11,<2.14"  # the tested range (README, "PyTorch on your own machine")
 
 
 #: Modules that make ``import beatlite`` slow (seconds each); the I/O and skeleton layers need none of them.

@@ -1,0 +1,347 @@
+"""``make site``: the course site and the slides build from executed notebooks and work offline from ``file://``.
+
+The site is built from two small notebooks (one already executed in ``build/notebooks/``, one that the builder
+must execute), never from the course's own notebooks, which are only checked for their slide metadata and Colab
+cell. The browser tests reuse ``test_pages``' headless Chromium (network emulated offline, names unresolvable,
+every request recorded).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import importlib.util
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import nbformat
+import pytest
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
+from test_pages import Browser, _chromium, open_offline
+
+REPO = Path(__file__).resolve().parents[1]
+NOTEBOOKS = sorted((REPO / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+
+
+def _png() -> bytes:
+    """A 2 x 2 RGB PNG (the "figure" of the fixture)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    rows = b"".join(b"\x00" + bytes([200, 30, 30, 30, 30, 200]) for _ in range(2))
+    header = struct.pack(">IIBBBBB", 2, 2, 8, 2, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(rows))
+        + chunk(b"IEND", b"")
+    )
+
+
+PNG = _png()
+
+
+def _site():
+    spec = importlib.util.spec_from_file_location("build_site", REPO / "scripts" / "build_site.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault("build_site", module)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _lecture(number: str, title: str, goal: str, minutes: int) -> nbformat.NotebookNode:
+    """A small lecture: header, Colab cell, setup, two sections with a formula, check and solution cells."""
+    site = _site()
+    nb = new_notebook(
+        cells=[
+            new_markdown_cell(
+                f"# {number} · {title}\n\n**Goals**\n- {goal}\n- A second goal.\n\n"
+                f"**Estimated time:** lecture ~{minutes} min; running it takes ~1 s on 2 CPU cores."
+            ),
+            new_code_cell("x = 21"),
+            new_markdown_cell(f"## 1. Squares of {title}\n\n$$\\frac{{a}}{{b}} = x^2$$"),
+            new_code_cell("print(x * 2)"),
+            new_code_cell("assert x == 21", metadata={"tags": ["check"]}),
+            new_markdown_cell("### 1.1 A detail\n\nInline $\\lVert v \\rVert$ here."),
+            new_markdown_cell("## 2. Exercise\n\nWrite `double`."),
+            new_code_cell("def double(v):\n    return 'SECRET-ANSWER'", metadata={"tags": ["solution"]}),
+        ]
+    )
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    site.add_colab_cell(nb)
+    site.tag_slides(nb)
+    return nb
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """Notebooks 01 (executed copy in build/notebooks/, without slide metadata) and 02 (not executed yet)."""
+    root = tmp_path_factory.mktemp("course")
+    notebooks, build = root / "notebooks", root / "build"
+    notebooks.mkdir()
+    (build / "notebooks").mkdir(parents=True)
+    (build / "figures").mkdir()
+    (build / "figures" / "01_alpha_fig.png").write_bytes(PNG)
+    first = _lecture("01", "Alpha", "Learn what $x^2$ is.", 10)
+    second = _lecture("02", "Beta", "Read a take.", 25)
+    nbformat.write(first, notebooks / "01_alpha.ipynb")
+    nbformat.write(second, notebooks / "02_beta.ipynb")
+
+    executed = nbformat.from_dict(first)  # as make run leaves it, but written before the slides were tagged
+    for cell in executed.cells:
+        cell.metadata.pop("slideshow", None)
+        if cell.source == "print(x * 2)":
+            cell.outputs = [
+                new_output("stream", name="stdout", text="PRINTED-42\n"),
+                new_output("display_data", data={"image/png": base64.b64encode(PNG).decode()}),
+            ]
+    nbformat.write(executed, build / "notebooks" / "01_alpha.ipynb")
+
+    paths = [notebooks / "01_alpha.ipynb", notebooks / "02_beta.ipynb"]
+    summary = _site().build_site(root / "site", build, paths, guide=REPO / "docs" / "teaching.md")
+    return root / "site", summary, paths, build
+
+
+def _links(page: Path) -> list[tuple[str, str]]:
+    """``(tag, url)`` of every link, image, style sheet and script of a page."""
+    text = page.read_text(encoding="utf-8")
+    return re.findall(r"<(a|img|link|script|source)\b[^>]*?\s(?:href|src)=[\"']([^\"']*)[\"']", text)
+
+
+def test_site_reuses_executed_notebooks_and_runs_the_others(built):
+    site, summary, _, build = built
+    assert summary == {"lectures": ["01_alpha", "02_beta"], "executed": ["02_beta"], "colab": False}
+    assert "PRINTED-42" in (site / "lectures" / "01_alpha.html").read_text()  # the stored output, not a rerun
+    assert (build / "notebooks" / "02_beta.ipynb").is_file()
+    ran = nbformat.read(build / "notebooks" / "02_beta.ipynb", as_version=4)
+    assert [o.get("text") for c in ran.cells if c.source == "print(x * 2)" for o in c.outputs] == ["42\n"]
+    for name in ("index.html", "guide.html", "figures.html", "figures/01_alpha_fig.png"):
+        assert (site / name).is_file(), name
+    student = nbformat.read(site / "student" / "01_alpha.ipynb", as_version=4)
+    assert (
+        "SECRET-ANSWER" not in str(student)
+        and len(student.cells) == len(_lecture("01", "A", "g", 1).cells) - 1
+    )
+
+
+def test_every_link_of_the_site_resolves_to_a_file(built):
+    site = built[0]
+    pages = sorted(site.rglob("*.html"))
+    assert len(pages) == 3 + 2 + 2  # index, guide, figures; two lecture pages; two slide decks
+    checked = 0
+    for page in pages:
+        for tag, url in _links(page):
+            if url.startswith(("#", "data:")) or (tag == "a" and url.startswith("https://")):
+                continue  # a web link is followed only when clicked; nothing else may name the web
+            assert not re.match(r"^[a-z]+:", url), f"{page.name}: <{tag}> {url} leaves the site"
+            target = (page.parent / html.unescape(url).split("#")[0]).resolve()
+            assert target.is_file(), f"{page.relative_to(site)}: {url} is missing"
+            assert site in target.parents, f"{page.relative_to(site)}: {url} points outside the site"
+            checked += 1
+    assert checked >= 2 * 5 + 3  # each index row: page, slides, student copy; the slides' reveal.js files
+
+
+def test_index_is_the_course_map(built):
+    index = (built[0] / "index.html").read_text()
+    rows = re.findall(
+        r"<tr><td><a href='lectures/([^']+)\.html'>([^<]+)</a></td><td>(.*?)</td><td>([^<]*)</td>", index
+    )
+    assert [(r[0], r[1], r[3]) for r in rows] == [
+        ("01_alpha", "01 · Alpha", "10 min"),
+        ("02_beta", "02 · Beta", "25 min"),
+    ]
+    assert "Learn what" in rows[0][2] and "<math" in rows[0][2]  # the goal line, its formula as MathML
+    assert "colab.research.google.com" not in index and "make site COLAB_REPO=owner/name" in index
+
+
+def test_colab_links_name_the_repository(built, tmp_path):
+    site = _site()
+    _, _, paths, build = built
+    summary = site.build_site(tmp_path / "site", build, paths, repo="someone/beatlite", branch="course")
+    assert summary["executed"] == [] and summary["colab"]  # both executed copies are current now
+    index = (tmp_path / "site" / "index.html").read_text()
+    assert re.findall(r'href="(https://colab[^"]+)"', index) == [
+        "https://colab.research.google.com/github/someone/beatlite/blob/course/notebooks/01_alpha.ipynb",
+        "https://colab.research.google.com/github/someone/beatlite/blob/course/notebooks/02_beta.ipynb",
+    ]
+    assert "--set-repo someone/beatlite" not in index  # the placeholder is not another repository
+
+
+def test_the_repository_comes_from_the_setting_or_a_github_origin(tmp_path):
+    site = _site()
+    assert site.github_repo("a-b/c.d") == "a-b/c.d"
+    with pytest.raises(ValueError, match="owner/name"):
+        site.github_repo("https://github.com/a/b")
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    assert site.github_repo(None, cwd=tmp_path) is None  # no origin
+    for url, repo in (
+        ("https://github.com/owner/course.git", "owner/course"),
+        ("git@github.com:owner/course.git", "owner/course"),
+        ("https://gitlab.com/owner/course.git", None),
+    ):
+        subprocess.run(["git", "-C", str(tmp_path), "remote", "remove", "origin"], capture_output=True)
+        subprocess.run(["git", "-C", str(tmp_path), "remote", "add", "origin", url], check=True)
+        assert site.github_repo(None, cwd=tmp_path) == repo, url
+
+
+def test_set_repo_writes_the_colab_cells(tmp_path):
+    site = _site()
+    path = tmp_path / "01_x.ipynb"
+    nbformat.write(_lecture("01", "X", "g", 1), path)
+    assert site.notebook_repo(nbformat.read(path, as_version=4)) is None
+    assert site.set_repo([path], "me/course") == 1 and site.set_repo([path], "me/course") == 0
+    assert site.notebook_repo(nbformat.read(path, as_version=4)) == "me/course"
+
+
+def test_slides_follow_the_source_slide_metadata(built):
+    slides = (built[0] / "slides" / "01_alpha.html").read_text()
+    # title, section 1 (+ subslide 1.1), section 2: the executed copy had no metadata, the source's is used
+    assert slides.count("<section") == 3 + 4  # 3 slides (columns), holding 1, 2 and 1 (sub)slides
+    assert "PRINTED-42" in slides and "SECRET-ANSWER" not in slides and "assert x == 21" not in slides
+    assert "google.colab" not in slides  # the Colab cell is skipped
+    assert not re.search(r"<(script|link|img)[^>]+(src|href)=[\"']?(https?:)?//", slides)
+    assert "<math" in slides and "\\frac" not in slides
+
+
+def test_tag_slides_rules():
+    site = _site()
+    nb = _lecture("01", "A", "g", 1)
+    kinds = [c.metadata["slideshow"]["slide_type"] for c in nb.cells]
+    # header, colab, setup, section, print, check, subsection, section, solution
+    assert kinds == ["slide", "skip", "skip", "slide", "-", "skip", "subslide", "slide", "skip"]
+    nb.cells[4].metadata["slideshow"]["slide_type"] = "fragment"
+    assert site.tag_slides(nb) == 0 and nb.cells[4].metadata["slideshow"]["slide_type"] == "fragment"
+    # text after a shown code cell goes below it; after a skipped one it continues the slide
+    more = new_notebook(
+        cells=[
+            new_markdown_cell("# T"),
+            new_code_cell("import x"),
+            new_markdown_cell("after the skipped setup"),
+            new_code_cell("f()"),
+            new_markdown_cell("after a shown cell"),
+            new_markdown_cell("text after text"),
+        ]
+    )
+    site.tag_slides(more)
+    assert [c.metadata["slideshow"]["slide_type"] for c in more.cells] == [
+        "slide",
+        "skip",
+        "-",
+        "-",
+        "subslide",
+        "-",
+    ]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_slide_metadata_is_valid(path):
+    """Every cell has a slide type RISE and nbconvert know; a title slide; setup, checks and answers skipped."""
+    nb = nbformat.read(path, as_version=4)
+    kinds = [c.metadata.get("slideshow", {}).get("slide_type") for c in nb.cells]
+    assert set(kinds) <= set(_site().SLIDE_TYPES), f"unknown or missing slide types: {set(kinds)}"
+    assert kinds[0] == "slide" and nb.cells[0].source.startswith("# "), "no title slide"
+    assert kinds.count("slide") >= 3
+    for cell, kind in zip(nb.cells, kinds):
+        if {"colab", "check", "solution"} & set(cell.metadata.get("tags", [])):
+            assert kind == "skip", cell.source[:60]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_starts_with_the_colab_cell(path):
+    nb = nbformat.read(path, as_version=4)
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert "colab" in code[0].metadata.get("tags", []), "the first code cell must be the Colab cell"
+    assert [c for c in code if "colab" in c.metadata.get("tags", [])] == [code[0]]
+    expected = _site().COLAB_CELL
+    assert re.sub(r'^REPO = ".*"$', 'REPO = "OWNER/NAME"', code[0].source, flags=re.M) == expected
+
+
+def _run_colab_cell(monkeypatch, on_colab: bool) -> tuple[list[list[str]], list[str]]:
+    calls, dirs = [], []
+    monkeypatch.setattr(subprocess, "run", lambda cmd, **kw: calls.append([str(a) for a in cmd]))
+    monkeypatch.setattr("os.chdir", dirs.append)
+    monkeypatch.setattr("os.path.isdir", lambda p: False)
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    monkeypatch.delenv("BEATLITE_PYVISTA", raising=False)
+    if on_colab:
+        monkeypatch.setitem(sys.modules, "google.colab", type(sys)("google.colab"))
+    else:
+        monkeypatch.delitem(sys.modules, "google.colab", raising=False)
+    exec(compile(_site().COLAB_CELL.replace("OWNER/NAME", "me/course"), "colab-cell", "exec"), {})
+    return calls, dirs
+
+
+def test_colab_cell_does_nothing_outside_colab(monkeypatch):
+    calls, dirs = _run_colab_cell(monkeypatch, on_colab=False)
+    assert calls == [] and dirs == []
+
+
+def test_colab_cell_installs_beatlite_without_touching_torch(monkeypatch):
+    calls, dirs = _run_colab_cell(monkeypatch, on_colab=True)
+    assert calls[0][:2] == ["git", "clone"] and "https://github.com/me/course" in calls[0]
+    installs = [c for c in calls if c[1:4] == ["-m", "pip", "install"]]
+    assert len(installs) == 2 and "--no-deps" in installs[0] and "/content/beatlite" in installs[0]
+    assert not [c for c in calls if any("torch" in a for a in c)], "the cell must not install torch"
+    assert dirs == ["/content/beatlite/notebooks"] and sys.path[0] == "/content/beatlite"
+
+
+# In the browser: Reveal ready, which slide is shown, what it shows.
+SLIDE_STATE = """(() => ({ready: Reveal.isReady(), total: Reveal.getTotalSlides(), index: Reveal.getIndices(),
+  text: Reveal.getCurrentSlide().innerText, counter: (document.querySelector('.slide-number') || {}).innerText,
+  maths: [...Reveal.getCurrentSlide().querySelectorAll('math')].filter(m => m.getBoundingClientRect().width > 0).length}))()"""
+
+
+def _key(browser: Browser, key: str, code: int) -> None:
+    for kind in ("keyDown", "keyUp"):
+        browser.page("Input.dispatchKeyEvent", type=kind, key=key, code=key, windowsVirtualKeyCode=code)
+
+
+def test_site_and_slides_open_offline_in_chromium(built, tmp_path):
+    _chromium()
+    site = built[0]
+    urls, states, checks = [], [], {}
+    for name in (
+        "index.html",
+        "lectures/01_alpha.html",
+        "guide.html",
+        "figures.html",
+        "slides/01_alpha.html",
+    ):
+        browser = Browser(tmp_path / name.replace("/", "_"))
+        try:
+            open_offline(browser, site / name)
+            checks[name] = browser.evaluate(
+                "({title: document.title, images: [...document.images].map(i => i.naturalWidth),"
+                " bodyText: document.body.innerText.length})"
+            )
+            if name.startswith("slides/"):
+                browser.evaluate("new Promise(r => Reveal.isReady() ? r() : Reveal.on('ready', r))")
+                states.append(browser.evaluate(SLIDE_STATE))
+                _key(browser, "ArrowRight", 39)
+                states.append(browser.evaluate(SLIDE_STATE))
+                _key(browser, "ArrowDown", 40)
+                states.append(browser.evaluate(SLIDE_STATE))
+            urls += browser.requested_urls()
+        finally:
+            browser.close()
+    left = [u for u in urls if not u.startswith(("file:", "data:", "about:", "blob:"))]
+    assert left == [], f"requests left the machine: {left}"
+    assert any(u.endswith("/assets/reveal/dist/reveal.js") for u in urls)  # the local copy was loaded
+    assert checks["index.html"]["title"] == "beatlite course"
+    assert all(w > 0 for c in checks.values() for w in c["images"]), checks  # every image decoded
+    assert checks["figures.html"]["images"] == [2]
+    first, second, third = states
+    assert first["ready"] and first["total"] == 4 and first["index"]["h"] == 0
+    assert first["text"].strip().lower().startswith("01 · alpha") and first["counter"] == "1 / 4"
+    assert (
+        second["index"]["h"] == 1
+        and "squares of alpha" in second["text"].lower()
+        and "PRINTED-42" in second["text"]
+    )
+    assert second["maths"] == 1 and second["counter"] == "2 / 4"
+    assert (third["index"]["h"], third["index"]["v"]) == (1, 1) and "a detail" in third["text"].lower()
