@@ -67,6 +67,8 @@ if "google.colab" in sys.modules:
     import os
     import subprocess
 
+    if REPO == "{PLACEHOLDER_REPO}":
+        raise RuntimeError("this copy does not name its GitHub repository: set REPO above to 'owner/name'")
     if not os.path.isdir("/content/beatlite"):
         subprocess.run(["git", "clone", "--depth", "1", f"https://github.com/{{REPO}}", "/content/beatlite"], check=True)
         pip = [sys.executable, "-m", "pip", "install", "--quiet"]

@@ -261,7 +261,9 @@ def test_notebook_starts_with_the_colab_cell(path):
     assert re.sub(r'^REPO = ".*"$', 'REPO = "OWNER/NAME"', code[0].source, flags=re.M) == expected
 
 
-def _run_colab_cell(monkeypatch, on_colab: bool) -> tuple[list[list[str]], list[str]]:
+def _run_colab_cell(
+    monkeypatch, on_colab: bool, repo: str = "me/course"
+) -> tuple[list[list[str]], list[str]]:
     calls, dirs = [], []
     monkeypatch.setattr(subprocess, "run", lambda cmd, **kw: calls.append([str(a) for a in cmd]))
     monkeypatch.setattr("os.chdir", dirs.append)
@@ -272,13 +274,23 @@ def _run_colab_cell(monkeypatch, on_colab: bool) -> tuple[list[list[str]], list[
         monkeypatch.setitem(sys.modules, "google.colab", type(sys)("google.colab"))
     else:
         monkeypatch.delitem(sys.modules, "google.colab", raising=False)
-    exec(compile(_site().COLAB_CELL.replace("OWNER/NAME", "me/course"), "colab-cell", "exec"), {})
+    source = _site().COLAB_CELL.replace('REPO = "OWNER/NAME"', f'REPO = "{repo}"')
+    exec(compile(source, "colab-cell", "exec"), {})
     return calls, dirs
 
 
 def test_colab_cell_does_nothing_outside_colab(monkeypatch):
     calls, dirs = _run_colab_cell(monkeypatch, on_colab=False)
     assert calls == [] and dirs == []
+
+
+def test_colab_cell_without_a_repository_says_so_before_cloning(monkeypatch):
+    calls = []
+    monkeypatch.setattr(subprocess, "run", lambda cmd, **kw: calls.append(cmd))
+    monkeypatch.setitem(sys.modules, "google.colab", type(sys)("google.colab"))
+    with pytest.raises(RuntimeError, match="set REPO above"):
+        exec(compile(_site().COLAB_CELL, "colab-cell", "exec"), {})
+    assert calls == []  # nothing cloned or installed
 
 
 def test_colab_cell_installs_beatlite_without_touching_torch(monkeypatch):
