@@ -22,6 +22,11 @@ take (matched by stem, everything before the first dot):
                        Read with ``allow_pickle=False``.
 =====================  ===================================================================================
 
+``--protocol clips`` scores HA2G's evaluation protocol instead of whole takes: one 34-frame prediction
+``{stem}@{start}.*`` (same formats) per window of every take, ``start`` = 0, 10, 20, ... (frames at 15 fps),
+each generated from that clip's first 4 ground-truth frames (:func:`load_split`,
+:func:`beatlite.train.testset.clip_test_set`); ``--export`` then writes a checkpoint's clips.
+
 Every prediction becomes the :class:`~beatlite.metrics.scoring.Takes` of one row exactly as
 :func:`beatlite.train.evaluation.evaluate_models` builds a model's row (TED-43 directions, positions of the
 common space, extractor features of the 34-frame windows, the 141 Euler channels where the file has them),
@@ -69,6 +74,7 @@ __all__ = [
     "beat_channels",
     "bootstrap_intervals",
     "export_checkpoint_takes",
+    "load_split",
     "main",
     "match_predictions",
     "read_prediction",
@@ -513,19 +519,49 @@ def _truth_sha(test: Any) -> str:
     return h.hexdigest()[:16]
 
 
-def _load_test_set(data: str | Path | None, split: str) -> Any:
+#: Values of ``protocol``: whole takes, or HA2G's evaluator (every 34-frame clip, stride 10, a take of its own).
+PROTOCOLS = ("takes", "clips")
+
+
+def load_split(data: str | Path | None = None, split: str = "test", *, protocol: str = "takes") -> Any:
+    """The ground truth a folder of predictions is scored against.
+
+    Parameters
+    ----------
+    data : str or Path, optional
+        BEAT-format data folder (default :func:`beatlite.paths.data_dir`).
+    split : str
+        Which takes (``"test"``).
+    protocol : {"takes", "clips"}
+        ``"takes"``: whole takes, one prediction ``{stem}.*`` each. ``"clips"``: HA2G's evaluator, every 34-frame
+        window (stride 10) of every take on its own (:func:`beatlite.train.testset.clip_test_set`), one prediction
+        ``{stem}@{start}.*`` each (34 frames, generated from that clip's first 4 ground-truth frames).
+
+    Returns
+    -------
+    EvaluationSet
+        With ``folder``, the resolved data folder.
+    """
     from beatlite.data.index import index_folder
     from beatlite.paths import data_dir
-    from beatlite.train.testset import load_test_set
+    from beatlite.train.testset import clip_test_set, load_test_set
 
+    if protocol not in PROTOCOLS:
+        raise ValueError(f"protocol must be one of {PROTOCOLS}, got {protocol!r}")
     folder = Path(data_dir() if data is None else data)
     if not folder.is_dir():
         raise ScoreInputError([f"{folder}: no such data folder"])
     test = load_test_set(index_folder(folder), split=split)
     if not test.takes:
         raise ScoreInputError([f"{folder}: no usable takes in the {split!r} split"])
+    if protocol == "clips":
+        test = clip_test_set(test)
     test.folder = str(folder.resolve())
     return test
+
+
+def _load_test_set(data: str | Path | None, split: str) -> Any:
+    return load_split(data, split)
 
 
 def score_folder(
@@ -916,9 +952,10 @@ def export_ground_truth(test: Any, out_dir: str | Path, data: str | Path | None 
     index = index_folder(getattr(test, "folder", None) or data, read_durations=False)
     out, written = Path(out_dir), []
     for stem, truth in zip(test.takes, test.gt_directions, strict=True):
-        record = index[stem]
+        take_stem, _, start = stem.partition("@")  # a clip of the "clips" protocol: {stem}@{start}
+        record, first = index[take_stem], int(start or 0)
         take = load_take(record.path("motion"), fps=FPS, bvh_fps=record.bvh_fps)
-        motion = Motion(take.motion.skeleton, take.motion.channels[: len(truth)], FPS)
+        motion = Motion(take.motion.skeleton, take.motion.channels[first : first + len(truth)], FPS)
         written.append(out / f"{stem}.bvh")
         write_bvh(written[-1], motion, precision=EXPORT_PRECISION)
     return written
@@ -976,6 +1013,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--data", help="BEAT-format data folder (default $BEATLITE_DATA or data_samples/)")
     p.add_argument("--split", default="test", help="the ground-truth takes (default test)")
     p.add_argument(
+        "--protocol",
+        choices=PROTOCOLS,
+        default="takes",
+        help="takes: one {stem}.* per take; clips: HA2G's evaluator, one 34-frame {stem}@{start}.* per window (stride 10)",
+    )
+    p.add_argument(
         "--metrics",
         nargs="+",
         choices=list(METRICS),
@@ -999,16 +1042,15 @@ def _parser() -> argparse.ArgumentParser:
 def _run(args: argparse.Namespace) -> int:
     from beatlite.io.atomic import atomic_write
 
+    test = load_split(args.data, args.split, protocol=args.protocol)
     if args.export:
         if not args.pred:
             raise ScoreInputError(["--export needs PRED, the folder to write"])
-        files = export_checkpoint_takes(
-            args.export, args.pred, args.data, split=args.split, format=args.format
-        )
+        files = export_checkpoint_takes(args.export, args.pred, test=test, format=args.format)
         print(f"wrote {len(files)} files to {args.pred}")
         return 0
     common = {"split": args.split, "metrics": args.metrics, "bootstrap": args.bootstrap, "seed": args.seed,
-              "extractor": args.extractor, "progress": True}  # fmt: skip
+              "extractor": args.extractor, "progress": True, "test": test}  # fmt: skip
     if args.self_check:
         result = self_check(args.data, **common)
     elif args.pred:

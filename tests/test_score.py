@@ -114,6 +114,33 @@ def test_exported_then_scored_equals_the_in_library_evaluation(name, test_set, l
     _assert_same_scores(result.evaluation.values(), library.get(name).metrics, name)
 
 
+def test_the_clips_protocol_exports_and_scores_ha2g_evaluator_clips(test_set, tmp_path):
+    """``--protocol clips``: one 34-frame prediction {stem}@{start} per window, each generated from its own seed
+    frames, scores as evaluate_models on clip_test_set; the ground truth's clips self-check to FGD 0."""
+    from beatlite.score import load_split
+    from beatlite.train.evaluation import evaluate_models
+    from beatlite.train.testset import clip_test_set
+
+    clips = load_split(REPO / "data_samples", protocol="clips")
+    assert clips.takes == clip_test_set(test_set).takes and clips.folder == test_set.folder
+    starts = [int(t.partition("@")[2]) for t in clips.takes if t.startswith(test_set.takes[0] + "@")]
+    assert starts == list(range(0, test_set.gt_directions[0].shape[0] - 33, 10))
+    keys = ["FGD", "BC (ha2g)", "BC (ha2g published)", "Diversity (ha2g)", "SRGR"]
+    want = evaluate_models(["ha2g_tiny"], test=clips, columns=keys).get("ha2g_tiny").metrics
+    out = tmp_path / "clips"
+    r = _run_cli(
+        str(out), "--export", "ha2g_tiny", "--protocol", "clips", "--data", str(REPO / "data_samples")
+    )
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name.split(".")[0] for p in out.iterdir()) == sorted(clips.takes)
+    assert all(np.load(p).shape == (34, 42, 3) for p in out.iterdir())
+    got = score_folder(out, test=clips, metrics=keys).evaluation.values()
+    for key in keys:
+        np.testing.assert_allclose(got[key], want[key], rtol=1e-6, err_msg=key)
+    truth = self_check(test=clips, metrics=["FGD", "PCK"]).evaluation.values()
+    assert truth["FGD"] < 1e-6 and truth["PCK"] == 1.0
+
+
 def test_an_euler_model_exported_as_npy_scores_the_same(test_set, library, tmp_path):
     files = export_checkpoint_takes("camn_tiny", tmp_path, test=test_set, format="npy")
     assert np.load(files[0], allow_pickle=False).shape[1:] == (141,)
