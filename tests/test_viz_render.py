@@ -233,8 +233,7 @@ def _descends(sk, j, ancestor):
 def test_camera_frames_every_joint_below_the_toolbar(pyvista_ok, view, size):
     from beatlite.viz._inputs import bone_groups
 
-    pos, sk = _beat_rest()
-    pos = pos.copy()
+    pos, sk = _beat_rest(arms_down=70.0)
     pos[sk.index("RightHand")] += (-30.0, 40.0, 20.0)  # a gesture: the box is not the rest pose's
     top = render.TRAME_TOOLBAR_PX
     plotter, _ = render._scene(pos[None], bone_groups(sk), size, view, None, None, top=top)

@@ -213,19 +213,24 @@ def _scene(
     r = radius if radius is not None else max(extent / 120.0, 0.2)
     plotter = pv.Plotter(off_screen=True, window_size=size)
     plotter.set_background("white")
-    if draw_floor:
+    shown = box
+    if draw_floor:  # a square under the box with a rim of 10 % of its size; the camera shows all of it
         centre = (lo + hi) / 2
+        side = float(max(hi[0] - lo[0], hi[2] - lo[2])) + 0.2 * extent
         plane = pv.Plane(
             center=(centre[0], lo[1] - r, centre[2]),
             direction=(0, 1, 0),
-            i_size=extent * 1.2,
-            j_size=extent * 1.2,
+            i_size=side,
+            j_size=side,
             i_resolution=6,
             j_resolution=6,
         )
         plotter.add_mesh(plane, color=FLOOR_COLOUR, show_edges=True, edge_color="#c8c8c8", lighting=False)
+        half = np.array([side / 2, 0.0, side / 2])
+        shown = np.stack([np.minimum(lo, centre - half), np.maximum(hi, centre + half)])
+        shown[0, 1] = lo[1] - r
     skel = _PyvistaSkeleton(plotter, bones, positions[0], r)
-    position, focal, up = frame_camera(box, view, size, view_angle=plotter.camera.view_angle, top=top)
+    position, focal, up = frame_camera(shown, view, size, view_angle=plotter.camera.view_angle, top=top)
     plotter.camera.focal_point = tuple(focal)
     plotter.camera.position = tuple(position)
     plotter.camera.up = up
