@@ -338,7 +338,7 @@ def test_show_skeleton_trame_view_fills_the_cell_and_frames_the_body(pyvista_ok,
     pos, sk = _beat_rest()
     render.show_skeleton(pos, sk, size=(960, 500), jupyter_backend="trame", backend="pyvista")
     assert seen["jupyter_backend"] == "trame"
-    assert seen["jupyter_kwargs"] == {"width": "100%", "height": "500px"}
+    assert seen["jupyter_kwargs"] == {"width": "max(100%, 600px)", "height": "500px"}
     for width in (500, 800, 1200):  # the cell's width is unknown: the body fits any at least 500 px wide
         plotter, _ = render._scene(pos[None], bone_groups(sk), (width, 500), "default", None, None)
         try:

@@ -44,6 +44,10 @@ FLOOR_COLOUR = "#f0f0f0"
 #: (:func:`show_skeleton` keeps the skeleton below it).
 TRAME_TOOLBAR_PX = 64
 
+#: Narrowest trame view in pixels: its toolbar (14 buttons, about 575 px with its left offset) would
+#: otherwise draw buttons over each other in a narrow cell; a narrower cell scrolls sideways instead.
+TRAME_MIN_WIDTH_PX = 600
+
 
 def _check_size(size: Any) -> tuple[int, int]:
     try:
@@ -498,8 +502,8 @@ def show_skeleton(
     frame : int
         Frame to show.
     size : (width, height)
-        Pixels of the image. The trame view is as wide as the notebook cell and ``height`` pixels
-        high; its camera keeps the whole skeleton below the toolbar that trame draws over the top
+        Pixels of the image. The trame view is as wide as the notebook cell (at least
+        :data:`TRAME_MIN_WIDTH_PX`) and ``height`` pixels high; its camera keeps the whole skeleton below the toolbar that trame draws over the top
         :data:`TRAME_TOOLBAR_PX` pixels (in any cell at least ``height`` pixels wide).
     view : {"default", "front", "side", "top"}
         Initial camera.
@@ -542,7 +546,10 @@ def show_skeleton(
     # trame: the view fills the cell's width, unknown here. VTK's view angle is vertical, so framing
     # for a square view fits every view at least as wide as it is high.
     plotter, _ = _scene(pos[k : k + 1], bones, (h, h), view, None, None, box, top=TRAME_TOOLBAR_PX)
-    return plotter.show(jupyter_backend="trame", jupyter_kwargs={"width": "100%", "height": f"{h}px"})
+    width = (
+        f"max(100%, {TRAME_MIN_WIDTH_PX}px)"  # the cell's width, never so narrow that the toolbar overlaps
+    )
+    return plotter.show(jupyter_backend="trame", jupyter_kwargs={"width": width, "height": f"{h}px"})
 
 
 def _in_notebook() -> bool:
