@@ -349,3 +349,19 @@ def test_show_skeleton_trame_view_fills_the_cell_and_frames_the_body(pyvista_ok,
             plotter.close()
         assert px[:, 0].min() > 0 and px[:, 0].max() < width
         assert px[:, 1].min() > render.TRAME_TOOLBAR_PX and px[:, 1].max() < 500
+
+
+def test_matplotlib_fallback_honours_the_box():
+    from beatlite.skeleton import TED43_JOINTS, TED_BONES, beat_to_ted43
+
+    full, sk = _beat_rest(arms_down=70.0)
+    upper = beat_to_ted43(full[None])[0]
+    parents = np.full(len(TED43_JOINTS), -1)
+    parents[np.asarray(TED_BONES)[:, 1]] = np.asarray(TED_BONES)[:, 0]
+    box = np.stack([full.min(axis=0), full.max(axis=0)])
+    kw = dict(size=(200, 240), view="front", floor=False, backend="matplotlib")
+    heights = [
+        np.ptp(_ink_rows(render.render_frame(p, s, box=box, **kw))) for p, s in ((full, sk), (upper, parents))
+    ]
+    ratio_cm = np.ptp(upper[:, 1]) / np.ptp(full[:, 1])  # 0.51
+    assert abs(heights[1] / heights[0] - ratio_cm) < 0.08, (heights, ratio_cm)
