@@ -154,6 +154,28 @@ def frame_camera(
     view); its distance is the smallest at which the 8 corners of the box project inside that
     area, leaving ``margin`` (a fraction of the image height) on every side. Renders that share
     a box share one camera, hence one scale (cm per pixel).
+
+    Parameters
+    ----------
+    box : (2, 3) float, centimetres
+        Corners ``[lo, hi]`` of what must be seen.
+    view : {"default", "front", "side", "top"}
+        Direction the camera looks from (:data:`CAMERAS`).
+    size : (width, height)
+        Image size in pixels.
+    view_angle : float
+        Vertical field of view, degrees (VTK's default 30).
+    top : int
+        Pixels at the top of the image kept free (trame's toolbar: :data:`TRAME_TOOLBAR_PX`).
+    margin : float
+        Free border on every side, as a fraction of the height.
+
+    Returns
+    -------
+    position, focal_point : (3,) float
+        Camera position and the point it looks at, centimetres.
+    up : (3,) float tuple
+        The view's up vector.
     """
     if view not in CAMERAS:
         raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
@@ -180,9 +202,8 @@ def frame_camera(
             and np.all(px[:, 1] >= top + pad) and np.all(px[:, 1] <= h - pad)
         )  # fmt: skip
 
-    near = far = (
-        0.51 * size_cm
-    )  # outside the box's bounding sphere: every corner in front; grow until it fits
+    # start just outside the box's bounding sphere (every corner in front), double until it fits
+    near = far = 0.51 * size_cm
     while not fits(far):
         near, far = far, far * 2
     for _ in range(40):  # bisection to a fraction of a millimetre
