@@ -189,3 +189,179 @@ def test_show_skeleton_outside_a_notebook(fresh_probe, monkeypatch):
 def test_show_skeleton_with_pyvista_returns_the_image_outside_jupyter(pyvista_ok):
     img = render.show_skeleton(wave_motion(), tiny_skeleton(), 1, size=(120, 90), backend="pyvista")
     assert img.shape == (90, 120, 3) and img.std() > 5
+
+
+# ------------------------------------------------------------------------- camera, scale and floor
+def _display_rows_cols(plotter, points):
+    """(N, 2) pixel (column, row from the top) of world points, by VTK's own world -> display transform."""
+    ren = plotter.renderer
+    h = plotter.window_size[1]
+    out = []
+    for p in np.asarray(points, dtype=float):
+        ren.SetWorldPoint(*p, 1.0)
+        ren.WorldToDisplay()
+        x, y, _ = ren.GetDisplayPoint()
+        out.append((x, h - y))
+    return np.array(out)
+
+
+def _beat_rest(arms_down: float = 0.0):
+    """BEAT rest pose (T-pose, cm), each arm turned down by ``arms_down`` degrees about its shoulder."""
+    from beatlite.skeleton import beat_skeleton, rest_pose
+
+    sk = beat_skeleton()
+    pos = rest_pose(sk)
+    for side, sign in (("Right", 1.0), ("Left", -1.0)):
+        a = np.radians(sign * arms_down)
+        rot = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+        pivot = pos[sk.index(f"{side}Arm")].copy()
+        arm = [j for j in range(sk.n_joints) if _descends(sk, j, sk.index(f"{side}Arm"))]
+        pos[arm] = (pos[arm] - pivot) @ rot.T + pivot
+    return pos, sk
+
+
+def _descends(sk, j, ancestor):
+    while j >= 0:
+        if j == ancestor:
+            return True
+        j = sk.parents[j]
+    return False
+
+
+@pytest.mark.parametrize("view", ["default", "front", "side"])
+@pytest.mark.parametrize("size", [(500, 500), (960, 500), (360, 300)])
+def test_camera_frames_every_joint_below_the_toolbar(pyvista_ok, view, size):
+    from beatlite.viz._inputs import bone_groups
+
+    pos, sk = _beat_rest(arms_down=70.0)
+    pos[sk.index("RightHand")] += (-30.0, 40.0, 20.0)  # a gesture: the box is not the rest pose's
+    top = render.TRAME_TOOLBAR_PX
+    plotter, _ = render._scene(pos[None], bone_groups(sk), size, view, None, None, top=top)
+    try:
+        plotter.render()
+        px = _display_rows_cols(plotter, pos)
+    finally:
+        plotter.close()
+    w, h = size
+    margin = 0.02 * h  # frame_camera leaves 4 % of the height around the box; the joints are inside the box
+    assert px[:, 0].min() >= margin and px[:, 0].max() <= w - margin
+    assert px[:, 1].max() <= h - margin
+    head_row = px[sk.index("HeadEnd"), 1] if "HeadEnd" in sk.names else px[:, 1].min()
+    assert px[:, 1].min() >= top + margin and head_row >= top + margin  # nothing under the toolbar
+    # and the body is not lost in a corner: it spans most of the height (or width) left to it
+    span = max((px[:, 1].max() - px[:, 1].min()) / (h - top), (px[:, 0].max() - px[:, 0].min()) / w)
+    assert span > 0.6
+
+
+def test_project_matches_vtk(pyvista_ok):
+    from beatlite.viz._inputs import bone_groups
+
+    pos, sk = _beat_rest()
+    plotter, _ = render._scene(pos[None], bone_groups(sk), (400, 300), "default", None, None, top=40)
+    try:
+        plotter.render()
+        cam = plotter.camera
+        mine = render.project(pos, np.array(cam.position), np.array(cam.focal_point), cam.up, (400, 300))
+        np.testing.assert_allclose(mine, _display_rows_cols(plotter, pos), atol=0.5)
+    finally:
+        plotter.close()
+
+
+def _ink_rows(img):
+    """Rows that hold skeleton pixels: saturated or dark (bones, joints), not white or floor grey."""
+    rgb = img.astype(int)
+    ink = (rgb.max(axis=-1) - rgb.min(axis=-1) > 40) | (rgb.max(axis=-1) < 150)
+    return np.flatnonzero(ink.any(axis=1))
+
+
+def test_one_box_gives_one_scale_and_a_floor(pyvista_ok):
+    from beatlite.skeleton import TED43_JOINTS, TED_BONES, beat_to_ted43
+
+    full, sk = _beat_rest(arms_down=70.0)  # a speaker's pose: taller than wide
+    upper = beat_to_ted43(full[None])[0]  # the same body on HA2G's upper-body skeleton, same centimetres
+    parents = np.full(len(TED43_JOINTS), -1)
+    parents[np.asarray(TED_BONES)[:, 1]] = np.asarray(TED_BONES)[:, 0]
+    every = np.concatenate([full, upper])
+    box = np.stack([every.min(axis=0), every.max(axis=0)])
+    size, kw = (300, 300), dict(view="front", backend="pyvista")
+    shared = [
+        render.render_frame(p, s, size=size, box=box, floor=False, **kw)
+        for p, s in ((full, sk), (upper, parents))
+    ]
+    heights_px = [np.ptp(_ink_rows(img)) for img in shared]
+    heights_cm = [np.ptp(full[:, 1]), np.ptp(upper[:, 1])]  # 177 cm and 90 cm (hands at the hips)
+    ratio_px, ratio_cm = heights_px[1] / heights_px[0], heights_cm[1] / heights_cm[0]
+    assert ratio_cm < 0.6
+    assert abs(ratio_px - ratio_cm) < 0.06, (
+        ratio_px,
+        ratio_cm,
+    )  # one scale (perspective and tube radius aside)
+    widths_px = [np.ptp(_ink_rows(img.transpose(1, 0, 2))) for img in shared]  # same shoulders and arms
+    assert abs(widths_px[1] / widths_px[0] - 1) < 0.05, widths_px
+    own = render.render_frame(
+        upper, parents, size=size, floor=False, **kw
+    )  # its own box: it fills the picture
+    assert np.ptp(_ink_rows(own)) / heights_px[1] > 1.6  # what notebook 08 showed before: HA2G twice as large
+    # a floor under every render that shares a box, also under the upper body that has no feet
+    for p, s in ((full, sk), (upper, parents)):
+        img = render.render_frame(p, s, size=size, box=box, **kw)
+        rgb = img.astype(int)
+        floor = (np.abs(rgb - 240).max(axis=-1) <= 6).any(axis=1)  # FLOOR_COLOUR #f0f0f0, unlit
+        assert render.FLOOR_COLOUR == "#f0f0f0"
+        assert floor[_ink_rows(img).max() :].sum() >= 10  # floor rows below the lowest joint
+    no_floor = render.render_frame(upper, parents, size=size, **kw)  # alone, an upper body has none
+    assert not (np.abs(no_floor.astype(int) - 240).max(axis=-1) <= 6).any()
+
+
+def test_box_is_checked():
+    with pytest.raises(ValueError, match="box"):
+        render.render_frame(wave_motion(3), tiny_skeleton(), box=[[0, 0, 0], [1, 1]], backend="matplotlib")
+    with pytest.raises(ValueError, match="box"):
+        render.render_frame(
+            wave_motion(3), tiny_skeleton(), box=[[0, 0, 0], [-1, 1, 1]], backend="matplotlib"
+        )
+
+
+def test_show_skeleton_trame_view_fills_the_cell_and_frames_the_body(pyvista_ok, monkeypatch):
+    import pyvista as pv
+
+    from beatlite.viz._inputs import bone_groups
+
+    seen = {}
+
+    def fake_show(plotter, **kwargs):  # what pyvista's trame backend would receive
+        seen.update(kwargs, camera=plotter.camera.copy())
+        plotter.close()
+
+    monkeypatch.setattr(pv.Plotter, "show", fake_show)
+    monkeypatch.setattr(render, "_in_notebook", lambda: True)
+    pos, sk = _beat_rest()
+    render.show_skeleton(pos, sk, size=(960, 500), jupyter_backend="trame", backend="pyvista")
+    assert seen["jupyter_backend"] == "trame"
+    assert seen["jupyter_kwargs"] == {"width": "max(100%, 600px)", "height": "500px"}
+    for width in (500, 800, 1200):  # the cell's width is unknown: the body fits any at least 500 px wide
+        plotter, _ = render._scene(pos[None], bone_groups(sk), (width, 500), "default", None, None)
+        try:
+            plotter.camera = seen["camera"]
+            plotter.render()
+            px = _display_rows_cols(plotter, pos)
+        finally:
+            plotter.close()
+        assert px[:, 0].min() > 0 and px[:, 0].max() < width
+        assert px[:, 1].min() > render.TRAME_TOOLBAR_PX and px[:, 1].max() < 500
+
+
+def test_matplotlib_fallback_honours_the_box():
+    from beatlite.skeleton import TED43_JOINTS, TED_BONES, beat_to_ted43
+
+    full, sk = _beat_rest(arms_down=70.0)
+    upper = beat_to_ted43(full[None])[0]
+    parents = np.full(len(TED43_JOINTS), -1)
+    parents[np.asarray(TED_BONES)[:, 1]] = np.asarray(TED_BONES)[:, 0]
+    box = np.stack([full.min(axis=0), full.max(axis=0)])
+    kw = dict(size=(200, 240), view="front", floor=False, backend="matplotlib")
+    heights = [
+        np.ptp(_ink_rows(render.render_frame(p, s, box=box, **kw))) for p, s in ((full, sk), (upper, parents))
+    ]
+    ratio_cm = np.ptp(upper[:, 1]) / np.ptp(full[:, 1])  # 0.51
+    assert abs(heights[1] / heights[0] - ratio_cm) < 0.08, (heights, ratio_cm)

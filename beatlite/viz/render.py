@@ -37,6 +37,17 @@ CAMERAS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]
     "default": ((0.5, 0.25, 0.83), (0.0, 1.0, 0.0)),
 }
 
+#: Colour of the floor plane (grid lines are a darker grey).
+FLOOR_COLOUR = "#f0f0f0"
+
+#: Height in pixels of the toolbar that pyvista's trame view draws over the top of the 3D view
+#: (:func:`show_skeleton` keeps the skeleton below it).
+TRAME_TOOLBAR_PX = 64
+
+#: Narrowest trame view in pixels: its toolbar (14 buttons, about 575 px with its left offset) would
+#: otherwise draw buttons over each other in a narrow cell; a narrower cell scrolls sideways instead.
+TRAME_MIN_WIDTH_PX = 600
+
 
 def _check_size(size: Any) -> tuple[int, int]:
     try:
@@ -89,6 +100,119 @@ class _PyvistaSkeleton:
                     old.copy_from(fresh)
 
 
+def _check_box(box: Any) -> np.ndarray | None:
+    if box is None:
+        return None
+    try:
+        arr = np.asarray(box, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
+    if arr.shape != (2, 3) or not np.all(np.isfinite(arr)) or np.any(arr[1] < arr[0]):
+        raise ValueError(f"box must be [[x0, y0, z0], [x1, y1, z1]] cm with x0 <= x1 etc., got {box!r}")
+    return arr
+
+
+def project(
+    points: np.ndarray,
+    position: np.ndarray,
+    focal: np.ndarray,
+    up: Sequence[float],
+    size: tuple[int, int],
+    view_angle: float = 30.0,
+) -> np.ndarray:
+    """(N, 3) world points -> (N, 2) pixel (column, row) of a perspective camera, row 0 at the top.
+
+    ``view_angle`` (degrees) is the vertical field of view, as in VTK.
+    """
+    w, h = size
+    back = np.asarray(position, dtype=np.float64) - focal
+    back /= np.linalg.norm(back)
+    up_v = np.asarray(up, dtype=np.float64) - back * (np.asarray(up, dtype=np.float64) @ back)
+    up_v /= np.linalg.norm(up_v)
+    right = np.cross(up_v, back)
+    rel = np.asarray(points, dtype=np.float64).reshape(-1, 3) - position
+    depth = -(rel @ back)
+    t = np.tan(np.radians(view_angle) / 2)
+    ndc_x = (rel @ right) / depth / (t * w / h)
+    ndc_y = (rel @ up_v) / depth / t
+    return np.column_stack([(ndc_x + 1) * w / 2, (1 - ndc_y) * h / 2])
+
+
+def frame_camera(
+    box: np.ndarray,
+    view: str,
+    size: tuple[int, int],
+    *,
+    view_angle: float = 30.0,
+    top: int = 0,
+    margin: float = 0.04,
+) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float]]:
+    """Camera position, focal point and up vector that show every point of ``box`` inside the image.
+
+    The camera looks along the named view at the box's centre, moved up so that the centre lands
+    in the middle of the image area below a band of ``top`` pixels (a toolbar drawn over the
+    view); its distance is the smallest at which the 8 corners of the box project inside that
+    area, leaving ``margin`` (a fraction of the image height) on every side. Renders that share
+    a box share one camera, hence one scale (cm per pixel).
+
+    Parameters
+    ----------
+    box : (2, 3) float, centimetres
+        Corners ``[lo, hi]`` of what must be seen.
+    view : {"default", "front", "side", "top"}
+        Direction the camera looks from (:data:`CAMERAS`).
+    size : (width, height)
+        Image size in pixels.
+    view_angle : float
+        Vertical field of view, degrees (VTK's default 30).
+    top : int
+        Pixels at the top of the image kept free (trame's toolbar: :data:`TRAME_TOOLBAR_PX`).
+    margin : float
+        Free border on every side, as a fraction of the height.
+
+    Returns
+    -------
+    position, focal_point : (3,) float
+        Camera position and the point it looks at, centimetres.
+    up : (3,) float tuple
+        The view's up vector.
+    """
+    if view not in CAMERAS:
+        raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
+    w, h = size
+    direction, up = CAMERAS[view]
+    d = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
+    centre = box.mean(axis=0)
+    corners = np.array([[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    up_v = np.asarray(up, dtype=np.float64) - d * (np.asarray(up, dtype=np.float64) @ d)
+    up_v /= np.linalg.norm(up_v)
+    t = np.tan(np.radians(view_angle) / 2)
+    pad = margin * h
+    size_cm = max(float(np.linalg.norm(box[1] - box[0])), 1.0)
+
+    def place(dist: float) -> tuple[np.ndarray, np.ndarray]:
+        focal = centre + up_v * (top / h) * t * dist  # look above the centre: it drops to the area's middle
+        return focal + d * dist, focal
+
+    def fits(dist: float) -> bool:
+        position, focal = place(dist)
+        px = project(corners, position, focal, up, size, view_angle)
+        return bool(
+            np.all(px[:, 0] >= pad) and np.all(px[:, 0] <= w - pad)
+            and np.all(px[:, 1] >= top + pad) and np.all(px[:, 1] <= h - pad)
+        )  # fmt: skip
+
+    # start just outside the box's bounding sphere (every corner in front), double until it fits
+    near = far = 0.51 * size_cm
+    while not fits(far):
+        near, far = far, far * 2
+    for _ in range(40):  # bisection to a fraction of a millimetre
+        mid = (near + far) / 2
+        near, far = (near, mid) if fits(mid) else (mid, far)
+    position, focal = place(far)
+    return position, focal, up
+
+
 def _scene(
     positions: np.ndarray,
     bones: Bones,
@@ -96,35 +220,44 @@ def _scene(
     view: str,
     floor: bool | None,
     radius: float | None,
+    box: np.ndarray | None = None,
+    top: int = 0,
 ) -> tuple[Any, _PyvistaSkeleton]:
     import pyvista as pv
 
+    if view not in CAMERAS:
+        raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
     pts = positions.reshape(-1, 3)
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    if box is None:
+        box = np.stack([pts.min(axis=0), pts.max(axis=0)])
+        draw_floor = bones.has_feet if floor is None else floor
+    else:  # a box shared by several renders: one world, so one floor under all of them
+        draw_floor = True if floor is None else floor
+    lo, hi = box
     extent = float(np.max(hi - lo)) or 1.0
     r = radius if radius is not None else max(extent / 120.0, 0.2)
     plotter = pv.Plotter(off_screen=True, window_size=size)
     plotter.set_background("white")
-    if bones.has_feet if floor is None else floor:
+    shown = box
+    if draw_floor:  # a square under the box with a rim of 10 % of its size; the camera shows all of it
         centre = (lo + hi) / 2
+        side = float(max(hi[0] - lo[0], hi[2] - lo[2])) + 0.2 * extent
         plane = pv.Plane(
             center=(centre[0], lo[1] - r, centre[2]),
             direction=(0, 1, 0),
-            i_size=extent * 1.2,
-            j_size=extent * 1.2,
+            i_size=side,
+            j_size=side,
             i_resolution=6,
             j_resolution=6,
         )
-        plotter.add_mesh(plane, color="#f0f0f0", show_edges=True, edge_color="#c8c8c8", lighting=False)
+        plotter.add_mesh(plane, color=FLOOR_COLOUR, show_edges=True, edge_color="#c8c8c8", lighting=False)
+        half = np.array([side / 2, 0.0, side / 2])
+        shown = np.stack([np.minimum(lo, centre - half), np.maximum(hi, centre + half)])
+        shown[0, 1] = lo[1] - r
     skel = _PyvistaSkeleton(plotter, bones, positions[0], r)
-    if view not in CAMERAS:
-        raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
-    direction, up = CAMERAS[view]
-    centre = (lo + hi) / 2
-    d = np.asarray(direction) / np.linalg.norm(direction)
-    dist = 1.25 * extent / (2 * np.tan(np.radians(plotter.camera.view_angle) / 2))
-    plotter.camera.focal_point = tuple(centre)
-    plotter.camera.position = tuple(centre + d * dist)
+    position, focal, up = frame_camera(shown, view, size, view_angle=plotter.camera.view_angle, top=top)
+    plotter.camera.focal_point = tuple(focal)
+    plotter.camera.position = tuple(position)
     plotter.camera.up = up
     return plotter, skel
 
@@ -136,6 +269,7 @@ def _mpl_frame_image(
     size: tuple[int, int],
     view: str,
     floor: bool | None,
+    box: np.ndarray | None = None,
 ) -> np.ndarray:
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -150,7 +284,10 @@ def _mpl_frame_image(
         canvas = FigureCanvasAgg(fig)
         ax = fig.add_axes((0, 0, 1, 1), projection="3d")
         bones = bone_groups(skeleton)
-        setup_axes(ax, positions, view=view, floor=bones.has_feet if floor is None else floor)
+        if box is None:
+            setup_axes(ax, positions, view=view, floor=bones.has_feet if floor is None else floor)
+        else:  # the box's corners join the limits, and the floor is under them
+            setup_axes(ax, [positions, box[None]], view=view, floor=True if floor is None else floor)
         SkeletonArtist(ax, bones).update(positions[frame])
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[..., :3].copy()
@@ -166,6 +303,7 @@ def render_frame(
     view: str = "default",
     floor: bool | None = None,
     radius: float | None = None,
+    box: Any = None,
     path: str | Path | None = None,
     backend: str = "auto",
 ) -> np.ndarray:
@@ -184,11 +322,17 @@ def render_frame(
     view : {"default", "front", "side", "top"}
         Camera.
     floor : bool, optional
-        Draw a floor plane under the lowest joint; default only for a skeleton with
-        feet (under an upper body the floor would meet the lowest hand, and the
-        side view would look like a figure crawling on the ground).
+        Draw a floor plane under the lowest joint (under ``box`` when given); default: always with
+        ``box``, else only for a skeleton with feet (under an upper body alone the floor would meet
+        the lowest hand, and the side view would look like a figure crawling on the ground).
     radius : float, optional
         Bone tube radius, centimetres (default: 1/120 of the scene size).
+    box : (2, 3) float, optional
+        Corners ``[[x0, y0, z0], [x1, y1, z1]]`` (cm) of the region the camera frames, the floor
+        lies under (at ``y0``) and the bone radius scales with; default the skeleton's own bounding
+        box. Renders of several systems that share one box share one camera and one scale: an
+        upper body (HA2G's TED-43) is then as large as the upper half of a full body, instead of
+        filling the picture on its own.
     path : str or Path, optional
         Also write the image there (PNG), atomically.
     backend : {"auto", "pyvista", "matplotlib"}
@@ -209,14 +353,15 @@ def render_frame(
         raise ValueError(f"frame={frame!r} is not a frame index for {len(pos)} frames")
     frame = int(frame) % len(pos)
     w, h = _check_size(size)
+    box = _check_box(box)
     if use_pyvista(backend):
-        plotter, skel = _scene(pos[frame : frame + 1], bones, (w, h), view, floor, radius)
+        plotter, skel = _scene(pos[frame : frame + 1], bones, (w, h), view, floor, radius, box)
         try:
             img = np.asarray(plotter.screenshot(return_img=True))[..., :3].copy()
         finally:
             plotter.close()
     else:
-        img = _mpl_frame_image(pos, skeleton, frame, (w, h), view, floor)
+        img = _mpl_frame_image(pos, skeleton, frame, (w, h), view, floor, box)
     if path is not None:
         from matplotlib.image import imsave
 
@@ -256,6 +401,7 @@ def render_animation(
     view: str = "default",
     floor: bool | None = None,
     radius: float | None = None,
+    box: Any = None,
     backend: str = "auto",
 ) -> Path:
     """Render a clip to ``.gif`` (``plotter.open_gif``) or ``.mp4`` (ffmpeg), atomically.
@@ -277,9 +423,15 @@ def render_animation(
     view : {"default", "front", "side", "top"}
         Camera (fixed for the whole clip).
     floor : bool, optional
-        Draw a floor plane; default only for a skeleton with feet.
+        Draw a floor plane; default with ``box``, else only for a skeleton with feet.
     radius : float, optional
         Bone radius, centimetres.
+    box : (2, 3) float, optional
+        Corners ``[[x0, y0, z0], [x1, y1, z1]]`` (cm) of the region the camera frames, the floor
+        lies under (at ``y0``) and the bone radius scales with; default the bounding box of every
+        frame. Renders of several systems that share one box share one camera and one scale: an
+        upper body (HA2G's TED-43) is then as large as the upper half of a full body, instead of
+        filling the picture on its own.
     backend : {"auto", "pyvista", "matplotlib"}
         Renderer; ``"auto"``/``"pyvista"`` fall back to matplotlib with one warning.
 
@@ -292,6 +444,7 @@ def render_animation(
     pos = check_positions(positions, bones.n_joints)
     fps = check_fps(fps)
     w, h = _check_size(size)
+    box = _check_box(box)
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".mp4"):
@@ -309,7 +462,7 @@ def render_animation(
         anim = animate_skeletons(pos, skeleton, fps, out_fps=out_fps, view=view, width=w, dpi=100)
         anim.figure.set_size_inches(w / 100, h / 100)
         return anim.save_as(path)
-    plotter, skel = _scene(pos, bones, (w, h), view, floor, radius)
+    plotter, skel = _scene(pos, bones, (w, h), view, floor, radius, box)
     try:
         with atomic_target(path) as tmp:
             if suffix == ".gif":
@@ -353,8 +506,9 @@ def show_skeleton(
     skeleton: SkeletonLike,
     frame: int = 0,
     *,
-    size: Sequence[int] = (600, 500),
+    size: Sequence[int] = (SLIDE_WIDTH_PX, 500),
     view: str = "default",
+    box: Any = None,
     jupyter_backend: str | None = None,
     backend: str = "auto",
 ) -> Any:
@@ -369,9 +523,13 @@ def show_skeleton(
     frame : int
         Frame to show.
     size : (width, height)
-        Pixels.
+        Pixels of the image. The trame view is as wide as the notebook cell (at least
+        :data:`TRAME_MIN_WIDTH_PX`) and ``height`` pixels high; its camera keeps the whole skeleton below the toolbar that trame draws over the top
+        :data:`TRAME_TOOLBAR_PX` pixels (in any cell at least ``height`` pixels wide).
     view : {"default", "front", "side", "top"}
         Initial camera.
+    box : (2, 3) float, optional
+        Region the camera frames, as in :func:`render_frame`.
     jupyter_backend : str, optional
         pyvista's Jupyter backend (default :func:`notebook_backend`: ``"trame"`` in a live JupyterLab
         kernel with the ``interactive`` extra, ``"static"`` under ``make run`` / ``make test``).
@@ -388,6 +546,7 @@ def show_skeleton(
     bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
     w, h = _check_size(size)
+    box = _check_box(box)
     if not -len(pos) <= int(frame) < len(pos):
         raise ValueError(f"frame={frame!r} is not a frame index for {len(pos)} frames")
     if not use_pyvista(backend):
@@ -395,13 +554,23 @@ def show_skeleton(
 
         return plot_frame(pos, skeleton, int(frame), view=view, figsize=(w / 100, h / 100))
     k = int(frame) % len(pos)
-    plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, None, None)
     if not _in_notebook():
+        plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, None, None, box)
         try:
             return np.asarray(plotter.screenshot(return_img=True))[..., :3].copy()
         finally:
             plotter.close()
-    return plotter.show(jupyter_backend=jupyter_backend or notebook_backend())
+    jb = jupyter_backend or notebook_backend()
+    if jb != "trame":
+        plotter, _ = _scene(pos[k : k + 1], bones, (w, h), view, None, None, box)
+        return plotter.show(jupyter_backend=jb)
+    # trame: the view fills the cell's width, unknown here. VTK's view angle is vertical, so framing
+    # for a square view fits every view at least as wide as it is high.
+    plotter, _ = _scene(pos[k : k + 1], bones, (h, h), view, None, None, box, top=TRAME_TOOLBAR_PX)
+    width = (
+        f"max(100%, {TRAME_MIN_WIDTH_PX}px)"  # the cell's width, never so narrow that the toolbar overlaps
+    )
+    return plotter.show(jupyter_backend="trame", jupyter_kwargs={"width": width, "height": f"{h}px"})
 
 
 def _in_notebook() -> bool:
