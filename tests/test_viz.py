@@ -587,10 +587,10 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
 
     fgd = {"CaMN": 1.0, "HA2G": 2.0, "mean pose": 25.0}
     ax = charts.plot_scores(fgd, "FGD").axes[0]
-    # 25 > 3 x 2: the axis ends at 1.3 x 2 x 1.35, the bar is cut and its value written
-    assert ax.get_xlim()[1] == pytest.approx(2.0 * 1.3 * 1.35)
-    assert max(p.get_width() for p in ax.patches) == pytest.approx(2.6)
-    assert any("25 (bar cut)" in t.get_text() for t in ax.texts)
+    # 25 > 3 x 2 (the median): the axis ends at 1.4 x 2, the bar stops at 1.12 x 2, cut, its value written
+    assert ax.get_xlim()[1] == pytest.approx(2.0 * 1.4)
+    assert max(p.get_width() for p in ax.patches) == pytest.approx(2.0 * 1.12)
+    assert any("25 (cut)" in t.get_text() for t in ax.texts)
     plain = charts.plot_scores({"a": 1.0, "b": 2.0}, "FGD").axes[0]
     assert plain.get_xlim()[1] == pytest.approx(2.0 * 1.12)
     with pytest.raises(ValueError, match="finite"):
@@ -605,6 +605,51 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
     labels = [t for t in ax.texts if t.get_text()]
     assert len(labels) == 3 and all(_inside(t.get_window_extent(renderer), ax.get_window_extent(renderer))
                                     for t in labels)  # fmt: skip
+    plt.close("all")
+
+
+#: Notebook 07's one-run FGD column, best first (the mean pose's 25.3 used to set the axis: CaMN vs HA2G in an eighth).
+BENCHMARK_FGD = {"Ground truth": 0.0, "Ground truth (141 Euler channels)": 0.0411, "CaMN": 2.97, "HA2G": 3.92,
+                 "Random clip": 4.22, "DiffGesture-style": 4.81, "S2G-style": 4.86, "Trimodal-style": 5.31,
+                 "A2G-style": 8.0, "Seq2Seq-style": 8.35, "Joint Embedding-style": 10.4, "Mean pose": 25.3}  # fmt: skip
+
+
+def test_score_bars_of_the_benchmark_cut_only_the_mean_pose_and_give_every_row_its_colour():
+    from matplotlib.colors import to_hex
+
+    from beatlite.viz import charts, check
+
+    ax = charts.plot_scores(BENCHMARK_FGD, "FGD").axes[0]
+    # median of the 11 positive values 4.86, 3 x 4.86 = 14.6: only 25.3 is cut; the axis ends at 1.4 x 10.4
+    assert ax.get_xlim()[1] == pytest.approx(1.4 * 10.4)
+    assert [t.get_text().strip() for t in ax.texts if "cut" in t.get_text()] == ["25.3 (cut)"]
+    assert (3.92 - 2.97) / ax.get_xlim()[1] > 0.06  # the CaMN-HA2G gap: 1/15 of the axis, was 1/30
+    colours = {to_hex(p.get_facecolor()) for p in ax.patches}
+    assert len(colours) == len(BENCHMARK_FGD)  # 12 rows, 12 colours (Random clip and Mean pose shared one)
+    assert check.check_figure(ax.figure) == []
+    plt.close("all")
+
+
+def test_score_scatter_ties_a_label_that_is_not_beside_its_point():
+    from matplotlib.text import Text
+
+    from beatlite.viz import charts
+
+    bc = dict(
+        zip(BENCHMARK_FGD, [0.665, 0.67, 0.727, 0.786, 0.51, 0.79, 0.815, 0.75, 0.75, 0.26, 0.125, np.nan])
+    )
+    fig, ax = plt.subplots(figsize=(5.5, 4.6), layout="constrained")
+    ax.set_title("closeness to the data vs synchrony")
+    charts.plot_score_scatter(BENCHMARK_FGD, bc, "FGD", "BC", ax=ax)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert len(ax.texts) == 11  # the mean pose has no BC
+    for note in ax.texts:
+        box = Text.get_window_extent(note, renderer)
+        point = ax.transData.transform((BENCHMARK_FGD[note.get_text()], bc[note.get_text()]))
+        gap = max(box.x0 - point[0], point[0] - box.x1, box.y0 - point[1], point[1] - box.y1, 0.0)
+        # beside its point (within 12 points) or tied to it by a visible line
+        assert gap <= 12 * fig.dpi / 72 or note.arrow_patch.get_visible(), (note.get_text(), gap)
     plt.close("all")
 
 
