@@ -729,20 +729,35 @@ def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
 
 def test_bone_levels_mark_the_new_bones_of_each_level_on_shared_limits():
     from beatlite.skeleton import ted
+    from beatlite.viz import check
 
     pose = upper_body(1)[0]
     levels = ted.HA2G_LEVELS
     fig = plot3d.plot_bone_levels(pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist")
-    body, hands = fig.axes[0::2], fig.axes[1::2]
-    assert len(body) == len(hands) == len(levels) == 6
+    # rows: levels 1-3 (body), levels 4-6 (body), levels 4-6 (right hand): the right hand's 15 finger bones
+    # arrive in levels 4-6, so levels 1-3 get no hand row (it was three panels saying "no bones here yet")
+    assert len(fig.axes) == 9
+    body, hands = fig.axes[:6], fig.axes[6:]
     red = style.GROUP_COLOURS["hands"]
     for k, ax in enumerate(body):  # thick red lines = the bones this level adds (levels are cumulative)
         added = len(levels[k]) - (len(levels[k - 1]) if k else 0)
         assert sum(line.get_color() == red for line in ax.lines) == added
     assert len({(ax.get_xlim(), ax.get_ylim()) for ax in body}) == 1  # one scale for every level
-    # the right hand's 15 finger bones arrive in levels 4-6; before that its panel says so
-    assert [bool(ax.texts) for ax in hands] == [True, True, True, False, False, False]
-    assert sum(len(ax.lines) for ax in hands[-1:]) == 15
+    assert [ax.get_title()[:8] for ax in hands] == ["level 4:", "level 5:", "level 6:"]
+    assert [len(ax.lines) for ax in hands] == [5, 10, 15]  # 5 finger bones per level
+    assert check.check_figure(fig) == []  # no empty panel
+    # two levels a row: the row of levels 3-4 has hand bones only in level 4; level 3's hand panel shows the
+    # 15 bones to come, dotted, instead of nothing
+    fig = plot3d.plot_bone_levels(
+        pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist", ncols=2
+    )
+    assert len(fig.axes) == 10
+    ghost = fig.axes[4]
+    assert ghost.get_title().startswith("level 3:") and [t.get_text() for t in ghost.texts] == [
+        "none of these bones yet"
+    ]
+    assert len(ghost.lines) == 15 and all(line.get_linestyle() == ":" for line in ghost.lines)
+    assert check.check_figure(fig) == []
     plt.close("all")
 
 
