@@ -289,6 +289,11 @@ def test_animation_size_is_width_in_pixels_with_square_panels():
         animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, panel_size=2.0)  # beatlite 0.1
 
 
+#: _animation() is 300 px wide at 50 dpi to keep these tests fast: its 9-pt text is 6 px, which the figure check flags.
+SMALL_FOR_SPEED = pytest.mark.filterwarnings("ignore::beatlite.viz.check.FigureWarning")
+
+
+@SMALL_FOR_SPEED
 def test_animation_gif_round_trip(tmp_path):
     anim = _animation(out_fps=5, max_frames=4)
     path = anim.save_as(tmp_path / "clip.gif")
@@ -300,6 +305,7 @@ def test_animation_gif_round_trip(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["clip.gif"]
 
 
+@SMALL_FOR_SPEED
 def test_animation_mp4_and_html(tmp_path):
     anim = _animation(out_fps=5, max_frames=3)
     if animation.ffmpeg_available():
@@ -767,6 +773,27 @@ def test_inline_player_resolution_and_format_are_chosen_per_call():
     assert len(small) < len(large)
     assert "data:image/jpeg" in anim.to_html(dpi=20, frame_format="jpeg")
     assert "data:image/png" in small
+
+
+def test_inline_player_text_is_checked_at_the_size_it_is_shown(monkeypatch):
+    """Notebooks 05 and 08 embedded their players at dpi=60 (576 px): 9-pt ticks and legends 7.5 px high."""
+    from beatlite.viz import check
+
+    timeline = animation.Timeline(np.zeros(16000), 16000, np.array([0.5]), np.array([1.0]))
+    anim = animation.animate_skeletons({"ground truth": wave_motion(4), "CaMN": wave_motion(4)}, tiny_skeleton(), 15,
+                                       timeline=timeline, max_frames=2)  # fmt: skip
+    problems = check.check_figure(anim.figure, dpi=60)
+    assert problems and {p.kind for p in problems} == {"small text"}
+    assert any("'audio beats' is 7.5 px" in p.detail for p in problems)  # 9 pt x 60 / 72
+    assert check.check_figure(anim.figure, dpi=80) == []  # 768 px: 9 pt = 10 px
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    with pytest.raises(check.FigureError, match="to_html\\(dpi=60\\)"):
+        anim.to_html(dpi=60)
+    html = anim.to_html(dpi=80, frame_format="jpeg")
+    assert "data:image/jpeg" in html
+    first = anim.frame_image(0)
+    assert first.shape[1] == 960  # the check drew the figure at its own size; the player restarts at frame 0
+    plt.close("all")
 
 
 def test_score_scatter_labels_of_close_points_do_not_overlap():
