@@ -29,7 +29,8 @@ small text: 'no data yet' is 6.2 px high at 150 dpi (under 8 px)
 shared colour: axes 1 of 2: 'CaMN' and 'mean pose' are both #1f77b4
 >>> plt.close(fig)
 
-Taught in notebooks/00_setup_and_tour.ipynb, section 2 (``save_figure`` checks what it saves).
+Used on every figure the notebooks save (``bl.viz.save_figure``, first in notebooks/00_setup_and_tour.ipynb)
+and on the animation players of notebooks 05 and 08 (``to_html(dpi=80)``).
 """
 
 from __future__ import annotations
