@@ -148,12 +148,25 @@ def test_save_figure_raises_warns_or_stays_quiet_as_beatlite_figure_check_says(t
 
 def test_save_figure_checks_text_at_the_dpi_it_saves_with(tmp_path, monkeypatch):
     monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
-    fig, ax = plt.subplots()
+    fig, ax = plt.subplots(dpi=100)
     ax.plot([0, 1], [0, 1])
-    ax.set_xlabel("x (cm)", fontsize=5)  # 10.4 px at the style's 150 dpi, 6.9 px at 100
+    ax.set_xlabel("x (cm)", fontsize=7)  # 14.6 px at the style's 150 dpi, 9.7 px at 100, 5.8 px at 60
     style.save_figure(fig, tmp_path / "fine", formats=("png",))
-    with pytest.raises(check.FigureError, match="small text: 'x \\(cm\\)' is 6.9 px high at 100 dpi"):
-        style.save_figure(fig, tmp_path / "coarse", formats=("png",), dpi=100)
+    with pytest.raises(check.FigureError, match="small text: 'x \\(cm\\)' is 5.8 px high at 60 dpi"):
+        style.save_figure(fig, tmp_path / "coarse", formats=("png",), dpi=60)
+    plt.close(fig)
+
+
+def test_save_figure_checks_text_at_the_size_a_notebook_shows_it_inline_too(tmp_path, monkeypatch):
+    """A notebook shows a figure at its own dpi (IPython's inline PNG); saved at 150 dpi it may be larger."""
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    fig, ax = plt.subplots(dpi=60)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("x (cm)", fontsize=9)  # 18.8 px in the 150-dpi file, 7.5 px inline at 60 dpi
+    with pytest.raises(check.FigureError, match="'x \\(cm\\)' is 7.5 px high at 60 dpi"):
+        style.save_figure(fig, tmp_path / "coarse", formats=("png",))
+    fig.set_dpi(100)  # 12.5 px inline
+    style.save_figure(fig, tmp_path / "fine", formats=("png",))
     plt.close(fig)
 
 

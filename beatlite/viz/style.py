@@ -158,8 +158,10 @@ def save_figure(
     beatlite.viz.check.FigureError
         With ``BEATLITE_FIGURE_CHECK=raise`` (``make run``, ``make test``), when
         :func:`beatlite.viz.check.check_figure` finds an empty panel, text under
-        8 px at the saved dpi or two series in one colour (nothing is written); the
-        default ``warn`` gives a :class:`~beatlite.viz.check.FigureWarning` and saves.
+        8 px or two series in one colour (nothing is written); the default ``warn``
+        gives a :class:`~beatlite.viz.check.FigureWarning` and saves. Text is measured
+        at the lower of the saved dpi (150) and the figure's own dpi (100), at which
+        a notebook shows the figure inline.
     """
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -178,6 +180,9 @@ def save_figure(
 
     if (mode := check_mode()) != "off":
         dpi = savefig_kwargs.get("dpi", save_params["savefig.dpi"])
+        dpi = (
+            fig.dpi if dpi == "figure" else min(float(dpi), fig.dpi)
+        )  # saved, and shown inline at the figure's dpi
         report_problems(check_figure(fig, dpi=dpi), f"save_figure({stem.name!r})", mode)
     stem.parent.mkdir(parents=True, exist_ok=True)
     written = []
