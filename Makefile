@@ -12,6 +12,9 @@ export MPLBACKEND ?= Agg
 export BEATLITE_THREADS ?= 1
 export BEATLITE_MODE ?= lecture
 export PYTHONHASHSEED ?= 0
+# What bl.viz.save_figure and the animation players do with a figure that has an empty panel, text under 8 px at
+# the saved size or two series in one colour (beatlite.viz.check): `make run` and `make test` fail on it.
+FIGURE_CHECK ?= raise
 # Training processes at once for `make checkpoints` / `make seeds` (1 torch thread each; 2 on an idle 2-core machine).
 JOBS ?= 1
 # Recipes `make seeds` trains and records (default: all).
@@ -39,7 +42,7 @@ system-deps:
 
 ## The main job: execute every notebook in order on data_samples/ and write build/.
 run: $(STAMP) $(INTERACTIVE) system-deps
-	$(VPY) scripts/run_notebooks.py --out build
+	BEATLITE_FIGURE_CHECK=$(FIGURE_CHECK) $(VPY) scripts/run_notebooks.py --out build
 
 ## The course site in build/site/ (works from file://, offline): index.html (the course map), every notebook as an
 ## offline page and as reveal.js slides, the guide, the figures, the student copies. Reuses the executed notebooks of
@@ -68,14 +71,15 @@ lab: $(INTERACTIVE) system-deps
 
 ## The test suite: lint, unit tests, nbval over every notebook, then the doctests (Examples) of beatlite.
 test: $(STAMP) system-deps lint
-	BEATLITE_INTERACTIVE=off $(VPY) -m pytest tests notebooks --nbval-lax --nbval-cell-timeout=900 -p no:cacheprovider
-	BEATLITE_INTERACTIVE=off $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
+	BEATLITE_INTERACTIVE=off BEATLITE_FIGURE_CHECK=$(FIGURE_CHECK) $(VPY) -m pytest tests notebooks --nbval-lax \
+		--nbval-cell-timeout=900 -p no:cacheprovider
+	BEATLITE_INTERACTIVE=off BEATLITE_FIGURE_CHECK=$(FIGURE_CHECK) $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider
 
 ## The quick loop while editing (about 2 minutes on 2 cores): lint, the unit tests not marked `slow` (no
 ## torchrun, no whole-recipe training, no notebooks), the doctests. `make test` (CI) runs everything.
 test-fast: $(STAMP) system-deps lint
-	BEATLITE_INTERACTIVE=off $(VPY) -m pytest tests -m "not slow" -p no:cacheprovider -q
-	BEATLITE_INTERACTIVE=off $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider -q
+	BEATLITE_INTERACTIVE=off BEATLITE_FIGURE_CHECK=$(FIGURE_CHECK) $(VPY) -m pytest tests -m "not slow" -p no:cacheprovider -q
+	BEATLITE_INTERACTIVE=off BEATLITE_FIGURE_CHECK=$(FIGURE_CHECK) $(VPY) -m pytest --doctest-modules beatlite -p no:cacheprovider -q
 
 lint: $(STAMP)
 	$(VPY) -m ruff check beatlite tests bench scripts

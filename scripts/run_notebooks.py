@@ -81,6 +81,9 @@ _MATH = re.compile(
     re.S,
 )
 _PLAIN_BARS = re.compile(r"<mo>(&#x0007C;|&#x02016;)</mo>")
+# latex2mathml writes `\big)^2` as <msup><mo minsize=.. maxsize=..>)</mo>...: Chromium then draws that ")" small and
+# low, unlike its "(" (an operator as a script base is stretched differently); in an <mrow> it matches its pair.
+_SIZED_SCRIPT_BASE = re.compile(r"<(msup|msub|msubsup)><mo( [^>]*minsize=[^>]*)>(.*?)</mo>")
 
 
 def markdown_to_html(source: str, **renderer_options) -> str:
@@ -112,6 +115,7 @@ def markdown_to_html(source: str, **renderer_options) -> str:
             raise ValueError(f"cannot convert the formula {m[0]!r} to MathML: {exc!r}") from exc
         if unknown := re.findall(r">(\\[A-Za-z]+)<", mathml):  # latex2mathml prints commands it does not know
             raise ValueError(f"cannot convert the formula {m[0]!r} to MathML: unknown {', '.join(unknown)}")
+        mathml = _SIZED_SCRIPT_BASE.sub(r"<\1><mrow><mo\2>\3</mo></mrow>", mathml)  # \big)^2 like \big(
         # latex2mathml leaves \lvert, \rvert, \lVert, \rVert stretchy; in TeX only \left/\right stretch
         maths.append(_PLAIN_BARS.sub(r'<mo stretchy="false">\1</mo>', mathml))
         return f"@@math{len(maths) - 1}@@"

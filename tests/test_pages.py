@@ -231,6 +231,39 @@ def test_formulas_are_taken_out_before_markdown_parses_them():
             _runner().markdown_to_html(broken)
 
 
+#: Notebook 04's Wasserstein formula: its `\big)^2` was drawn small and low beside a 1.2 em "(" in Chromium.
+BIG_PARENS = "$$W_2^2 = \\mathbb{E}\\,\\big(m_1 - m_2 + (s_1 - s_2) z\\big)^2 = \\Big[a\\Big]_i$$"
+
+
+def test_a_big_delimiter_before_a_script_is_sized_like_its_pair():
+    html = _runner().markdown_to_html(BIG_PARENS)
+    sized = re.findall(r"<mo minsize=\"([0-9.]+em)\" maxsize=\"\1\">(.)</mo>", html)
+    assert sized == [("1.2em", "("), ("1.2em", ")"), ("1.623em", "["), ("1.623em", "]")]
+    # the closing ones are script bases: wrapped in an <mrow>, never the <mo> straight under <msup>/<msub>
+    assert not re.search(r"<(msup|msub|msubsup)><mo ", html)
+    assert html.count("<msup><mrow><mo minsize") == 1 and html.count("<msub><mrow><mo minsize") == 1
+
+
+def test_big_parentheses_render_as_a_matching_pair_in_chromium(tmp_path):
+    _chromium()
+    page = tmp_path / "big.html"
+    page.write_text(f"<!DOCTYPE html><html><body style='font-size:24px'>{_runner().markdown_to_html(BIG_PARENS)}"
+                    "</body></html>", encoding="utf-8")  # fmt: skip
+    browser = Browser(tmp_path / "profile")
+    try:
+        open_offline(browser, page)
+        boxes = browser.evaluate(
+            "[...document.querySelectorAll('mo[minsize]')].map(m => { const r = m.getBoundingClientRect(); "
+            "return [m.textContent, r.top, r.bottom]; })"
+        )
+    finally:
+        browser.close()
+    assert [b[0] for b in boxes] == ["(", ")", "[", "]"]
+    for (_, top_open, bottom_open), (_, top_close, bottom_close) in (boxes[:2], boxes[2:]):
+        # one height and one baseline: within a pixel (the ")" was about 40 % smaller and lower before)
+        assert abs(top_open - top_close) <= 1 and abs(bottom_open - bottom_close) <= 1, boxes
+
+
 def test_page_has_no_remote_reference(small_page):
     html = small_page.read_text(encoding="utf-8")
     assert not re.search(r"<(script|link|img|iframe)[^>]+(src|href)=[\"']?(https?:)?//", html)

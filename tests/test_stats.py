@@ -316,7 +316,8 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
     assert sep.n == 18 and sep.n_classes == 3
     fig4 = plot_figure4(takes, out=tmp_path / "fig4")
     assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)", "(c)"]  # the paper's panel order
-    plot_correlations(takes, out=tmp_path / "corr")
+    corr = plot_correlations(takes, out=tmp_path / "corr")  # saved through the figure check: no empty panel
+    assert [ax.get_title() for ax in corr.axes] == ["gesture vs audio energy", "gesture energy per emotion"]
     plot_table6({"neutral": 0.5, "avg": 0.5}, out=tmp_path / "table6")
     plt.close("all")
     for stem in ("fig2", "fig3a", "fig4", "corr", "table6"):
@@ -403,6 +404,24 @@ def test_figures_label_every_axis_and_keep_legends_off_the_data() -> None:
     labels = [t.get_text() for t in table6.axes[0].get_legend().get_texts()]
     assert labels[-1] == "beatlite, generated (CaMN)"  # the generated row names its model
     plt.close("all")
+
+
+def test_table6_writes_a_zero_bar_as_0_and_leaves_a_missing_class_empty() -> None:
+    import matplotlib.pyplot as plt
+
+    real = {"neutral": 1.0, "anger": 0.9, "avg": 0.95}
+    generated = {"neutral": 1.0, "anger": 0.0, "avg": 0.5}  # CaMN never right on anger; no other class given
+    fig = plot_table6(real, generated, generated_by="CaMN")
+    ax = fig.axes[0]
+    zeros = [t for t in ax.texts if t.get_text() == "0"]
+    assert len(zeros) == 1  # only the 0 %, not the classes without a value (NaN: no bar, no number)
+    names = [t.get_text() for t in ax.get_xticklabels()]
+    assert names[round(zeros[0].get_position()[0])] == "anger"  # above the anger group's slot
+    from matplotlib.colors import to_hex
+
+    generated_colour = to_hex(ax.get_legend().legend_handles[-1].get_facecolor())
+    assert to_hex(zeros[0].get_color()) == generated_colour  # in the colour of the generated row
+    plt.close(fig)
 
 
 @pytest.mark.filterwarnings("ignore:The least populated class:UserWarning")

@@ -289,6 +289,17 @@ def test_animation_size_is_width_in_pixels_with_square_panels():
         animation.animate_skeletons(wave_motion(6), tiny_skeleton(), fps=15, panel_size=2.0)  # beatlite 0.1
 
 
+@pytest.fixture
+def figure_check_off(monkeypatch):
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "off")
+
+
+#: _animation() is 300 px wide at 50 dpi to keep these tests fast: its 9-pt text is 6 px, which the figure check
+#: flags (a warning, or an error under `make test`'s BEATLITE_FIGURE_CHECK=raise): these tests turn it off.
+SMALL_FOR_SPEED = pytest.mark.usefixtures("figure_check_off")
+
+
+@SMALL_FOR_SPEED
 def test_animation_gif_round_trip(tmp_path):
     anim = _animation(out_fps=5, max_frames=4)
     path = anim.save_as(tmp_path / "clip.gif")
@@ -300,6 +311,7 @@ def test_animation_gif_round_trip(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["clip.gif"]
 
 
+@SMALL_FOR_SPEED
 def test_animation_mp4_and_html(tmp_path):
     anim = _animation(out_fps=5, max_frames=3)
     if animation.ffmpeg_available():
@@ -587,10 +599,10 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
 
     fgd = {"CaMN": 1.0, "HA2G": 2.0, "mean pose": 25.0}
     ax = charts.plot_scores(fgd, "FGD").axes[0]
-    # 25 > 3 x 2: the axis ends at 1.3 x 2 x 1.35, the bar is cut and its value written
-    assert ax.get_xlim()[1] == pytest.approx(2.0 * 1.3 * 1.35)
-    assert max(p.get_width() for p in ax.patches) == pytest.approx(2.6)
-    assert any("25 (bar cut)" in t.get_text() for t in ax.texts)
+    # 25 > 3 x 2 (the median): the axis ends at 1.4 x 2, the bar stops at 1.12 x 2, cut, its value written
+    assert ax.get_xlim()[1] == pytest.approx(2.0 * 1.4)
+    assert max(p.get_width() for p in ax.patches) == pytest.approx(2.0 * 1.12)
+    assert any("25 (cut)" in t.get_text() for t in ax.texts)
     plain = charts.plot_scores({"a": 1.0, "b": 2.0}, "FGD").axes[0]
     assert plain.get_xlim()[1] == pytest.approx(2.0 * 1.12)
     with pytest.raises(ValueError, match="finite"):
@@ -605,6 +617,51 @@ def test_score_bars_cut_an_outlier_and_scatter_labels_stay_inside():
     labels = [t for t in ax.texts if t.get_text()]
     assert len(labels) == 3 and all(_inside(t.get_window_extent(renderer), ax.get_window_extent(renderer))
                                     for t in labels)  # fmt: skip
+    plt.close("all")
+
+
+#: Notebook 07's one-run FGD column, best first (the mean pose's 25.3 used to set the axis: CaMN vs HA2G in an eighth).
+BENCHMARK_FGD = {"Ground truth": 0.0, "Ground truth (141 Euler channels)": 0.0411, "CaMN": 2.97, "HA2G": 3.92,
+                 "Random clip": 4.22, "DiffGesture-style": 4.81, "S2G-style": 4.86, "Trimodal-style": 5.31,
+                 "A2G-style": 8.0, "Seq2Seq-style": 8.35, "Joint Embedding-style": 10.4, "Mean pose": 25.3}  # fmt: skip
+
+
+def test_score_bars_of_the_benchmark_cut_only_the_mean_pose_and_give_every_row_its_colour():
+    from matplotlib.colors import to_hex
+
+    from beatlite.viz import charts, check
+
+    ax = charts.plot_scores(BENCHMARK_FGD, "FGD").axes[0]
+    # median of the 11 positive values 4.86, 3 x 4.86 = 14.6: only 25.3 is cut; the axis ends at 1.4 x 10.4
+    assert ax.get_xlim()[1] == pytest.approx(1.4 * 10.4)
+    assert [t.get_text().strip() for t in ax.texts if "cut" in t.get_text()] == ["25.3 (cut)"]
+    assert (3.92 - 2.97) / ax.get_xlim()[1] > 0.06  # the CaMN-HA2G gap: 1/15 of the axis, was 1/30
+    colours = {to_hex(p.get_facecolor()) for p in ax.patches}
+    assert len(colours) == len(BENCHMARK_FGD)  # 12 rows, 12 colours (Random clip and Mean pose shared one)
+    assert check.check_figure(ax.figure) == []
+    plt.close("all")
+
+
+def test_score_scatter_ties_a_label_that_is_not_beside_its_point():
+    from matplotlib.text import Text
+
+    from beatlite.viz import charts
+
+    bc = dict(
+        zip(BENCHMARK_FGD, [0.665, 0.67, 0.727, 0.786, 0.51, 0.79, 0.815, 0.75, 0.75, 0.26, 0.125, np.nan])
+    )
+    fig, ax = plt.subplots(figsize=(5.5, 4.6), layout="constrained")
+    ax.set_title("closeness to the data vs synchrony")
+    charts.plot_score_scatter(BENCHMARK_FGD, bc, "FGD", "BC", ax=ax)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert len(ax.texts) == 11  # the mean pose has no BC
+    for note in ax.texts:
+        box = Text.get_window_extent(note, renderer)
+        point = ax.transData.transform((BENCHMARK_FGD[note.get_text()], bc[note.get_text()]))
+        gap = max(box.x0 - point[0], point[0] - box.x1, box.y0 - point[1], point[1] - box.y1, 0.0)
+        # beside its point (within 12 points) or tied to it by a visible line
+        assert gap <= 12 * fig.dpi / 72 or note.arrow_patch.get_visible(), (note.get_text(), gap)
     plt.close("all")
 
 
@@ -684,20 +741,35 @@ def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
 
 def test_bone_levels_mark_the_new_bones_of_each_level_on_shared_limits():
     from beatlite.skeleton import ted
+    from beatlite.viz import check
 
     pose = upper_body(1)[0]
     levels = ted.HA2G_LEVELS
     fig = plot3d.plot_bone_levels(pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist")
-    body, hands = fig.axes[0::2], fig.axes[1::2]
-    assert len(body) == len(hands) == len(levels) == 6
+    # rows: levels 1-3 (body), levels 4-6 (body), levels 4-6 (right hand): the right hand's 15 finger bones
+    # arrive in levels 4-6, so levels 1-3 get no hand row (it was three panels saying "no bones here yet")
+    assert len(fig.axes) == 9
+    body, hands = fig.axes[:6], fig.axes[6:]
     red = style.GROUP_COLOURS["hands"]
     for k, ax in enumerate(body):  # thick red lines = the bones this level adds (levels are cumulative)
         added = len(levels[k]) - (len(levels[k - 1]) if k else 0)
         assert sum(line.get_color() == red for line in ax.lines) == added
     assert len({(ax.get_xlim(), ax.get_ylim()) for ax in body}) == 1  # one scale for every level
-    # the right hand's 15 finger bones arrive in levels 4-6; before that its panel says so
-    assert [bool(ax.texts) for ax in hands] == [True, True, True, False, False, False]
-    assert sum(len(ax.lines) for ax in hands[-1:]) == 15
+    assert [ax.get_title()[:8] for ax in hands] == ["level 4:", "level 5:", "level 6:"]
+    assert [len(ax.lines) for ax in hands] == [5, 10, 15]  # 5 finger bones per level
+    assert check.check_figure(fig) == []  # no empty panel
+    # two levels a row: the row of levels 3-4 has hand bones only in level 4; level 3's hand panel shows the
+    # 15 bones to come, dotted, instead of nothing
+    fig = plot3d.plot_bone_levels(
+        pose, ted.TED_BONES, levels, names=ted.TED43_JOINTS, zoom="right_wrist", ncols=2
+    )
+    assert len(fig.axes) == 10
+    ghost = fig.axes[4]
+    assert ghost.get_title().startswith("level 3:") and [t.get_text() for t in ghost.texts] == [
+        "none of these bones yet"
+    ]
+    assert len(ghost.lines) == 15 and all(line.get_linestyle() == ":" for line in ghost.lines)
+    assert check.check_figure(fig) == []
     plt.close("all")
 
 
@@ -707,6 +779,27 @@ def test_inline_player_resolution_and_format_are_chosen_per_call():
     assert len(small) < len(large)
     assert "data:image/jpeg" in anim.to_html(dpi=20, frame_format="jpeg")
     assert "data:image/png" in small
+
+
+def test_inline_player_text_is_checked_at_the_size_it_is_shown(monkeypatch):
+    """Notebooks 05 and 08 embedded their players at dpi=60 (576 px): 9-pt ticks and legends 7.5 px high."""
+    from beatlite.viz import check
+
+    timeline = animation.Timeline(np.zeros(16000), 16000, np.array([0.5]), np.array([1.0]))
+    anim = animation.animate_skeletons({"ground truth": wave_motion(4), "CaMN": wave_motion(4)}, tiny_skeleton(), 15,
+                                       timeline=timeline, max_frames=2)  # fmt: skip
+    problems = check.check_figure(anim.figure, dpi=60)
+    assert problems and {p.kind for p in problems} == {"small text"}
+    assert any("'audio beats' is 7.5 px" in p.detail for p in problems)  # 9 pt x 60 / 72
+    assert check.check_figure(anim.figure, dpi=80) == []  # 768 px: 9 pt = 10 px
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    with pytest.raises(check.FigureError, match="to_html\\(dpi=60\\)"):
+        anim.to_html(dpi=60)
+    html = anim.to_html(dpi=80, frame_format="jpeg")
+    assert "data:image/jpeg" in html
+    first = anim.frame_image(0)
+    assert first.shape[1] == 960  # the check drew the figure at its own size; the player restarts at frame 0
+    plt.close("all")
 
 
 def test_score_scatter_labels_of_close_points_do_not_overlap():

@@ -303,6 +303,8 @@ def plot_correlations(
 ):
     """Three panels: gesture energy vs audio energy, vs facial activity (windows), and per emotion (takes).
 
+    Takes without facial data get no facial-activity panel (two panels, none empty).
+
     Returns
     -------
     matplotlib.figure.Figure
@@ -313,22 +315,24 @@ def plot_correlations(
 
     wm = window_means(takes, seconds=seconds)
     speeds = speed_by_emotion(takes)
+    has_face = not np.any(np.isnan(wm["face"]))
     with figure_style():
-        fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")
+        n = 3 if has_face else 2  # no facial data (no .json): no empty panel for it
+        fig, axes = plt.subplots(1, n, figsize=(13 * n / 3, 4.2), layout="constrained")
         axes[0].scatter(wm["audio"], wm["speed"], s=6, alpha=0.5, color=SYSTEM_COLOURS[0])
         axes[0].set_xlabel(f"audio RMS (full scale, {seconds:g}-s window mean)")
         axes[0].set_ylabel("gesture speed (cm/s)")
         axes[0].set_title("gesture vs audio energy")
-        if not np.any(np.isnan(wm["face"])):
+        if has_face:
             axes[1].scatter(wm["face"], wm["speed"], s=6, alpha=0.5, color=SYSTEM_COLOURS[0])
-        axes[1].set_xlabel(f"facial activity (1/s, {seconds:g}-s window mean)")
-        axes[1].set_ylabel("gesture speed (cm/s)")
-        axes[1].set_title("gesture vs facial activity")
-        axes[2].bar(list(speeds), list(speeds.values()), color=SYSTEM_COLOURS[0])
-        axes[2].set_xlabel("emotion")
-        axes[2].set_ylabel("mean gesture speed (cm/s)")
-        axes[2].set_title("gesture energy per emotion")
-        axes[2].tick_params(axis="x", rotation=45)
+            axes[1].set_xlabel(f"facial activity (1/s, {seconds:g}-s window mean)")
+            axes[1].set_ylabel("gesture speed (cm/s)")
+            axes[1].set_title("gesture vs facial activity")
+        axes[-1].bar(list(speeds), list(speeds.values()), color=SYSTEM_COLOURS[0])
+        axes[-1].set_xlabel("emotion")
+        axes[-1].set_ylabel("mean gesture speed (cm/s)")
+        axes[-1].set_title("gesture energy per emotion")
+        axes[-1].tick_params(axis="x", rotation=45)
         if out is not None:
             save_figure(fig, out, formats)
     return fig

@@ -226,7 +226,8 @@ def plot_table6(
 
     BEAT (ECCV 2022) Table 6 as bars: the paper's rows in light colours, this
     corpus's in the systems' colours (:func:`beatlite.viz.style.system_colour`),
-    the legend right of the bars.
+    the legend right of the bars. A 0 % bar is drawn as a thick line on the axis
+    with a "0" above it, so it does not look like a missing value.
 
     Parameters
     ----------
@@ -262,7 +263,15 @@ def plot_table6(
         x = np.arange(len(names))
         width = 0.8 / len(rows)
         for k, (label, values, colour) in enumerate(rows):
-            ax.bar(x + (k - (len(rows) - 1) / 2) * width, values, width, label=label, color=colour)
+            where = x + (k - (len(rows) - 1) / 2) * width
+            ax.bar(where, values, width, label=label, color=colour)
+            for xi, v in zip(where, values):  # a 0 % bar has no height: say 0, so it does not read as missing
+                if np.isfinite(v) and v < 0.5:
+                    ax.plot([xi - width / 2, xi + width / 2], [0, 0], color=colour, lw=3, solid_capstyle="butt",
+                            label="_zero", clip_on=False)  # fmt: skip
+                    ax.text(
+                        xi, 1.5, "0", ha="center", va="bottom", fontsize=9, color=colour, fontweight="bold"
+                    )
         ax.set_xticks(x, names, rotation=30, ha="right")
         ax.set_xlabel("emotion class")
         ax.set_ylabel("accuracy (%)")

@@ -6,6 +6,8 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ==========================  ==================================================================
 ``style``                    one figure style (:func:`figure_style`, :data:`STYLE`), :func:`save_figure`,
                              :func:`system_colour`, :func:`legend_outside`
+``check``                    :func:`check_figure` (empty panels, text under 8 px, two series in one
+                             colour), run by :func:`save_figure` on every figure it saves
 ``plot3d``                   :func:`plot_frame`, :func:`plot_filmstrip`, :func:`plot_views`,
                              :func:`plot_trajectories`, :func:`plot_keyframes` (matplotlib 3D),
                              :func:`plot_bone_levels` (what each hierarchy level adds, 2D)
@@ -39,7 +41,18 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-_SUBMODULES = ("style", "plot3d", "animation", "face", "charts", "figures", "render", "probe", "bvh_export")
+_SUBMODULES = (
+    "style",
+    "check",
+    "plot3d",
+    "animation",
+    "face",
+    "charts",
+    "figures",
+    "render",
+    "probe",
+    "bvh_export",
+)
 _EXPORTS: dict[str, str] = {
     "STYLE": "style",
     "GROUP_COLOURS": "style",
@@ -47,7 +60,10 @@ _EXPORTS: dict[str, str] = {
     "figure_style": "style",
     "save_figure": "style",
     "system_colour": "style",
+    "system_colours": "style",
     "legend_outside": "style",
+    "check_figure": "check",
+    "FigureProblem": "check",
     "plot_frame": "plot3d",
     "plot_filmstrip": "plot3d",
     "plot_views": "plot3d",

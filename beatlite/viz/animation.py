@@ -93,7 +93,11 @@ class SkeletonAnimation(FuncAnimation):
         ----------
         dpi : float, optional
             Resolution of the embedded frames (default: the figure's, 960 px wide);
-            e.g. ``dpi=60`` embeds 576-px frames to keep a saved notebook small.
+            e.g. ``dpi=80`` embeds 768-px frames to keep a saved notebook small. The
+            player shows the frames at that size, so the figure is checked at that
+            dpi first (:func:`beatlite.viz.check.check_figure`, as ``BEATLITE_FIGURE_CHECK``
+            says): at ``dpi=60`` (576 px) the 9-pt tick labels and legends are 7.5 px
+            high, under the 8 px the check asks for.
         frame_format : {"png", "jpeg"}
             Format of the embedded frames; JPEG frames are several times smaller.
 
@@ -103,6 +107,13 @@ class SkeletonAnimation(FuncAnimation):
             HTML with the frames base64-embedded.
         """
         import matplotlib.pyplot as plt
+
+        from beatlite.viz.check import check_figure, check_mode, report_problems
+
+        if (mode := check_mode()) != "off":
+            shown = self._fig.dpi if dpi is None else float(dpi)
+            report_problems(check_figure(self._fig, dpi=shown), f"to_html(dpi={shown:g})", mode)
+            self._draw_update(0)  # the check drew the figure: back to the first frame
 
         params = {
             "animation.embed_limit": STYLE["animation.embed_limit"],
@@ -175,6 +186,14 @@ def save_animation(anim: Any, path: str | Path, *, fps: float, dpi: float | None
         writer = None
     else:
         raise ValueError(f"path must end in .gif, .mp4 or .html, got {path.name!r}")
+    from beatlite.viz.check import check_figure, check_mode, report_problems
+
+    fig = getattr(anim, "_fig", None)
+    if fig is not None and (mode := check_mode()) != "off":
+        shown = fig.dpi if dpi is None else float(dpi)
+        report_problems(check_figure(fig, dpi=shown), f"save_animation({path.name!r})", mode)
+        if isinstance(anim, SkeletonAnimation):
+            anim._draw_update(0)
     with atomic_target(path) as tmp:
         if writer is None:
             html = anim.to_jshtml(fps=fps)
@@ -406,11 +425,11 @@ def _draw_face(fig: Any, rect: Any, face: FacePanel) -> tuple[Any, Any]:
         ax.set_ylim(0, top)
         ax.set_xlim(-0.6, k - 0.4)
         ax.set_ylabel("weight (0-1)")
-        ax.set_xticks(np.arange(k), face.names, rotation=90, fontsize=8)
+        ax.set_xticks(np.arange(k), face.names, rotation=90, fontsize=9)
         return None, bars
     im = ax.imshow(w.T, aspect="auto", origin="upper", extent=(0, len(w) / face.fps, k - 0.5, -0.5),
                    vmin=0, vmax=top, cmap="magma", interpolation="nearest")  # fmt: skip
-    ax.set_yticks(np.arange(k), face.names, fontsize=8)
+    ax.set_yticks(np.arange(k), face.names, fontsize=9)
     ax.set_xlabel("time (s)")
     x0, y0, wd, ht = rect
     bar_ax = fig.add_axes((x0 + wd + 0.01, y0, 0.012, ht))

@@ -17,9 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from beatlite.viz.style import figure_style, legend_outside, system_colour
+from beatlite.viz.style import figure_style, legend_outside, system_colour, system_colours
 
-#: A bar longer than this many times the longest other bar is drawn cut, with its value written.
+#: A bar longer than this many times the median positive bar is drawn cut, with its value written.
 OUTLIER_FACTOR = 3.0
 
 
@@ -144,12 +144,15 @@ def plot_scores(
     ax: Any = None,
     figsize: tuple[float, float] = (6.4, 3.4),
 ) -> Any:
-    """Horizontal bars of one metric per system; an outlier bar is cut so it does not flatten the others.
+    """Horizontal bars of one metric per system; far outliers are cut so they do not flatten the others.
 
-    A bar longer than :data:`OUTLIER_FACTOR` times the longest other bar (e.g. the
-    mean-pose baseline, FGD 25, beside models near 1) is drawn up to the axis
-    end with a break mark and its value written on it; every bar carries its
-    value. Bars are in the systems' colours, in the order given, first at the top.
+    A bar longer than :data:`OUTLIER_FACTOR` times the median of the positive values
+    (e.g. the mean-pose baseline, FGD 25, beside models near 3-5) is drawn past the
+    axis' last grid line with a white break mark and its value written after it;
+    the axis spans the other bars. Every bar carries its value, a zero is written
+    as ``0`` (not an empty slot). Bars are in the systems' colours
+    (:func:`beatlite.viz.style.system_colours`, one distinct colour each), in the
+    order given, first at the top; each bar is its own labelled series.
 
     Parameters
     ----------
@@ -171,19 +174,22 @@ def plot_scores(
     labels = list(scores)
     values = _check_scores(scores)
     limit = _axis_limit(values)
+    cut = values > limit
     with figure_style():
         ax = _new_axes(ax, figsize)
         y = np.arange(len(labels))[::-1]
-        colours = [system_colour(k, i) for i, k in enumerate(labels)]
-        ax.barh(y, np.minimum(values, limit), color=colours)
-        for yi, v in zip(y, values):
-            ax.text(
-                min(v, limit), yi, f" {v:.3g}" + (" (bar cut)" if v > limit else ""), va="center", fontsize=9
-            )
-            if v > limit:  # a white break across the bar
-                ax.plot([limit * 0.88, limit * 0.9], [yi - 0.45, yi + 0.45], color="white", lw=4)
+        colours = system_colours(labels)
+        end = limit * 1.12  # where a cut bar stops, past the last bar that fits
+        for yi, v, label, colour, far in zip(y, values, labels, colours, cut):
+            ax.barh(yi, end if far else v, color=colour, label=label)
+            text = f" {v:.3g}" + (" (cut)" if far else "")
+            ax.text(end if far else v, yi, text, va="center", fontsize=9, clip_on=False)
+            if far:  # a white break across the bar, just before its end
+                ax.plot(
+                    [limit * 1.02, limit * 1.05], [yi - 0.45, yi + 0.45], color="white", lw=3, label="_break"
+                )
         ax.set_yticks(y, labels)
-        ax.set_xlim(0, limit * (1.35 if values.max() > limit else 1.12))
+        ax.set_xlim(0, limit * (1.4 if cut.any() else 1.12))
         ax.set_xlabel(f"{metric} ({'lower' if lower_is_better else 'higher'} is better)")
         ax.grid(axis="y", visible=False)
     return ax.figure
@@ -198,12 +204,12 @@ def _check_scores(scores: Mapping[str, float]) -> np.ndarray:
 
 
 def _axis_limit(values: np.ndarray) -> float:
-    """x-axis end: the largest value, or 1.3 x the largest non-outlier when one bar dwarfs the rest."""
-    top = float(values.max())
-    rest = np.sort(values)[:-1]
-    if len(rest) and rest.max() > 0 and top > OUTLIER_FACTOR * rest.max():
-        return float(1.3 * rest.max())
-    return top if top > 0 else 1.0
+    """The largest value that is not an outlier (> :data:`OUTLIER_FACTOR` x the median positive value)."""
+    positive = values[values > 0]
+    if not len(positive):
+        return 1.0
+    inside = positive[positive <= OUTLIER_FACTOR * np.median(positive)]
+    return float(inside.max())
 
 
 def _finite_pair(a: float | None, b: float | None) -> bool:
@@ -223,7 +229,10 @@ def plot_score_scatter(
 
     Each label takes the first of a few places around its point (beside it, above or below, on
     the side facing the middle first) where it stays inside the axes and meets neither a placed
-    label nor a marker (:func:`_place_labels`); with no such place it takes the first. Labels are
+    label nor a marker (:func:`_place_labels`); with no such place it takes the first. A label
+    not written right beside its point is tied to it by a thin line in its colour. Colours are
+    those of :func:`plot_scores` for the same mapping (:func:`beatlite.viz.style.system_colours`
+    of ``x``'s labels); each point is its own labelled series. Labels are
     placed for the figure's layout at call time: give the axes their title before calling.
     Systems missing from ``y`` or with a non-finite value are left out.
 
@@ -247,10 +256,12 @@ def plot_score_scatter(
         raise ValueError("plot_score_scatter: no system has both scores")
     xs = np.array([float(x[k]) for k in keep])
     ys = np.array([float(y[k]) for k in keep])
-    colours = [system_colour(label, list(x).index(label)) for label in keep]
+    by_label = dict(zip(x, system_colours(list(x)), strict=True))
+    colours = [by_label[label] for label in keep]
     with figure_style():
         ax = _new_axes(ax, figsize)
-        ax.scatter(xs, ys, color=colours, s=40, zorder=3)
+        for xi, yi, label, colour in zip(xs, ys, keep, colours, strict=True):
+            ax.scatter([xi], [yi], color=colour, s=40, zorder=3, label=label)
         ax.margins(x=0.15, y=0.2)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -267,7 +278,12 @@ _PLACES = [
     (0, -8, "top"),
     (6, 16, "bottom"),
     (6, -16, "top"),
+    (10, 26, "bottom"),
+    (10, -26, "top"),
 ]
+
+#: A label placed at most this many points above or below its point reads as its own; further away a line ties it.
+_BESIDE = 8
 
 
 def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, colours: list[Any]) -> None:
@@ -278,6 +294,7 @@ def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, co
     figure is drawn once first, so that the layout and the text sizes are final; the labels are left
     out of the layout, so placing them does not move the axes.
     """
+    from matplotlib.text import Text
     from matplotlib.transforms import Bbox
 
     fig = ax.figure
@@ -293,15 +310,18 @@ def _place_labels(ax: Any, labels: list[str], xs: np.ndarray, ys: np.ndarray, co
         places = [(side * dx, dy, va) for dx, dy, va in _PLACES]
         places += [(-dx, dy, va) for dx, dy, va in places if dx]  # the mirrored side
         note = ax.annotate(labels[i], (xs[i], ys[i]), xytext=(0, 0), textcoords="offset points",
-                           fontsize=9, color=colours[i])  # fmt: skip
+                           fontsize=9, color=colours[i], arrowprops={"arrowstyle": "-", "color": colours[i],
+                           "lw": 0.7, "shrinkA": 0, "shrinkB": 4})  # fmt: skip
         note.set_in_layout(False)
         for dx, dy, va in [*places, places[0]]:  # the first again when none is free
             note.xyann = (dx, dy)
             note.set(ha="center" if dx == 0 else ("left" if dx > 0 else "right"), va=va)
-            box = note.get_window_extent(renderer)
+            note.update_positions(renderer)
+            box = Text.get_window_extent(note, renderer)  # the words only, not the tie line
             inside = frame.contains(box.x0, box.y0) and frame.contains(box.x1, box.y1)
             if inside and not any(b.overlaps(box) for b in taken):
                 break
+        note.arrow_patch.set_visible(abs(dy) > _BESIDE)  # a label away from its point is tied to it
         taken.append(box)
 
 

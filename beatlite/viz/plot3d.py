@@ -549,15 +549,26 @@ def plot_keyframes(
 
 
 def _level_panel(
-    ax: Any, pts: np.ndarray, bones: np.ndarray, shown: Sequence[int], new: set[int], box: np.ndarray
+    ax: Any,
+    pts: np.ndarray,
+    bones: np.ndarray,
+    shown: Sequence[int],
+    new: set[int],
+    box: np.ndarray,
+    ghost: Sequence[int] = (),
 ) -> None:
-    """2D bones (``pts`` already projected) inside ``box`` ((2, 2): min, max): new ones thick red, earlier grey."""
+    """2D bones (``pts`` already projected) inside ``box`` ((2, 2): min, max): new ones thick red, earlier grey;
+    ``ghost`` bones (not in this level yet) dotted and light, so a panel without bones still shows where they go."""
+    for b in ghost:
+        xy = pts[bones[b]]
+        ax.plot(xy[:, 0], xy[:, 1], ":", lw=0.9, color="0.75")
     for b in shown:
         xy = pts[bones[b]]
         ax.plot(xy[:, 0], xy[:, 1], "-o", ms=2.5, lw=2.2 if b in new else 1.0,
                 color=GROUP_COLOURS["hands"] if b in new else "0.6")  # fmt: skip
-    if not len(shown):
-        ax.text(0.5, 0.5, "no bones here yet", transform=ax.transAxes, ha="center", va="center", color="0.5")
+    if len(ghost) and not len(shown):
+        ax.text(0.5, 0.02, "none of these bones yet", transform=ax.transAxes, ha="center", va="bottom",
+                color="0.4", fontsize=9)  # fmt: skip
     ax.set_xlim(box[0, 0], box[1, 0])
     ax.set_ylim(box[0, 1], box[1, 1])
     ax.set_aspect("equal")
@@ -601,7 +612,7 @@ def _levels_title(root: int | None, names: Sequence[str] | None) -> str:
     title = "bones each level adds (red) to the earlier ones (grey)"
     if root is None:
         return title
-    return f"{title}; under each: the bones below {names[root] if names else root}, from above"
+    return f"{title}; below the levels that reach it: the bones below {names[root] if names else root}, from above"
 
 
 def plot_bone_levels(
@@ -615,9 +626,12 @@ def plot_bone_levels(
 ) -> Any:
     """What each level of a bone hierarchy adds (HA2G's 6 levels, Sec. 3.2): new bones red, earlier ones grey.
 
-    One panel per level: the body from the front; with ``zoom``, a second panel per
-    level shows the bones below that joint (e.g. the right hand) from above,
-    enlarged. Panels are tight around the bones (equal aspect, no empty axes).
+    One panel per level: the body from the front; with ``zoom``, a second panel
+    shows the bones below that joint (e.g. the right hand) from above, enlarged,
+    for the rows of levels that reach it (HA2G: levels 4-6; no row of three
+    empty panels for levels 1-3). A zoom panel of a level without those bones, in
+    a row drawn for the others, shows them dotted and light ("none of these bones
+    yet"). Panels are tight around the bones (equal aspect, no empty axes).
 
     Parameters
     ----------
@@ -645,20 +659,30 @@ def plot_bone_levels(
     boxes = [_box(pts[np.unique(bones[sorted(keep)])]) for pts, keep in views]
     col_w = 9.6 / ncols
     heights = [min(col_w * float(np.ptp(b[:, 1]) / np.ptp(b[:, 0])), 1.5) for b in boxes]
-    n_blocks = -(-len(levels) // ncols)
+    blocks = [list(range(k, min(k + ncols, len(levels)))) for k in range(0, len(levels), ncols)]
+    # a row of views is drawn for a block of levels only when one of them has bones in that view (HA2G: the hand
+    # gets its first bones at level 4, so levels 1-3 have no hand row instead of three empty panels)
+    rows = [(block, v) for block in blocks for v, (_, keep) in enumerate(views)
+            if any(set(levels[k]) & keep for k in block)]  # fmt: skip
     with figure_style():
-        fig = _new_figure((9.6, n_blocks * (sum(heights) + 0.35 * len(views)) + 0.5), None)
+        fig = _new_figure((9.6, sum(heights[v] + 0.35 for _, v in rows) + 0.5), None)
         grid = fig.add_gridspec(
-            n_blocks * len(views), ncols, height_ratios=heights * n_blocks, hspace=0.2, wspace=0.05
+            len(rows), ncols, height_ratios=[heights[v] for _, v in rows], hspace=0.2, wspace=0.05
         )
-        previous: set[int] = set()
-        for k, level in enumerate(levels):
-            block, col = divmod(k, ncols)
-            for v, ((pts, keep), box) in enumerate(zip(views, boxes)):
-                ax = fig.add_subplot(grid[block * len(views) + v, col])
-                _level_panel(ax, pts, bones, sorted(set(level) & keep), (set(level) - previous) & keep, box)
+        for r, (block, v) in enumerate(rows):
+            pts, keep = views[v]
+            for col, k in enumerate(block):
+                previous = set(levels[k - 1]) if k else set()
+                ax = fig.add_subplot(grid[r, col])
+                shown = sorted(set(levels[k]) & keep)
+                _level_panel(ax, pts, bones, shown, (set(levels[k]) - previous) & keep, boxes[v],
+                             ghost=sorted(keep) if not shown else ())  # fmt: skip
                 if v == 0:
-                    ax.set_title(f"level {k + 1}: {len(level)} bones, {3 * len(level)} dims", fontsize=10)
-            previous = set(level)
+                    ax.set_title(
+                        f"level {k + 1}: {len(levels[k])} bones, {3 * len(levels[k])} dims", fontsize=10
+                    )
+                else:
+                    below = names[root] if names else root
+                    ax.set_title(f"level {k + 1}: below {below}, from above", fontsize=9, color="0.3")
         fig.suptitle(_levels_title(root, names), fontsize=11)
     return fig

@@ -152,6 +152,16 @@ def save_figure(
     -------
     list of Path
         The written files, in the order of ``formats``.
+
+    Raises
+    ------
+    beatlite.viz.check.FigureError
+        With ``BEATLITE_FIGURE_CHECK=raise`` (``make run``, ``make test``), when
+        :func:`beatlite.viz.check.check_figure` finds an empty panel, text under
+        8 px or two series in one colour (nothing is written); the default ``warn``
+        gives a :class:`~beatlite.viz.check.FigureWarning` and saves. Text is measured
+        at the lower of the saved dpi (150) and the figure's own dpi (100), at which
+        a notebook shows the figure inline.
     """
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -166,6 +176,14 @@ def save_figure(
     stem = Path(path_stem)
     if stem.suffix.lstrip(".").lower() in {f.lower().lstrip(".") for f in formats}:
         stem = stem.with_suffix("")
+    from beatlite.viz.check import check_figure, check_mode, report_problems
+
+    if (mode := check_mode()) != "off":
+        dpi = savefig_kwargs.get("dpi", save_params["savefig.dpi"])
+        dpi = (
+            fig.dpi if dpi == "figure" else min(float(dpi), fig.dpi)
+        )  # saved, and shown inline at the figure's dpi
+        report_problems(check_figure(fig, dpi=dpi), f"save_figure({stem.name!r})", mode)
     stem.parent.mkdir(parents=True, exist_ok=True)
     written = []
     for fmt in formats:
@@ -205,6 +223,53 @@ def system_colour(label: str, index: int = 0) -> str:
         if low.startswith(name):
             return NAMED_SYSTEM_COLOURS[name]
     return OTHER_SYSTEM_COLOURS[int(index) % len(OTHER_SYSTEM_COLOURS)]
+
+
+def system_colours(labels: Sequence[str]) -> list[str]:
+    """One distinct colour per system of a figure: named systems by name, the others in turn.
+
+    Unlike ``system_colour(label, index)`` with the position in the figure, the
+    systems without a named colour count only among themselves, so up to ten of
+    them never share a colour, whatever the order (e.g. rows ranked by a score).
+    A label whose named colour is already taken by another label of the list (e.g.
+    a second ground-truth row) gets a lighter shade of it.
+
+    Parameters
+    ----------
+    labels : sequence of str
+        The systems, in the figure's order.
+
+    Returns
+    -------
+    list of str
+        Hex colours, one per label; equal labels get equal colours.
+
+    Examples
+    --------
+    >>> system_colours(["Ground truth", "Ground truth (141 channels)", "CaMN", "Mean pose", "Random clip"])
+    ['#333333', '#999999', '#1f77b4', '#2ca02c', '#9467bd']
+    """
+    from matplotlib.colors import to_hex, to_rgb
+
+    colours: dict[str, str] = {}
+    unnamed = 0
+    for label in labels:
+        if label in colours:
+            continue
+        low = str(label).lower()
+        named = next((NAMED_SYSTEM_COLOURS[n] for n in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True)
+                      if low.startswith(n)), None)  # fmt: skip
+        if named is None:
+            colours[label] = OTHER_SYSTEM_COLOURS[unnamed % len(OTHER_SYSTEM_COLOURS)]
+            unnamed += 1
+            continue
+        colour, lighter = named, 0
+        while colour in colours.values() and lighter < 3:  # a second row of a named system: a lighter shade
+            lighter += 1
+            mix = 1.0 - 0.5**lighter
+            colour = to_hex([c + (1.0 - c) * mix for c in to_rgb(named)])
+        colours[label] = colour
+    return [colours[label] for label in labels]
 
 
 def slide_figsize(

@@ -1,0 +1,274 @@
+"""One check of a finished figure: empty panels, text too small to read, two series in one colour.
+
+:func:`check_figure` returns the problems it finds, as :class:`FigureProblem` records;
+:func:`beatlite.viz.style.save_figure` calls it on every figure it saves and warns
+(:class:`FigureWarning`) or raises (:class:`FigureError`) as ``BEATLITE_FIGURE_CHECK`` says
+(``warn``, the default; ``raise``, set by ``make run``, ``make test`` and the test suite; ``off``).
+
+What counts as a problem:
+
+- **empty panel**: a visible axes that shows no data (no line with a finite point, no patch,
+  image or non-empty collection), e.g. one that only says "nothing here yet"; an axes switched
+  off with nothing in it at all is a blank space, not a panel, and passes;
+- **small text**: a visible, non-empty text (titles, labels, tick labels, legend entries,
+  annotations) whose font is smaller than :data:`MIN_TEXT_PX` pixels at the saved size
+  (font size in points x dpi / 72);
+- **shared colour**: two labelled series (lines, bars, scatter points, filled areas with
+  different labels, as in a legend) of one axes or of the figure's legends drawn in the same
+  colour; the same label in several panels is one series and may keep its colour.
+
+>>> import matplotlib.pyplot as plt
+>>> fig, (a, b) = plt.subplots(1, 2)
+>>> _ = a.plot([0, 1], [0, 1], color="C0", label="CaMN")
+>>> _ = a.plot([0, 1], [1, 0], color="C0", label="mean pose")
+>>> _ = b.text(0.5, 0.5, "no data yet", fontsize=3)
+>>> for problem in check_figure(fig, dpi=150):
+...     print(problem)
+empty panel: axes 2 of 2 shows no data (its text: 'no data yet')
+small text: 'no data yet' is 6.2 px high at 150 dpi (under 8 px)
+shared colour: axes 1 of 2: 'CaMN' and 'mean pose' are both #1f77b4
+>>> plt.close(fig)
+
+Used on every figure the notebooks save (``bl.viz.save_figure``, first in notebooks/00_setup_and_tour.ipynb)
+and on the animation players of notebooks 05 and 08 (``to_html(dpi=80)``).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+#: Smallest readable font size, pixels of the saved (or shown) picture.
+MIN_TEXT_PX = 8.0
+
+#: Two colours closer than this in every RGB channel (0-1) count as one colour.
+COLOUR_TOLERANCE = 0.02
+
+#: ``BEATLITE_FIGURE_CHECK`` values: what :func:`beatlite.viz.style.save_figure` does with problems.
+CHECK_MODES = ("warn", "raise", "off")
+
+
+class FigureWarning(UserWarning):
+    """A saved figure has a problem :func:`check_figure` flags (``BEATLITE_FIGURE_CHECK=warn``)."""
+
+
+class FigureError(ValueError):
+    """A saved figure has a problem :func:`check_figure` flags (``BEATLITE_FIGURE_CHECK=raise``)."""
+
+
+@dataclass(frozen=True)
+class FigureProblem:
+    """One problem of a figure: ``kind`` is ``"empty panel"``, ``"small text"`` or ``"shared colour"``."""
+
+    kind: str
+    detail: str
+
+    def __str__(self) -> str:
+        return f"{self.kind}: {self.detail}"
+
+
+def check_mode() -> str:
+    """``BEATLITE_FIGURE_CHECK`` (``warn`` when unset): ``warn``, ``raise`` or ``off``."""
+    mode = os.environ.get("BEATLITE_FIGURE_CHECK", "warn").strip().lower() or "warn"
+    if mode not in CHECK_MODES:
+        raise ValueError(f"BEATLITE_FIGURE_CHECK must be one of {CHECK_MODES}, got {mode!r}")
+    return mode
+
+
+def check_figure(
+    fig: Any, *, dpi: float | None = None, min_text_px: float = MIN_TEXT_PX
+) -> list[FigureProblem]:
+    """The problems of a figure as it will be saved: empty panels, small text, shared colours.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        A finished figure (drawn once here, so that tick labels exist).
+    dpi : float, optional
+        Resolution of the saved picture, dots per inch; default ``rcParams["savefig.dpi"]``
+        (``"figure"`` means the figure's own dpi). Animations pass the dpi of their frames.
+    min_text_px : float
+        Smallest font size allowed, pixels at ``dpi``.
+
+    Returns
+    -------
+    list of FigureProblem
+        Empty when the figure passes; in figure order (axes by axes).
+    """
+    import matplotlib as mpl
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise TypeError(f"check_figure: fig must be a matplotlib Figure, got {type(fig).__name__}")
+    if dpi is None or dpi == "figure":
+        saved = mpl.rcParams["savefig.dpi"] if dpi is None else "figure"
+        dpi = fig.dpi if saved == "figure" else float(saved)
+    fig.canvas.draw()  # tick labels and layouts are final only after a draw
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    problems = [p for i, ax in enumerate(axes) if (p := _empty_panel(ax, i, len(axes)))]
+    problems += _small_texts(fig, float(dpi), float(min_text_px))
+    for i, ax in enumerate(axes):
+        problems += _shared_colours(_series(ax), f"axes {i + 1} of {len(axes)}")
+    for legend in fig.legends:
+        pairs = zip(legend.legend_handles, (t.get_text() for t in legend.get_texts()), strict=False)
+        problems += _shared_colours(
+            [(label, c) for h, label in pairs if (c := _colour(h)) is not None], "figure legend"
+        )
+    return problems
+
+
+def report_problems(problems: Iterable[FigureProblem], what: str, mode: str | None = None) -> None:
+    """Warn (:class:`FigureWarning`) or raise (:class:`FigureError`) about ``problems``, as ``mode`` says.
+
+    ``mode`` defaults to :func:`check_mode`; nothing happens when there is no problem or the mode is ``off``.
+    """
+    problems = list(problems)
+    mode = check_mode() if mode is None else mode
+    if not problems or mode == "off":
+        return
+    text = f"{what}: {len(problems)} figure problem(s):\n  " + "\n  ".join(map(str, problems))
+    if mode == "raise":
+        raise FigureError(text)
+    warnings.warn(text, FigureWarning, stacklevel=3)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _has_data(artist: Any) -> bool:
+    """Whether an artist draws data: a line with a finite point, a non-empty collection, a patch or an image."""
+    from matplotlib.collections import Collection
+    from matplotlib.lines import Line2D
+
+    if not artist.get_visible():
+        return False
+    if isinstance(artist, Line2D):
+        xy = np.asarray(artist.get_xydata(), dtype=float)
+        return bool(xy.size and np.isfinite(xy).all(axis=-1).any())
+    if isinstance(artist, Collection):
+        return len(artist.get_paths()) > 0 or len(artist.get_offsets()) > 0
+    return True
+
+
+def _empty_panel(ax: Any, index: int, n: int) -> FigureProblem | None:
+    data = [a for a in (*ax.lines, *ax.patches, *ax.collections, *ax.images, *ax.tables) if _has_data(a)]
+    if data:
+        return None
+    texts = [t.get_text() for t in ax.texts if t.get_visible() and t.get_text().strip()]
+    if not ax.axison and not texts and not ax.get_title() and ax.get_legend() is None:
+        return None  # a blank space left in a grid, nothing drawn
+    said = f" (its text: {texts[0]!r})" if texts else ""
+    return FigureProblem("empty panel", f"axes {index + 1} of {n} shows no data{said}")
+
+
+def _small_texts(fig: Any, dpi: float, min_px: float) -> list[FigureProblem]:
+    problems = []
+    seen: set[tuple[str, float]] = set()
+    for name, text in _drawn_texts(fig):
+        px = text.get_fontsize() * dpi / 72.0
+        if px < min_px and (name, px) not in seen:
+            seen.add((name, px))
+            verb = "are" if name.startswith("tick labels") else "is"
+            problems.append(
+                FigureProblem(
+                    "small text", f"{name} {verb} {px:.1f} px high at {dpi:g} dpi (under {min_px:g} px)"
+                )
+            )
+    return problems
+
+
+def _drawn_texts(fig: Any) -> list[tuple[str, Any]]:
+    """(name, Text) of the visible texts a saved figure shows: figure texts and legends, and per visible
+    axes its titles, texts, legend and, when its axis is on, axis labels and tick labels."""
+    texts = [
+        *fig.texts,
+        *(t for legend in fig.legends if legend.get_visible() for t in _legend_texts(legend)),
+    ]
+    texts += [
+        t for name in ("_suptitle", "_supxlabel", "_supylabel") if (t := getattr(fig, name, None)) is not None
+    ]
+    ticks: list[tuple[str, Any]] = []
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    for i, ax in enumerate(axes):
+        texts += [ax.title, getattr(ax, "_left_title", None), getattr(ax, "_right_title", None), *ax.texts]
+        legend = ax.get_legend()
+        if legend is not None and legend.get_visible():
+            texts += _legend_texts(legend)
+        if not ax.axison:
+            continue
+        for n in "xyz":
+            axis = getattr(ax, f"{n}axis", None)
+            if axis is not None and axis.get_visible():
+                texts += [axis.label, axis.get_offset_text()]
+                name = f"tick labels of axes {i + 1} of {len(axes)} ({n} axis)"
+                ticks += [(name, t) for t in axis.get_ticklabels(which="both")]
+    named = [(_quote(t.get_text()), t) for t in texts if t is not None]
+    return [(name, t) for name, t in [*named, *ticks] if t.get_visible() and t.get_text().strip()]
+
+
+def _quote(words: str) -> str:
+    words = words.strip()
+    return repr(words if len(words) <= 40 else words[:37] + "...")
+
+
+def _legend_texts(legend: Any) -> list[Any]:
+    return [*legend.get_texts(), legend.get_title()]
+
+
+def _series(ax: Any) -> list[tuple[str, tuple[float, float, float]]]:
+    """(label, colour) of each labelled artist of ``ax`` (what a legend would show)."""
+    handles, labels = ax.get_legend_handles_labels()
+    return [(label, c) for h, label in zip(handles, labels, strict=True) if (c := _colour(h)) is not None]
+
+
+def _colour(artist: Any) -> tuple[float, float, float] | None:
+    """The RGB colour that identifies a series: a line's colour, a bar's or point's face (else edge) colour."""
+    from matplotlib.colors import to_rgba
+    from matplotlib.container import Container
+    from matplotlib.lines import Line2D
+
+    if isinstance(artist, Container):
+        children = [a for a in artist if a is not None]
+        artist = children[0] if children else None
+    if artist is None:
+        return None
+    try:
+        if isinstance(artist, Line2D):
+            rgba = to_rgba(artist.get_color())
+        else:
+            faces = np.atleast_2d(artist.get_facecolor())
+            if not faces.size or faces[0, 3] == 0:
+                faces = np.atleast_2d(artist.get_edgecolor())
+            if not faces.size:
+                return None
+            rgba = tuple(faces[0])
+    except (AttributeError, ValueError, TypeError):
+        return None
+    return (float(rgba[0]), float(rgba[1]), float(rgba[2]))
+
+
+def _shared_colours(series: list[tuple[str, tuple[float, float, float]]], where: str) -> list[FigureProblem]:
+    from matplotlib.colors import to_hex
+
+    problems = []
+    first: list[tuple[str, tuple[float, float, float]]] = []
+    for label, colour in series:
+        same = [
+            other
+            for other, c in first
+            if other != label and max(abs(a - b) for a, b in zip(c, colour)) < COLOUR_TOLERANCE
+        ]
+        if same:
+            problems.append(
+                FigureProblem(
+                    "shared colour", f"{where}: {same[0]!r} and {label!r} are both {to_hex(colour)}"
+                )
+            )
+        if all(other != label for other, _ in first):
+            first.append((label, colour))
+    return problems

@@ -1,0 +1,177 @@
+"""beatlite.viz.check: each problem found on a purposely bad figure and not on a good one; save_figure runs it."""
+
+from __future__ import annotations
+
+import warnings
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from beatlite.viz import check, style  # noqa: E402
+
+
+def good_figure() -> plt.Figure:
+    """Two panels with data, 9-12 pt text, three series in three colours (and one label in both panels)."""
+    with style.figure_style():
+        fig, (a, b) = plt.subplots(1, 2, figsize=(6.4, 3.0), layout="constrained")
+        t = np.linspace(0, 1, 20)
+        a.plot(t, t, color="C0", label="CaMN")
+        a.plot(t, t**2, color="C1", label="HA2G")
+        a.set(xlabel="time (s)", ylabel="score (0-1)", title="curves")
+        style.legend_outside(a, "top")
+        b.bar([0, 1], [1.0, 2.0], color=["C2", "C3"])
+        b.plot(t, t, color="C0", label="CaMN")  # the same series in another panel keeps its colour
+        b.set_ylabel("FGD")
+        b.axvline(np.nan, color="C1", label="legend only")  # no finite point, but another colour
+        b.axis("on")
+    return fig
+
+
+def kinds(problems: list[check.FigureProblem]) -> list[str]:
+    return [p.kind for p in problems]
+
+
+def test_a_good_figure_has_no_problem():
+    fig = good_figure()
+    assert check.check_figure(fig, dpi=150) == []
+    plt.close(fig)
+
+
+def test_a_panel_that_only_says_nothing_is_here_is_empty_and_a_blank_grid_cell_is_not():
+    fig, axes = plt.subplots(1, 4, figsize=(8, 2))
+    axes[0].plot([0, 1], [0, 1])
+    axes[1].text(0.5, 0.5, "no bones here yet", transform=axes[1].transAxes)
+    axes[1].axis("off")  # switched off, but it shows words: a panel without data
+    axes[2].axvline(np.nan, label="only a legend entry")  # a line with no finite point draws nothing
+    axes[3].axis("off")  # an unused grid cell: nothing at all is drawn there
+    problems = check.check_figure(fig, dpi=150)
+    assert kinds(problems) == ["empty panel", "empty panel"]
+    assert "axes 2 of 4" in problems[0].detail and "no bones here yet" in problems[0].detail
+    assert "axes 3 of 4" in problems[1].detail
+    plt.close(fig)
+
+
+@pytest.mark.parametrize(("points", "dpi", "small"), [(5.0, 100, True), (5.0, 150, False), (3.5, 150, True)])
+def test_text_under_8_px_at_the_saved_dpi_is_flagged(points, dpi, small):
+    # 5 pt at 100 dpi = 6.94 px; at 150 dpi 10.4 px; 3.5 pt at 150 dpi = 7.29 px
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("time (s)", fontsize=points)
+    problems = check.check_figure(fig, dpi=dpi)
+    assert kinds(problems) == (["small text"] if small else [])
+    if small:
+        assert f"{points * dpi / 72:.1f} px" in problems[0].detail and "'time (s)'" in problems[0].detail
+    plt.close(fig)
+
+
+def test_small_tick_labels_of_a_hidden_axis_are_not_text_on_the_picture():
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    ax.tick_params(labelsize=3)
+    # 3 pt at 150 dpi: 6.25 px; one problem per axis, not one per tick label
+    problems = check.check_figure(fig, dpi=150)
+    assert [p.detail for p in problems] == [
+        f"tick labels of axes 1 of 1 ({a} axis) are 6.2 px high at 150 dpi (under 8 px)" for a in "xy"
+    ]
+    ax.axis("off")
+    assert check.check_figure(fig, dpi=150) == []
+    plt.close(fig)
+
+
+def test_the_default_dpi_is_the_saved_one():
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    ax.set_title("t", fontsize=5)  # 6.9 px at 100 dpi, 10.4 px at 150 dpi
+    with plt.rc_context({"savefig.dpi": 100}):
+        assert kinds(check.check_figure(fig)) == ["small text"]
+    with plt.rc_context({"savefig.dpi": 150}):
+        assert check.check_figure(fig) == []
+    plt.close(fig)
+
+
+def test_two_series_in_one_colour_are_flagged_lines_bars_and_points():
+    fig, (a, b, c) = plt.subplots(1, 3)
+    a.plot([0, 1], [0, 1], color="#9467bd", label="Random clip")
+    a.plot([0, 1], [1, 0], color="#9467bd", label="Mean pose")
+    b.bar([0], [1.0], color="#2ca02c", label="S2G")
+    b.bar([1], [2.0], color="#2ca02d", label="A2G")  # 1/255 apart in green: one colour to the eye
+    c.scatter([0], [1], color="#1f77b4", label="CaMN")
+    c.scatter([1], [1], color="#ff7f0e", label="HA2G")
+    problems = check.check_figure(fig, dpi=150)
+    assert kinds(problems) == ["shared colour", "shared colour"]
+    assert "'Random clip' and 'Mean pose'" in problems[0].detail and "#9467bd" in problems[0].detail
+    assert "axes 2 of 3" in problems[1].detail and "'S2G' and 'A2G'" in problems[1].detail
+    plt.close(fig)
+
+
+def test_a_figure_legend_with_two_entries_in_one_colour_is_flagged():
+    fig, (a, b) = plt.subplots(1, 2)
+    first = a.plot([0, 1], [0, 1], color="C0")[0]
+    second = b.plot([0, 1], [1, 0], color="C0")[0]
+    fig.legend([first, second], ["train", "validation"])
+    problems = check.check_figure(fig, dpi=150)
+    assert kinds(problems) == ["shared colour"] and "figure legend" in problems[0].detail
+    plt.close(fig)
+
+
+def bad_figure() -> plt.Figure:
+    fig, (a, b) = plt.subplots(1, 2)
+    a.plot([0, 1], [0, 1])
+    b.text(0.5, 0.5, "nothing yet")
+    return fig
+
+
+def test_save_figure_raises_warns_or_stays_quiet_as_beatlite_figure_check_says(tmp_path, monkeypatch):
+    fig = bad_figure()
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    with pytest.raises(check.FigureError, match="empty panel: axes 2 of 2"):
+        style.save_figure(fig, tmp_path / "bad")
+    assert list(tmp_path.iterdir()) == []  # nothing written
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "warn")
+    with pytest.warns(check.FigureWarning, match="save_figure\\('warned'\\): 1 figure problem"):
+        written = style.save_figure(fig, tmp_path / "warned", formats=("png",))
+    assert [p.name for p in written] == ["warned.png"] and written[0].stat().st_size > 0
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "off")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        style.save_figure(fig, tmp_path / "quiet", formats=("png",))
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "loud")
+    with pytest.raises(ValueError, match="BEATLITE_FIGURE_CHECK"):
+        style.save_figure(fig, tmp_path / "x", formats=("png",))
+    plt.close(fig)
+
+
+def test_save_figure_checks_text_at_the_dpi_it_saves_with(tmp_path, monkeypatch):
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    fig, ax = plt.subplots(dpi=100)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("x (cm)", fontsize=7)  # 14.6 px at the style's 150 dpi, 9.7 px at 100, 5.8 px at 60
+    style.save_figure(fig, tmp_path / "fine", formats=("png",))
+    with pytest.raises(check.FigureError, match="small text: 'x \\(cm\\)' is 5.8 px high at 60 dpi"):
+        style.save_figure(fig, tmp_path / "coarse", formats=("png",), dpi=60)
+    plt.close(fig)
+
+
+def test_save_figure_checks_text_at_the_size_a_notebook_shows_it_inline_too(tmp_path, monkeypatch):
+    """A notebook shows a figure at its own dpi (IPython's inline PNG); saved at 150 dpi it may be larger."""
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    fig, ax = plt.subplots(dpi=60)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("x (cm)", fontsize=9)  # 18.8 px in the 150-dpi file, 7.5 px inline at 60 dpi
+    with pytest.raises(check.FigureError, match="'x \\(cm\\)' is 7.5 px high at 60 dpi"):
+        style.save_figure(fig, tmp_path / "coarse", formats=("png",))
+    fig.set_dpi(100)  # 12.5 px inline
+    style.save_figure(fig, tmp_path / "fine", formats=("png",))
+    plt.close(fig)
+
+
+def test_the_test_suite_turns_a_figure_warning_into_an_error(monkeypatch):
+    """pyproject's filterwarnings: a figure saved by any test with a problem fails that test."""
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "warn")
+    with pytest.raises(check.FigureWarning):
+        check.report_problems([check.FigureProblem("empty panel", "axes 1 of 1 shows no data")], "t")
