@@ -365,3 +365,25 @@ def test_matplotlib_fallback_honours_the_box():
     ]
     ratio_cm = np.ptp(upper[:, 1]) / np.ptp(full[:, 1])  # 0.51
     assert abs(heights[1] / heights[0] - ratio_cm) < 0.08, (heights, ratio_cm)
+
+
+def test_trame_vtklocal_downloads_nothing(monkeypatch, tmp_path):
+    """The interactive extra's trame-vtklocal fetches VTK's WebAssembly bundle when a trame server starts;
+    beatlite's views do not use it, and no_wasm_download() makes its registration copy from an empty folder."""
+    wasm = pytest.importorskip("trame_vtklocal.module.wasm")  # only with the `interactive` extra
+    from beatlite.viz.render import no_wasm_download
+
+    fetched = []
+
+    async def fake_setup(dest, url):  # what would download
+        fetched.append(url)
+
+    monkeypatch.setattr(wasm, "setup_wasm_directory", fake_setup)
+    monkeypatch.delenv("VTK_WASM_DIR_OVERRIDE", raising=False)
+    folder = no_wasm_download()
+    assert __import__("os").listdir(folder) == []
+    wasm.register_wasm(str(tmp_path / "serve"))
+    assert fetched == []
+    monkeypatch.delenv("VTK_WASM_DIR_OVERRIDE")
+    wasm.register_wasm(str(tmp_path / "serve2"))  # without it: the download the test guards against
+    assert len(fetched) == 1 and fetched[0].startswith("https://")

@@ -570,7 +570,24 @@ def show_skeleton(
     width = (
         f"max(100%, {TRAME_MIN_WIDTH_PX}px)"  # the cell's width, never so narrow that the toolbar overlaps
     )
+    no_wasm_download()
     return plotter.show(jupyter_backend="trame", jupyter_kwargs={"width": width, "height": f"{h}px"})
+
+
+def no_wasm_download() -> str:
+    """Point trame-vtklocal at an empty VTK WebAssembly folder (``$VTK_WASM_DIR_OVERRIDE``, unless set already).
+
+    ``trame-pyvista`` needs ``trame-vtklocal``, which downloads VTK's WebAssembly bundle from gitlab.kitware.com
+    when its first trame server starts, for client-side rendering. beatlite's views are rendered by the kernel's
+    VTK and do not use it; with the folder set, nothing is downloaded (offline, the attempt printed a traceback
+    in the cell). Returns the folder (a temporary one of this process).
+    """
+    import os
+    import tempfile
+
+    if not os.environ.get("VTK_WASM_DIR_OVERRIDE"):
+        os.environ["VTK_WASM_DIR_OVERRIDE"] = tempfile.mkdtemp(prefix="beatlite-no-vtk-wasm-")
+    return os.environ["VTK_WASM_DIR_OVERRIDE"]
 
 
 def _in_notebook() -> bool:
