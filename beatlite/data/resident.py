@@ -11,22 +11,6 @@ zeros, the mel spectrogram with its last row), so the batches equal the view's b
 
 :func:`beatlite.train.fit` uses it for a store view when ``TrainConfig.data_on_device`` says so (on CUDA by
 default when the streams take at most half of the free GPU memory, :func:`fits_on_device`).
-
-Examples
---------
->>> from pathlib import Path
->>> from beatlite.data.examples import example_corpus
->>> from beatlite.data.index import index_folder
->>> from beatlite.data.store import build_store
->>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
->>> view = build_store(index_folder(tmp.name, cache=False), Path(tmp.name) / "store").windows("test")
->>> resident = ResidentWindows(view, keys=("pose", "audio", "word"), device="cpu")
->>> batch = resident.batch(torch.tensor([0, 5]))
->>> tuple(batch["pose"].shape), tuple(batch["audio"].shape), batch["word"].dtype
-((2, 34, 141), (2, 36266), torch.int64)
->>> bool(torch.equal(batch["pose"], torch.from_numpy(view.batch([0, 5], keys=("pose",))["pose"])))
-True
->>> tmp.cleanup()
 """
 
 from __future__ import annotations
@@ -78,7 +62,20 @@ def resident_bytes(view: StoreWindows, keys: Sequence[str]) -> int:
 
 def fits_on_device(view: StoreWindows, keys: Sequence[str], device: Any, *, share: float = 0.5) -> bool:
     """Whether the streams of ``keys`` fit in ``share`` of ``device``'s free memory (CUDA); ``False`` on the CPU,
-    where the store's loader keeps training memory-flat (ask for residency explicitly there)."""
+    where the store's loader keeps training memory-flat (ask for residency explicitly there).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.store import build_store
+    >>> tmp = example_corpus()
+    >>> view = build_store(index_folder(tmp.name, cache=False), Path(tmp.name) / "store").windows("test")
+    >>> fits_on_device(view, ("pose",), "cpu")  # the CPU route stays the memory-flat loader
+    False
+    >>> tmp.cleanup()
+    """
     device = torch.device(device)
     if device.type != "cuda":
         return False
@@ -111,6 +108,22 @@ class ResidentWindows:
     ----------
     nbytes : int
         Device memory held by the streams and offsets (:func:`resident_bytes`).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.store import build_store
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
+    >>> view = build_store(index_folder(tmp.name, cache=False), Path(tmp.name) / "store").windows("test")
+    >>> resident = ResidentWindows(view, keys=("pose", "audio", "word"), device="cpu")
+    >>> batch = resident.batch(torch.tensor([0, 5]))
+    >>> tuple(batch["pose"].shape), tuple(batch["audio"].shape), batch["word"].dtype
+    ((2, 34, 141), (2, 36266), torch.int64)
+    >>> bool(torch.equal(batch["pose"], torch.from_numpy(view.batch([0, 5], keys=("pose",))["pose"])))
+    True
+    >>> tmp.cleanup()
     """
 
     def __init__(self, view: StoreWindows, keys: Sequence[str], device: Any = "cpu") -> None:

@@ -579,7 +579,16 @@ DIVERSITY_BATCH = 16
 
 
 class TooFewWindows(ValueError):
-    """A metric needs more windows than the takes give; :func:`evaluate` lists it as skipped, with this message."""
+    """A metric needs more windows than the takes give; :func:`evaluate` lists it as skipped, with this message.
+
+    Examples
+    --------
+    17 windows make one batch of 16 for ``Diversity (ha2g)``, which needs two:
+
+    >>> takes = Takes(positions=[np.zeros((50, 2, 3))], features=np.zeros((17, 4)))
+    >>> evaluate(takes, GroundTruth(takes), metrics=("Diversity (ha2g)",)).skipped
+    {'Diversity (ha2g)': 'needs at least 2 batches of 16 windows, got 17 windows'}
+    """
 
 
 def _diversity_ha2g(g: Takes, t: GroundTruth, seed: int) -> float:
