@@ -61,6 +61,22 @@ def test_two_processes_take_the_same_steps_as_one_with_two_micro_batches(tmp_pat
 
 
 @pytest.mark.slow
+def test_two_processes_on_resident_windows_take_the_loaders_steps(tmp_path):
+    """Under torchrun, every process gathering its micro-batches from streams held on its device
+    (data_on_device="always") ends the epoch with the weights of the loader route, to the bit."""
+    torchrun = _torchrun()
+    runs = {}
+    for mode in ("never", "always"):
+        out = tmp_path / f"{mode}.pt"
+        run_ok([torchrun, "--standalone", "--nproc_per_node=2", str(SCRIPT), str(out), "2", "48", mode],
+               env=_env(), timeout=900)  # fmt: skip
+        runs[mode] = torch.load(out, weights_only=True)
+    a, b = runs["never"], runs["always"]
+    assert a["history"] == b["history"]
+    assert all(torch.equal(a["params"][k], b["params"][k]) for k in a["params"])
+
+
+@pytest.mark.slow
 def test_two_micro_batches_per_process_give_the_mean_gradient(tmp_path):
     """With 4 micro-batches per global batch, each of the 2 processes takes 2 (forwards under DDP's
     ``no_sync`` but the last, one backward over their sum): the generator gradient of the step is the
