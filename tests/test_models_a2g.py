@@ -222,3 +222,18 @@ def test_paper_preset_has_the_reference_parameter_count(batch):
     # 128 log-mel bands in (the reference: 64), 141 Euler channels out (the reference: 22 joints x 6)
     assert model.n_parameters() == reference_count(128, 141)
     assert model.eval()(batch)["pose"].shape == (3, 34, 141)
+
+
+def test_tiny_uses_the_code_means_and_freezes_the_unused_log_variances(batch):
+    model = _model()
+    assert not model.config.vae and model.config.speed_weight == model.config.xspeed_weight == 0
+    out = model(batch)
+    assert torch.equal(out["z_audio"], out["audio_mu"]) and torch.equal(out["z_m"], out["spec_mu"])
+    assert torch.equal(out["z_x"], out["map_mu"])
+    frozen = [n for n, p in model.named_parameters() if not p.requires_grad]
+    assert frozen and all(".logvar." in n for n in frozen)
+    parts = {k: v.detach() for k, v in model.losses(batch, out, epoch=0).items()}
+    assert float(parts["total"] - sum(parts[k] for k in ("rec", "cross", "relaxed"))) == pytest.approx(
+        float(0.1 * (parts["code"] + parts["cycle_spec"] + parts["cycle_share"]) + 0.1 * parts["diverse"]),
+        rel=1e-5,
+    )

@@ -72,14 +72,18 @@ Differences from the reference code at the ``paper`` preset (same layers and par
 Differences from the paper itself (Li et al. 2021, as far as its method section states them): the
 reference code above is followed wherever the two differ.
 
-The ``tiny`` preset (``a2g_tiny``, 40 epochs on ``data_samples/``) differs from ``paper`` in three ways:
+The ``tiny`` preset (``a2g_tiny``, 40 epochs on ``data_samples/``) differs from ``paper`` in four ways:
 every TCN and head is narrower (widths in :data:`PRESETS`); weights start from PyTorch's default
-initialisation (``init_std=0``), not N(0, 0.01); and the three speed terms are off (``speed_weight`` =
-``xspeed_weight`` = 0). Measured on ``a2g_tiny``, seed 2021: with the reference's speed weights (1, 1, 5),
-or even (0.2, 0.2, 0.2), the output froze into a static pose within the first epochs (the sampled
-per-frame codes make any motion costly under the speed L1), train reconstruction L1 0.61 and validation
-FGD 23.4 after 12 epochs, next to the mean pose's 25.3; without them the best validation FGD of 40
-epochs was 4.6. The reference trains for thousands of epochs at lr 1e-4.
+initialisation (``init_std=0``), not N(0, 0.01); the codes are their means (``vae=False``, the reference's
+four ``--with_*_vae`` switches off, so no KL terms; inference still draws ``z_x`` from the stored code
+statistics, so it still samples); and the three speed terms are off (``speed_weight`` = ``xspeed_weight`` = 0).
+Measured on ``a2g_tiny``: with the reference's speed weights (1, 1, 5) the output froze into a static pose
+(the sampled per-frame codes make any motion costly under the speed L1): seed 2021, train reconstruction L1
+0.61 and validation FGD 23.4 after 10 epochs with either initialisation, next to the mean pose's 25.3 (in a
+200-step fit of 64 training windows it stayed frozen with speed weights of 0.2 too). Without the speed terms but with sampled codes seed 2021 reached a best validation FGD of
+4.6, while seed 2022 stayed frozen for 22 epochs and then diverged (non-finite poses: with the KL weight at
+its schedule's 1e-7 nothing bounds the log-variances); with the means instead, seed 2022 reached 5.8 after
+13 epochs. The reference trains for thousands of epochs at lr 1e-4.
 """
 
 from __future__ import annotations
@@ -129,7 +133,7 @@ class A2GConfig(ModelConfig):
     vae : bool
         Sample the four codes (the reference's ``--with_audio_share_vae``, ``--with_motion_share_vae``,
         ``--with_motion_spec_vae``, ``--with_mapping_net_vae``, all on in its ``start.sh``); False uses
-        their means (the ``z_x`` draw from the stored statistics stays).
+        their means (the ``z_x`` draw from the stored statistics stays) and freezes the log-variance heads.
     stat_pool : int
         Training windows whose ``z_m`` statistics are kept for inference.
     eval_z : str
@@ -290,6 +294,9 @@ class A2G(GestureModel):
             nn.Conv1d(m, m, 3, padding=1),
         )  # fmt: skip
         self.mapping_code = _Gaussian(m, m, m)
+        if not cfg.vae:  # the log-variance heads exist (as in the reference) but are never used
+            for gaussian in (self.audio_code, self.share_code, self.spec_code, self.mapping_code):
+                gaussian.logvar.requires_grad_(False)
         for module in self.modules() if cfg.init_std > 0 else ():  # the reference's init
             if isinstance(module, (nn.Conv1d, nn.Linear)):
                 nn.init.normal_(module.weight, 0.0, cfg.init_std)
@@ -466,10 +473,11 @@ PRESETS: dict[str, dict[str, Any]] = {
         "out_hidden": 64,
         "stat_pool": 256,
         "init_std": 0.0,
+        "vae": False,
         "speed_weight": 0.0,
         "xspeed_weight": 0.0,
     },
 }
 """``paper``: the reference's widths and losses (2.47 M parameters); ``tiny``: every TCN and head a quarter to
-half as wide (0.21 M), same codes (16 + 16), PyTorch's default initialisation and no speed terms (module
-docstring: with them the 40-epoch recipe collapses to a static pose)."""
+half as wide (0.21 M), same code sizes (16 + 16), PyTorch's default initialisation, codes = their means and no
+speed terms (module docstring: the reference's sampling and speed terms froze or broke the 40-epoch recipe)."""
