@@ -237,3 +237,16 @@ def test_tiny_uses_the_code_means_and_freezes_the_unused_log_variances(batch):
         float(0.1 * (parts["code"] + parts["cycle_spec"] + parts["cycle_share"]) + 0.1 * parts["diverse"]),
         rel=1e-5,
     )
+
+
+def test_the_recipes_and_shipped_checkpoints_evaluate_with_sampled_codes():
+    from beatlite.paths import checkpoints_dir
+    from beatlite.train.checkpoint import load_checkpoint
+    from beatlite.train.recipes import RECIPES
+
+    for name in ("a2g_tiny", "joint_embedding_tiny"):
+        recipe = RECIPES[name]
+        assert build_model(recipe.model, preset="tiny", **recipe.overrides).config.eval_z == "sample", name
+        path = checkpoints_dir() / f"{name}.pt"
+        if path.is_file():
+            assert load_checkpoint(path)["model"]["eval_z"] == "sample", name
