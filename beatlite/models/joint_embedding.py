@@ -40,7 +40,8 @@ pose encoder's log-variance head included but frozen, below):
   eval call since construction or :meth:`JointEmbedding.reset` (the reference draws from the global
   random state); ``eval_z="mean"`` (an extra option) decodes ``mu``.
 - The text is the window's per-frame word ids (a word repeated over the frames it spans, PAD = 0 in
-  silences), as every beatlite model reads it; the reference pads the word sequence the same way.
+  silences, BEAT's rule), as every beatlite model reads it; the reference's padded word sequence puts each word
+  only at the frame where it starts (docs/reference_code.md#textgrid, the "onset" rule).
 - The output is ``euler141`` (z-scored Euler channels, like CaMN, S2G and Trimodal), not TED's 27
   direction-vector channels; the optimiser settings are the recipe's (reference: Adam, lr 5e-4,
   batch 128, 100 epochs).
