@@ -122,7 +122,7 @@ def test_claim_close_follows_the_record():
     assert not claim_close(edited, ["A", "B", "Text only"], "Ground truth", "BeatAlign", within=0.05).far
 
 
-def test_claim_close_on_the_shipped_record_names_the_text_only_models():
+def test_claim_close_on_the_shipped_record_names_seq2seq_and_joint_embedding():
     record = _recorded()
     moving = [
         "Random clip",
