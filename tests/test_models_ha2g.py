@@ -139,6 +139,37 @@ def test_holistic_switch_has_one_level_with_all_bones() -> None:
     assert tuple(out["style_weights"].shape) == (2, 3, 1)
 
 
+def test_the_reference_layer_order_is_the_codes() -> None:
+    # HA2G's ResNetSE34V2 / SEBasicBlock: stem conv (biased) -> ReLU -> BN; block conv1 -> ReLU -> BN1; each stream
+    # conv -> ReLU -> BN -> fc. Built by hand from a beatlite-order encoder's weights, the reference order gives
+    # the same features as HierarchicalAudioEncoder(order="reference") with those weights.
+    torch.manual_seed(0)
+    ref = HierarchicalAudioEncoder((8, 8, 16, 16), (1, 1, 1, 1), 4, 6, order="reference").eval()
+    for m in ref.modules():  # non-trivial BatchNorm statistics
+        if isinstance(m, torch.nn.BatchNorm2d):
+            m.running_mean.uniform_(-0.5, 0.5), m.running_var.uniform_(0.5, 2.0)
+    mel = torch.randn(2, 70, 128) * 20 - 40
+    x = (mel / 40.0 + 1.0).transpose(1, 2).unsqueeze(1)
+    conv, bn = ref.stem[0], ref.stem[2]
+    assert conv.bias is not None and isinstance(ref.stem[1], torch.nn.ReLU)
+    y = bn(torch.relu(conv(x)))
+    for block in [*ref.layer1, *ref.layer2]:
+        h = block.bn1(torch.relu(block.conv1(y)))
+        h = block.se(block.bn2(block.conv2(h)))
+        y = torch.relu(h + block.shortcut(y))
+    s = ref.streams["low"]
+    z = s.post[1](torch.relu(s.conv(y)))
+    b, c, f, t = z.shape
+    low = s.proj(z.permute(0, 3, 1, 2).reshape(b, t, c * f))[:, :34]
+    torch.testing.assert_close(ref(mel)["low"], low)
+    beat = HierarchicalAudioEncoder((8, 8, 16, 16), (1, 1, 1, 1), 4, 6)
+    assert beat.stem[0].bias is None and isinstance(beat.stem[1], torch.nn.BatchNorm2d)
+    extra = sum(p.numel() for p in ref.parameters()) - sum(p.numel() for p in beat.parameters())
+    assert extra == 8 + 2 * (8 + 4 + 1)  # the stem bias, and each stream's BatchNorm (2 per channel)
+    with pytest.raises(ValueError, match="order must be one of"):
+        HierarchicalAudioEncoder(order="other")
+
+
 def test_single_audio_and_same_audio_switches() -> None:
     single = _model(**ABLATIONS["single_audio"])
     assert single.coordinator is None

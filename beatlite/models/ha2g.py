@@ -121,7 +121,9 @@ class HA2GConfig(TextConfig, AdversarialConfig):
     ``no_adv_epochs`` is the 0-based epoch from which the GAN term is on (reference: epoch >
     ``loss_warmup`` = 10). ``slope`` is the LeakyReLU slope of the output heads and the
     discriminator (reference 0.01). ``audio_freq_stride`` is the frequency stride of the audio
-    learner's first convolution (reference 1; ``tiny`` 2).
+    learner's first convolution (reference 1; ``tiny`` 2). ``audio_order`` its layer order: ``"beatlite"``
+    (conv -> BN -> ReLU) or ``"reference"`` (HA2G's code: conv -> ReLU -> BN, biased stem, ReLU and BN after each
+    stream's convolution; docs/reference_code.md#ha2g-audio, where the difference is measured).
     """
 
     preset: str = "paper"
@@ -134,6 +136,7 @@ class HA2GConfig(TextConfig, AdversarialConfig):
     se_reduction: int = 8
     audio_features: int = 32
     audio_freq_stride: int = 1
+    audio_order: str = "beatlite"
     hidden: int = 300
     n_layers: int = 4
     dropout: float = 0.3
@@ -424,7 +427,7 @@ class HA2G(GestureModel):
             needed |= {"low", "high"}
         self.audio = HierarchicalAudioEncoder(
             c.audio_channels, c.audio_blocks, c.se_reduction, c.audio_features, sorted(needed), c.n_frames,
-            c.audio_freq_stride,
+            c.audio_freq_stride, c.audio_order,
         )  # fmt: skip
         self.coordinator: StyleCoordinator | None = None
         if c.audio_mode == "blend":

@@ -22,6 +22,7 @@ three audio levels for each body level (paper eq. 3).
 Differs from HA2G's code in the layer order only (docs/reference_code.md#ha2g-audio): the code's stem and
 first convolution of each block run convolution -> ReLU -> BatchNorm (here convolution -> BatchNorm -> ReLU, the
 stem unbiased), and its three streams add ReLU and BatchNorm after their convolution (here none).
+``order="reference"`` (``HA2GConfig.audio_order``) builds the code's order instead.
 
 Taught in notebooks/06_ha2g.ipynb, sections 3 (the hierarchical audio learner) and 5 (the style coordinator).
 """
@@ -37,6 +38,10 @@ from beatlite.constants import WINDOW_LENGTH
 
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
+
+LAYER_ORDERS: tuple[str, ...] = ("beatlite", "reference")
+"""Values of ``HierarchicalAudioEncoder(order=)``: beatlite's conv -> BN -> ReLU, or HA2G's code's conv -> ReLU -> BN
+(biased stem, ReLU and BN after each stream's convolution)."""
 
 N_MELS = 128
 
@@ -71,8 +76,9 @@ class SEBasicBlock2d(nn.Module):
     (B, in_ch, H, W) -> (B, out_ch, ceil(H / stride), ceil(W / stride))
     """
 
-    def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int) -> None:
+    def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int, order: str = "beatlite") -> None:
         super().__init__()
+        self.reference_order = order == "reference"  # HA2G's code: conv1 -> ReLU -> BN
         self.conv1 = nn.Conv2d(in_ch, out_ch, 3, stride=stride, padding=1, bias=False)
         self.bn1 = nn.BatchNorm2d(out_ch)
         self.conv2 = nn.Conv2d(out_ch, out_ch, 3, padding=1, bias=False)
@@ -86,21 +92,31 @@ class SEBasicBlock2d(nn.Module):
         )
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        y = self.relu(self.bn1(self.conv1(x)))
+        y = self.conv1(x)
+        y = self.bn1(self.relu(y)) if self.reference_order else self.relu(self.bn1(y))
         y = self.se(self.bn2(self.conv2(y)))
         return self.relu(y + self.shortcut(x))
 
 
-def _layer(in_ch: int, out_ch: int, n_blocks: int, stride: int, reduction: int) -> nn.Sequential:
-    blocks = [SEBasicBlock2d(in_ch, out_ch, stride, reduction)]
-    blocks += [SEBasicBlock2d(out_ch, out_ch, 1, reduction) for _ in range(n_blocks - 1)]
+def _layer(in_ch: int, out_ch: int, n_blocks: int, stride: int, reduction: int, order: str) -> nn.Sequential:
+    blocks = [SEBasicBlock2d(in_ch, out_ch, stride, reduction, order)]
+    blocks += [SEBasicBlock2d(out_ch, out_ch, 1, reduction, order) for _ in range(n_blocks - 1)]
     return nn.Sequential(*blocks)
 
 
 class _Stream(nn.Module):
-    """One feature stream: optional PixelShuffle, a 2-D conv, then a per-frame Linear."""
+    """One feature stream: optional PixelShuffle, a 2-D conv (HA2G's code: then ReLU and BatchNorm), then a
+    per-frame Linear."""
 
-    def __init__(self, channels: int, upscale: int, kernel: int, freq_in: int, out_features: int) -> None:
+    def __init__(
+        self,
+        channels: int,
+        upscale: int,
+        kernel: int,
+        freq_in: int,
+        out_features: int,
+        order: str = "beatlite",
+    ) -> None:
         super().__init__()
         if channels % (upscale * upscale):
             raise ValueError(
@@ -110,11 +126,16 @@ class _Stream(nn.Module):
         self.shuffle: nn.Module = nn.PixelShuffle(upscale) if upscale > 1 else nn.Identity()
         ch = channels // (upscale * upscale)
         self.conv = nn.Conv2d(ch, ch, kernel)
+        self.post: nn.Module = (
+            nn.Sequential(nn.ReLU(inplace=True), nn.BatchNorm2d(ch))
+            if order == "reference"
+            else nn.Identity()
+        )
         freq = freq_in * upscale - kernel + 1
         self.proj = nn.Linear(freq * ch, out_features)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        y = self.conv(self.shuffle(x))  # (B, C', F', T')
+        y = self.post(self.conv(self.shuffle(x)))  # (B, C', F', T')
         b, c, f, t = y.shape
         return self.proj(y.permute(0, 3, 1, 2).reshape(b, t, c * f))  # (B, T', out)
 
@@ -143,6 +164,10 @@ class HierarchicalAudioEncoder(nn.Module):
         frequency size of every layer (the stride-(2, 1) stem of voxceleb_trainer's "fast"
         SE-ResNet-34), so the low / mid / high streams read 32 / 16 / 8 frequency rows instead of
         64 / 32 / 16; the time axis, and so the 34 output frames, is unchanged.
+    order : {"beatlite", "reference"}
+        Layer order (:data:`LAYER_ORDERS`): conv -> BN -> ReLU, or HA2G's code's conv -> ReLU -> BN with a biased
+        stem and ReLU + BN after each stream's convolution (same weights' shapes, plus the stem bias and the
+        streams' BatchNorms).
 
     Shapes
     ------
@@ -159,8 +184,11 @@ class HierarchicalAudioEncoder(nn.Module):
         levels: Sequence[str] = AUDIO_LEVELS,
         n_frames: int = WINDOW_LENGTH,
         freq_stride: int = 1,
+        order: str = "beatlite",
     ) -> None:
         super().__init__()
+        if order not in LAYER_ORDERS:
+            raise ValueError(f"order must be one of {LAYER_ORDERS}, got {order!r}")
         c = tuple(int(v) for v in channels)
         nb = tuple(int(v) for v in blocks)
         if len(c) != 4 or len(nb) != 4 or min(c) < 1 or min(nb) < 1:
@@ -173,24 +201,27 @@ class HierarchicalAudioEncoder(nn.Module):
         fs = int(freq_stride)
         if fs not in (1, 2, 4):
             raise ValueError(f"freq_stride must be 1, 2 or 4, got {freq_stride}")
-        self.stem = nn.Sequential(
-            nn.Conv2d(1, c[0], 3, stride=(fs, 1), padding=1, bias=False),
-            nn.BatchNorm2d(c[0]),
-            nn.ReLU(inplace=True),
+        ref = order == "reference"  # HA2G's code: a biased stem conv, then ReLU before BatchNorm
+        stem = nn.Conv2d(1, c[0], 3, stride=(fs, 1), padding=1, bias=ref)
+        norm_act = (
+            (nn.ReLU(inplace=True), nn.BatchNorm2d(c[0]))
+            if ref
+            else (nn.BatchNorm2d(c[0]), nn.ReLU(inplace=True))
         )
-        self.layer1 = _layer(c[0], c[0], nb[0], 1, reduction)
-        self.layer2 = _layer(c[0], c[1], nb[1], 2, reduction)
+        self.stem = nn.Sequential(stem, *norm_act)
+        self.layer1 = _layer(c[0], c[0], nb[0], 1, reduction, order)
+        self.layer2 = _layer(c[0], c[1], nb[1], 2, reduction, order)
         need3 = "mid" in self.levels or "high" in self.levels
         need4 = "high" in self.levels
-        self.layer3 = _layer(c[1], c[2], nb[2], 2, reduction) if need3 else None
-        self.layer4 = _layer(c[2], c[3], nb[3], 2, reduction) if need4 else None
+        self.layer3 = _layer(c[1], c[2], nb[2], 2, reduction, order) if need3 else None
+        self.layer4 = _layer(c[2], c[3], nb[3], 2, reduction, order) if need4 else None
         streams: dict[str, nn.Module] = {}
         if "low" in self.levels:
-            streams["low"] = _Stream(c[1], 1, 2, N_MELS // (2 * fs), out_features)
+            streams["low"] = _Stream(c[1], 1, 2, N_MELS // (2 * fs), out_features, order)
         if "mid" in self.levels:
-            streams["mid"] = _Stream(c[2], 2, 3, N_MELS // (4 * fs), out_features)
+            streams["mid"] = _Stream(c[2], 2, 3, N_MELS // (4 * fs), out_features, order)
         if "high" in self.levels:
-            streams["high"] = _Stream(c[3], 4, 3, N_MELS // (8 * fs), out_features)
+            streams["high"] = _Stream(c[3], 4, 3, N_MELS // (8 * fs), out_features, order)
         self.streams = nn.ModuleDict(streams)
         self.out_features = int(out_features)
 
