@@ -61,6 +61,7 @@ from typing import Any
 import torch
 from torch import nn
 
+from beatlite.constants import WINDOW_LENGTH
 from beatlite.models.base import N_PRE, Batch, GestureModel, TextConfig, check_batch
 from beatlite.models.layers import PlainWavEncoder, TextEncoderTCN, match_length, sum_directions
 
@@ -120,7 +121,7 @@ class JointEmbeddingConfig(TextConfig):
     dropout: float = 0.3
     slope: float = 1.0
     rec_weight: float = 0.5
-    n_frames: int = 34
+    n_frames: int = WINDOW_LENGTH
     eval_z: str = "sample"
     seed: int = 0
 
