@@ -170,21 +170,15 @@ class ResidentWindows:
         """One take's stream of ``key`` as its batches hold it, padded at the end for windows running past it."""
         view, stream = self.view, KEY_STREAM[key]
         raw = take.stream(stream).read(0, int(take.meta["shapes"][stream][0]))
-        if key == "pose":
-            return view.normalizers.pose.transform(raw).astype(np.float32)
-        if key == "dirvec":
-            return view.normalizers.dirvec.transform(raw).astype(np.float32)
         if key == "word":
             return view._word_table(take_id)[raw]
-        if key == "emotion":
-            return raw.astype(np.int64)
         if key == "audio":
             samples = (raw * np.float64(take.meta["audio_scale"])).astype(np.float32)
             return np.concatenate([samples, np.zeros(self.n_audio, np.float32)])
+        rows = view._row_values(key, raw)
         if key == "mel":
-            rows = raw.astype(np.float32, copy=False)
             return np.concatenate([rows, np.repeat(rows[-1:], self.n_mel, axis=0)])
-        return raw.astype(np.float32, copy=False)
+        return rows
 
     def __len__(self) -> int:
         return int(self._offsets.shape[1])

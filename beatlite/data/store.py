@@ -723,22 +723,28 @@ class StoreWindows:
     def _key_values(self, k: str, idx: np.ndarray, raw: dict[str, np.ndarray]) -> np.ndarray:
         """Batch key ``k`` of the windows ``idx`` from their raw streams (normalised, mapped to the vocabulary)."""
         takes = self.store.takes
-        if k == "pose":
-            return self.normalizers.pose.transform(raw["pose_raw"]).astype(np.float32)
-        if k == "dirvec":
-            return self.normalizers.dirvec.transform(raw["dirs"]).astype(np.float32)
         if k == "word":
             rows = [self._word_table(int(t))[w] for t, w in zip(self.take_ids[idx], raw["word"])]
             return np.stack(rows).reshape(len(idx), self.length)
-        if k == "emotion":
-            return raw[k].astype(np.int64)
         if k == "speaker":
             return np.array([takes[t].meta["speaker"] for t in self.take_ids[idx]], np.int64)
         if k == "take":
             return np.array([takes[t].stem for t in self.take_ids[idx]])
         if k == "start":
             return self.starts[idx].copy()
-        return raw[KEY_STREAM[k]].astype(np.float32, copy=False)
+        return self._row_values(k, raw[KEY_STREAM[k]])
+
+    def _row_values(self, k: str, rows: np.ndarray) -> np.ndarray:
+        """Rows (any leading shape) of the stream of a per-frame key ``k`` other than ``word`` as its batches
+        hold them: ``pose`` and ``dirvec`` z-scored with this view's statistics, float32; ``emotion`` int64; the
+        other streams float32. Elementwise, so a whole take's rows give its windows' values."""
+        if k == "pose":
+            return self.normalizers.pose.transform(rows).astype(np.float32)
+        if k == "dirvec":
+            return self.normalizers.dirvec.transform(rows).astype(np.float32)
+        if k == "emotion":
+            return rows.astype(np.int64)
+        return rows.astype(np.float32, copy=False)
 
     def _read(self, idx: np.ndarray, streams: set[str]) -> dict[str, np.ndarray]:
         """Rows of ``streams`` for the windows ``idx``: frame streams (B, L, ...), audio (B, n), mel (B, M, 128)."""
