@@ -198,26 +198,36 @@ def evaluate_losses(
     ``windows``: in-memory windows, a window store view read batch by batch (only the model's keys), or
     :class:`~beatlite.data.resident.ResidentWindows` on the model's device.
     """
+    device = model_device(model)
     if isinstance(windows, ResidentWindows):
-        keys = _needed_keys(model, dict.fromkeys(windows.keys), "evaluate_losses")
-        store, arrays, n = None, None, len(windows)
+        _needed_keys(model, dict.fromkeys(windows.keys), "evaluate_losses")
+        n = len(windows)
+
+        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
+            return windows.batch(torch.from_numpy(idx).to(windows.device))
+
+    elif _is_store_view(windows):
+        keys = _needed_keys(model, windows, "evaluate_losses")
+        n = len(windows)
+
+        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
+            return _batch(windows.batch(idx, keys=keys), keys, slice(None), device)
+
     else:
-        store = windows if _is_store_view(windows) else None
-        arrays = None if store is not None else as_arrays(windows)
-        keys = _needed_keys(model, windows if store is not None else arrays, "evaluate_losses")
-        n = len(store) if store is not None else _n_windows(arrays, keys, "evaluate_losses")
+        arrays = as_arrays(windows)
+        keys = _needed_keys(model, arrays, "evaluate_losses")
+        n = _n_windows(arrays, keys, "evaluate_losses")
+
+        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
+            return _batch(arrays, keys, idx, device)
+
     was_training = model.training
     model.eval()
     sums: dict[str, Any] = {}
-    device = model_device(model)
     try:
         for start in range(0, n, batch_size):
             idx = np.arange(start, min(n, start + batch_size))
-            if isinstance(windows, ResidentWindows):
-                batch = windows.batch(torch.arange(start, start + len(idx), device=windows.device))
-            else:
-                source = arrays if store is None else store.batch(idx, keys=keys)
-                batch = _batch(source, keys, idx if store is None else slice(None), device)
+            batch = read(idx)
             _accumulate(sums, model.losses(batch, model(batch), epoch=epoch), len(idx))
     finally:
         model.train(was_training)
@@ -288,12 +298,12 @@ def fit(
         if run.path is not None and run.path.is_file():
             run.resume()
     run.wrap()
-    data.hold(config.data_on_device, run.device)
-    if data.resident is not None and val_windows is not None and _is_store_view(val_windows):
-        val_windows = ResidentWindows(val_windows, data.keys, run.device)
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
         return run.result()
+    data.hold(config.data_on_device, run.device)
+    if data.resident is not None and val_windows is not None and _is_store_view(val_windows):
+        val_windows = ResidentWindows(val_windows, data.keys, run.device)
     show = config.progress and run.rank == 0  # under torchrun, process 0 logs, scores and saves
     bar = progress(range(run.start_epoch, config.epochs), disable=not show, desc=model.name, unit="epoch")
     for epoch in bar:
