@@ -560,10 +560,6 @@ def load_split(data: str | Path | None = None, split: str = "test", *, protocol:
     return test
 
 
-def _load_test_set(data: str | Path | None, split: str) -> Any:
-    return load_split(data, split)
-
-
 def score_folder(
     pred: str | Path,
     data: str | Path | None = None,
@@ -612,7 +608,7 @@ def score_folder(
     ScoreInputError
         One line per problem: missing takes, unreadable or unconvertible files, too short predictions.
     """
-    test = _load_test_set(data, split) if test is None else test
+    test = load_split(data, split) if test is None else test
     files, missing, extra = match_predictions(pred, test.takes)
     problems = []
     if extra:
@@ -919,7 +915,7 @@ def export_checkpoint_takes(
 
     if format not in ("bvh", "npy"):
         raise ValueError(f"format must be 'bvh' or 'npy', got {format!r}")
-    test = _load_test_set(data, split) if test is None else test
+    test = load_split(data, split) if test is None else test
     torch.set_num_threads(n_threads())
     model, norms, _, _ = load_checkpoint_for(str(checkpoint), test)
     with torch.no_grad():
@@ -979,7 +975,7 @@ def self_check(
     whose offsets are not beatlite's: predictions are scored on beatlite's BEAT skeleton).
     Arguments as :func:`score_folder`.
     """
-    test = _load_test_set(data, split) if test is None else test
+    test = load_split(data, split) if test is None else test
     with tempfile.TemporaryDirectory(prefix="beatlite_self_check_") as tmp:
         export_ground_truth(test, tmp, data)
         result = score_folder(
@@ -1042,10 +1038,12 @@ def _parser() -> argparse.ArgumentParser:
 def _run(args: argparse.Namespace) -> int:
     from beatlite.io.atomic import atomic_write
 
+    if args.export and not args.pred:
+        raise ScoreInputError(["--export needs PRED, the folder to write"])
+    if not (args.export or args.self_check or args.pred):
+        raise ScoreInputError(["give PRED (a folder of predictions) or --self-check"])
     test = load_split(args.data, args.split, protocol=args.protocol)
     if args.export:
-        if not args.pred:
-            raise ScoreInputError(["--export needs PRED, the folder to write"])
         files = export_checkpoint_takes(args.export, args.pred, test=test, format=args.format)
         print(f"wrote {len(files)} files to {args.pred}")
         return 0
@@ -1053,10 +1051,8 @@ def _run(args: argparse.Namespace) -> int:
               "extractor": args.extractor, "progress": True, "test": test}  # fmt: skip
     if args.self_check:
         result = self_check(args.data, **common)
-    elif args.pred:
-        result = score_folder(args.pred, args.data, allow_missing=args.allow_missing, **common)
     else:
-        raise ScoreInputError(["give PRED (a folder of predictions) or --self-check"])
+        result = score_folder(args.pred, args.data, allow_missing=args.allow_missing, **common)
     text = result.to_markdown()
     print(text)
     if args.md:

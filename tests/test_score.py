@@ -38,9 +38,9 @@ REPRESENTATIVE = ("camn_tiny", "ha2g_tiny", "mean_pose")  # an Euler model, a di
 
 @pytest.fixture(scope="module")
 def test_set():
-    from beatlite.score import _load_test_set
+    from beatlite.score import load_split
 
-    return _load_test_set(REPO / "data_samples", "test")
+    return load_split(REPO / "data_samples", "test")
 
 
 @pytest.fixture(scope="module")
