@@ -766,31 +766,31 @@ def ablation_table(
     variants = [label for label in rows if label != full]
     by = {(e.variant, e.metric): e for e in compare_rows(record, full, variants, metrics=deltas)}
     heads = column_headers(metrics)
-    names = [METRICS[m].name if m in METRICS else m for m in metrics]  # a paper reports one variant per name
+    # a paper reports one variant per metric name: its value of "BC (ha2g)" is its "BC"
+    name = {m: METRICS[m].name if m in METRICS else m for m in (*metrics, *deltas)}
+
+    def paper_cells(published: Mapping[str, float]) -> list[str]:
+        return [fmt_metric(published.get(m, published.get(name[m], math.nan)), m) for m in metrics]
+
     header = [
         "variant",
         "paper row",
-        *[f"paper {h}" for h in column_headers(names)],
+        *[f"paper {h}" for h in column_headers([name[m] for m in metrics])],
         *[f"ours {h}" for h in heads],
     ]
     header += [f"Δ {m} ± 2 SE" for m in deltas] + ["seeds"]
     body = []
     for label, paper_row in rows.items():
         published = paper.get(paper_row, {}) if paper_row else {}
-        cells = [label, paper_row or "—"]
-        cells += [fmt_metric(published.get(m, published.get(n, math.nan)), m) for m, n in zip(metrics, names)]
+        cells = [label, paper_row or "—", *paper_cells(published)]
         cells += [record.cell(label, m) for m in metrics]
         cells += [
-            "" if label == full else by[label, m].cell(3 if n in ("SRGR", "BeatAlign", "BC") else 2)
-            for m, n in zip(deltas, [METRICS[m].name if m in METRICS else m for m in deltas])
+            "" if label == full else by[label, m].cell(3 if name[m] in ("SRGR", "BeatAlign", "BC") else 2)
+            for m in deltas
         ]
         body.append([*cells, record.count(label, metrics[0])])
     for paper_row, reason in (absent or {}).items():
         published = paper.get(paper_row, {})
-        cells = [
-            "—",
-            paper_row,
-            *[fmt_metric(published.get(m, published.get(n, math.nan)), m) for m, n in zip(metrics, names)],
-        ]
+        cells = ["—", paper_row, *paper_cells(published)]
         body.append([*cells, f"not trained: {reason}", *[""] * (len(metrics) - 1 + len(deltas)), 0])
     return markdown_table(header, body)
