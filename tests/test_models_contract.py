@@ -92,14 +92,23 @@ def _broken_models() -> dict[str, tuple[type, str]]:
         def batch_keys(cls, config) -> tuple[str, ...]:  # noqa: ANN001
             return ("mel",)
 
+    class ChecksOnTheHost(S2G):  # a per-step range check that copies the ids to the host
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            if int(batch["pose"].abs().max()) > 1e6:
+                raise ValueError("pose out of range")
+            return super().forward(batch)
+
     return {
         "dead parameter": (DeadParameter, "gradients", "no gradient: ['unused.weight', 'unused.bias']"),
+        "checks on the host": (ChecksOnTheHost, "no_host_reads", "the training pass reads the device"),
         "reads the future": (ReadsTheFuture, "shapes", "generate reads frames after the seed"),
         "forgets a key": (ForgetsAKey, "shapes", "batch_keys lacks ['pose']"),
     }
 
 
-@pytest.mark.parametrize("broken", ["dead parameter", "reads the future", "forgets a key"])
+@pytest.mark.parametrize(
+    "broken", ["dead parameter", "reads the future", "forgets a key", "checks on the host"]
+)
 def test_the_contract_names_the_rule_a_model_breaks(broken: str, tmp_path: Path) -> None:
     cls, check, message = _broken_models()[broken]
     with pytest.raises(AssertionError, match=re.escape(message)):

@@ -227,16 +227,20 @@ def kl_reference(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
     return torch.mean(-0.5 * torch.sum(1 + logvar - mu.pow(2) - logvar.exp(), dim=1))
 
 
-def kl_schedule(step: int) -> float:
+def kl_schedule(step: int | torch.Tensor) -> float | torch.Tensor:
     """The reference's KL weight factor at training step ``step``: ``max((step // 10) % 10000 * 1e-4, 1e-4)``.
 
-    It rises from 1e-4 to 0.9999 over 100000 steps, then starts again.
+    It rises from 1e-4 to 0.9999 over 100000 steps, then starts again. ``step`` may be an integer
+    tensor (the model's step counter, on the training device): the factor is then a float64 tensor
+    there, with the same value, so that the losses never read the counter back to the host.
 
     Examples
     --------
     >>> kl_schedule(0), kl_schedule(25), kl_schedule(100_000)
     (0.0001, 0.0002, 0.0001)
     """
+    if torch.is_tensor(step):
+        return (((step // 10) % 10000).double() * 1e-4).clamp(min=1e-4)
     return max((int(step) // 10) % 10000 * 1e-4, 1e-4)
 
 
@@ -346,7 +350,7 @@ class A2G(GestureModel):
         """Append each window's (mean, sd over frames) of ``z_m`` to the ring buffer ``spec_stats``."""
         stats = torch.stack([z_m.mean(1), z_m.std(1)], 1).float()[-self.config.stat_pool :]
         k, pool = stats.shape[0], self.config.stat_pool
-        idx = (int(self.n_stats) + torch.arange(k)) % pool
+        idx = (self.n_stats + torch.arange(k, device=stats.device)) % pool  # on the device: no host read
         self.spec_stats[idx] = stats
         self.n_stats += k
 
@@ -422,10 +426,10 @@ class A2G(GestureModel):
         cfg = self.config
         target = batch["pose"]
         l1 = nn.functional.l1_loss
-        step = int(self.steps)
+        step = self.steps  # on the device: the scheduled weights are tensors there (no host read per step)
         distance = (out["pose"] - target).abs()
         over = distance > cfg.tolerance
-        relaxed = distance[over].mean() if bool(over.any()) else distance.sum() * 0.0
+        relaxed = (distance * over).sum() / over.sum().clamp(min=1)  # mean beyond the tolerance (0 if none)
         parts = {
             "rec": l1(out["pose_motion"], target),
             "cross": l1(out["pose_cross"], target),
@@ -448,7 +452,7 @@ class A2G(GestureModel):
             "relaxed": cfg.xpose_weight,
             "relaxed_speed": cfg.xspeed_weight,
             "code": cfg.code_weight,
-            "diverse": max(cfg.ds_weight * (1.0 - step / cfg.ds_decay_steps), 0.0)
+            "diverse": (cfg.ds_weight * (1.0 - step.double() / cfg.ds_decay_steps)).clamp(min=0.0)
             if cfg.ds_decay_steps
             else 0.0,
             **dict.fromkeys(
@@ -459,7 +463,10 @@ class A2G(GestureModel):
             parts["cycle_spec"] = l1(out["z_x_spec"], out["z_x"])
             parts["cycle_share"] = l1(out["z_x_share"], out["z_pose"])
             weights["cycle_spec"] = weights["cycle_share"] = cfg.cycle_weight
-        parts["total"] = sum(weights[k] * parts[k] for k in weights)
+        # a float64 weight tensor is cast to the loss' dtype first, as a Python float would be
+        parts["total"] = sum(
+            (w.to(parts[k].dtype) if torch.is_tensor(w) else w) * parts[k] for k, w in weights.items()
+        )
         if self.training:
             self.steps += 1
         return parts

@@ -45,6 +45,7 @@ from beatlite.models.layers import (
     ConvDiscriminator,
     PlainWavEncoder,
     TextEncoderTCN,
+    check_ids,
     match_length,
     ns_gan_d_loss,
     ns_gan_g_loss,
@@ -354,11 +355,9 @@ class Trimodal(_Adversarial):
         pose = _check_pose(batch, "Trimodal")
         check_batch(batch, self.input_keys, "Trimodal")
         speaker = batch["speaker"]
-        if speaker.ndim != 1 or int(speaker.max()) >= self.config.n_speakers or int(speaker.min()) < 0:
-            raise ValueError(
-                f"Trimodal: batch['speaker'] must be (B,) ids in [0, {self.config.n_speakers}), "
-                f"got shape {tuple(speaker.shape)}"
-            )
+        if speaker.ndim != 1:
+            raise ValueError(f"Trimodal: batch['speaker'] must be (B,), got shape {tuple(speaker.shape)}")
+        check_ids(speaker, self.config.n_speakers, "Trimodal: batch['speaker'] ids")
         b, t, _ = pose.shape
         text = match_length(self.text_encoder(batch["word"]), t)
         audio = match_length(self.audio_encoder(batch["audio"]), t)

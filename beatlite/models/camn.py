@@ -54,6 +54,7 @@ from beatlite.models.layers import (
     ConvDiscriminator,
     TextEncoderTCN,
     WavEncoder,
+    check_ids,
     match_length,
     mlp,
     ns_gan_d_loss,
@@ -174,11 +175,7 @@ class SpeakerEncoder(nn.Module):
     def forward(self, speaker: torch.Tensor) -> torch.Tensor:
         if speaker.ndim != 1:
             raise ValueError(f"speaker must be (B,), got shape {tuple(speaker.shape)}")
-        n = self.embedding.num_embeddings
-        if speaker.numel() and (int(speaker.min()) < 0 or int(speaker.max()) >= n):
-            raise ValueError(
-                f"speaker ids must be in [0, {n}), got range [{int(speaker.min())}, {int(speaker.max())}]"
-            )
+        check_ids(speaker, self.embedding.num_embeddings, "speaker ids")
         return self.mlp(self.embedding(speaker))
 
 
@@ -201,11 +198,7 @@ class EmotionEncoder(nn.Module):
     def forward(self, emotion: torch.Tensor) -> torch.Tensor:
         if emotion.ndim != 2:
             raise ValueError(f"emotion must be (B, T), got shape {tuple(emotion.shape)}")
-        n = self.embedding.num_embeddings
-        if emotion.numel() and (int(emotion.min()) < 0 or int(emotion.max()) >= n):
-            raise ValueError(
-                f"emotion ids must be in [0, {n}), got range [{int(emotion.min())}, {int(emotion.max())}]"
-            )
+        check_ids(emotion, self.embedding.num_embeddings, "emotion ids")
         x = self.linear(self.embedding(emotion)).transpose(1, 2)
         return self.convs(x).transpose(1, 2)
 

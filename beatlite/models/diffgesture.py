@@ -200,10 +200,19 @@ class NoiseSchedule:
         self.betas = torch.cat([zero, torch.linspace(beta_1, beta_T, steps, dtype=torch.float64)])
         self.alphas = 1.0 - self.betas
         self.alpha_bars = torch.cumprod(self.alphas, 0)
+        self._on_device: dict[torch.device, dict[str, torch.Tensor]] = {}
 
-    def _at(self, values: torch.Tensor, t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
-        """``values[t]`` as (B, 1, 1) in ``like``'s dtype and device."""
-        return values[t.cpu()].to(like.device, like.dtype).view(-1, *([1] * (like.ndim - 1)))
+    def _at(self, name: str, t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+        """Table ``name`` at the steps ``t``, as (B, 1, 1) in ``like``'s dtype and device.
+
+        Indexed on ``t``'s device, from a copy of the table made there once: no host copy of ``t`` per call
+        (which would make the host wait for the device at every training step).
+        """
+        tables = self._on_device.get(t.device)
+        if tables is None:
+            names = ("betas", "alphas", "alpha_bars")
+            tables = self._on_device[t.device] = {n: getattr(self, n).to(t.device) for n in names}
+        return tables[name][t].to(like.dtype).view(-1, *([1] * (like.ndim - 1)))
 
     def q_sample(self, x0: torch.Tensor, t: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         """A draw of ``x_t ~ q(x_t | x_0)`` in closed form: ``sqrt(abar_t) x0 + sqrt(1 - abar_t) noise``.
@@ -213,23 +222,23 @@ class NoiseSchedule:
         x0, noise : (B, ...) float tensors
         t : (B,) int64 tensor, steps in 0..T
         """
-        ab = self._at(self.alpha_bars, t, x0)
+        ab = self._at("alpha_bars", t, x0)
         return ab.sqrt() * x0 + (1.0 - ab).sqrt() * noise
 
     def q_step(self, x_prev: torch.Tensor, t: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         """One step of the forward kernel ``q(x_t | x_{t-1}) = N(sqrt(alpha_t) x_{t-1}, beta_t I)``."""
         return (
-            self._at(self.alphas, t, x_prev).sqrt() * x_prev + self._at(self.betas, t, x_prev).sqrt() * noise
+            self._at("alphas", t, x_prev).sqrt() * x_prev + self._at("betas", t, x_prev).sqrt() * noise
         )
 
     def predict_x0(self, x_t: torch.Tensor, t: torch.Tensor, eps: torch.Tensor) -> torch.Tensor:
         """The clean window implied by a noise estimate: ``(x_t - sqrt(1 - abar_t) eps) / sqrt(abar_t)``."""
-        ab = self._at(self.alpha_bars, t, x_t)
+        ab = self._at("alpha_bars", t, x_t)
         return (x_t - (1.0 - ab).sqrt() * eps) / ab.sqrt()
 
     def predict_eps(self, x_t: torch.Tensor, t: torch.Tensor, x0: torch.Tensor) -> torch.Tensor:
         """The noise implied by a clean-window estimate: ``(x_t - sqrt(abar_t) x0) / sqrt(1 - abar_t)``."""
-        ab = self._at(self.alpha_bars, t, x_t)
+        ab = self._at("alpha_bars", t, x_t)
         return (x_t - ab.sqrt() * x0) / (1.0 - ab).sqrt()
 
     def posterior_variance(self, t: int) -> float:

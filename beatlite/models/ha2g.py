@@ -89,6 +89,7 @@ from beatlite.models.ha2g_losses import (
 from beatlite.models.layers import (
     ConvDiscriminator,
     TextEncoderTCN,
+    check_ids,
     ns_gan_d_loss,
     ns_gan_g_loss,
     sum_directions,
@@ -471,6 +472,13 @@ class HA2G(GestureModel):
         self.register_buffer("angle_var", torch.ones(len(pairs)))
         self.register_buffer("angle_change", torch.ones(len(pairs)))
         self.register_buffer("statistics_ready", torch.zeros((), dtype=torch.bool))
+        # the flag as a Python bool too, so that the losses check it without reading the device
+        self._ready = False
+        self.register_load_state_dict_post_hook(HA2G._read_ready)
+
+    @staticmethod
+    def _read_ready(module: nn.Module, _keys: Any) -> None:
+        module._ready = bool(module.statistics_ready)
 
     # ------------------------------------------------------------------ data statistics
     def set_statistics(
@@ -500,6 +508,7 @@ class HA2G(GestureModel):
                 self.angle_var.copy_(torch.as_tensor(stats.var))
                 self.angle_change.copy_(torch.as_tensor(stats.change))
             self.statistics_ready.fill_(True)
+        self._ready = True
 
     def prepare(self, train_windows: Any, normalizers: Normalizers | None = None) -> None:
         """Compute the data statistics from the training windows (called by ``fit``).
@@ -541,12 +550,7 @@ class HA2G(GestureModel):
         mel = batch["mel"]
         if mel.ndim != 3 or mel.shape[0] != b or mel.shape[2] != 128:
             raise ValueError(f"HA2G: batch['mel'] must be ({b}, M, 128), got {tuple(mel.shape)}")
-        spk = batch["speaker"]
-        if b and (int(spk.min()) < 0 or int(spk.max()) >= self.config.n_speakers):
-            raise ValueError(
-                f"HA2G: speaker ids must be in [0, {self.config.n_speakers}), "
-                f"got range [{int(spk.min())}, {int(spk.max())}]"
-            )
+        check_ids(batch["speaker"], self.config.n_speakers, "HA2G: speaker ids")
 
     def speaker_style(
         self, speaker: torch.Tensor, *, sample: bool | None = None, generator: torch.Generator | None = None
@@ -802,7 +806,7 @@ class HA2G(GestureModel):
                 - c.contrastive_neg_weight * con["negative"]
             )
         if c.use_physical:
-            if not bool(self.statistics_ready):
+            if not self._ready:
                 raise RuntimeError(
                     "HA2G: call prepare(train_windows) before training (angle statistics unset)"
                 )

@@ -226,11 +226,7 @@ class TextEncoderTCN(nn.Module):
     def forward(self, words: torch.Tensor) -> torch.Tensor:
         if words.ndim != 2:
             raise ValueError(f"TextEncoderTCN: words must be (B, T), got shape {tuple(words.shape)}")
-        if words.numel() and (int(words.min()) < 0 or int(words.max()) >= self.embedding.num_embeddings):
-            raise ValueError(
-                f"TextEncoderTCN: word ids must be in [0, {self.embedding.num_embeddings}), "
-                f"got range [{int(words.min())}, {int(words.max())}]"
-            )
+        check_ids(words, self.embedding.num_embeddings, "TextEncoderTCN: word ids")
         x = self.emb_drop(self.embedding(words)).transpose(1, 2)
         return self.proj(self.tcn(x).transpose(1, 2))
 
@@ -306,6 +302,23 @@ class ConvDiscriminator(nn.Module):
         feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
         seq, _ = getattr(self, self.rnn_name)(feat)
         return self.out2(self.out(sum_directions(seq, self.hidden)).squeeze(-1))
+
+
+def check_ids(ids: torch.Tensor, n: int, what: str) -> None:
+    """Raise ``ValueError`` naming ``what`` unless every id of ``ids`` is in ``[0, n)``; checked on the CPU only.
+
+    Reading the range of ids on a GPU would copy it to the host and make the host wait for the device
+    at every step (no step could then be queued ahead or captured in a CUDA graph); there the
+    embedding's own device-side bounds check stops a bad id (a CUDA error, never a wrong answer).
+    The windows a model trains on are in range by construction (the store's vocabulary and speaker ids).
+
+    Shapes: ids any shape, integer.
+    """
+    if ids.device.type != "cpu" or not ids.numel():
+        return
+    low, high = int(ids.min()), int(ids.max())
+    if low < 0 or high >= n:
+        raise ValueError(f"{what} must be in [0, {n}), got range [{low}, {high}]")
 
 
 def mlp(sizes: Sequence[int], slope: float = 0.1, *, last_act: bool = True) -> nn.Sequential:

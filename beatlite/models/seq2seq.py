@@ -46,7 +46,7 @@ import torch
 from torch import nn
 
 from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch
-from beatlite.models.layers import sum_directions
+from beatlite.models.layers import check_ids, sum_directions
 
 POSE_DIM = 141
 
@@ -142,11 +142,7 @@ class Seq2Seq(GestureModel):
             raise ValueError(
                 f"Seq2Seq: batch['word'] must be (B, T) = {tuple(pose.shape[:2])}, got {tuple(words.shape)}"
             )
-        if words.numel() and (int(words.min()) < 0 or int(words.max()) >= self.config.vocab_size):
-            raise ValueError(
-                f"Seq2Seq: word ids must be in [0, {self.config.vocab_size}), got range "
-                f"[{int(words.min())}, {int(words.max())}]"
-            )
+        check_ids(words, self.config.vocab_size, "Seq2Seq: word ids")
         return pose, words
 
     def forward(self, batch: Batch) -> dict[str, torch.Tensor]:

@@ -7,7 +7,7 @@ forward/backward pass can be unit-tested without the data pipeline.
 :func:`check_model` runs every rule of the :class:`~beatlite.models.base.GestureModel` contract on a
 model (in the spirit of scikit-learn's ``check_estimator``): shapes and seed-only generation on a batch of
 exactly its ``batch_keys``, finite losses whose backward reaches every parameter, determinism under a
-seed, the checkpoint round trip, and (given a small window store) two training steps from the store that
+seed, the checkpoint round trip, a training pass that never reads the device back to the host, and (given a small window store) two training steps from the store that
 equal the in-memory route bit for bit, and two under bfloat16 autocast with CUDA's dtype rules.
 ``tests/test_models_contract.py`` runs it over the whole registry.
 
@@ -342,12 +342,37 @@ def check_bf16_training(case: ModelCase) -> None:
     _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite bf16 losses {history}")
 
 
+def check_no_host_reads(case: ModelCase) -> None:
+    """The training pass (forward, losses, backward, and the discriminator's when adversarial) never reads a
+    value of a tensor back to the host.
+
+    Run on torch's ``meta`` device (shapes without data), where any such read (``int(t)``, ``bool(t)``,
+    ``t.item()``, ``t.cpu()``, indexing by a boolean mask) raises. On a GPU each would make the host wait
+    for the device at every step, so no step could be queued ahead of the device or captured in a CUDA
+    graph (``TrainConfig.compile="reduce-overhead"``).
+    """
+    model = _prepared(case, case.build())
+    batch = {k: v.to("meta") for k, v in case.batch(model).items()}
+    model.to("meta")
+    try:
+        losses = _train_losses(model, batch)
+        if model.trainable:
+            losses["total"].backward()
+        if model.discriminator is not None:
+            model.discriminator_losses(batch, model(batch))["total"].backward()
+    except (RuntimeError, NotImplementedError) as error:
+        raise AssertionError(
+            f"{case.cls.__name__} ({case.preset}): the training pass reads the device: {error}"
+        ) from error
+
+
 #: Contract checks on fake batches: name -> check(case).
 CHECKS = {
     "shapes": check_shapes,
     "gradients": check_gradients,
     "determinism": check_determinism,
     "checkpoint": check_checkpoint,
+    "no_host_reads": check_no_host_reads,
 }
 #: Contract checks that train from a window store (they need ``ModelCase.train`` and ``.reference``).
 STORE_CHECKS = {"store_training": check_store_training, "bf16_training": check_bf16_training}
