@@ -23,6 +23,13 @@ Per row:
   that it does not know, oneDNN's ``mkldnn_rnn_layer`` and cuDNN's ``_cudnn_rnn``, are counted here as
   ``2 x frames x windows x`` the size of their weight matrices forward and twice that backward; elementwise
   work is not counted).
+- **ops/step**: operators of one eager training step that reach a kernel (counted below autograd by a
+  ``TorchDispatchMode``; about one kernel launch each on a GPU, where the host's cost per launch bounds a
+  step of many small kernels whatever the batch). On the CPU a GRU counts its time steps' cell operators
+  (CUDA runs it as one cuDNN kernel), and Adam its loop over parameters (one fused kernel on CUDA).
+- **compile**: :attr:`beatlite.train.TrainConfig.compile` of the row (``--compile``; ``eager`` = none; the
+  timed steps come after a first, compiling one). FLOPs and operators are the eager step's; the fit
+  columns are left out (``-``): a fit of a few steps would time its compilation.
 - **% of peak**: achieved FLOP/s (GFLOP/window x step windows/s) over the rate of a large matrix product
   of the same precision measured in the same run on the same device (``peak`` line; 1024^2 on the CPU, 8192^2
   on CUDA), i.e. of what this device reaches on dense GEMMs, not of its datasheet.
@@ -50,11 +57,13 @@ from typing import Any
 
 import numpy as np
 import torch
+from torch.utils._python_dispatch import TorchDispatchMode
 from torch.utils.flop_counter import FlopCounterMode
 
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.paths import data_dir, n_threads
 from beatlite.train import TrainConfig, fit
+from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.training import _Run, model_keys
 
 QUICK_TAKES = ("2_scott_0_9_9", "4_lawrence_0_11_11", "6_carla_0_13_13")
@@ -155,6 +164,7 @@ class Row:
     device: str
     precision: str
     batch: int
+    compile: str = "eager"
     params: int | None = None
     gflop_per_window: float | None = None
     step_wps: float | None = None
@@ -163,6 +173,7 @@ class Row:
     fit_resident_wps: float | None = None
     peak_mib: float | None = None
     peak_fraction: float | None = None
+    ops_per_step: int | None = None
     note: str = ""
 
 
@@ -178,19 +189,34 @@ def _model(name: str, preset: str, train: Any, *, prepare: bool = True) -> Any:
     return model
 
 
-def _config(device: str, precision: str, batch: int, **kw: Any) -> TrainConfig:
+def _config(device: str, precision: str, batch: int, compile: str = "eager", **kw: Any) -> TrainConfig:  # noqa: A002
     return TrainConfig(
-        batch_size=batch, device=device, amp=precision == "bf16", progress=False, no_adv_epochs=0, **kw
-    )
+        batch_size=batch, device=device, amp=precision == "bf16", progress=False, no_adv_epochs=0,
+        compile=None if compile == "eager" else compile, **kw,
+    )  # fmt: skip
+
+
+class _CountOps(TorchDispatchMode):
+    """Counts the operators that reach a device kernel (after autograd): about one launch each on a GPU."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.count = 0
+
+    def __torch_dispatch__(self, func: Any, types: Any, args: tuple = (), kwargs: dict | None = None) -> Any:
+        self.count += 1
+        return func(*args, **(kwargs or {}))
 
 
 def measure_step(
-    name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0
-) -> Row:
-    """The step columns of one row: FLOPs, windows/s and peak memory of ``fit``'s training step (and, with
-    ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly operators)."""
+    name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0,
+    compile: str = "eager",  # noqa: A002
+) -> Row:  # fmt: skip
+    """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
+    (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
+    operators)."""
     model = _model(name, preset, train)
-    run = _Run(model, _config(device, precision, batch, epochs=1), "bench", {})
+    run = _Run(model, _config(device, precision, batch, compile, epochs=1), "bench", {})
     keys = model_keys(model)
     data = train.batch(np.arange(batch) % len(train), keys=keys)
     tensors = {k: torch.from_numpy(np.ascontiguousarray(v)).to(run.device) for k, v in data.items()}
@@ -199,9 +225,14 @@ def measure_step(
     }
     step = [(tensors, batch)]
     model.train()
+    counted = run  # FLOPs and operators of the eager step (a compiled step's kernels are not dispatched)
+    if compile != "eager":
+        counted = _Run(_model(name, preset, train), _config(device, precision, batch, epochs=1), "bench", {})
     with _flop_counter() as counter:
-        run.step(step, 1, 0, {})
-    run.step(step, 1, 0, {})  # warm-up (allocator, oneDNN primitives, cuDNN plans)
+        counted.step(step, 1, 0, {})
+    with _CountOps() as ops:
+        counted.step(step, 1, 0, {})
+    run.step(step, 1, 0, {})  # warm-up (allocator, oneDNN primitives, cuDNN plans; compilation)
     _sync(run.device)
     with _PeakMemory(run.device) as memory:
         start = time.perf_counter()
@@ -214,8 +245,9 @@ def measure_step(
     dtype = torch.bfloat16 if precision == "bf16" else torch.float32
     gflop = counter.get_total_flops() / batch / 1e9
     row = Row(
-        name, preset, device, precision, batch, model.n_parameters(), gflop, batch / seconds, 1e3 * seconds
-    )
+        name, preset, device, precision, batch, compile, model.n_parameters(), gflop, batch / seconds,
+        1e3 * seconds, ops_per_step=ops.count,
+    )  # fmt: skip
     row.peak_mib = memory.mib
     row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
     return row
@@ -253,8 +285,9 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
         view = store_train.store.windows("train", keys=keys, stats=store_train.normalizers)
         n = min(len(view), steps * row.batch)
         config = _config(
-            row.device, row.precision, row.batch, epochs=1, windows_per_epoch=n, data_on_device=mode
-        )
+            row.device, row.precision, row.batch, row.compile, epochs=1, windows_per_epoch=n,
+            data_on_device=mode,
+        )  # fmt: skip
         start = time.perf_counter()
         fit(model, view, config)
         setattr(row, field, n / (time.perf_counter() - start))
@@ -263,14 +296,15 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
 # ---------------------------------------------------------------------------- table and command line
 COLUMNS = (
     ("model", "model"), ("preset", "preset"), ("device", "device"), ("precision", "precision"),
-    ("batch", "batch"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
+    ("batch", "batch"), ("compile", "compile"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
+    ("ops_per_step", "ops/step"),
     ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s (loader)"),
     ("fit_ratio", "fit/step"), ("fit_resident_wps", "fit windows/s (resident)"), ("resident_ratio", "resident/loader"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
 )  # fmt: skip
 
 
 def _cell(row: Row, field: str) -> str:
-    if row.note and field not in ("model", "preset", "device", "precision", "batch"):
+    if row.note and field not in ("model", "preset", "device", "precision", "batch", "compile"):
         return row.note
     ratios = {"fit_ratio": (row.fit_wps, row.step_wps), "resident_ratio": (row.fit_resident_wps, row.fit_wps)}
     if field in ratios:
@@ -327,6 +361,10 @@ def _parse() -> argparse.Namespace:
     p.add_argument(
         "--fit-steps", type=int, default=None, help="steps of the timed fit epoch (default 10, quick 2)"
     )
+    p.add_argument(
+        "--compile", nargs="+", default=["eager"], choices=["eager", *COMPILE_MODES, *COMPILE_BACKENDS],
+        help="TrainConfig.compile of the rows (eager: none); default eager",
+    )  # fmt: skip
     p.add_argument("--json", type=Path, default=None, help="also write the rows as JSON here")
     p.add_argument(
         "--profile", type=int, default=0, help="print the N most costly operators of one step per row"
@@ -339,15 +377,17 @@ def _parse() -> argparse.Namespace:
     return args
 
 
-def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int]]:
-    """(model, preset, device, precision, batch) of every row; by default the paper presets on CUDA only."""
+def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str]]:
+    """(model, preset, device, precision, batch, compile) of every row; by default the paper presets on CUDA
+    only."""
     grid = []
     for name in args.models:
         for device in args.devices:
             paper = name in ("camn", "ha2g") and device == "cuda" and not args.quick
             for preset in args.presets or (["tiny", "paper"] if paper else ["tiny"]):
                 for precision in args.precisions:
-                    grid += [(name, preset, device, precision, b) for b in args.batch_sizes]
+                    for b in args.batch_sizes:
+                        grid += [(name, preset, device, precision, b, c) for c in args.compile]
     return grid
 
 
@@ -358,15 +398,19 @@ def main() -> None:
         train = _store_train(args.quick, Path(tmp) / "store")
         print(f"threads={torch.get_num_threads()}  torch {torch.__version__}  {len(train)} train windows")
         rows = []
-        for name, preset, device, precision, batch in _grid(args):
+        for name, preset, device, precision, batch, comp in _grid(args):
             if device == "cuda" and not torch.cuda.is_available():
-                rows.append(Row(name, preset, device, precision, batch, note=UNMEASURED))
+                rows.append(Row(name, preset, device, precision, batch, comp, note=UNMEASURED))
                 continue
-            row = measure_step(name, preset, device, precision, batch, train, args.steps, args.profile)
-            measure_fit(row, train, args.fit_steps)
+            row = measure_step(
+                name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp
+            )
+            if comp == "eager":  # (a compiled row's short fit would time its compilation)
+                measure_fit(row, train, args.fit_steps)
             rows.append(row)
             print(
-                f"  {name} {preset} {device} {precision} b{batch}: {row.step_wps:,.0f} windows/s", flush=True
+                f"  {name} {preset} {device} {precision} b{batch} {comp}: {row.step_wps:,.0f} windows/s",
+                flush=True,
             )
     for (device, dtype), flops in sorted(_PEAKS.items(), key=str):
         print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")

@@ -542,3 +542,46 @@ def test_convert_legacy_needs_trust_and_writes_a_plain_copy(windows, tmp_path):
     assert all(torch.equal(v, data["state"][k]) for k, v in plain["state"].items())
     model, _ = load_model(tmp_path / "plain.pt")
     assert all(torch.equal(v, data["state"][k]) for k, v in model.state_dict().items())
+
+
+def test_a_compiled_step_gives_the_losses_and_weights_of_the_eager_one(windows):
+    """``TrainConfig.compile``: the step through ``torch.compile`` (the ``aot_eager`` backend: traced into
+    graphs, run by the same kernels, as on a CPU without a compiler) trains as the eager step does: the same
+    losses and, in eval mode, the same poses. (Not the same raw weights: a convolution's bias before a
+    BatchNorm has a gradient of rounding noise only, which Adam scales up to full steps in either run.)"""
+    train, val = windows
+    eager, compiled = camn(), camn()
+    a = fit(eager, train, cfg(), val)
+    b = fit(compiled, train, cfg(compile="aot_eager"), val)
+    assert b.history[-1]["train"].keys() == a.history[-1]["train"].keys()
+    for x, y in zip(a.history, b.history, strict=True):  # fp32 reassociation in traced graphs at most
+        assert y["train"] == pytest.approx(x["train"], rel=1e-5)
+        assert y["val"] == pytest.approx(x["val"], rel=1e-5)
+    batch = {k: torch.from_numpy(v) for k, v in val.items()}
+    with torch.no_grad():
+        poses = [m.eval()(batch)["pose"] for m in (eager, compiled)]
+    # z-scored poses (sd 1): 1e-3 = a thousandth of a standard deviation (seen: 1.5e-4 after 6 steps)
+    torch.testing.assert_close(poses[1], poses[0], rtol=0, atol=1e-3)
+    with pytest.raises(ValueError, match="compile must be None or one of"):
+        TrainConfig(compile="fast")
+
+
+def test_adam_is_fused_on_cuda_only_and_the_fused_kernel_takes_the_same_steps():
+    """Fused Adam (CUDA's one kernel for all parameters) and torch's default loop: the same updates (to
+    float32 rounding), checked on the CPU, where torch has the fused kernel too; the CPU keeps the loop."""
+    from beatlite.train.training import _adam
+
+    torch.manual_seed(0)
+    params = [torch.nn.Parameter(torch.randn(5, 3)), torch.nn.Parameter(torch.randn(7))]
+    assert _adam(params, 1e-3, (0.5, 0.999)).defaults["fused"] is None  # on the CPU: the default loop
+    assert _adam([], 1e-3, (0.5, 0.999)) is None
+    copies = [[torch.nn.Parameter(p.detach().clone()) for p in params] for _ in range(2)]
+    loop = torch.optim.Adam(copies[0], lr=1e-2, betas=(0.5, 0.999))
+    fused = torch.optim.Adam(copies[1], lr=1e-2, betas=(0.5, 0.999), fused=True)
+    for step in range(5):
+        for group, opt in zip(copies, (loop, fused), strict=True):
+            opt.zero_grad()
+            sum(((p - step) ** 2).sum() for p in group).backward()
+            opt.step()
+    for p, q in zip(*copies, strict=True):
+        torch.testing.assert_close(q, p, rtol=1e-5, atol=1e-6)

@@ -271,7 +271,8 @@ def test_fit_command_writes_only_under_out(tmp_path):
         str(repo_root() / "data_samples"),
     ]
     env = {k: v for k, v in __import__("os").environ.items() if k != "BEATLITE_BUILD"}
-    options = ["--epochs", "1", "--device", "cpu", "--batch-size", "24", "--data-on-device", "always"]
+    options = ["--epochs", "1", "--device", "cpu", "--batch-size", "24", "--data-on-device", "always",
+               "--precision", "bf16", "--compile", "aot_eager"]  # fmt: skip
     run_ok([*cmd, "--out", str(out), *options], env=env, timeout=600)
     assert (out / "s2g_tiny.pt").is_file() and (out / "train" / "s2g_tiny.pt").is_file()
     assert list((out / "build" / "cache" / "store").rglob("meta.json"))  # the window store went under --out
@@ -285,6 +286,7 @@ def test_fit_command_writes_only_under_out(tmp_path):
 
     recipe, used = RECIPES["s2g_tiny"], full["train_config"]
     assert used["batch_size"] == 24 and used["data_on_device"] == "always"
+    assert used["amp"] is True and used["compile"] == "aot_eager"
     assert used["lr"] == (None if recipe.lr is None else pytest.approx(recipe.lr * 24 / recipe.batch_size))
     assert full["best"] is not None  # the validation FGD scored the epoch
 

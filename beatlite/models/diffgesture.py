@@ -227,9 +227,7 @@ class NoiseSchedule:
 
     def q_step(self, x_prev: torch.Tensor, t: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         """One step of the forward kernel ``q(x_t | x_{t-1}) = N(sqrt(alpha_t) x_{t-1}, beta_t I)``."""
-        return (
-            self._at("alphas", t, x_prev).sqrt() * x_prev + self._at("betas", t, x_prev).sqrt() * noise
-        )
+        return self._at("alphas", t, x_prev).sqrt() * x_prev + self._at("betas", t, x_prev).sqrt() * noise
 
     def predict_x0(self, x_t: torch.Tensor, t: torch.Tensor, eps: torch.Tensor) -> torch.Tensor:
         """The clean window implied by a noise estimate: ``(x_t - sqrt(1 - abar_t) eps) / sqrt(abar_t)``."""

@@ -309,12 +309,13 @@ def check_ids(ids: torch.Tensor, n: int, what: str) -> None:
 
     Reading the range of ids on a GPU would copy it to the host and make the host wait for the device
     at every step (no step could then be queued ahead or captured in a CUDA graph); there the
-    embedding's own device-side bounds check stops a bad id (a CUDA error, never a wrong answer).
+    embedding's own device-side bounds check stops a bad id (a CUDA error, never a wrong answer); so does
+    the CPU embedding's own check (an ``IndexError``) inside a ``torch.compile``-d pass.
     The windows a model trains on are in range by construction (the store's vocabulary and speaker ids).
 
     Shapes: ids any shape, integer.
     """
-    if ids.device.type != "cpu" or not ids.numel():
+    if ids.device.type != "cpu" or not ids.numel() or torch.compiler.is_compiling():
         return
     low, high = int(ids.min()), int(ids.max())
     if low < 0 or high >= n:

@@ -1,6 +1,7 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
-``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume]`` trains one recipe
+``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B]
+[--precision bf16] [--compile MODE]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
@@ -41,6 +42,7 @@ from pathlib import Path
 
 from beatlite import paths
 from beatlite.io.atomic import atomic_write, exclusive_lock
+from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
 from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
 from beatlite.train.seeds import (
@@ -93,6 +95,17 @@ def _parser() -> argparse.ArgumentParser:
         choices=("auto", "always", "never"),
         default="auto",
         help="hold the store's streams on the device, batches gathered there (auto: CUDA when they fit in half its free memory)",
+    )
+    f.add_argument(
+        "--precision",
+        choices=("fp32", "bf16"),
+        default="fp32",
+        help="bf16: bfloat16 autocast (TrainConfig.amp; weights and optimiser stay float32)",
+    )
+    f.add_argument(
+        "--compile",
+        choices=COMPILE_MODES + COMPILE_BACKENDS,
+        help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs); default eager",
     )
     f.add_argument(
         "--extractor-epochs",
@@ -203,6 +216,8 @@ def _fit_command(args: argparse.Namespace) -> int:
         checkpoint_every=args.checkpoint_every,
         batch_size=args.batch_size,
         data_on_device=args.data_on_device,
+        amp=args.precision == "bf16",
+        compile=args.compile,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

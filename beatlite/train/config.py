@@ -14,6 +14,10 @@ LR_SCHEDULES = ("constant", "cosine")
 """Values of :attr:`TrainConfig.lr_schedule`."""
 DATA_ON_DEVICE = ("auto", "always", "never")
 """Values of :attr:`TrainConfig.data_on_device`."""
+COMPILE_MODES = ("default", "reduce-overhead", "max-autotune", "max-autotune-no-cudagraphs")
+"""Values of :attr:`TrainConfig.compile` that are ``torch.compile`` modes (of its default backend, inductor)."""
+COMPILE_BACKENDS = ("cudagraphs", "aot_eager")
+"""Values of :attr:`TrainConfig.compile` that are other ``torch.compile`` backends."""
 
 
 @dataclasses.dataclass
@@ -74,6 +78,14 @@ class TrainConfig:
         disk read, host copy or DataLoader per step; the same batches to the bit). ``"auto"``: on CUDA when
         they take at most half of its free memory (:func:`beatlite.data.resident.fits_on_device`), never on
         the CPU, where the store's loader keeps the memory flat. In-memory windows are indexed in the loop.
+    compile : str or None
+        Run the forward pass and the losses through ``torch.compile``: one of :data:`COMPILE_MODES`
+        (``"reduce-overhead"``: inductor's kernels replayed as CUDA graphs, one launch for the many small
+        kernels of a step) or :data:`COMPILE_BACKENDS` (``"cudagraphs"``: CUDA graphs of the eager kernels;
+        ``"aot_eager"``: traced, not compiled, for checking on a CPU). ``None`` (default): eager. The
+        first steps compile (tens of seconds, again for a new batch shape); the recurrent layers run
+        eagerly between compiled parts. The training pass of every registered model reads nothing back
+        from the device (a model contract), which capturing a step in a CUDA graph needs.
     micro_batches : int
         Split every batch into this many micro-batches whose gradients are averaged before the step
         (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
@@ -102,6 +114,7 @@ class TrainConfig:
     workers: int = 0
     checkpoint_every: int | None = None
     data_on_device: str = "auto"
+    compile: str | None = None
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -123,6 +136,11 @@ class TrainConfig:
         if self.data_on_device not in DATA_ON_DEVICE:
             raise ValueError(
                 f"TrainConfig: data_on_device must be one of {DATA_ON_DEVICE}, got {self.data_on_device!r}"
+            )
+        if self.compile is not None and self.compile not in COMPILE_MODES + COMPILE_BACKENDS:
+            raise ValueError(
+                f"TrainConfig: compile must be None or one of {COMPILE_MODES + COMPILE_BACKENDS}, "
+                f"got {self.compile!r}"
             )
         if self.workers < 0:
             raise ValueError(f"TrainConfig: workers must be >= 0, got {self.workers}")

@@ -430,6 +430,8 @@ def retrain(
     checkpoint_every: int | None = None,
     batch_size: int | None = None,
     data_on_device: str = "auto",
+    amp: bool = False,
+    compile: str | None = None,  # noqa: A002
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -465,6 +467,11 @@ def retrain(
         its own ``lr``. Not the recipe the shipped numbers were measured with.
     data_on_device : {"auto", "always", "never"}
         :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
+    amp : bool
+        :attr:`beatlite.train.TrainConfig.amp` (bfloat16 autocast). Not the precision the shipped numbers
+        were measured with.
+    compile : str, optional
+        :attr:`beatlite.train.TrainConfig.compile` (``torch.compile`` mode or backend).
 
     Returns
     -------
@@ -495,6 +502,8 @@ def retrain(
         device=device,
         checkpoint_every=checkpoint_every,
         data_on_device=data_on_device,
+        amp=amp,
+        compile=compile,
     )
     score = None
     if recipe.select_best and config.epochs > 0:

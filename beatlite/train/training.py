@@ -21,7 +21,7 @@ from beatlite.data.resident import ResidentWindows, fits_on_device
 from beatlite.models.base import GestureModel
 from beatlite.notebook import progress
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
-from beatlite.train.config import TrainConfig
+from beatlite.train.config import COMPILE_BACKENDS, TrainConfig
 from beatlite.train.distributed import (
     distributed_rank,
     local_device,
@@ -416,6 +416,24 @@ class _Data:
             ]
 
 
+def _adam(params: list[torch.nn.Parameter], lr: float, betas: tuple[float, float]) -> torch.optim.Adam | None:
+    """Adam over ``params`` (``None`` without any): fused (one kernel for all parameters) when they are on
+    CUDA; torch's default elsewhere, so float32 training on the CPU stays bitwise what it was."""
+    if not params:
+        return None
+    fused = all(p.is_cuda for p in params) or None
+    return torch.optim.Adam(params, lr=lr, betas=betas, fused=fused)
+
+
+def _compiled(fn: Callable[..., Any], mode: str | None) -> Callable[..., Any]:
+    """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``)."""
+    if mode is None:
+        return fn
+    if mode in COMPILE_BACKENDS:
+        return torch.compile(fn, backend=mode)
+    return torch.compile(fn, mode=mode)
+
+
 class _Run:
     """One training run's optimisers, history, best epoch and checkpoint (the state :func:`fit` resumes)."""
 
@@ -429,13 +447,11 @@ class _Run:
         self.amp = bool(config.amp)
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
-        self.g_opt = (
-            torch.optim.Adam(self.g_params, lr=self.lr, betas=config.betas) if self.g_params else None
-        )
+        self.g_opt = _adam(self.g_params, self.lr, config.betas)
         self.d_opt = None
         if model.discriminator is not None:
             d_lr = self.lr * config.d_lr_weight
-            self.d_opt = torch.optim.Adam(model.discriminator.parameters(), lr=d_lr, betas=config.betas)
+            self.d_opt = _adam(list(model.discriminator.parameters()), d_lr, config.betas)
         # under torchrun: DistributedDataParallel over the generator and the discriminator (see wrap)
         self.g_ddp: Any = None
         self.d_ddp: Any = None
@@ -446,12 +462,22 @@ class _Run:
         )
         self.best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
         self.path = None if config.checkpoint is None else Path(config.checkpoint)
+        self._bind()
 
     def wrap(self) -> None:
         """Under ``torchrun``, build the DDP wrappers (after :meth:`resume`: they give every process process
         0's weights)."""
         if self.world > 1 and self.g_opt is not None:
             self.g_ddp, self.d_ddp = wrap_for_ddp(self.model, self.device)
+        self._bind()
+
+    def _bind(self) -> None:
+        """The step's forward pass and losses: the model's (or its DDP wrappers'), compiled when
+        ``config.compile`` says so."""
+        mode, model = self.config.compile, self.model
+        self.forward = _compiled(self.g_ddp or model, mode)
+        self.losses = _compiled(model.losses, mode)
+        self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
 
     def resume(self) -> None:
         """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``)."""
@@ -531,13 +557,13 @@ class _Run:
         outs = []
         for i, (batch, _) in enumerate(batches):
             with sync_on_last(self.g_ddp, i == last), self._autocast():
-                outs.append((self.g_ddp or model)(batch))
+                outs.append(self.forward(batch))
         if self.d_opt is not None and model.adversarial_active(epoch):
             self.d_opt.zero_grad(set_to_none=True)
             d_totals = []
             for i, ((batch, weight), out) in enumerate(zip(batches, outs, strict=True)):
                 with sync_on_last(self.d_ddp, i == last), self._autocast():
-                    d_losses = (self.d_ddp or model.discriminator_losses)(batch, out)
+                    d_losses = self.d_losses(batch, out)
                 d_totals.append(d_losses["total"] * self.world / parts)
                 _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
             _backward(d_totals, self.d_ddp)
@@ -547,7 +573,7 @@ class _Run:
         totals = []
         for (batch, weight), out in zip(batches, outs, strict=True):
             with self._autocast():
-                losses = model.losses(batch, out, epoch=epoch)
+                losses = self.losses(batch, out, epoch=epoch)
             totals.append(losses["total"] * self.world / parts)
             _accumulate(sums, losses, weight)
         _backward(totals, self.g_ddp)
