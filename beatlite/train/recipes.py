@@ -430,6 +430,7 @@ def retrain(
     checkpoint_every: int | None = None,
     batch_size: int | None = None,
     data_on_device: str = "auto",
+    val_every: int | None = None,
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -465,6 +466,9 @@ def retrain(
         its own ``lr``. Not the recipe the shipped numbers were measured with.
     data_on_device : {"auto", "always", "never"}
         :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
+    val_every : int, optional
+        :attr:`beatlite.train.TrainConfig.val_every`: validate (losses, validation FGD, best weights) every
+        this many optimiser steps instead of every epoch.
 
     Returns
     -------
@@ -495,6 +499,7 @@ def retrain(
         device=device,
         checkpoint_every=checkpoint_every,
         data_on_device=data_on_device,
+        val_every=val_every,
     )
     score = None
     if recipe.select_best and config.epochs > 0:
