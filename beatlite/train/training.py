@@ -263,7 +263,7 @@ def fit(
         model's :meth:`~beatlite.models.base.GestureModel.batch_keys` are read (a ``KeyError`` names
         the missing ones). :meth:`~beatlite.models.base.GestureModel.prepare` gets the same window set.
     config : TrainConfig
-        Epochs, batch size, learning rates, seed, threads, checkpoint path, resume.
+        Epochs, batch size, learning rates, seed, threads, checkpoint path, resume, validation interval.
     val_windows : same type as ``train_windows``, optional
         Validation windows: their mean losses are recorded after every epoch (or every
         ``config.val_every`` optimiser steps, see Notes).
@@ -496,9 +496,11 @@ class _Run:
         self.start_epoch = int(data["epoch"])
         self.partial = data.get("partial")
         self.best = data.get("best")
-        in_epoch = 0 if self.partial is None else int(self.partial["step"])
-        default = self.start_epoch * len(self.plan(train, 0)[0]) + in_epoch
-        self.steps = int(data.get("steps", default))
+        if "steps" in data:
+            self.steps = int(data["steps"])
+        else:  # written before the global step was stored: the epochs' steps, plus the partial epoch's
+            in_epoch = 0 if self.partial is None else int(self.partial["step"])
+            self.steps = self.start_epoch * len(self.plan(train, 0)[0]) + in_epoch
 
     def train_epoch(self, data: _Data, epoch: int) -> dict[str, float]:
         """One epoch of optimiser steps; returns the mean losses over its windows (over all processes).
