@@ -434,6 +434,143 @@ def test_resume_keeps_the_best_epoch_so_far(windows, tmp_path):
     assert [h["val_score"] for h in res.history] == [2.0, 1.0, 5.0]
 
 
+STEPS_PER_EPOCH = 24 // 8  # the fixture's 24 train windows in batches of 8 (cfg)
+
+
+def _steps_of(history):
+    """The global steps of every epoch's validations."""
+    return [[v["step"] for v in h["validations"]] for h in history]
+
+
+def _trained_four_steps(train, path):
+    """CaMN after a run's first 4 optimiser steps, trained another way: one full epoch (3 steps), then
+    resumed for epoch 1 on its first batch only (``windows_per_epoch=8``: batch 0 of the same shuffle)."""
+    fit(camn(), train, cfg(epochs=1, checkpoint=path))
+    fit(camn(), train, cfg(epochs=2, checkpoint=path, resume=True, windows_per_epoch=8))
+    return load_model(path)[0]
+
+
+def _assert_same_weights(a, b):
+    for (name, p), q in zip(a.state_dict().items(), b.state_dict().values(), strict=True):
+        assert torch.equal(p, q), name
+
+
+def test_val_every_validates_at_every_nth_step_of_the_run_and_at_its_end(windows, tmp_path):
+    from beatlite.train.training import evaluate_losses
+
+    train, val = windows
+    res = fit(camn(), train, cfg(epochs=3, val_every=4), val)
+    # 3 epochs of 3 steps: steps 4 and 8 (in epochs (4 - 1) // 3 = 1 and (8 - 1) // 3 = 2), then the last, 9
+    assert 3 * STEPS_PER_EPOCH == 9 and _steps_of(res.history) == [[], [4], [8, 9]]
+    assert res.history[0]["val"] == {} and "val_score" not in res.history[0]
+    assert [h["val"] for h in res.history[1:]] == [h["validations"][-1]["val"] for h in res.history[1:]]
+    # step 4's losses are those of the model trained 4 steps another way (step 4 is in epoch 1)
+    four = _trained_four_steps(train, tmp_path / "four.pt")
+    assert res.history[1]["validations"][0]["val"] == evaluate_losses(four, val, epoch=1, batch_size=8)
+    # step 9 ends a plain 3-epoch run, whose per-epoch validation of its last epoch saw the same model
+    plain = fit(camn(), train, cfg(epochs=3), val)
+    assert res.history[2]["validations"][1]["val"] == plain.history[2]["val"]
+    assert [h["train"] for h in res.history] == [
+        h["train"] for h in plain.history
+    ]  # validating changed nothing
+    assert "validations" not in plain.history[0] and plain.best_step is None
+
+
+def test_val_every_keeps_the_weights_of_the_lowest_scoring_step(windows, tmp_path):
+    train, val = windows
+    score, calls = _scripted_scores(3.0, 1.0, 2.0)
+    config = cfg(epochs=2, val_every=2, checkpoint=tmp_path / "run.pt")
+    res = fit(camn(), train, config, val, val_score=score)
+    assert calls == [False] * 3  # steps 2, 4 and 6 (the last: no extra one), scored in eval mode
+    assert _steps_of(res.history) == [[2], [4, 6]]
+    assert [[v["val_score"] for v in h["validations"]] for h in res.history] == [[3.0], [1.0, 2.0]]
+    assert [h["val_score"] for h in res.history] == [3.0, 2.0]  # an epoch's last validation
+    assert (res.best_epoch, res.best_step, res.best_score) == (1, 4, 1.0)
+    export_checkpoint(tmp_path / "run.pt", tmp_path / "best.pt", half=False)
+    best, data = load_model(tmp_path / "best.pt")
+    assert data["selected"] == {"epoch": 1, "score": 1.0, "of_epochs": 2, "step": 4}
+    _assert_same_weights(best, _trained_four_steps(train, tmp_path / "four.pt"))
+
+
+def test_a_run_validating_every_n_steps_killed_mid_epoch_resumes_with_the_same_record(
+    windows, tmp_path, monkeypatch
+):
+    """val_every=2 with checkpoint_every=1: a run stopped after 5 steps (epoch 1, after its validation at step
+    4) resumes at step 5 without validating step 4 again, and ends with the history, best and weights of an
+    uninterrupted run."""
+    from beatlite.train import training
+
+    train, val = windows
+    every = {"val_every": 2, "checkpoint_every": 1}
+    score = _scripted_scores(3.0, 1.0, 2.0)[0]
+    full = fit(camn(), train, cfg(checkpoint=tmp_path / "full.pt", **every), val, val_score=score)
+    calls, real_step = {"n": 0}, training._Run.step
+
+    def dying_step(self, *args):
+        if calls["n"] == 5:
+            raise KeyboardInterrupt("killed")
+        calls["n"] += 1
+        return real_step(self, *args)
+
+    monkeypatch.setattr(training._Run, "step", dying_step)
+    with pytest.raises(KeyboardInterrupt):
+        fit(
+            camn(),
+            train,
+            cfg(checkpoint=tmp_path / "part.pt", **every),
+            val,
+            val_score=_scripted_scores(3.0, 1.0)[0],
+        )
+    monkeypatch.setattr(training._Run, "step", real_step)
+    saved = torch.load(tmp_path / "part.pt", weights_only=True)
+    assert (saved["epoch"], saved["partial"]["step"], saved["steps"]) == (1, 2, 5)
+    assert [v["step"] for v in saved["partial"]["validations"]] == [4] and saved["best"]["step"] == 4
+    score, scored = _scripted_scores(2.0)
+    resumed = fit(
+        camn(), train, cfg(checkpoint=tmp_path / "part.pt", resume=True, **every), val, val_score=score
+    )
+    assert len(scored) == 1  # step 6 only
+    assert resumed.history == full.history and _steps_of(resumed.history) == [[2], [4, 6]]
+    assert (resumed.best_epoch, resumed.best_step, resumed.best_score) == (1, 4, 1.0)
+    a = torch.load(tmp_path / "full.pt", weights_only=True)
+    b = torch.load(tmp_path / "part.pt", weights_only=True)
+    for key in ("state", "optimizer", "best"):
+        assert _equal(a[key], b[key]), key
+
+
+def _equal(a, b):
+    """Nested dicts, lists and tensors equal to the bit."""
+    if torch.is_tensor(a):
+        return torch.is_tensor(b) and a.dtype == b.dtype and torch.equal(a, b)
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple):
+        return type(a) is type(b) and len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
+    return a == b
+
+
+def test_resuming_a_checkpoint_without_the_step_count_counts_the_epochs_steps(windows, tmp_path):
+    """A checkpoint written before the global step was stored: the run goes on counting from
+    epochs done x steps per epoch (epoch 1's steps are 4, 5, 6: validations at 4 and 6)."""
+    train, val = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "old.pt"), val)
+    old = torch.load(tmp_path / "old.pt", weights_only=True)
+    del old["steps"]
+    torch.save(old, tmp_path / "old.pt")
+    res = fit(camn(), train, cfg(epochs=2, val_every=2, checkpoint=tmp_path / "old.pt", resume=True), val)
+    assert "validations" not in res.history[0] and [v["step"] for v in res.history[1]["validations"]] == [
+        4,
+        6,
+    ]
+    assert torch.load(tmp_path / "old.pt", weights_only=True)["steps"] == 2 * STEPS_PER_EPOCH
+
+
+def test_val_every_must_be_positive():
+    with pytest.raises(ValueError, match="val_every must be >= 1 or None, got 0"):
+        TrainConfig(val_every=0)
+    assert TrainConfig(val_every=1).val_every == 1 and TrainConfig().val_every is None
+
+
 class _Marker:
     """A pickled object whose loading would run code: it writes a file when unpickled with the full loader."""
 

@@ -115,6 +115,30 @@ def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path)
         assert all(abs(a["train"][k] - b["train"][k]) <= 1e-9 * (1 + abs(a["train"][k])) for k in a["train"])
 
 
+@pytest.mark.slow
+def test_two_processes_validating_every_two_steps_resume_mid_epoch_with_the_same_record(tmp_path):
+    """Under torchrun with val_every=2, process 0 validates between steps (before a checkpoint of the same
+    step) while process 1 goes on: the steps' collectives still meet, validations fall on the global steps
+    2, 4 and 6 (3 steps per epoch), and a run stopped in epoch 2 resumes to the validations, best and
+    weights of an uninterrupted one."""
+    torchrun = _torchrun()
+    script = Path(__file__).with_name("ddp_resume.py")
+    out = {}
+    for mode in ("whole", "kill"):
+        path = tmp_path / f"{mode}.pt"
+        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, "val"]
+        run_ok(cmd, env=_env(), timeout=900)
+        out[mode] = torch.load(str(path) + ".out", weights_only=True)
+    whole, resumed = out["whole"], out["kill"]
+    assert [[v["step"] for v in h["validations"]] for h in whole["history"]] == [[2], [4, 6]]
+    assert whole["history"][1]["validations"][0]["val"]["rec"] > 0
+    for a, b in zip(whole["history"], resumed["history"], strict=True):
+        assert a["validations"] == b["validations"] and a["val"] == b["val"]
+    assert whole["best"] == resumed["best"] and whole["best"][1] in (2, 4, 6)
+    for name, p in whole["params"].items():
+        assert torch.equal(p, resumed["params"][name]), name
+
+
 EXIT_CHECK = """
 import atexit, sys
 import torch.distributed as dist

@@ -291,6 +291,35 @@ def test_fit_command_writes_only_under_out(tmp_path):
     assert full["best"] is not None  # the validation FGD scored the epoch
 
 
+class _Stop(Exception):
+    """Raised by a stand-in ``fit``, with the config it was given."""
+
+
+def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypatch):
+    """``fit --val-every N`` reaches ``TrainConfig.val_every`` (data, model and training stood in for)."""
+    import types
+
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+    from beatlite.train import recipes, training
+
+    def stand_in_fit(model, train, config, val=None, **kw):
+        raise _Stop(config)
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = types.SimpleNamespace(train=None, val=None, meta={})
+    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
+    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
+    monkeypatch.setattr(training, "fit", stand_in_fit)
+    argv = ["fit", "s2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(tmp_path / "run")]
+    for extra, expected in (([], None), (["--val-every", "25"], 25)):
+        with pytest.raises(_Stop) as stopped:
+            command.main([*argv, "--epochs", "0", *extra])
+        assert stopped.value.args[0].val_every == expected
+    with pytest.raises(ValueError, match="val_every must be >= 1"):
+        command.main([*argv, "--epochs", "0", "--val-every", "0"])
+
+
 def test_ablation_table_values_changes_and_paper_rows():
     from beatlite.train.seeds import SeedResults, ablation_table
 

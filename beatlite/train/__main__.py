@@ -7,7 +7,7 @@ batch split over them, gradients averaged by ``DistributedDataParallel``, proces
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
 float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
 are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
-for the per-epoch validation FGD.
+for the per-epoch validation FGD (``--val-every N``: every N optimiser steps instead).
 
 ``retrain-all [--only NAME ...] [--seed S] [--jobs J]`` rebuilds every shipped checkpoint of
 :data:`beatlite.train.recipes.RECIPES` (CaMN and its ablations, the baselines, HA2G and its
@@ -85,6 +85,11 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
     f.add_argument("--checkpoint-every", type=int, help="also checkpoint every N steps inside an epoch")
+    f.add_argument(
+        "--val-every",
+        type=int,
+        help="validate (losses, FGD, best weights) every N optimiser steps instead of every epoch",
+    )
     f.add_argument(
         "--batch-size",
         type=int,
@@ -218,6 +223,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         data_on_device=args.data_on_device,
         amp=args.precision == "bf16",
         compile=args.compile,
+        val_every=args.val_every,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

@@ -8,6 +8,7 @@ A checkpoint is a ``torch.save`` dict::
      "epoch": completed epochs, "history": [per-epoch loss dicts],
      "fingerprint": data fingerprint (str), "train_config": TrainConfig.to_dict(),
      "meta": {...}                          # e.g. normalisation statistics for generation
+     "steps": optimiser steps done over the whole run,
      # training checkpoints only:
      "optimizer", "d_optimizer", "rng": torch RNG state}
 
@@ -191,7 +192,8 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
     ``half`` (:func:`model_from_checkpoint` converts them back to float32). With ``best`` and a
     ``"best"`` entry (training with ``val_score``, see :func:`beatlite.train.fit`), the exported
     weights are those of the best-scoring epoch, recorded as ``"selected"``:
-    ``{"epoch": e, "score": s, "of_epochs": n}``; otherwise the last epoch's.
+    ``{"epoch": e, "score": s, "of_epochs": n}`` (and ``"step"``, the global optimiser step, when it was
+    validated every ``TrainConfig.val_every`` steps); otherwise the last epoch's.
     """
     data = load_checkpoint(src)
     keep = {k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng", "best")}
@@ -203,6 +205,8 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
             "score": float(chosen["score"]),
             "of_epochs": int(data.get("epoch", 0)),
         }
+        if chosen.get("step") is not None:
+            keep["selected"]["step"] = int(chosen["step"])
     if half:
         keep["state"] = {
             k: v.half() if torch.is_tensor(v) and v.is_floating_point() else v

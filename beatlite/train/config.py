@@ -69,6 +69,11 @@ class TrainConfig:
         Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
         BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as
         an uninterrupted run (under ``torchrun`` too: the checkpoint keeps the loss sums of all processes).
+    val_every : int or None
+        Validate (the validation losses and ``val_score`` of :func:`beatlite.train.fit`, and the best weights)
+        after every this many optimiser steps, counted over the whole run (steps of the earlier epochs plus
+        the step in this one, the same when resuming), instead of after every epoch; the run ends with one
+        more validation when its last step was not one. ``None`` = after every epoch.
     workers : int
         DataLoader worker processes that read the batches of a window store
         (:class:`beatlite.data.store.StoreWindows`); in-memory windows are indexed in the loop.
@@ -113,6 +118,7 @@ class TrainConfig:
     micro_batches: int = 1
     workers: int = 0
     checkpoint_every: int | None = None
+    val_every: int | None = None
     data_on_device: str = "auto"
     compile: str | None = None
 
@@ -133,6 +139,8 @@ class TrainConfig:
             raise ValueError(
                 f"TrainConfig: checkpoint_every must be >= 1 or None, got {self.checkpoint_every}"
             )
+        if self.val_every is not None and self.val_every < 1:
+            raise ValueError(f"TrainConfig: val_every must be >= 1 or None, got {self.val_every}")
         if self.data_on_device not in DATA_ON_DEVICE:
             raise ValueError(
                 f"TrainConfig: data_on_device must be one of {DATA_ON_DEVICE}, got {self.data_on_device!r}"

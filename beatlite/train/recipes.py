@@ -432,6 +432,7 @@ def retrain(
     data_on_device: str = "auto",
     amp: bool = False,
     compile: str | None = None,  # noqa: A002
+    val_every: int | None = None,
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -472,6 +473,9 @@ def retrain(
         were measured with.
     compile : str, optional
         :attr:`beatlite.train.TrainConfig.compile` (``torch.compile`` mode or backend).
+    val_every : int, optional
+        :attr:`beatlite.train.TrainConfig.val_every`: validate (losses, validation FGD, best weights) every
+        this many optimiser steps instead of every epoch.
 
     Returns
     -------
@@ -504,6 +508,7 @@ def retrain(
         data_on_device=data_on_device,
         amp=amp,
         compile=compile,
+        val_every=val_every,
     )
     score = None
     if recipe.select_best and config.epochs > 0:

@@ -43,7 +43,10 @@ class FitResult:
     ----------
     history : list of dict
         One entry per completed epoch: ``{"epoch": e, "train": {loss: mean}, "val": {loss: mean}}``
-        (``"val"`` is ``{}`` without validation windows).
+        (``"val"`` is ``{}`` without validation windows), plus ``"val_score"`` with a ``val_score``. With
+        ``TrainConfig.val_every`` also ``"validations"``: the epoch's validations in order,
+        ``[{"step": global step, "val": {...}, "val_score": score}, ...]`` (possibly none); ``"val"`` and
+        ``"val_score"`` are then the last of them (``{}`` and absent when the epoch had none).
     checkpoint : Path or None
         The checkpoint written after the last epoch.
     fingerprint : str
@@ -53,6 +56,9 @@ class FitResult:
         *last* epoch's weights; the checkpoint holds both, :func:`export_checkpoint` exports the best).
     best_score : float or None
         That epoch's score.
+    best_step : int or None
+        With ``TrainConfig.val_every``: the global optimiser step (1-based, counted over the whole run) of
+        the best-scoring validation, which happened in ``best_epoch``; ``None`` for per-epoch validation.
     """
 
     history: list[dict[str, Any]]
@@ -60,6 +66,7 @@ class FitResult:
     fingerprint: str
     best_epoch: int | None = None
     best_score: float | None = None
+    best_step: int | None = None
 
 
 def as_arrays(windows: Any) -> Mapping[str, np.ndarray]:
@@ -256,9 +263,10 @@ def fit(
         model's :meth:`~beatlite.models.base.GestureModel.batch_keys` are read (a ``KeyError`` names
         the missing ones). :meth:`~beatlite.models.base.GestureModel.prepare` gets the same window set.
     config : TrainConfig
-        Epochs, batch size, learning rates, seed, threads, checkpoint path, resume.
+        Epochs, batch size, learning rates, seed, threads, checkpoint path, resume, validation interval.
     val_windows : same type as ``train_windows``, optional
-        Validation windows: their mean losses are recorded after every epoch.
+        Validation windows: their mean losses are recorded after every epoch (or every
+        ``config.val_every`` optimiser steps, see Notes).
     meta : mapping, optional
         Stored verbatim in the checkpoint (e.g. the train split's
         :meth:`~beatlite.data.normalize.Normalizers.to_meta` needed by :func:`beatlite.train.generate`).
@@ -266,7 +274,8 @@ def fit(
         ``val_score(model) -> float``, lower is better, called in eval mode after every epoch
         (e.g. :func:`beatlite.train.testset.fgd_scorer`: FGD on the validation takes, the
         reference's choice of its best checkpoint). Recorded as ``history[e]["val_score"]``; the
-        lowest-scoring epoch's weights are kept in the checkpoint as ``"best"``.
+        lowest-scoring epoch's weights are kept in the checkpoint as ``"best"`` (or every
+        ``config.val_every`` steps: the lowest-scoring step's, see Notes).
 
     Returns
     -------
@@ -281,6 +290,14 @@ def fit(
     ``numpy.random.default_rng([seed, epoch])`` (an epoch keeps the first
     ``windows_per_epoch`` windows of its shuffle when that is set) and the torch RNG state is checkpointed,
     so ``resume=True`` reproduces the losses of an uninterrupted run exactly.
+
+    With ``config.val_every = N`` the validation (losses, ``val_score``, best weights) runs after the
+    optimiser steps N, 2N, ... of the whole run (steps of the earlier epochs plus the step in this one;
+    checkpoints store the count, so resuming, also from a mid-epoch checkpoint, validates at the same steps
+    with the same numbers), not at epoch ends, except that the run ends with one more validation when its
+    last step was not one (a finished run extended by resuming with more ``epochs`` keeps it). Under
+    ``torchrun`` process 0 validates while the others go on to the next step (they wait for it in its
+    gradient reduction).
     """
     if not isinstance(model, GestureModel):
         raise TypeError(f"fit: model must be a GestureModel, got {type(model).__name__}")
@@ -296,7 +313,7 @@ def fit(
     if config.resume:
         wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
         if run.path is not None and run.path.is_file():
-            run.resume()
+            run.resume(data)
     run.wrap()
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
@@ -304,14 +321,12 @@ def fit(
     data.hold(config.data_on_device, run.device)
     if data.resident is not None and val_windows is not None and _is_store_view(val_windows):
         val_windows = ResidentWindows(val_windows, data.keys, run.device)
+    run.val_windows, run.val_score = val_windows, val_score
     show = config.progress and run.rank == 0  # under torchrun, process 0 logs, scores and saves
     bar = progress(range(run.start_epoch, config.epochs), disable=not show, desc=model.name, unit="epoch")
     for epoch in bar:
-        entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch), "val": {}}
-        if val_windows is not None and run.rank == 0:
-            entry["val"] = evaluate_losses(model, val_windows, epoch=epoch, batch_size=config.batch_size)
-        if val_score is not None and run.rank == 0:
-            run.score(epoch, val_score, entry)
+        entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch)}
+        entry.update(run.epoch_validation(epoch))
         run.history.append(entry)
         bar.set_postfix(_shown_losses(entry))
         run.save(epoch + 1)
@@ -442,6 +457,8 @@ class _Run:
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
         self.rank, self.world = distributed_rank()
+        # micro-batches per optimiser step, spread over the processes
+        self.parts = max(config.micro_batches, self.world)
         self.device = local_device(config.torch_device())
         model.to(self.device)
         self.amp = bool(config.amp)
@@ -457,10 +474,13 @@ class _Run:
         self.d_ddp: Any = None
         self.history: list[dict[str, Any]] = []
         self.start_epoch = 0
-        self.partial: dict[str, Any] | None = (
-            None  # a mid-epoch checkpoint's position: epoch, step, loss sums
-        )
-        self.best: dict[str, Any] | None = None  # {"epoch", "score", "state"} of the lowest val_score
+        self.partial: dict[str, Any] | None = None  # a mid-epoch checkpoint's epoch, step, sums, validations
+        # {"epoch", "score", "state"} of the lowest val_score ("step" too with val_every)
+        self.best: dict[str, Any] | None = None
+        self.steps = 0  # optimiser steps done over the whole run (the global step of val_every)
+        self.validations: list[dict[str, Any]] = []  # with val_every: this epoch's validations so far
+        self.val_windows: Any = None
+        self.val_score: Callable[[GestureModel], float] | None = None
         self.path = None if config.checkpoint is None else Path(config.checkpoint)
         self._bind()
 
@@ -479,8 +499,11 @@ class _Run:
         self.losses = _compiled(model.losses, mode)
         self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
 
-    def resume(self) -> None:
-        """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``)."""
+    def resume(self, train: _Data) -> None:
+        """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``).
+
+        A checkpoint written before the global step was stored counts ``train``'s steps per epoch instead.
+        """
         data = load_checkpoint(self.path)
         if data.get("fingerprint") != self.fingerprint:
             raise ValueError(
@@ -499,44 +522,66 @@ class _Run:
         self.start_epoch = int(data["epoch"])
         self.partial = data.get("partial")
         self.best = data.get("best")
+        if "steps" in data:
+            self.steps = int(data["steps"])
+        else:  # written before the global step was stored: the epochs' steps, plus the partial epoch's
+            in_epoch = 0 if self.partial is None else int(self.partial["step"])
+            self.steps = self.start_epoch * len(self.plan(train, 0)[0]) + in_epoch
 
     def train_epoch(self, data: _Data, epoch: int) -> dict[str, float]:
-        """One epoch of optimiser steps; returns the mean losses over its windows (over all processes)."""
+        """One epoch of optimiser steps; returns the mean losses over its windows (over all processes).
+
+        With ``val_every``, validates after every ``val_every``-th step of the run (:meth:`validate_step`),
+        before a mid-epoch checkpoint of the same step.
+        """
         model, config = self.model, self.config
         model.train()
         factor = config.lr_factor(epoch)
         for opt, base in ((self.g_opt, self.lr), (self.d_opt, self.lr * config.d_lr_weight)):
             for group in [] if opt is None else opt.param_groups:
                 group["lr"] = base * factor
+        steps, seen = self.plan(data, epoch)
+        first, sums = self.position(epoch)
+        every, val_every = config.checkpoint_every, config.val_every
+        for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
+            self.step(batches, self.parts, epoch, sums)
+            self.steps += 1
+            if val_every and self.steps % val_every == 0:
+                self.validate_step(epoch)
+            if every and (k + 1) % every == 0 and k + 1 < len(steps):
+                # (a collective: every process calls it)
+                total = sum_over_processes(_floats(sums), self.world)
+                self.partial = {"epoch": epoch, "step": k + 1, "sums": total, "validations": self.validations}
+                self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
+                self.partial = None
+        return _mean_losses(sum_over_processes(_floats(sums), self.world), seen)
+
+    def plan(self, data: _Data, epoch: int) -> tuple[list[list[np.ndarray]], int]:
+        """``epoch``'s optimiser steps (this process's micro-batches of each) and the windows they train on."""
+        config = self.config
         order = np.random.default_rng([config.seed, epoch]).permutation(data.n)
         if config.windows_per_epoch is not None:
             order = order[: config.windows_per_epoch]
-        seen = 0
-        parts = max(config.micro_batches, self.world)  # micro-batches per step, spread over the processes
-        steps = []
+        steps, seen = [], 0
         for start in range(0, len(order), config.batch_size):
             idx = np.sort(order[start : start + config.batch_size])
-            micro = [idx[m::parts] for m in range(parts)]
+            micro = [idx[m :: self.parts] for m in range(self.parts)]
             if min(len(m) for m in micro) < 2:  # BatchNorm needs 2 windows per micro-batch
                 continue
             steps.append(micro[self.rank :: self.world])
             seen += len(idx)
-        first, sums = 0, {}
+        return steps, seen
+
+    def position(self, epoch: int) -> tuple[int, dict[str, Any]]:
+        """Where ``epoch`` starts: its first step and loss sums, 0 and none unless a mid-epoch checkpoint
+        of it was resumed (then its step, and on process 0 the sums of all processes and the validations)."""
+        first, sums, self.validations = 0, {}, []
         if self.partial is not None and self.partial["epoch"] == epoch:  # resuming inside this epoch
             first = int(self.partial["step"])
-            sums = dict(self.partial["sums"]) if self.rank == 0 else {}  # all processes' sums so far
+            if self.rank == 0:
+                sums, self.validations = dict(self.partial["sums"]), list(self.partial.get("validations", []))
         self.partial = None
-        every = config.checkpoint_every
-        for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
-            self.step(batches, parts, epoch, sums)
-            if every and (k + 1) % every == 0 and k + 1 < len(steps):
-                total = sum_over_processes(
-                    _floats(sums), self.world
-                )  # (a collective: every process calls it)
-                self.partial = {"epoch": epoch, "step": k + 1, "sums": total}
-                self.save(epoch)  # ``epoch`` epochs done, plus ``step`` steps of the next
-                self.partial = None
-        return _mean_losses(sum_over_processes(_floats(sums), self.world), seen)
+        return first, sums
 
     def step(
         self,
@@ -584,15 +629,54 @@ class _Run:
         """bfloat16 autocast on the training device (CUDA or CPU) when ``config.amp`` (a no-op otherwise)."""
         return torch.autocast(self.device.type, dtype=torch.bfloat16, enabled=self.amp)
 
-    def score(self, epoch: int, val_score: Callable[[GestureModel], float], entry: dict[str, Any]) -> None:
-        """Score the epoch in eval mode; keep a copy of the weights when it is the best so far."""
+    def validate(self, epoch: int, step: int | None = None) -> dict[str, Any]:
+        """The model's validation now: ``{"val": mean losses on the validation windows ({} without them)}``,
+        plus ``"val_score"`` with a ``val_score`` (:meth:`score`); on process 0 only (``{"val": {}}`` on the others).
+        """
+        record: dict[str, Any] = {"val": {}}
+        if self.rank != 0:
+            return record
+        if self.val_windows is not None:
+            batch = self.config.batch_size
+            record["val"] = evaluate_losses(self.model, self.val_windows, epoch=epoch, batch_size=batch)
+        if self.val_score is not None:
+            where = {"epoch": epoch} if step is None else {"epoch": epoch, "step": step}
+            record["val_score"] = self.score(where, self.val_score)
+        return record
+
+    def validate_step(self, epoch: int) -> None:
+        """With ``val_every``: validate after step :attr:`steps` (in ``epoch``) and record it in
+        :attr:`validations` as ``{"step", "val", "val_score"}``; the model goes on training. Process 0,
+        when there is something to validate (the other processes go on to the next step)."""
+        if self.rank == 0 and (self.val_windows is not None or self.val_score is not None):
+            self.validations.append({"step": self.steps, **self.validate(epoch, self.steps)})
+            self.model.train()
+
+    def epoch_validation(self, epoch: int) -> dict[str, Any]:
+        """The validation part of ``epoch``'s history entry.
+
+        Per epoch (``val_every`` None): :meth:`validate` now. With ``val_every``: ``"validations"``, the
+        epoch's (and one more at the end of the run when its last step was not one), and the last of them's
+        ``"val"`` (``{}`` without any) and ``"val_score"``.
+        """
+        every = self.config.val_every
+        if every is None:
+            return self.validate(epoch)
+        if epoch == self.config.epochs - 1 and self.steps % every:
+            self.validate_step(epoch)
+        last = self.validations[-1] if self.validations else {"val": {}}
+        return {**{k: v for k, v in last.items() if k != "step"}, "validations": list(self.validations)}
+
+    def score(self, where: dict[str, int], val_score: Callable[[GestureModel], float]) -> float:
+        """Score the model in eval mode; keep a copy of the weights as :attr:`best` (with ``where``: the
+        epoch, and the step with ``val_every``) when it is the best so far."""
         self.model.eval()
         with torch.no_grad():
             score = float(val_score(self.model))
-        entry["val_score"] = score
         if math.isfinite(score) and (self.best is None or score < self.best["score"]):
             state = {k: v.detach().cpu().clone() for k, v in self.model.state_dict().items()}
-            self.best = {"epoch": epoch, "score": score, "state": state}
+            self.best = {**where, "score": score, "state": state}
+        return score
 
     def save(self, epoch_done: int) -> None:
         """Write the full (resumable) checkpoint, when a path is configured (process 0 only)."""
@@ -614,12 +698,19 @@ class _Run:
                 "meta": self.meta,
                 "best": self.best,
                 "partial": self.partial,
+                "steps": self.steps,
             },
         )
 
     def result(self) -> FitResult:
         if self.best is None:
             return FitResult(self.history, self.path, self.fingerprint)
+        step = self.best.get("step")
         return FitResult(
-            self.history, self.path, self.fingerprint, int(self.best["epoch"]), float(self.best["score"])
+            self.history,
+            self.path,
+            self.fingerprint,
+            int(self.best["epoch"]),
+            float(self.best["score"]),
+            None if step is None else int(step),
         )
