@@ -23,9 +23,9 @@ Per row:
   that it does not know, oneDNN's ``mkldnn_rnn_layer`` and cuDNN's ``_cudnn_rnn``, are counted here as
   ``2 x frames x windows x`` the size of their weight matrices forward and twice that backward; elementwise
   work is not counted).
-- **ops/step**: operators of one eager training step that reach a kernel (counted below autograd by a
-  ``TorchDispatchMode``; about one kernel launch each on a GPU, where the host's cost per launch bounds a
-  step of many small kernels whatever the batch). On the CPU a GRU counts its time steps' cell operators
+- **ops/step**: operators of one eager training step dispatched below autograd (counted by a
+  ``TorchDispatchMode``): a kernel launch each on a GPU, views aside, and the host's cost per launch bounds
+  a step of many small kernels whatever the batch. On the CPU a GRU counts its time steps' cell operators
   (CUDA runs it as one cuDNN kernel), and Adam its loop over parameters (one fused kernel on CUDA).
 - **compile**: :attr:`beatlite.train.TrainConfig.compile` of the row (``--compile``; ``eager`` = none; the
   timed steps come after a first, compiling one). FLOPs and operators are the eager step's; the fit
@@ -197,7 +197,8 @@ def _config(device: str, precision: str, batch: int, compile: str = "eager", **k
 
 
 class _CountOps(TorchDispatchMode):
-    """Counts the operators that reach a device kernel (after autograd): about one launch each on a GPU."""
+    """Counts the operators dispatched below autograd: a kernel launch each on a GPU, except views
+    (``detach``, ``t``, ``view``), which launch none."""
 
     def __init__(self) -> None:
         super().__init__()
@@ -314,6 +315,8 @@ def _cell(row: Row, field: str) -> str:
         value = getattr(row, field)
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-"
+    if field == "peak_mib":
+        value = max(value, 0.0)  # (the CPU's resident set may shrink during the steps)
     if field == "params":
         return f"{value / 1e6:.2f}"
     if field == "peak_fraction":

@@ -1,0 +1,60 @@
+"""bench/bench_train.py's counting and table (its timings are measured by running it, not here)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+torch = pytest.importorskip("torch")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_train", ROOT / "bench" / "bench_train.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_train"] = module  # (its dataclass looks its module up)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_ops_are_counted_below_autograd_one_per_kernel():
+    bench = _bench()
+    a, b = torch.randn(3, 4, requires_grad=True), torch.randn(4, 2)
+    with bench._CountOps() as ops:
+        (a @ b).sum()
+    assert ops.count == 2  # mm, sum
+    with bench._CountOps() as ops:
+        torch.add(a, 1.0).detach()
+    assert ops.count == 2  # add, detach: a view is an operator too (no kernel, but dispatched)
+
+
+def test_the_grid_has_a_row_per_compile_setting_and_compiled_rows_leave_the_fit_columns_out():
+    bench = _bench()
+    args = argparse.Namespace(models=["camn"], devices=["cuda"], quick=False, presets=None,
+                              precisions=["bf16"], batch_sizes=[256], compile=["eager", "reduce-overhead"])  # fmt: skip
+    assert bench._grid(args) == [
+        ("camn", preset, "cuda", "bf16", 256, c)
+        for preset in ("tiny", "paper")
+        for c in ("eager", "reduce-overhead")
+    ]
+    row = bench.Row("camn", "paper", "cuda", "bf16", 256, "reduce-overhead", step_wps=1000.0, step_ms=256.0)
+    cells = bench.markdown([row]).splitlines()[2].split(" | ")
+    header = bench.markdown([row]).splitlines()[0].split(" | ")
+    assert cells[header.index("compile")] == "reduce-overhead"
+    assert (
+        cells[header.index("fit windows/s (loader)")] == "-"
+        and cells[header.index("step windows/s")] == "1,000"
+    )
+
+
+def test_the_gpu_session_script_refuses_an_unknown_stage_before_doing_anything(tmp_path):
+    proc = subprocess.run(["bash", str(ROOT / "bench" / "gpu_session.sh"), "nope"], capture_output=True,
+                          text=True, cwd=ROOT, env={"PATH": "/usr/bin:/bin", "OUT": str(tmp_path)})  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    assert "unknown stage nope" in proc.stderr and not any(tmp_path.iterdir())
