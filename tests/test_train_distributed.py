@@ -200,9 +200,15 @@ def test_the_fit_command_prepares_new_data_once_under_torchrun(tmp_path):
 
     corpus, out = symlinked_corpus(tmp_path / "corpus", 1), tmp_path / "run"
     cmd = [_torchrun(), "--standalone", "--nproc_per_node=2", "-m", "beatlite.train", "fit", "s2g_tiny",
-           "--data", str(corpus), "--out", str(out), "--epochs", "1", "--device", "cpu", "--extractor-epochs", "1"]  # fmt: skip
+           "--data", str(corpus), "--out", str(out), "--epochs", "1", "--device", "cpu", "--extractor-epochs", "1",
+           "--compile", "aot_eager"]  # fmt: skip
+    # (--compile: the DDP-wrapped modules through torch.compile too)
     env = {k: v for k, v in _env().items() if k != "BEATLITE_BUILD"}
     done = run_ok(cmd, env=env, timeout=900)
     assert done.stdout.count("training the FGD extractor") == 1, done.stdout
     assert (out / "fgd_dirvec.pt").is_file() and (out / "s2g_tiny.pt").is_file()
     assert len(list((out / "build" / "cache" / "store").iterdir())) == 1  # one store, built once
+    from beatlite.train.checkpoint import load_checkpoint
+
+    full = load_checkpoint(out / "train" / "s2g_tiny.pt")
+    assert full["train_config"]["compile"] == "aot_eager" and full["epoch"] == 1
