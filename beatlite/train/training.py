@@ -599,6 +599,8 @@ class _Run:
         """
         model, config = self.model, self.config
         last = len(batches) - 1
+        if self.config.compile is not None:  # a new iteration for CUDA graphs (outputs of the last one freed)
+            torch.compiler.cudagraph_mark_step_begin()
         outs = []
         for i, (batch, _) in enumerate(batches):
             with sync_on_last(self.g_ddp, i == last), self._autocast():
