@@ -197,8 +197,8 @@ def _config(device: str, precision: str, batch: int, compile: str = "eager", **k
 
 
 class _CountOps(TorchDispatchMode):
-    """Counts the operators dispatched below autograd: a kernel launch each on a GPU, except views
-    (``detach``, ``t``, ``view``), which launch none."""
+    """Counts the operators dispatched below autograd, views (``detach``, ``t``, ``view``) included: a kernel
+    launch each on a GPU but the views, which launch none (so the count bounds the launches from above)."""
 
     def __init__(self) -> None:
         super().__init__()
@@ -233,7 +233,8 @@ def measure_step(
         counted.step(step, 1, 0, {})
     with _CountOps() as ops:
         counted.step(step, 1, 0, {})
-    run.step(step, 1, 0, {})  # warm-up (allocator, oneDNN primitives, cuDNN plans; compilation)
+    for _ in range(1 if compile == "eager" else 3):  # warm-up: allocator, oneDNN primitives, cuDNN plans;
+        run.step(step, 1, 0, {})  # compiled: the compilation, then reduce-overhead's CUDA-graph recording
     _sync(run.device)
     with _PeakMemory(run.device) as memory:
         start = time.perf_counter()
@@ -415,15 +416,22 @@ def main() -> None:
                 f"  {name} {preset} {device} {precision} b{batch} {comp}: {row.step_wps:,.0f} windows/s",
                 flush=True,
             )
+            _write_json(
+                args.json, rows
+            )  # after every row: a run stopped by a time limit keeps what it measured
     for (device, dtype), flops in sorted(_PEAKS.items(), key=str):
         print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")
     print(markdown(rows))
-    if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
-        args.json.write_text(
-            json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1)
-        )
+    _write_json(args.json, rows)
+
+
+def _write_json(path: Path | None, rows: list[Row]) -> None:
+    """The rows (and the GEMM peaks measured so far) as JSON at ``path`` (nothing without one)."""
+    if path is None:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
+    path.write_text(json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1))
 
 
 if __name__ == "__main__":

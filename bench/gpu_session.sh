@@ -3,12 +3,14 @@
 #
 # Here, once:  scripts/gpu_wheels.sh            (librosa & co. as wheels into .whl/, ignored by git)
 # There:       bash bench/gpu_session.sh STAGE  (the device tool's `run`, carry [".whl"], $OUT set)
-#   STAGE eager    bench_train: CaMN and HA2G, tiny and paper presets, fp32 and bf16, batch 64 and 256, eager,
-#                  with the torch.profiler table of each row's step (about 5 min on an H100/H200)
+#   STAGE eager    bench_train, eager: the paper presets of CaMN and HA2G in fp32 and bf16 at batch 64 and 256,
+#                  with the torch.profiler table of each row's step, and the tiny presets at batch 64
+#                  (one run per model, at most 200 s each)
 #   STAGE compile  the paper presets in bf16 at batch 256, compiled (reduce-overhead: CUDA graphs) and eager
-#                  in the same run (compilation included, about 5 min)
+#                  in the same run (compilation included; at most 240 s per model)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
-# Results: $OUT/<stage>.md (the table and the log) and $OUT/<stage>.json (bench_train's rows).
+# Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
+# after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
 stage=${1:?stage: eager, compile or cpu}
 case "$stage" in eager | compile | cpu) ;; *) echo "unknown stage $stage (eager, compile or cpu)" >&2; exit 2 ;; esac
@@ -28,10 +30,17 @@ print(f"{platform.node()}  torch {torch.__version__}  {gpu}")
 from beatlite.metrics.beats import warm_up  # librosa's numba code compiled once before the store's workers
 warm_up()
 PY
-bench() { timeout "$1" python3 bench/bench_train.py "${@:2}" --json "$out/$stage.json" 2>&1 | tee -a "$out/$stage.md"; }
-case "$stage" in
-    eager) bench 330 --models camn ha2g --presets tiny paper --devices cuda --batch-sizes 64 256 --profile 15 ;;
-    compile) bench 330 --models camn ha2g --presets paper --devices cuda --precisions bf16 --batch-sizes 256 \
-        --compile eager reduce-overhead ;;
-    cpu) bench 300 --quick --devices cpu --steps 2 --fit-steps 1 --compile eager aot_eager --profile 5 ;;
-esac
+bench() {  # bench SECONDS MODEL ARGS...
+    timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$out/$stage-$2.json" 2>&1 |
+        tee -a "$out/$stage.md"
+}
+for model in camn ha2g; do
+    case "$stage" in
+        eager)
+            bench 150 "$model" --presets paper --devices cuda --batch-sizes 64 256 --profile 15
+            bench 50 "$model" --presets tiny --devices cuda --batch-sizes 64 ;;
+        compile) bench 240 "$model" --presets paper --devices cuda --precisions bf16 --batch-sizes 256 \
+            --compile eager reduce-overhead ;;
+        cpu) bench 150 "$model" --quick --devices cpu --steps 2 --fit-steps 1 --compile eager aot_eager --profile 5 ;;
+    esac
+done

@@ -285,3 +285,20 @@ def test_input_widths_match_the_built_layers_and_the_paper():
         "body decoder in": 446,
         "hands decoder in": 473,
     }
+
+
+def test_id_ranges_are_checked_except_in_a_training_step_on_another_device():
+    """``check_ids``: out-of-range ids are a ValueError naming the ids and their range, on the CPU and whenever
+    gradients are off (generation, evaluation); a training step on another device (here ``meta``, which
+    has no values to read) is not read back to the host."""
+    from beatlite.models.layers import check_ids
+
+    check_ids(torch.tensor([0, 4]), 5, "speaker ids")  # in range
+    with pytest.raises(ValueError, match=r"speaker ids must be in \[0, 5\), got range \[-1, 4\]"):
+        check_ids(torch.tensor([4, -1]), 5, "speaker ids")
+    with pytest.raises(ValueError, match=r"got range \[0, 5\]"):
+        check_ids(torch.tensor([[0, 5]]), 5, "word ids")
+    on_device = torch.tensor([0, 9]).to("meta")
+    check_ids(on_device, 5, "speaker ids")  # gradients on: skipped, nothing read
+    with torch.no_grad(), pytest.raises(RuntimeError, match="meta"):
+        check_ids(on_device, 5, "speaker ids")  # gradients off: read (meta has nothing to give)

@@ -98,16 +98,27 @@ def _broken_models() -> dict[str, tuple[type, str]]:
                 raise ValueError("pose out of range")
             return super().forward(batch)
 
+    class CopiesToTheDevice(S2G):  # a per-step table built on the host and moved to the batch's device
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            out = super().forward(batch)
+            return {"pose": out["pose"] * torch.ones(out["pose"].shape[-1]).to(out["pose"].device)}
+
     return {
         "dead parameter": (DeadParameter, "gradients", "no gradient: ['unused.weight', 'unused.bias']"),
-        "checks on the host": (ChecksOnTheHost, "no_host_reads", "the training pass reads the device"),
+        "checks on the host": (
+            ChecksOnTheHost,
+            "no_host_reads",
+            "the training pass fails on the meta device",
+        ),
+        "copies to the device": (CopiesToTheDevice, "no_host_reads", "copies host data to the device"),
         "reads the future": (ReadsTheFuture, "shapes", "generate reads frames after the seed"),
         "forgets a key": (ForgetsAKey, "shapes", "batch_keys lacks ['pose']"),
     }
 
 
 @pytest.mark.parametrize(
-    "broken", ["dead parameter", "reads the future", "forgets a key", "checks on the host"]
+    "broken",
+    ["dead parameter", "reads the future", "forgets a key", "checks on the host", "copies to the device"],
 )
 def test_the_contract_names_the_rule_a_model_breaks(broken: str, tmp_path: Path) -> None:
     cls, check, message = _broken_models()[broken]

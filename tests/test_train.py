@@ -681,7 +681,7 @@ def test_convert_legacy_needs_trust_and_writes_a_plain_copy(windows, tmp_path):
     assert all(torch.equal(v, data["state"][k]) for k, v in model.state_dict().items())
 
 
-def test_a_compiled_step_gives_the_losses_and_weights_of_the_eager_one(windows):
+def test_a_compiled_step_gives_the_losses_and_poses_of_the_eager_one(windows):
     """``TrainConfig.compile``: the step through ``torch.compile`` (the ``aot_eager`` backend: traced into
     graphs, run by the same kernels, as on a CPU without a compiler) trains as the eager step does: the same
     losses and, in eval mode, the same poses. (Not the same raw weights: a convolution's bias before a
@@ -703,7 +703,7 @@ def test_a_compiled_step_gives_the_losses_and_weights_of_the_eager_one(windows):
         TrainConfig(compile="fast")
 
 
-def test_adam_is_fused_on_cuda_only_and_the_fused_kernel_takes_the_same_steps():
+def test_adam_keeps_the_loop_on_the_cpu_and_the_fused_kernel_takes_the_same_steps():
     """Fused Adam (CUDA's one kernel for all parameters) and torch's default loop: the same updates (to
     float32 rounding), checked on the CPU, where torch has the fused kernel too; the CPU keeps the loop."""
     from beatlite.train.training import _adam
@@ -722,3 +722,21 @@ def test_adam_is_fused_on_cuda_only_and_the_fused_kernel_takes_the_same_steps():
             opt.step()
     for p, q in zip(*copies, strict=True):
         torch.testing.assert_close(q, p, rtol=1e-5, atol=1e-6)
+
+
+def test_validating_every_n_steps_leaves_the_training_draws_alone(windows):
+    """With ``val_every``, a validation that draws random numbers does not shift the numbers training draws
+    (DiffGesture draws its steps and noise): the same train losses as a run that never validates."""
+    train, _ = windows
+
+    def diffgesture():
+        torch.manual_seed(0)
+        return build_model("diffgesture", preset="tiny")
+
+    def noisy_score(model):
+        return float(torch.rand(100).mean())  # draws from torch's global generator, as a sampled FGD does
+
+    plain = fit(diffgesture(), train, cfg(epochs=2))
+    scored = fit(diffgesture(), train, cfg(epochs=2, val_every=2), val_score=noisy_score)
+    assert [h["train"] for h in scored.history] == [h["train"] for h in plain.history]
+    assert [v["step"] for h in scored.history for v in h["validations"]] == [2, 4, 6]

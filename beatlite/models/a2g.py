@@ -244,6 +244,15 @@ def kl_schedule(step: int | torch.Tensor) -> float | torch.Tensor:
     return max((int(step) // 10) % 10000 * 1e-4, 1e-4)
 
 
+def _weighted(weight: float | torch.Tensor, loss: torch.Tensor) -> torch.Tensor:
+    """``weight * loss`` in ``loss``'s dtype, with a float64 weight tensor (a scheduled weight kept on the
+    device) multiplied as a Python float would be: in float32 (torch's arithmetic type for float32 and
+    bfloat16), then rounded to ``loss``'s dtype."""
+    if not torch.is_tensor(weight):
+        return weight * loss
+    return (weight.float() * loss.float()).to(loss.dtype)
+
+
 def reparameterize(mu: torch.Tensor, logvar: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
     """``mu + exp(logvar / 2) * noise``: a draw of N(mu, exp(logvar)) that is differentiable in mu, logvar."""
     return mu + torch.exp(0.5 * logvar) * noise
@@ -463,10 +472,7 @@ class A2G(GestureModel):
             parts["cycle_spec"] = l1(out["z_x_spec"], out["z_x"])
             parts["cycle_share"] = l1(out["z_x_share"], out["z_pose"])
             weights["cycle_spec"] = weights["cycle_share"] = cfg.cycle_weight
-        # a float64 weight tensor is cast to the loss' dtype first, as a Python float would be
-        parts["total"] = sum(
-            (w.to(parts[k].dtype) if torch.is_tensor(w) else w) * parts[k] for k, w in weights.items()
-        )
+        parts["total"] = sum(_weighted(w, parts[k]) for k, w in weights.items())
         if self.training:
             self.steps += 1
         return parts

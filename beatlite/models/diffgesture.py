@@ -205,14 +205,15 @@ class NoiseSchedule:
     def _at(self, name: str, t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
         """Table ``name`` at the steps ``t``, as (B, 1, 1) in ``like``'s dtype and device.
 
-        Indexed on ``t``'s device, from a copy of the table made there once: no host copy of ``t`` per call
-        (which would make the host wait for the device at every training step).
+        Indexed on ``like``'s device (where the model draws ``t``), from a copy of the table made there once:
+        no host copy of ``t`` per call (which would make the host wait for the device at every training step).
         """
-        tables = self._on_device.get(t.device)
+        device = like.device
+        tables = self._on_device.get(device)
         if tables is None:
             names = ("betas", "alphas", "alpha_bars")
-            tables = self._on_device[t.device] = {n: getattr(self, n).to(t.device) for n in names}
-        return tables[name][t].to(like.dtype).view(-1, *([1] * (like.ndim - 1)))
+            tables = self._on_device[device] = {n: getattr(self, n).to(device) for n in names}
+        return tables[name][t.to(device)].to(like.dtype).view(-1, *([1] * (like.ndim - 1)))
 
     def q_sample(self, x0: torch.Tensor, t: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         """A draw of ``x_t ~ q(x_t | x_0)`` in closed form: ``sqrt(abar_t) x0 + sqrt(1 - abar_t) noise``.

@@ -305,17 +305,19 @@ class ConvDiscriminator(nn.Module):
 
 
 def check_ids(ids: torch.Tensor, n: int, what: str) -> None:
-    """Raise ``ValueError`` naming ``what`` unless every id of ``ids`` is in ``[0, n)``; checked on the CPU only.
+    """Raise ``ValueError`` naming ``what`` unless every id of ``ids`` is in ``[0, n)``.
 
-    Reading the range of ids on a GPU would copy it to the host and make the host wait for the device
-    at every step (no step could then be queued ahead or captured in a CUDA graph); there the
-    embedding's own device-side bounds check stops a bad id (a CUDA error, never a wrong answer); so does
-    the CPU embedding's own check (an ``IndexError``) inside a ``torch.compile``-d pass.
-    The windows a model trains on are in range by construction (the store's vocabulary and speaker ids).
+    Not checked in a training step on a GPU (ids on another device than the CPU, gradients on): reading
+    their range would copy it to the host and make the host wait for the device at every step (no step
+    could then be queued ahead or captured in a CUDA graph); there the embedding's own device-side bounds
+    check stops a bad id (a CUDA error, never a wrong answer), as the CPU embedding's own check (an
+    ``IndexError``) does inside a ``torch.compile``-d pass. The windows a model trains on are in range by
+    construction (the store's vocabulary and speaker ids); generation and evaluation (no gradients) check.
 
     Shapes: ids any shape, integer.
     """
-    if ids.device.type != "cpu" or not ids.numel() or torch.compiler.is_compiling():
+    training_on_device = ids.device.type != "cpu" and torch.is_grad_enabled()
+    if not ids.numel() or training_on_device or torch.compiler.is_compiling():
         return
     low, high = int(ids.min()), int(ids.max())
     if low < 0 or high >= n:

@@ -16,13 +16,17 @@ Not taught in a notebook: fake windows and batches and the contract checks for t
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import torch
+from torch.utils._python_dispatch import TorchDispatchMode
+from torch.utils._pytree import tree_leaves
 
 from beatlite.constants import FPS, SR, WINDOW_LENGTH
 
@@ -293,16 +297,22 @@ def _store_view(case: ModelCase, keys: tuple[str, ...]) -> Any:
 
 
 def _fit_two_steps(
-    case: ModelCase, windows: Any, *, amp: bool, on_device: str = "never"
+    case: ModelCase,
+    windows: Any,
+    *,
+    amp: bool,
+    on_device: str = "never",
+    compile: str | None = None,  # noqa: A002
 ) -> tuple[Any, list[dict[str, Any]]]:
     """A fresh model trained for two steps of 4 windows on ``windows`` (adversarial from the start);
-    ``on_device``: ``TrainConfig.data_on_device`` (a store view read by the loader, or held on the device)."""
+    ``on_device``: ``TrainConfig.data_on_device`` (a store view read by the loader, or held on the device);
+    ``compile``: ``TrainConfig.compile``."""
     from beatlite.train import TrainConfig, fit
 
     model = case.build()
     config = TrainConfig(
         epochs=1, batch_size=4, windows_per_epoch=8, seed=1, no_adv_epochs=0, progress=False, amp=amp,
-        data_on_device=on_device,
+        data_on_device=on_device, compile=compile,
     )  # fmt: skip
     with CudaAutocastRules():
         history = fit(model, windows, config).history
@@ -342,28 +352,75 @@ def check_bf16_training(case: ModelCase) -> None:
     _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite bf16 losses {history}")
 
 
+class HostToDevice(TorchDispatchMode):
+    """Records the operators that bring host data to another device: a copy of a CPU tensor there, or an
+    operator with a CPU tensor of at least one dimension among its inputs and a result there (a 0-dim CPU
+    tensor in arithmetic is read as a number, as a Python float is)."""
+
+    COPIES = ("_to_copy", "copy_", "_copy_from")
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.found: list[str] = []
+
+    def __torch_dispatch__(self, func: Any, types: Any, args: tuple = (), kwargs: dict | None = None) -> Any:
+        out = func(*args, **(kwargs or {}))
+        inputs = [
+            t for t in tree_leaves((args, kwargs)) if isinstance(t, torch.Tensor) and t.device.type == "cpu"
+        ]
+        elsewhere = any(isinstance(t, torch.Tensor) and t.device.type != "cpu" for t in tree_leaves(out))
+        copy = func.overloadpacket.__name__ in self.COPIES
+        if elsewhere and any(copy or t.dim() > 0 for t in inputs):
+            self.found.append(str(func))
+        return out
+
+
 def check_no_host_reads(case: ModelCase) -> None:
     """The training pass (forward, losses, backward, and the discriminator's when adversarial) never reads a
-    value of a tensor back to the host.
+    value of a tensor back to the host, nor copies host data to the device.
 
-    Run on torch's ``meta`` device (shapes without data), where any such read (``int(t)``, ``bool(t)``,
-    ``t.item()``, ``t.cpu()``, indexing by a boolean mask) raises. On a GPU each would make the host wait
-    for the device at every step, so no step could be queued ahead of the device or captured in a CUDA
-    graph (``TrainConfig.compile="reduce-overhead"``).
+    Run on torch's ``meta`` device (shapes without data), where any read (``int(t)``, ``bool(t)``,
+    ``t.item()``, ``t.cpu()``, indexing by a boolean mask) raises, and, for a second pass (a table copied to
+    the device once, in the first, is set-up), under :class:`HostToDevice`. On a
+    GPU each would make the host wait for the device at every step, so no step could be queued ahead of the
+    device or captured in a CUDA graph (``TrainConfig.compile="reduce-overhead"``).
     """
     model = _prepared(case, case.build())
     batch = {k: v.to("meta") for k, v in case.batch(model).items()}
     model.to("meta")
+    copies = HostToDevice()
     try:
-        losses = _train_losses(model, batch)
-        if model.trainable:
-            losses["total"].backward()
-        if model.discriminator is not None:
-            model.discriminator_losses(batch, model(batch))["total"].backward()
+        for mode in (contextlib.nullcontext(), copies):  # the second pass: what every step does (no set-up)
+            with mode:
+                losses = _train_losses(model, batch)
+                if model.trainable:
+                    losses["total"].backward()
+                if model.discriminator is not None:
+                    model.discriminator_losses(batch, model(batch))["total"].backward()
     except (RuntimeError, NotImplementedError) as error:
         raise AssertionError(
-            f"{case.cls.__name__} ({case.preset}): the training pass reads the device: {error}"
+            f"{case.cls.__name__} ({case.preset}): the training pass fails on the meta device (it reads the "
+            f"device, or mixes devices): {error}"
         ) from error
+    if model.trainable:  # (an untrained baseline takes no training step)
+        _expect(
+            not copies.found, case, f"the training pass copies host data to the device: {copies.found[:5]}"
+        )
+
+
+def check_compiled_training(case: ModelCase) -> None:
+    """Two steps from the store with the step through ``torch.compile`` (``TrainConfig.compile="aot_eager"``:
+    traced into graphs and run by the same kernels) give the losses of two eager steps (to float32
+    reassociation, rel 1e-4)."""
+    model = case.build()
+    view = _store_view(case, type(model).batch_keys(model.config))
+    _, eager = _fit_two_steps(case, view, amp=False)
+    _, compiled = _fit_two_steps(case, view, amp=False, compile="aot_eager")
+    for a, b in zip(eager, compiled, strict=True):
+        close = a["train"].keys() == b["train"].keys() and all(
+            math.isclose(a["train"][k], b["train"][k], rel_tol=1e-4, abs_tol=1e-9) for k in a["train"]
+        )
+        _expect(close, case, f"compiled training losses {b['train']} != eager {a['train']}")
 
 
 #: Contract checks on fake batches: name -> check(case).
@@ -375,7 +432,11 @@ CHECKS = {
     "no_host_reads": check_no_host_reads,
 }
 #: Contract checks that train from a window store (they need ``ModelCase.train`` and ``.reference``).
-STORE_CHECKS = {"store_training": check_store_training, "bf16_training": check_bf16_training}
+STORE_CHECKS = {
+    "store_training": check_store_training,
+    "bf16_training": check_bf16_training,
+    "compiled_training": check_compiled_training,
+}
 
 
 def model_case(model: str | type, folder: str | Path, *, preset: str = "tiny", train: Any = None,

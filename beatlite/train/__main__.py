@@ -1,7 +1,7 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
 ``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B]
-[--precision bf16] [--compile MODE]`` trains one recipe
+[--precision bf16] [--compile MODE] [--val-every N]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the

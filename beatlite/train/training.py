@@ -651,7 +651,12 @@ class _Run:
         :attr:`validations` as ``{"step", "val", "val_score"}``; the model goes on training. Process 0,
         when there is something to validate (the other processes go on to the next step)."""
         if self.rank == 0 and (self.val_windows is not None or self.val_score is not None):
-            self.validations.append({"step": self.steps, **self.validate(epoch, self.steps)})
+            # the validation's random draws (HA2G's evaluation losses, a sampled val_score) come from a fork
+            # of torch's generators: training draws the same numbers with or without it, in every process,
+            # so a resumed run (which restores process 0's generator) takes the same steps
+            cuda = [self.device.index or 0] if self.device.type == "cuda" else []
+            with torch.random.fork_rng(devices=cuda):
+                self.validations.append({"step": self.steps, **self.validate(epoch, self.steps)})
             self.model.train()
 
     def epoch_validation(self, epoch: int) -> dict[str, Any]:
