@@ -21,7 +21,7 @@ from beatlite.data.store import (
     build_store,
     quantize_audio,
 )
-from beatlite.data.windows import build_windows
+from beatlite.data.windows import audio_start, build_windows, sliding_windows, take_features, window_starts
 from beatlite.io import FormatError
 
 #: 16-bit storage of audio on the step 2**-15: at most half a step off (plus float32 rounding, 0 here).
@@ -46,36 +46,44 @@ def _meta_times(store: WindowStore) -> dict[str, int]:
     return {t.stem: (t.folder / "meta.json").stat().st_mtime_ns for t in store.takes}
 
 
-def test_batches_equal_build_windows(corpus: Path, store: WindowStore) -> None:
+def test_batches_equal_windows_cut_from_each_takes_features(corpus: Path, store: WindowStore) -> None:
+    """The store's batches equal the windows cut directly from each take's features by the teaching
+    functions (``take_features``, ``sliding_windows``, ``audio_start``), and its pooled statistics equal
+    ``Normalizer.fit`` over every train frame; ``build_windows`` holds the same batches in memory."""
     idx = index_folder(corpus)
-    ref = build_windows(idx, split="train", vocab=VOCAB, cache=False)
     got = store.windows("train")
-    assert len(got) == len(ref) == 10 and got.keys() == [k for k in ref.keys()]
-    a, b = ref.batch(), got.batch()
-    for key in ref.keys():
-        assert b[key].dtype == a[key].dtype and b[key].shape == a[key].shape, key
-        if key == "audio":  # the ramp k / 2**20 is not on the 16-bit grid
-            assert 0 < np.abs(a[key] - b[key]).max() <= AUDIO_BOUND
-        elif key == "pose":  # statistics pooled per take: equal up to float rounding
-            assert np.allclose(a[key], b[key], rtol=0, atol=1e-5)
-        else:
-            assert np.array_equal(a[key], b[key]), key
-    # with build_windows' statistics every key but audio is bit-identical, also for the val split
-    stats = ref.normalizers
-    val_ref = build_windows(idx, split="val", vocab=VOCAB, stats=stats, cache=False)
-    val = store.windows("val", stats=stats).batch()
-    for key in val_ref.keys():
-        assert key == "audio" or np.array_equal(val_ref[key], val[key]), key
+    features = [take_features(r, vocab=VOCAB) for r in idx if r.split == "train"]
+    pose_raw = np.concatenate([f.pose_raw for f in features])
+    fitted = Normalizer.fit(pose_raw)
     norms = store.statistics("train")
-    pose_norm, dir_norm = norms.pose, norms.dirvec
-    assert np.allclose(pose_norm.mean, ref.normalizers.pose.mean, rtol=1e-12, atol=1e-12)
-    assert np.allclose(pose_norm.std, ref.normalizers.pose.std, rtol=1e-12, atol=0)
-    assert np.allclose(dir_norm.mean, ref.normalizers.dirvec.mean, rtol=0, atol=1e-14) and np.all(
-        dir_norm.std == 1
-    )
+    assert np.allclose(norms.pose.mean, fitted.mean, rtol=1e-12, atol=1e-12)
+    assert np.allclose(norms.pose.std, fitted.std, rtol=1e-12, atol=0)
+    dir_mean = np.concatenate([f.dirs for f in features]).mean(0)
+    assert np.allclose(norms.dirvec.mean, dir_mean, rtol=0, atol=1e-14) and np.all(norms.dirvec.std == 1)
+    starts = [window_starts(f.n_frames) for f in features]
+    expected = {
+        "pose_raw": sliding_windows([f.pose_raw for f in features]).astype(np.float32),
+        "pose": norms.pose.transform(sliding_windows([f.pose_raw for f in features])).astype(np.float32),
+        "dirvec": norms.dirvec.transform(sliding_windows([f.dirs for f in features])).astype(np.float32),
+        **{k: sliding_windows([getattr(f, k) for f in features]) for k in ("face", "word", "emotion", "semantic")},
+        "audio": np.stack([f.audio[audio_start(int(s), 15, 16000) :][:36266] for f, ss in zip(features, starts)
+                           for s in ss]),
+        "start": np.concatenate(starts),
+    }  # fmt: skip
+    a = got.batch()
+    assert len(got) == len(a["start"]) == 10
+    for key, value in expected.items():
+        assert a[key].shape == value.shape, key
+        if key == "audio":  # the ramp k / 2**20 is not on the 16-bit grid
+            assert 0 < np.abs(a[key] - value).max() <= AUDIO_BOUND
+        else:
+            assert np.array_equal(a[key], value.astype(a[key].dtype)), key
+    ref = build_windows(idx, split="train", vocab=VOCAB, cache=False)
+    assert ref.keys() == got.keys() and all(np.array_equal(ref[k], a[k]) for k in ref.keys())
+    assert ref.fingerprint == got.fingerprint
     # item / key access as Windows, the word key through the take-local ids
     assert np.array_equal(got.item(3)["word"], a["word"][3]) and np.array_equal(got["start"], a["start"])
-    assert set(np.unique(b["word"])) >= {0, VOCAB["hello"], VOCAB["world"], 3}  # "zebra" -> UNK
+    assert set(np.unique(a["word"])) >= {0, VOCAB["hello"], VOCAB["world"], 3}  # "zebra" -> UNK
 
 
 def test_word_recorder_maps_to_the_vocabulary() -> None:

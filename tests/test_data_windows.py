@@ -154,8 +154,10 @@ def test_audio_mel_face_word_semantic_emotion(train: Windows) -> None:
     for i in (0, 1, 6):
         s = int(train["start"][i])
         a0 = (s * 16000) // 15
-        # sample k of the ramp is k / 2**20: the window starts at sample floor(s * 16000 / 15)
-        assert np.allclose(train["audio"][i][[0, -1]] * 2**20, [a0, a0 + 36265])
+        # sample k of the ramp is k / 2**20, stored as 16-bit PCM (step 2**-15: round(k / 32) steps): the
+        # window starts at sample floor(s * 16000 / 15) (a shift of one sample moves the steps' edges)
+        k = a0 + np.arange(36266)
+        np.testing.assert_array_equal(train["audio"][i] * 2**15, np.rint(k / 32))
     mel = train["mel"]
     assert np.all(np.isfinite(mel)) and mel.max() <= 0.0 and mel.min() >= -80.0 - 1e-3
     assert np.allclose(train["face"], 0.25, atol=1e-6)
@@ -225,22 +227,29 @@ def test_whole_take_mode(corpus: Path) -> None:
         w.batch()
 
 
-def test_cache_round_trip(corpus: Path, tmp_path: Path) -> None:
+def test_the_store_behind_the_windows_is_kept_and_reused(corpus: Path, tmp_path: Path) -> None:
+    """``cache=folder``: the index's window store is built there once; later calls, other window parameters
+    and whole takes read it without rebuilding a take; a sub-index gets its own store (a store drops the
+    takes its index lacks); saved windows load back."""
     idx = index_folder(corpus)
     first = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
-    assert first.path is not None and first.path.is_file() and first.path.parent == tmp_path
+    (folder,) = (tmp_path / "store").iterdir()
+    built = {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")}
+    assert len(built) == len(idx)
     second = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
-    assert second.path == first.path
     for k in first.keys():
         assert np.array_equal(first[k], second[k]), k
     assert (
         np.array_equal(second.normalizers.pose.std, first.normalizers.pose.std)
         and second.params == first.params
     )
-    other = build_windows(idx, split="test", vocab=VOCAB, stride=5, cache=tmp_path)  # new parameters
-    assert other.path != first.path
+    other = build_windows(idx, split="test", vocab=VOCAB, stride=5, cache=tmp_path)  # new window parameters
+    assert len(other) > len(first) and other.fingerprint != first.fingerprint
     whole = build_windows(idx, split="test", vocab=VOCAB, whole_takes=True, cache=tmp_path)
-    again = Windows.load(whole.path)
+    assert {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")} == built  # nothing rebuilt
+    build_windows(idx.where(split=["train", "test"]), split="test", vocab=VOCAB, cache=tmp_path)
+    assert len(list((tmp_path / "store").iterdir())) == 2 and len(list(folder.glob("takes/*"))) == len(idx)
+    again = Windows.load(whole.save(tmp_path / "whole.npz"))
     assert np.array_equal(again.item(0)["mel"], whole.item(0)["mel"])
     (tmp_path / "junk.npz").write_bytes(b"junk")
     with pytest.raises(ValueError, match="junk.npz"):

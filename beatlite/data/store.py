@@ -1,6 +1,6 @@
 """A window store on disk: each take's aligned streams stored once, windows sliced at batch time.
 
-:func:`build_windows` holds every window of a split in RAM (about 244 KB per window, the
+:func:`build_windows` reads every window of a split of this store into RAM (about 244 KB per window, the
 16 kHz audio repeated 3.4 times at stride 10), so its memory grows with the corpus. The
 store keeps, per take, one ``.npy`` file per stream (memory-mappable, read by byte range),
 and a split's windows are only an index ``(take, start)``; a batch reads the rows it needs
@@ -20,8 +20,8 @@ stream (file)  on disk               batch keys
 ``positions``  (T, 47, 3) float32    ``positions`` (only in a store built with ``positions=True``)
 =============  ====================  ==================================================================
 
-Batches equal :func:`beatlite.data.windows.build_windows`'s for the same takes, windows and
-statistics, bit for bit except ``audio``: it is stored as 16-bit PCM with a per-take step
+Batches equal the windows cut from each take's features (:func:`beatlite.data.windows.take_features`,
+:func:`~beatlite.data.windows.sliding_windows`) bit for bit except ``audio``: it is stored as 16-bit PCM with a per-take step
 ``audio_scale``, so ``|audio - stored| <= audio_scale / 2 + 2**-24 |audio|`` (half a step plus
 float32 rounding). ``audio_scale = 2**-15`` when the take's samples lie in ``[-1, 32767/32768]``
 (then ``q * 2**-15`` is exact in float32 and the bound is ``2**-16 ~ 1.5e-5``), else

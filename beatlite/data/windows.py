@@ -24,9 +24,11 @@ key            shape, dtype              content
 =============  =======================  =============================================================
 
 Normalisation statistics (pose mean/std, direction mean) are computed on the
-**train** split only and saved with the arrays. Results are cached as ``.npz``
-under :func:`beatlite.paths.cache_dir` keyed by a fingerprint of the source
-files (their content: :mod:`beatlite.data.fingerprint`), the per-take overrides and every parameter.
+**train** split only and kept with the arrays. The windows are read from the window store of the index
+(:mod:`beatlite.data.store`: every take's streams cut, normalised and cached once under
+:func:`beatlite.paths.cache_dir`, keyed by a fingerprint of the source files' content, the per-take overrides
+and every parameter, :mod:`beatlite.data.fingerprint`): ``build_windows`` holds in memory what training reads
+from the store one batch at a time.
 
 With ``whole_takes=True`` there is one item per take, full length (the
 reference's test mode); per-frame keys are then lists of (T_i, ...) arrays.
@@ -41,8 +43,10 @@ Taught in notebooks/05_camn.ipynb, section 1 (a batch of training windows); its 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import tempfile
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -56,6 +60,7 @@ from beatlite.data.normalize import Normalizer, Normalizers
 
 if TYPE_CHECKING:
     from beatlite.data.index import TakeIndex, TakeRecord
+    from beatlite.data.store import WindowStore
     from beatlite.data.vocab import Vocab
 
 #: Keys of a window batch, in contract order (``positions`` only when asked for).
@@ -77,8 +82,6 @@ WINDOW_KEYS = (
 #: HA2G log-mel settings (HA2G §4.2, docs/reference_code.md#ha2g-audio).
 MEL_SETTINGS = {"n_mels": 128, "n_fft": 1024, "hop_length": 512, "power": 2.0}
 POSE_SUBSET = "spine_neck_141"
-#: Bump when the content of the cache changes.
-CACHE_VERSION = 2
 
 
 def window_starts(n_frames: int, length: int = WINDOW_LENGTH, stride: int = WINDOW_STRIDE) -> np.ndarray:
@@ -316,23 +319,6 @@ def take_features(
     )
 
 
-def _fit_audio(audio: np.ndarray, start: int, n: int) -> np.ndarray:
-    """``audio[start:start+n]`` zero-padded to exactly n samples."""
-    out = audio[start : start + n]
-    if len(out) < n:
-        out = np.concatenate([out, np.zeros(n - len(out), dtype=audio.dtype)])
-    return out
-
-
-def _fit_rows(x: np.ndarray, start: int, n: int) -> np.ndarray:
-    """``x[start:start+n]`` padded by repeating the last row (or zeros if empty)."""
-    out = x[start : start + n]
-    if len(out) < n:
-        pad = np.repeat(out[-1:] if len(out) else np.zeros((1, *x.shape[1:]), x.dtype), n - len(out), axis=0)
-        out = np.concatenate([out, pad])
-    return out
-
-
 # ---------------------------------------------------------------------- container
 class Windows:
     """The windows (or whole takes) of one split, with their normalisation statistics.
@@ -501,13 +487,6 @@ class Windows:
 
 
 # ---------------------------------------------------------------------- building
-def _fingerprint(records: Sequence[TakeRecord], payload: dict[str, Any]) -> str:
-    """:func:`beatlite.data.fingerprint.takes_fingerprint` of ``records`` with ``payload`` and :data:`CACHE_VERSION`."""
-    from beatlite.data.fingerprint import takes_fingerprint
-
-    return takes_fingerprint(records, {**payload, "version": CACHE_VERSION})
-
-
 def _usable(index: TakeIndex, split: str | None) -> list[TakeRecord]:
     chosen = [r for r in index if split is None or r.split == split]
     skipped = [r.stem for r in chosen if not r.usable]
@@ -517,52 +496,6 @@ def _usable(index: TakeIndex, split: str | None) -> list[TakeRecord]:
             stacklevel=3,
         )
     return [r for r in chosen if r.usable]
-
-
-def _stats_path(records: Sequence[TakeRecord], fps: float, sr: int, cache: bool | str | Path) -> Path | None:
-    folder = _cache_folder(cache)
-    if folder is None:
-        return None
-    fp = _fingerprint(records, {"kind": "stats", "fps": fps, "sr": sr})
-    return folder / f"stats_{fp[:20]}.npz"
-
-
-def _load_stats(path: Path | None) -> Normalizers | None:
-    if path is None or not path.is_file():
-        return None
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return Normalizers(Normalizer.from_arrays(z, "pose"), Normalizer.from_arrays(z, "dirvec"))
-    except (OSError, ValueError, KeyError):
-        return None  # a broken cache file is rebuilt
-
-
-def _fit_stats(features: Sequence[TakeFeatures], path: Path | None) -> Normalizers:
-    norms = Normalizers(
-        Normalizer.fit([f.pose_raw for f in features]),
-        Normalizer.fit([f.dirs for f in features], center_only=True),
-    )
-    if path is not None:
-        _save_npz(path, {**norms.pose.to_arrays("pose"), **norms.dirvec.to_arrays("dirvec")})
-    return norms
-
-
-def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    from beatlite.io.atomic import atomic_write
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_write(path, "wb") as f:
-        np.savez(f, **arrays)
-
-
-def _cache_folder(cache: bool | str | Path) -> Path | None:
-    from beatlite.paths import cache_dir
-
-    if cache is False or cache is None:
-        return None
-    if cache is True:
-        return cache_dir() / "windows"
-    return Path(cache)
 
 
 def build_windows(
@@ -581,7 +514,11 @@ def build_windows(
     cache: bool | str | Path = True,
     progress: bool = False,
 ) -> Windows:
-    """Windows (or whole takes) of one split, aligned across all modalities.
+    """Windows (or whole takes) of one split, aligned across all modalities, held in memory.
+
+    The takes are cut, normalised and cached by the window store (:func:`beatlite.data.store.build_store`,
+    the route training reads one batch at a time): this is that store's windows of ``split`` read into
+    arrays (one cutting rule, one normalisation, one cache format and one fingerprint for both).
 
     Parameters
     ----------
@@ -608,9 +545,10 @@ def build_windows(
     word_rule : {"span", "onset", "beat"}
         Word-to-frame rule of :func:`beatlite.io.words_to_frames`.
     cache : bool or str or Path
-        True: cache under ``cache_dir()/windows``; a folder: cache there; False: no cache.
+        Where the store of the index's usable takes is kept: True: under ``cache_dir()/store`` (built once,
+        then only changed takes); a folder: under it; False: a temporary folder, removed afterwards.
     progress : bool
-        Show a tqdm bar while loading takes.
+        Show a tqdm bar over the takes the store builds.
 
     Returns
     -------
@@ -638,46 +576,91 @@ def build_windows(
     records = _usable(index, split)
     if not records:
         raise ValueError(f"build_windows: no usable takes in split {split!r} ({len(index)} takes indexed)")
-    vocab = build_vocab(index) if vocab is None else vocab
-    feature_args = {"fps": fps, "sr": sr, "vocab": vocab, "word_rule": word_rule, "positions": positions}
-    loaded: dict[str, TakeFeatures] = {}
-    if stats is None:
-        stats, loaded = _train_normalizers(index, split, feature_args, cache)
-    elif not isinstance(stats, Normalizers):
+    if stats is None and not any(r.usable and r.split == "train" for r in index):
+        raise ValueError("build_windows: the index has no usable train takes to compute statistics from")
+    if stats is not None and not isinstance(stats, Normalizers):
         raise TypeError(
             f"build_windows: stats must be Normalizers (e.g. train.normalizers), got {type(stats).__name__}"
         )
+    vocab = build_vocab(index) if vocab is None else vocab
     params: dict[str, Any] = {
-        "split": split,
-        "length": int(length),
-        "stride": int(stride),
-        "fps": float(fps),
-        "sr": int(sr),
-        "whole_takes": bool(whole_takes),
-        "positions": bool(positions),
-        "word_rule": word_rule,
-        "vocab_size": len(vocab),
-        "mel": dict(MEL_SETTINGS),
-        "subset": POSE_SUBSET,
-    }
-    path = _windows_cache_path(records, params, vocab, stats, cache)
-    if path is not None and path.is_file():
-        try:
-            return Windows.load(path)
-        except ValueError:
-            pass  # broken cache: rebuild
-    shown = records
-    if progress:
-        from beatlite.notebook import progress as progress_bar
+        "split": split, "length": int(length), "stride": int(stride), "fps": float(fps), "sr": int(sr),
+        "whole_takes": bool(whole_takes), "positions": bool(positions), "word_rule": word_rule,
+        "vocab_size": len(vocab), "mel": dict(MEL_SETTINGS), "subset": POSE_SUBSET,
+    }  # fmt: skip
+    with _store_of(index, params, cache, progress) as store:
+        stats = store.statistics("train") if stats is None else stats
+        stems = [r.stem for r in records]
+        read = _whole_takes if whole_takes else _windows
+        arrays, params["fingerprint"] = read(store, stems, stats, vocab, params)
+    return Windows(arrays, normalizers=stats, params=params)
 
-        shown = progress_bar(records, desc=f"windows {split}")
-    features = (loaded.pop(r.stem, None) or take_features(r, **feature_args) for r in shown)
-    arrays = _cut(features, stats, params)
-    params["fingerprint"] = _windows_fingerprint(records, arrays, params, vocab)
-    windows = Windows(arrays, normalizers=stats, params=params)
-    if path is not None:
-        windows.save(path)
-    return windows
+
+@contextlib.contextmanager
+def _store_of(
+    index: TakeIndex, params: dict[str, Any], cache: bool | str | Path, progress: bool
+) -> Iterator[WindowStore]:
+    """The window store of ``index``'s usable takes (their own store: a store drops the takes its index
+    lacks, so one of a sub-index must not be the corpus' training store), kept as ``cache`` says."""
+    from beatlite.data.store import build_store, default_store_folder, store_params
+
+    usable = index.where(usable=True)
+    store = store_params(fps=params["fps"], sr=params["sr"], positions=params["positions"],
+                         word_rule=params["word_rule"])  # fmt: skip
+    if cache is False or cache is None:
+        with tempfile.TemporaryDirectory(prefix="beatlite-windows-") as tmp:
+            yield build_store(usable, tmp, **_build_args(store), workers=0, progress=progress)
+        return
+    takes = hashlib.sha256("\n".join(sorted(r.stem for r in usable)).encode()).hexdigest()[:16]
+    folder = default_store_folder(usable, {**store, "takes": takes})
+    if cache is not True:
+        folder = Path(cache) / "store" / folder.name
+    yield build_store(usable, folder, **_build_args(store), workers=0, progress=progress)
+
+
+def _build_args(store_params: dict[str, Any]) -> dict[str, Any]:
+    """:func:`build_store`'s keyword arguments of a store's parameters."""
+    return {k: store_params[k] for k in ("fps", "sr", "positions", "word_rule")}
+
+
+def _windows(
+    store: WindowStore, stems: list[str], stats: Normalizers, vocab: Vocab, params: dict[str, Any]
+) -> tuple[dict[str, np.ndarray], str]:
+    """Every window of the takes ``stems`` as arrays, and their fingerprint."""
+    from beatlite.data.store import StoreWindows
+
+    try:
+        view = StoreWindows(store, None, length=params["length"], stride=params["stride"], keys=None,
+                            stats=stats, vocab=vocab, stems=stems)  # fmt: skip
+    except ValueError:
+        raise ValueError(
+            f"build_windows: no take of split {params['split']!r} is at least {params['length']} frames long "
+            f"({len(stems)} takes)"
+        ) from None
+    return view.batch(None), _fingerprint(store, view.take_ids, params, vocab)
+
+
+def _whole_takes(
+    store: WindowStore, stems: list[str], stats: Normalizers, vocab: Vocab, params: dict[str, Any]
+) -> tuple[dict[str, np.ndarray], str]:
+    """The takes ``stems`` at full length, concatenated, with each one's frame, audio and mel lengths
+    (``_len_frames``, ``_len_audio``, ``_len_mel``), and their fingerprint."""
+    items = [store.whole_take(stem, stats=stats, vocab=vocab) for stem in stems]
+    arrays = {k: np.concatenate([np.atleast_1d(item[k]) for item in items]) for k in items[0]}
+    for key, name in (("frames", "pose"), ("audio", "audio"), ("mel", "mel")):
+        arrays[f"_len_{key}"] = np.array([len(item[name]) for item in items], np.int64)
+    ids = np.array([store.takes.index(store.take(stem)) for stem in stems])
+    return arrays, _fingerprint(store, ids, {**params, "length": 0, "stride": 0}, vocab)
+
+
+def _fingerprint(store: WindowStore, take_ids: np.ndarray, params: dict[str, Any], vocab: Vocab) -> str:
+    """:func:`beatlite.data.fingerprint.windows_fingerprint` of the store's takes ``take_ids``."""
+    from beatlite.data.fingerprint import windows_fingerprint
+
+    takes = [store.takes[int(i)].meta["fingerprint"] for i in np.unique(take_ids)]
+    return windows_fingerprint(
+        takes, split=params["split"], length=params["length"], stride=params["stride"], vocab=vocab.itos
+    )
 
 
 def _check_window_params(split: str | None, length: int, stride: int, fps: float, sr: int) -> None:
@@ -688,135 +671,3 @@ def _check_window_params(split: str | None, length: int, stride: int, fps: float
             raise ValueError(f"build_windows: {name} must be a positive int, got {v!r}")
     if not fps > 0:
         raise ValueError(f"build_windows: fps must be positive, got {fps!r}")
-
-
-def _train_normalizers(
-    index: TakeIndex, split: str | None, feature_args: dict[str, Any], cache: bool | str | Path
-) -> tuple[Normalizers, dict[str, TakeFeatures]]:
-    """The train split's normalisers (cached); for ``split="train"`` also the loaded train takes."""
-    records = _usable(index, "train")
-    if not records:
-        raise ValueError("build_windows: the index has no usable train takes to compute statistics from")
-    fps, sr = feature_args["fps"], feature_args["sr"]
-    stats_path = _stats_path(records, fps, sr, cache)
-    stats = _load_stats(stats_path)
-    if stats is not None:
-        return stats, {}
-    if split == "train":  # load the train takes once: for the statistics and the windows
-        loaded = {r.stem: take_features(r, **feature_args) for r in records}
-        return _fit_stats(list(loaded.values()), stats_path), loaded
-    return _fit_stats([take_features(r, fps=fps, sr=sr, mel=False) for r in records], stats_path), {}
-
-
-def _windows_fingerprint(
-    records: Sequence[TakeRecord], arrays: dict[str, np.ndarray], params: dict[str, Any], vocab: Vocab
-) -> str:
-    """:func:`beatlite.data.fingerprint.windows_fingerprint` of the takes that have windows (as the store's)."""
-    from beatlite.data.fingerprint import windows_fingerprint
-    from beatlite.data.store import store_params, take_fingerprint
-
-    have = set(np.asarray(arrays["take"]).tolist())
-    store = store_params(
-        fps=params["fps"], sr=params["sr"], positions=params["positions"], word_rule=params["word_rule"]
-    )
-    takes = [take_fingerprint(r, store) for r in records if r.stem in have]
-    length, stride = (0, 0) if params["whole_takes"] else (params["length"], params["stride"])
-    return windows_fingerprint(takes, split=params["split"], length=length, stride=stride, vocab=vocab.itos)
-
-
-def _windows_cache_path(
-    records: Sequence[TakeRecord],
-    params: dict[str, Any],
-    vocab: Vocab,
-    stats: Normalizers,
-    cache: bool | str | Path,
-) -> Path | None:
-    folder = _cache_folder(cache)
-    if folder is None:
-        return None
-    from beatlite.data.fingerprint import vocab_hash
-
-    stats_hash = hashlib.sha256(
-        b"".join(a.tobytes() for a in (stats.pose.mean, stats.pose.std, stats.dirvec.mean))
-    ).hexdigest()
-    fp = _fingerprint(records, {**params, "vocab": vocab_hash(vocab.itos), "stats": stats_hash})
-    return folder / f"windows_{params['split']}_{'takes' if params['whole_takes'] else 'win'}_{fp[:20]}.npz"
-
-
-def _cut(
-    features: Iterator[TakeFeatures], stats: Normalizers, params: dict[str, Any]
-) -> dict[str, np.ndarray]:
-    """The arrays of :class:`Windows`: every take's windows (or whole take) concatenated."""
-    parts: dict[str, list[np.ndarray]] = {k: [] for k in WINDOW_KEYS}
-    lens: dict[str, list[int]] = {"frames": [], "audio": [], "mel": []}
-    n_takes = 0
-    for f in features:
-        n_takes += 1
-        cut = _whole_take if params["whole_takes"] else _take_windows
-        for k, v in cut(f, _per_frame(f, stats), params, lens).items():
-            parts[k].append(v)
-    if not parts["take"]:
-        raise ValueError(
-            f"build_windows: no take of split {params['split']!r} is at least {params['length']} frames long "
-            f"({n_takes} takes)"
-        )
-    arrays = {k: np.concatenate(v) for k, v in parts.items() if v}
-    if params["whole_takes"]:
-        arrays.update({f"_len_{k}": np.array(v, dtype=np.int64) for k, v in lens.items()})
-    return arrays
-
-
-def _per_frame(f: TakeFeatures, stats: Normalizers) -> dict[str, np.ndarray]:
-    """The per-frame streams of one take, normalised (``positions`` only when loaded)."""
-    per_frame = {
-        "pose": stats.pose.transform(f.pose_raw).astype(np.float32),
-        "pose_raw": f.pose_raw.astype(np.float32),
-        "positions": f.positions,
-        "dirvec": stats.dirvec.transform(f.dirs).astype(np.float32),
-        "face": f.face,
-        "word": f.word,
-        "emotion": f.emotion,
-        "semantic": f.semantic,
-    }
-    return {k: v for k, v in per_frame.items() if v is not None}
-
-
-def _whole_take(
-    f: TakeFeatures, per_frame: dict[str, np.ndarray], params: dict[str, Any], lens: dict[str, list[int]]
-) -> dict[str, np.ndarray]:
-    """One full-length item; records its frame, audio and mel lengths in ``lens``."""
-    n = f.n_frames
-    n_audio = audio_samples(n, params["fps"], params["sr"])
-    n_mel = mel_frames(n_audio)
-    for key, value in (("frames", n), ("audio", n_audio), ("mel", n_mel)):
-        lens[key].append(value)
-    return {
-        **per_frame,
-        "audio": _fit_audio(f.audio, 0, n_audio),
-        "mel": _fit_rows(f.mel, 0, n_mel),
-        "speaker": np.array([f.speaker], np.int64),
-        "take": np.array([f.stem]),
-        "start": np.zeros(1, np.int64),
-    }
-
-
-def _take_windows(
-    f: TakeFeatures, per_frame: dict[str, np.ndarray], params: dict[str, Any], lens: dict[str, list[int]]
-) -> dict[str, np.ndarray]:
-    """The windows of one take (an empty dict when it is shorter than one window)."""
-    length, fps, sr = params["length"], params["fps"], params["sr"]
-    starts = window_starts(f.n_frames, length, params["stride"])
-    if len(starts) == 0:
-        return {}
-    n_audio = audio_samples(length, fps, sr)
-    n_mel = mel_frames(n_audio)
-    a0 = [audio_start(int(s), fps, sr) for s in starts]
-    hop = MEL_SETTINGS["hop_length"]
-    return {
-        **{k: sliding_windows(v, length, params["stride"]) for k, v in per_frame.items()},
-        "audio": np.stack([_fit_audio(f.audio, a, n_audio) for a in a0]),
-        "mel": np.stack([_fit_rows(f.mel, a // hop, n_mel) for a in a0]),
-        "speaker": np.full(len(starts), f.speaker, np.int64),
-        "take": np.array([f.stem] * len(starts)),
-        "start": starts,
-    }
