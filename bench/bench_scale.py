@@ -15,8 +15,9 @@ emotional blocks 65-118 alternately; conversation 2.. train, 1 test, 12 val) -- 
 - ``stats`` (``--stats``): :func:`beatlite.stats.emotion_separability` over :func:`beatlite.stats.iter_corpus`
   (at most 2000 windows scored): seconds and peak RSS; ``--step stats CORPUS all`` scores every window (the
   O(N^2) alternative);
-- ``build_windows`` (the alternative, for N <= ``--compare-max-hours``): the in-memory train
-  windows of :func:`beatlite.data.windows.build_windows` with its ``.npz`` cache: seconds, peak RSS, cache size.
+- ``build_windows`` (the alternative, for N <= ``--compare-max-hours``): the train windows held in memory by
+  :func:`beatlite.data.windows.build_windows` (its own store, built serially, then every window read into RAM):
+  seconds, peak RSS, its store's size.
 
 Targets (issue 17): peak RSS of build and epoch <= 2 GiB at every size, store <= 0.5 GB per hour of
 mocap, build <= 30 s per hour on 2 cores, loader >= 5 x CaMN tiny's CPU training rate (151 windows/s).
@@ -349,7 +350,7 @@ def print_table(rows: list[dict]) -> None:
         ("sep_n", "separability windows", "{:d}"),
         ("bw_s", "build_windows s", "{:.1f}"),
         ("bw_rss", "build_windows RSS GiB", "{:.2f}"),
-        ("bw_gb", "build_windows cache GB", "{:.3f}"),
+        ("bw_gb", "build_windows store GB", "{:.3f}"),
     ]
     print("| " + " | ".join(c[1] for c in cols) + " |")
     print("|" + "---|" * len(cols))
