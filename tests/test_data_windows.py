@@ -228,12 +228,16 @@ def test_whole_take_mode(corpus: Path) -> None:
 
 
 def test_the_store_behind_the_windows_is_kept_and_reused(corpus: Path, tmp_path: Path) -> None:
-    """``cache=folder``: the index's window store is built there once; later calls, other window parameters
-    and whole takes read it without rebuilding a take; a sub-index gets its own store (a store drops the
-    takes its index lacks); saved windows load back."""
+    """``cache=folder``: the index's window store (the one training builds: same folder name) is built there
+    once; later calls, other window parameters and whole takes read it without rebuilding a take; a
+    sub-index gets a store of its own (building the corpus' store from it would drop the other takes);
+    saved windows load back."""
+    from beatlite.data.store import default_store_folder, store_params
+
     idx = index_folder(corpus)
     first = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
     (folder,) = (tmp_path / "store").iterdir()
+    assert folder.name == default_store_folder(idx, store_params()).name
     built = {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")}
     assert len(built) == len(idx)
     second = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
@@ -249,6 +253,7 @@ def test_the_store_behind_the_windows_is_kept_and_reused(corpus: Path, tmp_path:
     assert {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")} == built  # nothing rebuilt
     build_windows(idx.where(split=["train", "test"]), split="test", vocab=VOCAB, cache=tmp_path)
     assert len(list((tmp_path / "store").iterdir())) == 2 and len(list(folder.glob("takes/*"))) == len(idx)
+    assert {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")} == built
     again = Windows.load(whole.save(tmp_path / "whole.npz"))
     assert np.array_equal(again.item(0)["mel"], whole.item(0)["mel"])
     (tmp_path / "junk.npz").write_bytes(b"junk")

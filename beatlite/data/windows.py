@@ -546,7 +546,8 @@ def build_windows(
         Word-to-frame rule of :func:`beatlite.io.words_to_frames`.
     cache : bool or str or Path
         Where the store of the index's usable takes is kept: True: under ``cache_dir()/store`` (built once,
-        then only changed takes); a folder: under it; False: a temporary folder, removed afterwards.
+        then only changed takes; the corpus' own store, the one training builds, unless that one lists takes
+        this index lacks); a folder: under it; False: a temporary folder, removed afterwards.
     progress : bool
         Show a tqdm bar over the takes the store builds.
 
@@ -600,8 +601,9 @@ def build_windows(
 def _store_of(
     index: TakeIndex, params: dict[str, Any], cache: bool | str | Path, progress: bool
 ) -> Iterator[WindowStore]:
-    """The window store of ``index``'s usable takes (their own store: a store drops the takes its index
-    lacks, so one of a sub-index must not be the corpus' training store), kept as ``cache`` says."""
+    """The window store of ``index``'s usable takes, kept as ``cache`` says: the corpus' own store (the one
+    training builds) unless that one holds takes this index lacks, which building it from this index would
+    drop (then a store of this set of takes beside it)."""
     from beatlite.data.store import build_store, default_store_folder, store_params
 
     usable = index.where(usable=True)
@@ -611,11 +613,22 @@ def _store_of(
         with tempfile.TemporaryDirectory(prefix="beatlite-windows-") as tmp:
             yield build_store(usable, tmp, **_build_args(store), workers=0, progress=progress)
         return
-    takes = hashlib.sha256("\n".join(sorted(r.stem for r in usable)).encode()).hexdigest()[:16]
-    folder = default_store_folder(usable, {**store, "takes": takes})
+    stems = {r.stem for r in usable}
+    folder = default_store_folder(usable, store)
     if cache is not True:
         folder = Path(cache) / "store" / folder.name
+    if not _listed_takes(folder) <= stems:
+        takes = hashlib.sha256("\n".join(sorted(stems)).encode()).hexdigest()[:16]
+        folder = folder.with_name(f"{folder.name}-{takes}")
     yield build_store(usable, folder, **_build_args(store), workers=0, progress=progress)
+
+
+def _listed_takes(folder: Path) -> set[str]:
+    """The take stems a store's ``store.json`` lists (none when it has none, or one that cannot be read)."""
+    try:
+        return set(json.loads((folder / "store.json").read_text())["takes"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return set()
 
 
 def _build_args(store_params: dict[str, Any]) -> dict[str, Any]:
