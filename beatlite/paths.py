@@ -46,7 +46,7 @@ def build_dir() -> Path:
 
 
 def cache_dir() -> Path:
-    """Folder for derived caches (window ``.npz`` files): ``<build>/cache``."""
+    """Folder for derived caches (the index cache, the window stores): ``<build>/cache``."""
     return build_dir() / "cache"
 
 

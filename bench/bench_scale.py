@@ -16,7 +16,7 @@ emotional blocks 65-118 alternately; conversation 2.. train, 1 test, 12 val) -- 
   (at most 2000 windows scored): seconds and peak RSS; ``--step stats CORPUS all`` scores every window (the
   O(N^2) alternative);
 - ``build_windows`` (the alternative, for N <= ``--compare-max-hours``): the train windows held in memory by
-  :func:`beatlite.data.windows.build_windows` (its own store, built serially, then every window read into RAM):
+  :func:`beatlite.data.windows.build_windows` (a store in its cache folder, built serially, then every window read into RAM):
   seconds, peak RSS, its store's size.
 
 Targets (issue 17): peak RSS of build and epoch <= 2 GiB at every size, store <= 0.5 GB per hour of

@@ -21,7 +21,15 @@ from beatlite.data.store import (
     build_store,
     quantize_audio,
 )
-from beatlite.data.windows import audio_start, build_windows, sliding_windows, take_features, window_starts
+from beatlite.data.windows import (
+    audio_samples,
+    audio_start,
+    build_windows,
+    mel_frames,
+    sliding_windows,
+    take_features,
+    window_starts,
+)
 from beatlite.io import FormatError
 
 #: 16-bit storage of audio on the step 2**-15: at most half a step off (plus float32 rounding, 0 here).
@@ -46,6 +54,12 @@ def _meta_times(store: WindowStore) -> dict[str, int]:
     return {t.stem: (t.folder / "meta.json").stat().st_mtime_ns for t in store.takes}
 
 
+def _rows(x: np.ndarray, start: int, n: int) -> np.ndarray:
+    """``x[start:start + n]``, the last row repeated up to ``n`` rows (HA2G's mel rule at a take's end)."""
+    out = x[start : start + n]
+    return np.concatenate([out, np.repeat(out[-1:], n - len(out), axis=0)]) if len(out) < n else out
+
+
 def test_batches_equal_windows_cut_from_each_takes_features(corpus: Path, store: WindowStore) -> None:
     """The store's batches equal the windows cut directly from each take's features by the teaching
     functions (``take_features``, ``sliding_windows``, ``audio_start``), and its pooled statistics equal
@@ -68,6 +82,8 @@ def test_batches_equal_windows_cut_from_each_takes_features(corpus: Path, store:
         **{k: sliding_windows([getattr(f, k) for f in features]) for k in ("face", "word", "emotion", "semantic")},
         "audio": np.stack([f.audio[audio_start(int(s), 15, 16000) :][:36266] for f, ss in zip(features, starts)
                            for s in ss]),
+        "mel": np.stack([_rows(f.mel, audio_start(int(s), 15, 16000) // 512, 70) for f, ss in zip(features, starts)
+                         for s in ss]),
         "start": np.concatenate(starts),
     }  # fmt: skip
     a = got.batch()
@@ -266,19 +282,27 @@ def test_default_vocabulary_follows_the_textgrids(corpus: Path, tmp_path: Path) 
     assert again.vocab["giraffe"] in word.tolist()  # the changed take was rebuilt with the new word
 
 
-def test_whole_take_equals_build_windows_whole_takes(corpus: Path, store: WindowStore) -> None:
+def test_whole_take_equals_the_takes_features(corpus: Path, store: WindowStore) -> None:
+    """A whole take: the take's features at full length (audio cut to ``audio_samples(T)``, the mel to
+    ``mel_frames`` of that), normalised with the given statistics; ``build_windows(whole_takes=True)`` holds the
+    same items."""
     idx = index_folder(corpus)
-    train = build_windows(idx, split="train", vocab=VOCAB, cache=False)
-    stats = train.normalizers
+    stats = store.statistics("train")
     ref = build_windows(idx, split="val", vocab=VOCAB, stats=stats, whole_takes=True, cache=False)
-    for i, stem in enumerate(ref["take"]):
-        want, got = ref.item(i), store.whole_take(str(stem), stats=stats)
-        assert got["take"] == stem and got["pose"].shape == want["pose"].shape
-        for key in ref.keys():
-            if key == "audio":
-                assert got[key].shape == want[key].shape and np.abs(got[key] - want[key]).max() <= AUDIO_BOUND
-            else:
-                assert np.array_equal(got[key], want[key]), key
+    for i, r in enumerate(r for r in idx if r.split == "val"):
+        f, got = take_features(r, vocab=VOCAB), store.whole_take(r.stem, stats=stats, vocab=VOCAB)
+        n_audio = audio_samples(f.n_frames, 15, 16000)
+        want = {
+            "pose": stats.pose.transform(f.pose_raw).astype(np.float32), "pose_raw": f.pose_raw.astype(np.float32),
+            "dirvec": stats.dirvec.transform(f.dirs).astype(np.float32), "face": f.face, "word": f.word,
+            "emotion": f.emotion, "semantic": f.semantic, "mel": _rows(f.mel, 0, mel_frames(n_audio)),
+        }  # fmt: skip
+        for key, value in want.items():
+            assert np.array_equal(got[key], value.astype(got[key].dtype)), key
+        assert (
+            got["audio"].shape == (n_audio,) and np.abs(got["audio"] - f.audio[:n_audio]).max() <= AUDIO_BOUND
+        )
+        assert got["take"] == r.stem and all(np.array_equal(ref.item(i)[k], got[k]) for k in ref.keys())
     # 100 frames: 106666 samples, round((106666 - 1024) / 512 + 1) = 207 mel frames (HA2G's clip rule)
     assert store.whole_take("2_scott_0_9_9", keys=("mel",))["mel"].shape == (207, 128)
 

@@ -1,4 +1,5 @@
-"""The window store on data_samples/: every key a model uses equals build_windows' batches, every split."""
+"""The window store on data_samples/: every key of every split equals the windows cut from each take's features
+(16-bit 16 kHz audio: stored exactly), and its statistics ``Normalizer.fit`` over the train frames."""
 
 from __future__ import annotations
 
@@ -8,38 +9,48 @@ import numpy as np
 import pytest
 
 from beatlite.data.index import index_folder
+from beatlite.data.normalize import Normalizer
 from beatlite.data.store import build_store
-from beatlite.data.windows import build_windows
+from beatlite.data.windows import audio_start, build_windows, sliding_windows, take_features, window_starts
 
 pytestmark = pytest.mark.slow
 
 
+def _cut(records: list, stats, vocab) -> dict[str, np.ndarray]:  # noqa: ANN001
+    """The windows of ``records`` cut from their features by the teaching functions."""
+    feats = [take_features(r, vocab=vocab, mel=False) for r in records]
+    pose_raw = sliding_windows([f.pose_raw for f in feats])
+    audio = [
+        f.audio[audio_start(int(s), 15, 16000) :][:36266] for f in feats for s in window_starts(f.n_frames)
+    ]
+    return {
+        "pose": stats.pose.transform(pose_raw).astype(np.float32),
+        "dirvec": stats.dirvec.transform(sliding_windows([f.dirs for f in feats])).astype(np.float32),
+        "audio": np.stack(audio),
+        **{
+            k: sliding_windows([getattr(f, k) for f in feats])
+            for k in ("face", "word", "emotion", "semantic")
+        },
+    }
+
+
 @pytest.mark.slow
-def test_store_equals_build_windows_on_data_samples(data_samples: Path, tmp_path: Path) -> None:
+def test_store_equals_the_takes_features_on_data_samples(data_samples: Path, tmp_path: Path) -> None:
     idx = index_folder(data_samples)
     store = build_store(idx, tmp_path / "store", workers=2)
-    train = build_windows(idx, split="train", cache=tmp_path / "cache")
-    stats = train.normalizers
-    for split in ("train", "val", "test"):
-        ref = (
-            train
-            if split == "train"
-            else build_windows(idx, split=split, stats=stats, cache=tmp_path / "cache")
-        )
-        got = store.windows(split, stats=stats)
-        assert len(got) == len(ref) > 0
-        a, b = ref.batch(), got.batch()
-        # data_samples' audio is 16 kHz 16-bit PCM: stored exactly, so every key is bit-identical
-        for key in ref.keys():
-            assert a[key].dtype == b[key].dtype and np.array_equal(a[key], b[key]), (split, key)
-    # the store's own streamed statistics: equal to the in-memory ones up to float rounding
+    train_records = [r for r in idx if r.usable and r.split == "train"]
+    frames = [take_features(r, mel=False) for r in train_records]
+    fitted = Normalizer.fit(np.concatenate([f.pose_raw for f in frames]))
     norms = store.statistics("train")
-    pose_norm, dir_norm = norms.pose, norms.dirvec
-    assert np.allclose(pose_norm.mean, train.normalizers.pose.mean, rtol=1e-12, atol=1e-10)
-    assert np.allclose(pose_norm.std, train.normalizers.pose.std, rtol=1e-12, atol=0)
-    assert np.allclose(dir_norm.mean, train.normalizers.dirvec.mean, rtol=0, atol=1e-12)
-    own = store.windows("train").batch()
-    assert (
-        np.abs(own["pose"] - train["pose"]).max() < 1e-5
-        and np.abs(own["dirvec"] - train["dirvec"]).max() < 1e-6
-    )
+    assert np.allclose(norms.pose.mean, fitted.mean, rtol=1e-12, atol=1e-10)
+    assert np.allclose(norms.pose.std, fitted.std, rtol=1e-12, atol=0)
+    dir_mean = np.concatenate([f.dirs for f in frames]).mean(0)
+    assert np.allclose(norms.dirvec.mean, dir_mean, rtol=0, atol=1e-12)
+    for split in ("train", "val", "test"):
+        records = [r for r in idx if r.usable and r.split == split]
+        got = store.windows(split, stats=norms).batch()
+        want = _cut(records, norms, store.vocab)
+        for key, value in want.items():  # audio included: 16-bit PCM at 16 kHz is stored exactly
+            assert np.array_equal(got[key], value.astype(got[key].dtype)), (split, key)
+    held = build_windows(idx, split="test", cache=tmp_path / "cache")  # the same windows, held in memory
+    assert all(np.array_equal(held[k], v) for k, v in store.windows("test").batch().items())

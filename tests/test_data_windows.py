@@ -228,16 +228,11 @@ def test_whole_take_mode(corpus: Path) -> None:
 
 
 def test_the_store_behind_the_windows_is_kept_and_reused(corpus: Path, tmp_path: Path) -> None:
-    """``cache=folder``: the index's window store (the one training builds: same folder name) is built there
-    once; later calls, other window parameters and whole takes read it without rebuilding a take; a
-    sub-index gets a store of its own (building the corpus' store from it would drop the other takes);
-    saved windows load back."""
-    from beatlite.data.store import default_store_folder, store_params
-
+    """``cache=folder``: the windows come from a store kept there, built once; later calls, other window
+    parameters and whole takes read it without rebuilding a take; saved windows load back."""
     idx = index_folder(corpus)
     first = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
     (folder,) = (tmp_path / "store").iterdir()
-    assert folder.name == default_store_folder(idx, store_params()).name
     built = {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")}
     assert len(built) == len(idx)
     second = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
@@ -251,14 +246,33 @@ def test_the_store_behind_the_windows_is_kept_and_reused(corpus: Path, tmp_path:
     assert len(other) > len(first) and other.fingerprint != first.fingerprint
     whole = build_windows(idx, split="test", vocab=VOCAB, whole_takes=True, cache=tmp_path)
     assert {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")} == built  # nothing rebuilt
-    build_windows(idx.where(split=["train", "test"]), split="test", vocab=VOCAB, cache=tmp_path)
-    assert len(list((tmp_path / "store").iterdir())) == 2 and len(list(folder.glob("takes/*"))) == len(idx)
-    assert {p: p.stat().st_mtime_ns for p in folder.glob("takes/*/meta.json")} == built
     again = Windows.load(whole.save(tmp_path / "whole.npz"))
     assert np.array_equal(again.item(0)["mel"], whole.item(0)["mel"])
     (tmp_path / "junk.npz").write_bytes(b"junk")
     with pytest.raises(ValueError, match="junk.npz"):
         Windows.load(tmp_path / "junk.npz")
+
+
+def test_the_windows_read_the_training_store_and_never_write_it(corpus: Path, tmp_path: Path) -> None:
+    """The corpus' own store (the one training builds) is read as it is when it holds exactly the index's
+    takes, all current; a sub-index, or a store without its manifest, gets a store of its own beside it: the
+    training store is never written (no take dropped, its manifest and vocabulary left as they are)."""
+    from beatlite.data.store import build_store, default_store_folder, store_params
+
+    idx = index_folder(corpus)
+    training = default_store_folder(idx, store_params())
+    training = tmp_path / "store" / training.name
+    build_store(idx, training, vocab=VOCAB, workers=0)
+    files = {p: p.stat().st_mtime_ns for p in training.rglob("*") if p.is_file() and p.name != ".build.lock"}
+    full = build_windows(idx, split="test", vocab=VOCAB, cache=tmp_path)
+    assert [p.name for p in (tmp_path / "store").iterdir()] == [training.name]  # read, not copied
+    sub = build_windows(idx.where(split=["train", "test"]), split="test", vocab=VOCAB, cache=tmp_path)
+    assert np.array_equal(sub["pose"], full["pose"]) and len(list((tmp_path / "store").iterdir())) == 2
+    (training / "store.json").unlink()  # a store whose manifest is gone (or not written yet): not shared
+    build_windows(idx.where(split=["train", "test"]), split="test", vocab=VOCAB, cache=tmp_path)
+    assert {p: t for p, t in files.items() if p.name != "store.json"} == {
+        p: p.stat().st_mtime_ns for p in training.rglob("*") if p.is_file() and p.name != ".build.lock"
+    }
 
 
 def test_torch_dataset(train: Windows) -> None:

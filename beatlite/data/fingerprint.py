@@ -1,6 +1,6 @@
 """Fingerprints of data: the same files and parameters give the same hex digits on every machine.
 
-One home for "is this the same data?": the window cache, the window store, the FGD extractor's
+One home for "is this the same data?": the window store (and the windows read from it), the FGD extractor's
 record of what it was trained on and the stale-checkpoint checks all call :func:`take_fingerprint`
 or :func:`takes_fingerprint`. A fingerprint hashes
 

@@ -832,6 +832,46 @@ def _is_current(folder: Path, record: TakeRecord, params: Mapping[str, Any]) -> 
     return True
 
 
+def open_if_current(index: TakeIndex, folder: str | Path, params: Mapping[str, Any]) -> WindowStore | None:
+    """The store in ``folder`` opened as it is, if it holds exactly the usable takes of ``index``, every one built
+    from the same files and parameters (``params``: :func:`store_params`); else ``None``. Writes nothing (it
+    waits while a build of that store is under way).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.data.index import index_folder
+    >>> tmp = example_corpus()  # a test and a train take of data_samples/, copied to a temporary folder
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> folder = Path(tmp.name) / "store"
+    >>> open_if_current(index, folder, store_params()) is None  # not built yet
+    True
+    >>> _ = build_store(index, folder)
+    >>> len(open_if_current(index, folder, store_params()).takes)
+    2
+    >>> open_if_current(index.where(split="test"), folder, store_params()) is None  # it has another take too
+    True
+    >>> tmp.cleanup()
+    """
+    from beatlite.io.atomic import exclusive_lock
+
+    folder = Path(folder)
+    records = [r for r in index if r.usable]
+    if not (folder / ".build.lock").is_file():
+        return None
+    with exclusive_lock(folder / ".build.lock"):
+        try:
+            listed = json.loads((folder / "store.json").read_text())["takes"]
+        except (OSError, ValueError, KeyError, TypeError):
+            return None
+        if sorted(listed) != sorted(r.stem for r in records):
+            return None
+        if not all(_is_current(folder / "takes" / r.stem, r, dict(params)) for r in records):
+            return None
+        return WindowStore.open(folder)
+
+
 def _text_fingerprint(index: TakeIndex) -> str:
     """sha256 over (stem, name, content) of every TextGrid of the index (what ``build_vocab`` reads)."""
     from beatlite.data.fingerprint import file_digest

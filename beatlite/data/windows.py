@@ -338,7 +338,8 @@ class Windows:
     whole_takes : bool
         One full-length item per take.
     path : Path or None
-        Cache file the windows were loaded from / saved to.
+        The ``.npz`` the windows were loaded from or saved to (:meth:`load`, :meth:`save`); None for
+        windows read from a store.
 
     Examples
     --------
@@ -589,7 +590,7 @@ def build_windows(
         "whole_takes": bool(whole_takes), "positions": bool(positions), "word_rule": word_rule,
         "vocab_size": len(vocab), "mel": dict(MEL_SETTINGS), "subset": POSE_SUBSET,
     }  # fmt: skip
-    with _store_of(index, params, cache, progress) as store:
+    with _store_of(index, records, params, vocab, cache, progress, need_train=stats is None) as store:
         stats = store.statistics("train") if stats is None else stats
         stems = [r.stem for r in records]
         read = _whole_takes if whole_takes else _windows
@@ -599,41 +600,40 @@ def build_windows(
 
 @contextlib.contextmanager
 def _store_of(
-    index: TakeIndex, params: dict[str, Any], cache: bool | str | Path, progress: bool
-) -> Iterator[WindowStore]:
-    """The window store of ``index``'s usable takes, kept as ``cache`` says: the corpus' own store (the one
-    training builds) unless that one holds takes this index lacks, which building it from this index would
-    drop (then a store of this set of takes beside it)."""
-    from beatlite.data.store import build_store, default_store_folder, store_params
+    index: TakeIndex, records: list[TakeRecord], params: dict[str, Any], vocab: Vocab, cache: bool | str | Path,
+    progress: bool, need_train: bool,
+) -> Iterator[WindowStore]:  # fmt: skip
+    """The window store to read ``records`` from, kept as ``cache`` says.
 
-    usable = index.where(usable=True)
+    ``cache=True`` (or a folder): the corpus' own store, the one training builds, opened read-only when it
+    holds exactly the index's usable takes, all current (:func:`beatlite.data.store.open_if_current`); else a
+    store of the index's usable takes beside it, built or updated (building the corpus' store from this index
+    would drop the takes it lacks, or rebuild them with other overrides). ``cache=False``: a temporary store of
+    ``records`` and (``need_train``) the train takes, removed afterwards.
+    """
+    from beatlite.data.store import build_store, default_store_folder, open_if_current, store_params
+
     store = store_params(fps=params["fps"], sr=params["sr"], positions=params["positions"],
                          word_rule=params["word_rule"])  # fmt: skip
+    args = {**{k: store[k] for k in ("fps", "sr", "positions", "word_rule")}, "vocab": vocab, "workers": 0}
     if cache is False or cache is None:
+        stems = {r.stem for r in records} | (
+            {r.stem for r in index if r.split == "train"} if need_train else set()
+        )
         with tempfile.TemporaryDirectory(prefix="beatlite-windows-") as tmp:
-            yield build_store(usable, tmp, **_build_args(store), workers=0, progress=progress)
+            yield build_store(index.where(usable=True, stem=stems), tmp, **args, progress=progress)
         return
-    stems = {r.stem for r in usable}
+    usable = index.where(usable=True)
     folder = default_store_folder(usable, store)
     if cache is not True:
         folder = Path(cache) / "store" / folder.name
-    if not _listed_takes(folder) <= stems:
-        takes = hashlib.sha256("\n".join(sorted(stems)).encode()).hexdigest()[:16]
-        folder = folder.with_name(f"{folder.name}-{takes}")
-    yield build_store(usable, folder, **_build_args(store), workers=0, progress=progress)
-
-
-def _listed_takes(folder: Path) -> set[str]:
-    """The take stems a store's ``store.json`` lists (none when it has none, or one that cannot be read)."""
-    try:
-        return set(json.loads((folder / "store.json").read_text())["takes"])
-    except (OSError, ValueError, KeyError, TypeError):
-        return set()
-
-
-def _build_args(store_params: dict[str, Any]) -> dict[str, Any]:
-    """:func:`build_store`'s keyword arguments of a store's parameters."""
-    return {k: store_params[k] for k in ("fps", "sr", "positions", "word_rule")}
+    shared = open_if_current(usable, folder, store)
+    if shared is not None:
+        yield shared
+        return
+    key = "\n".join(f"{r.stem} {r.bvh_fps}" for r in sorted(usable, key=lambda r: r.stem))
+    own = folder.with_name(f"{folder.name}-{hashlib.sha256(key.encode()).hexdigest()[:16]}")
+    yield build_store(usable, own, **args, progress=progress)
 
 
 def _windows(

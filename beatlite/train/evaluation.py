@@ -34,7 +34,7 @@ Metrics (``COLUMNS``):
 Two ground-truth rows: ``Ground truth`` (the dataset's TED-43 directions, the FGD reference,
 FGD 0 by definition) and ``Ground truth (141 Euler channels)`` (only the channels the Euler
 models predict, the rest at rest pose: the floor an Euler model can reach).
-Nothing is cached outside ``build/`` (the window caches of :mod:`beatlite.data.windows`).
+Nothing is cached outside ``build/`` (the window stores of :mod:`beatlite.data.store`).
 The test takes, the generation of one model's row and its scoring are :mod:`beatlite.train.testset`; the
 conversions to the common space are :mod:`beatlite.skeleton.ted`'s.
 

@@ -94,7 +94,7 @@ def as_arrays(windows: Any) -> Mapping[str, np.ndarray]:
 def data_fingerprint(windows: Any) -> str:
     """A short hash identifying a window set (shapes, dtypes and a sample of values).
 
-    Uses the object's ``fingerprint`` attribute (e.g. the window cache's) when it has one;
+    Uses the object's ``fingerprint`` attribute (``Windows`` and store views have one) when it has one;
     otherwise hashes, per key in sorted order, the name, shape, dtype and every
     ``max(1, N // 16)``-th window's bytes.
 
