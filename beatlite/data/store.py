@@ -52,7 +52,7 @@ import json
 import os
 import shutil
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -504,6 +504,17 @@ class WindowStore:
             raise ValueError(f"WindowStore: split must be 'train', 'val', 'test' or None, got {split!r}")
         return [t for t in self.takes if split is None or t.meta["split"] == split]
 
+    def windows_fingerprint(
+        self, stems: Iterable[str], *, split: str | None, length: int, stride: int, vocab: Vocab
+    ) -> str:
+        """:func:`beatlite.data.fingerprint.windows_fingerprint` of windows cut from the takes ``stems`` (in this
+        store's order; ``length = stride = 0`` for whole takes) with word ids of ``vocab``."""
+        from beatlite.data.fingerprint import windows_fingerprint
+
+        chosen = set(stems)
+        takes = [t.meta["fingerprint"] for t in self.takes if t.stem in chosen]
+        return windows_fingerprint(takes, split=split, length=length, stride=stride, vocab=vocab.itos)
+
     def statistics(self, split: str = "train") -> Normalizers:
         """The :class:`Normalizers` of ``split`` (pose mean/std, direction mean with std 1), from per-take moments.
 
@@ -655,15 +666,13 @@ class StoreWindows:
         overrides, store parameters, split, length, stride, vocabulary). What
         :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data.
         The statistics are left out (their float bits vary across machines; they derive from the takes)."""
-        from beatlite.data.fingerprint import windows_fingerprint
-
-        takes = [self.store.takes[int(i)].meta["fingerprint"] for i in np.unique(self.take_ids)]
-        return windows_fingerprint(
-            takes,
+        stems = [self.store.takes[int(i)].stem for i in np.unique(self.take_ids)]
+        return self.store.windows_fingerprint(
+            stems,
             split=self.params["split"],
             length=self.length,
             stride=self.params["stride"],
-            vocab=self.vocab.itos,
+            vocab=self.vocab,
         )
 
     # mapping-like access, as Windows -------------------------------------------

@@ -650,7 +650,13 @@ def _windows(
             f"build_windows: no take of split {params['split']!r} is at least {params['length']} frames long "
             f"({len(stems)} takes)"
         ) from None
-    return view.batch(None), _fingerprint(store, view.take_ids, params, vocab)
+    have = [
+        store.takes[int(i)].stem for i in np.unique(view.take_ids)
+    ]  # (the view's split is None: the split's)
+    fingerprint = store.windows_fingerprint(
+        have, split=params["split"], length=params["length"], stride=params["stride"], vocab=vocab
+    )
+    return view.batch(None), fingerprint
 
 
 def _whole_takes(
@@ -662,18 +668,7 @@ def _whole_takes(
     arrays = {k: np.concatenate([np.atleast_1d(item[k]) for item in items]) for k in items[0]}
     for key, name in (("frames", "pose"), ("audio", "audio"), ("mel", "mel")):
         arrays[f"_len_{key}"] = np.array([len(item[name]) for item in items], np.int64)
-    ids = np.array([store.takes.index(store.take(stem)) for stem in stems])
-    return arrays, _fingerprint(store, ids, {**params, "length": 0, "stride": 0}, vocab)
-
-
-def _fingerprint(store: WindowStore, take_ids: np.ndarray, params: dict[str, Any], vocab: Vocab) -> str:
-    """:func:`beatlite.data.fingerprint.windows_fingerprint` of the store's takes ``take_ids``."""
-    from beatlite.data.fingerprint import windows_fingerprint
-
-    takes = [store.takes[int(i)].meta["fingerprint"] for i in np.unique(take_ids)]
-    return windows_fingerprint(
-        takes, split=params["split"], length=params["length"], stride=params["stride"], vocab=vocab.itos
-    )
+    return arrays, store.windows_fingerprint(stems, split=params["split"], length=0, stride=0, vocab=vocab)
 
 
 def _check_window_params(split: str | None, length: int, stride: int, fps: float, sr: int) -> None:
