@@ -230,16 +230,16 @@ def measure_step(
     if compile != "eager":
         counted = _Run(_model(name, preset, train), _config(device, precision, batch, epochs=1), "bench", {})
     with _flop_counter() as counter:
-        counted.step(step, 1, 0, {})
+        counted.step(step, 0, {})
     with _CountOps() as ops:
-        counted.step(step, 1, 0, {})
+        counted.step(step, 0, {})
     for _ in range(1 if compile == "eager" else 3):  # warm-up: allocator, oneDNN primitives, cuDNN plans;
-        run.step(step, 1, 0, {})  # compiled: the compilation, then reduce-overhead's CUDA-graph recording
+        run.step(step, 0, {})  # compiled: the compilation, then reduce-overhead's CUDA-graph recording
     _sync(run.device)
     with _PeakMemory(run.device) as memory:
         start = time.perf_counter()
         for _ in range(steps):
-            run.step(step, 1, 0, {})
+            run.step(step, 0, {})
         _sync(run.device)
         seconds = (time.perf_counter() - start) / steps
     if profile:
@@ -261,7 +261,7 @@ def _profile(run: _Run, step: list, top: int) -> None:
 
     activities = [ProfilerActivity.CPU] + ([ProfilerActivity.CUDA] if run.device.type == "cuda" else [])
     with profile(activities=activities) as prof:
-        run.step(step, 1, 0, {})
+        run.step(step, 0, {})
         _sync(run.device)
     key = "self_cuda_time_total" if run.device.type == "cuda" else "self_cpu_time_total"
     print(prof.key_averages().table(sort_by=key, row_limit=top))

@@ -544,7 +544,7 @@ class _Run:
         first, sums = self.position(epoch)
         every, val_every = config.checkpoint_every, config.val_every
         for k, batches in enumerate(data.batches(steps[first:], self.device, config.workers), start=first):
-            self.step(batches, self.parts, epoch, sums)
+            self.step(batches, epoch, sums)
             self.steps += 1
             if val_every and self.steps % val_every == 0:
                 self.validate_step(epoch)
@@ -586,14 +586,13 @@ class _Run:
     def step(
         self,
         batches: list[tuple[dict[str, torch.Tensor], int]],
-        parts: int,
         epoch: int,
         sums: dict[str, Any],
     ) -> None:
         """The discriminator step (when adversarial) then the generator step on one global batch.
 
         ``batches`` are this process's micro-batches (tensors, windows) of a global batch split into
-        ``parts``, each loss scaled by ``world / parts``: under ``torchrun`` DDP averages the gradients
+        :attr:`parts`, each loss scaled by ``world / parts``: under ``torchrun`` DDP averages the gradients
         over the ``world`` processes, so every step sees the mean of the micro-batch gradients, whatever
         the process count (see :func:`_backward`).
         """
@@ -611,7 +610,7 @@ class _Run:
             for i, ((batch, weight), out) in enumerate(zip(batches, outs, strict=True)):
                 with sync_on_last(self.d_ddp, i == last), self._autocast():
                     d_losses = self.d_losses(batch, out)
-                d_totals.append(d_losses["total"] * self.world / parts)
+                d_totals.append(d_losses["total"] * self.world / self.parts)
                 _accumulate(sums, {k: v for k, v in d_losses.items() if k != "total"}, weight, "D_")
             _backward(d_totals, self.d_ddp)
             torch.nn.utils.clip_grad_norm_(model.discriminator.parameters(), config.grad_clip)
@@ -621,7 +620,7 @@ class _Run:
         for (batch, weight), out in zip(batches, outs, strict=True):
             with self._autocast():
                 losses = self.losses(batch, out, epoch=epoch)
-            totals.append(losses["total"] * self.world / parts)
+            totals.append(losses["total"] * self.world / self.parts)
             _accumulate(sums, losses, weight)
         _backward(totals, self.g_ddp)
         torch.nn.utils.clip_grad_norm_(self.g_params, config.grad_clip)
