@@ -287,9 +287,10 @@ class CudaAutocastRules(torch.overrides.TorchFunctionMode):
         return func(*args, **kwargs)
 
 
-def _store_view(case: ModelCase, keys: tuple[str, ...]) -> Any:
-    """The case's train windows read through a store view of exactly ``keys``."""
-    train = case.train
+def _store_view(case: ModelCase) -> Any:
+    """The case's train windows read through a store view of exactly the model's ``batch_keys``."""
+    model, train = case.build(), case.train
+    keys = type(model).batch_keys(model.config)
     return train.store.windows(
         train.params["split"], length=train.length, stride=train.params["stride"], keys=keys,
         stats=train.normalizers, vocab=train.vocab,
@@ -323,8 +324,7 @@ def check_store_training(case: ModelCase) -> None:
     """Two steps from a store view of exactly ``batch_keys``, read by the loader and held on the device
     (``data_on_device="always"``), equal two steps from the same windows in memory (same losses, weights and
     buffers, bit for bit), with finite losses."""
-    model = case.build()
-    view = _store_view(case, type(model).batch_keys(model.config))
+    view = _store_view(case)
     stored, history = _fit_two_steps(case, view, amp=False)
     memory, reference = _fit_two_steps(case, case.reference, amp=False)
     resident, held = _fit_two_steps(case, view, amp=False, on_device="always")
@@ -347,8 +347,7 @@ def check_store_training(case: ModelCase) -> None:
 
 def check_bf16_training(case: ModelCase) -> None:
     """Two steps from the store under bfloat16 autocast (CPU; CUDA's dtype rules enforced): finite losses."""
-    model = case.build()
-    _, history = _fit_two_steps(case, _store_view(case, type(model).batch_keys(model.config)), amp=True)
+    _, history = _fit_two_steps(case, _store_view(case), amp=True)
     _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite bf16 losses {history}")
 
 
@@ -412,8 +411,7 @@ def check_compiled_training(case: ModelCase) -> None:
     """Two steps from the store with the step through ``torch.compile`` (``TrainConfig.compile="aot_eager"``:
     traced into graphs and run by the same kernels) give the losses of two eager steps (to float32
     reassociation, rel 1e-4)."""
-    model = case.build()
-    view = _store_view(case, type(model).batch_keys(model.config))
+    view = _store_view(case)
     _, eager = _fit_two_steps(case, view, amp=False)
     _, compiled = _fit_two_steps(case, view, amp=False, compile="aot_eager")
     for a, b in zip(eager, compiled, strict=True):
