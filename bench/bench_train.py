@@ -30,6 +30,9 @@ Per row:
 - **compile**: :attr:`beatlite.train.TrainConfig.compile` of the row (``--compile``; ``eager`` = none; the
   timed steps come after a first, compiling one). FLOPs and operators are the eager step's; the fit
   columns are left out (``-``): a fit of a few steps would time its compilation.
+- **deterministic**: ``torch.use_deterministic_algorithms`` during the step (``--deterministic``; ``fit``
+  turns it on, so ``off`` rows leave the fit columns out): on CUDA some backward kernels (embedding, index
+  and scatter sums) and cuBLAS' workspace differ between the two.
 - **% of peak**: achieved FLOP/s (GFLOP/window x step windows/s) over the rate of a large matrix product
   of the same precision measured in the same run on the same device (``peak`` line; 1024^2 on the CPU, 8192^2
   on CUDA), i.e. of what this device reaches on dense GEMMs, not of its datasheet.
@@ -50,8 +53,10 @@ import argparse
 import dataclasses
 import json
 import math
+import os
 import tempfile
 import time
+import traceback
 from pathlib import Path
 from typing import Any
 
@@ -165,6 +170,7 @@ class Row:
     precision: str
     batch: int
     compile: str = "eager"
+    deterministic: bool = True
     params: int | None = None
     gflop_per_window: float | None = None
     step_wps: float | None = None
@@ -212,10 +218,12 @@ class _CountOps(TorchDispatchMode):
 def measure_step(
     name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0,
     compile: str = "eager",  # noqa: A002
+    deterministic: bool = True,
 ) -> Row:  # fmt: skip
     """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
     (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
     operators)."""
+    torch.use_deterministic_algorithms(deterministic)  # (fit turns it on: set for every row)
     model = _model(name, preset, train)
     run = _Run(model, _config(device, precision, batch, compile, epochs=1), "bench", {})
     keys = model_keys(model)
@@ -247,8 +255,8 @@ def measure_step(
     dtype = torch.bfloat16 if precision == "bf16" else torch.float32
     gflop = counter.get_total_flops() / batch / 1e9
     row = Row(
-        name, preset, device, precision, batch, compile, model.n_parameters(), gflop, batch / seconds,
-        1e3 * seconds, ops_per_step=ops.count,
+        name, preset, device, precision, batch, compile, deterministic, model.n_parameters(), gflop,
+        batch / seconds, 1e3 * seconds, ops_per_step=ops.count,
     )  # fmt: skip
     row.peak_mib = memory.mib
     row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
@@ -298,7 +306,7 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
 # ---------------------------------------------------------------------------- table and command line
 COLUMNS = (
     ("model", "model"), ("preset", "preset"), ("device", "device"), ("precision", "precision"),
-    ("batch", "batch"), ("compile", "compile"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
+    ("batch", "batch"), ("compile", "compile"), ("deterministic", "deterministic"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
     ("ops_per_step", "ops/step"),
     ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s (loader)"),
     ("fit_ratio", "fit/step"), ("fit_resident_wps", "fit windows/s (resident)"), ("resident_ratio", "resident/loader"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
@@ -306,7 +314,15 @@ COLUMNS = (
 
 
 def _cell(row: Row, field: str) -> str:
-    if row.note and field not in ("model", "preset", "device", "precision", "batch", "compile"):
+    if row.note and field not in (
+        "model",
+        "preset",
+        "device",
+        "precision",
+        "batch",
+        "compile",
+        "deterministic",
+    ):
         return row.note
     ratios = {"fit_ratio": (row.fit_wps, row.step_wps), "resident_ratio": (row.fit_resident_wps, row.fit_wps)}
     if field in ratios:
@@ -314,6 +330,8 @@ def _cell(row: Row, field: str) -> str:
         value = a / b if a and b else None
     else:
         value = getattr(row, field)
+    if isinstance(value, bool):
+        return "on" if value else "off"
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-"
     if field == "peak_mib":
@@ -363,11 +381,18 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--batch-sizes", nargs="+", type=int, default=None, help="default 16 64 (quick: 16)")
     p.add_argument("--steps", type=int, default=None, help="timed steps per row (default 10, quick 3)")
     p.add_argument(
-        "--fit-steps", type=int, default=None, help="steps of the timed fit epoch (default 10, quick 2)"
+        "--fit-steps",
+        type=int,
+        default=None,
+        help="steps of the timed fit epoch (default 10, quick 2; 0: no fit)",
     )
     p.add_argument(
         "--compile", nargs="+", default=["eager"], choices=["eager", *COMPILE_MODES, *COMPILE_BACKENDS],
         help="TrainConfig.compile of the rows (eager: none); default eager",
+    )  # fmt: skip
+    p.add_argument(
+        "--deterministic", nargs="+", default=["on"], choices=["on", "off"],
+        help="torch.use_deterministic_algorithms of the step (fit always turns it on: off rows skip the fit)",
     )  # fmt: skip
     p.add_argument("--json", type=Path, default=None, help="also write the rows as JSON here")
     p.add_argument(
@@ -377,13 +402,14 @@ def _parse() -> argparse.Namespace:
     args.models = args.models or (["camn", "ha2g"] if args.quick else trainable)
     args.batch_sizes = args.batch_sizes or ([16] if args.quick else [16, 64])
     args.steps = args.steps or (3 if args.quick else 10)
-    args.fit_steps = args.fit_steps or (2 if args.quick else 10)
+    if args.fit_steps is None:
+        args.fit_steps = 2 if args.quick else 10
     return args
 
 
-def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str]]:
-    """(model, preset, device, precision, batch, compile) of every row; by default the paper presets on CUDA
-    only."""
+def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, bool]]:
+    """(model, preset, device, precision, batch, compile, deterministic) of every row; by default the paper
+    presets on CUDA only."""
     grid = []
     for name in args.models:
         for device in args.devices:
@@ -391,31 +417,42 @@ def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str]]
             for preset in args.presets or (["tiny", "paper"] if paper else ["tiny"]):
                 for precision in args.precisions:
                     for b in args.batch_sizes:
-                        grid += [(name, preset, device, precision, b, c) for c in args.compile]
+                        grid += [
+                            (name, preset, device, precision, b, c, d == "on")
+                            for c in args.compile
+                            for d in args.deterministic
+                        ]
     return grid
 
 
 def main() -> None:
     args = _parse()
+    os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")  # (as fit's: before CUDA's first product)
     torch.set_num_threads(n_threads())
     with tempfile.TemporaryDirectory() as tmp:
         train = _store_train(args.quick, Path(tmp) / "store")
         print(f"threads={torch.get_num_threads()}  torch {torch.__version__}  {len(train)} train windows")
         rows = []
-        for name, preset, device, precision, batch, comp in _grid(args):
+        for name, preset, device, precision, batch, comp, det in _grid(args):
             if device == "cuda" and not torch.cuda.is_available():
-                rows.append(Row(name, preset, device, precision, batch, comp, note=UNMEASURED))
+                rows.append(Row(name, preset, device, precision, batch, comp, det, note=UNMEASURED))
                 continue
-            row = measure_step(
-                name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp
-            )
-            if comp == "eager":  # (a compiled row's short fit would time its compilation)
-                measure_fit(row, train, args.fit_steps)
+            try:
+                row = measure_step(
+                    name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp,
+                    deterministic=det,
+                )  # fmt: skip
+                # (a compiled row's short fit would time its compilation; fit turns determinism on)
+                if comp == "eager" and det and args.fit_steps > 0:
+                    measure_fit(row, train, args.fit_steps)
+            except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
+                traceback.print_exc()
+                row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))
+                if device == "cuda":
+                    torch.cuda.empty_cache()
             rows.append(row)
-            print(
-                f"  {name} {preset} {device} {precision} b{batch} {comp}: {row.step_wps:,.0f} windows/s",
-                flush=True,
-            )
+            print(f"  {name} {preset} {device} {precision} b{batch} {comp} det={det}: "
+                  + (row.note or f"{row.step_wps:,.0f} windows/s"), flush=True)  # fmt: skip
             _write_json(
                 args.json, rows
             )  # after every row: a run stopped by a time limit keeps what it measured
@@ -423,6 +460,12 @@ def main() -> None:
         print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")
     print(markdown(rows))
     _write_json(args.json, rows)
+
+
+def _failed(error: BaseException) -> str:
+    """A failed row's note: ``failed: <type>: <first line of the message, at most 80 characters>``."""
+    message = (str(error).strip().splitlines() or [""])[0][:80].replace("|", "/")
+    return f"failed: {type(error).__name__}: {message}"
 
 
 def _write_json(path: Path | None, rows: list[Row]) -> None:

@@ -8,12 +8,15 @@
 #                  (one run per model, at most 200 s each)
 #   STAGE compile  the paper presets in bf16 at batch 256, compiled (reduce-overhead: CUDA graphs) and eager
 #                  in the same run (compilation included; at most 240 s per model)
+#   STAGE full     both in one call of about 7 minutes, most telling rows first: per model the paper preset
+#                  eager (fp32/bf16 x batch 64/256, profiled; CaMN bf16 also at 1024), bf16 batch 256 with
+#                  determinism off, compiled with reduce-overhead; then the tiny presets at 64
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
 stage=${1:?stage: eager, compile or cpu}
-case "$stage" in eager | compile | cpu) ;; *) echo "unknown stage $stage (eager, compile or cpu)" >&2; exit 2 ;; esac
+case "$stage" in eager | compile | full | cpu) ;; *) echo "unknown stage $stage (eager, compile, full or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -29,11 +32,41 @@ gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no CUDA"
 print(f"{platform.node()}  torch {torch.__version__}  {gpu}")
 from beatlite.metrics.beats import warm_up  # librosa's numba code compiled once before the store's workers
 warm_up()
+import time
+from beatlite.data.index import index_folder
+from beatlite.data.store import build_store
+from beatlite.paths import data_dir, n_threads
+start = time.perf_counter()  # data_samples' store, built once here (outside the rows' time limits)
+store = build_store(index_folder(data_dir()), workers=n_threads())
+print(f"store: {len(store.windows('train'))} train windows, {time.perf_counter() - start:.1f} s")
 PY
-bench() {  # bench SECONDS MODEL ARGS...
-    timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$out/$stage-$2.json" 2>&1 |
-        tee -a "$out/$stage.md"
+n=0
+parts=$(mktemp -d)
+bench() {  # bench SECONDS MODEL ARGS...  (full: every call's rows merged into $out/full.json after it)
+    n=$((n + 1))
+    local json="$out/$stage-$2.json"
+    [ "$stage" = full ] && json="$parts/$(printf %02d $n).json"
+    timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$json" 2>&1 | tee -a "$out/$stage.md"
+    [ "$stage" = full ] && python3 -c 'import json, sys
+docs = [json.load(open(p)) for p in sys.argv[2:]]
+json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
+        "$out/full.json" "$parts"/*.json
+    return 0
 }
+if [ "$stage" = full ]; then
+    nvidia-smi 2>&1 | tee -a "$out/$stage.md"
+    for model in camn ha2g; do
+        bench 90 "$model" --presets paper --devices cuda --batch-sizes 64 256 --profile 12
+        [ "$model" = camn ] && bench 25 camn --presets paper --devices cuda --precisions bf16 --batch-sizes 1024 \
+            --fit-steps 0 --profile 12
+        bench 30 "$model" --presets paper --devices cuda --precisions bf16 --batch-sizes 256 --deterministic off \
+            --fit-steps 0
+        bench 100 "$model" --presets paper --devices cuda --precisions bf16 --batch-sizes 256 \
+            --compile reduce-overhead --profile 12
+    done
+    bench 35 camn ha2g --presets tiny --devices cuda --precisions fp32 --batch-sizes 64
+    exit 0
+fi
 for model in camn ha2g; do
     case "$stage" in
         eager)

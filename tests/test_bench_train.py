@@ -37,11 +37,13 @@ def test_ops_are_counted_below_autograd_one_per_kernel():
 def test_the_grid_has_a_row_per_compile_setting_and_compiled_rows_leave_the_fit_columns_out():
     bench = _bench()
     args = argparse.Namespace(models=["camn"], devices=["cuda"], quick=False, presets=None,
-                              precisions=["bf16"], batch_sizes=[256], compile=["eager", "reduce-overhead"])  # fmt: skip
+                              precisions=["bf16"], batch_sizes=[256], compile=["eager", "reduce-overhead"],
+                              deterministic=["on", "off"])  # fmt: skip
     assert bench._grid(args) == [
-        ("camn", preset, "cuda", "bf16", 256, c)
+        ("camn", preset, "cuda", "bf16", 256, c, d)
         for preset in ("tiny", "paper")
         for c in ("eager", "reduce-overhead")
+        for d in (True, False)
     ]
     row = bench.Row("camn", "paper", "cuda", "bf16", 256, "reduce-overhead", step_wps=1000.0, step_ms=256.0)
     cells = bench.markdown([row]).splitlines()[2].split(" | ")
@@ -58,3 +60,24 @@ def test_the_gpu_session_script_refuses_an_unknown_stage_before_doing_anything(t
                           text=True, cwd=ROOT, env={"PATH": "/usr/bin:/bin", "OUT": str(tmp_path)})  # fmt: skip
     assert proc.returncode == 2, proc.stderr
     assert "unknown stage nope" in proc.stderr and not any(tmp_path.iterdir())
+
+
+def test_a_row_that_fails_is_reported_in_the_table_and_the_others_still_run(monkeypatch, capsys, tmp_path):
+    bench = _bench()
+
+    def measure_step(name, *args, **kwargs):
+        if name == "ha2g":
+            raise RuntimeError("index_copy_(): self and source expected to have the same dtype | Float\nmore")
+        return bench.Row(name, "tiny", "cpu", "fp32", 16, step_wps=100.0, step_ms=160.0)
+
+    monkeypatch.setattr(bench, "measure_step", measure_step)
+    monkeypatch.setattr(bench, "_store_train", lambda quick, folder: [])
+    monkeypatch.setattr(sys, "argv", ["bench_train.py", "--models", "ha2g", "camn", "--devices", "cpu",
+                                      "--batch-sizes", "16", "--precisions", "fp32", "--fit-steps", "0",
+                                      "--json", str(tmp_path / "rows.json")])  # fmt: skip
+    bench.main()
+    table = capsys.readouterr().out.splitlines()
+    ha2g = next(line for line in table if line.startswith("| ha2g"))
+    camn = next(line for line in table if line.startswith("| camn"))
+    note = "failed: RuntimeError: index_copy_(): self and source expected to have the same dtype / Float"
+    assert ha2g.count(note) == 11 and "| 100 | 160 |" in camn  # every measured column says why; camn ran
