@@ -30,9 +30,11 @@ Per row:
 - **compile**: :attr:`beatlite.train.TrainConfig.compile` of the row (``--compile``; ``eager`` = none; the
   timed steps come after a first, compiling one). FLOPs and operators are the eager step's; the fit
   columns are left out (``-``): a fit of a few steps would time its compilation.
-- **deterministic**: ``torch.use_deterministic_algorithms`` during the step (``--deterministic``; ``fit``
-  turns it on, so ``off`` rows leave the fit columns out): on CUDA some backward kernels (embedding, index
-  and scatter sums) and cuBLAS' workspace differ between the two.
+- **deterministic**: :attr:`beatlite.train.TrainConfig.deterministic` of the row (``--deterministic on off``):
+  on CUDA, ``off`` lets torch pick nondeterministic kernels and skips filling new tensors.
+- ``--trace-rnn``: compiled rows trace the recurrent layers too (``torch._dynamo.config.allow_rnn``: the LSTM
+  and GRU unrolled over time into the compiled graph, instead of a graph break around cuDNN's kernel); their
+  compile cell says ``+rnn``.
 - **% of peak**: achieved FLOP/s (GFLOP/window x step windows/s) over the rate of a large matrix product
   of the same precision measured in the same run on the same device (``peak`` line; 1024^2 on the CPU, 8192^2
   on CUDA), i.e. of what this device reaches on dense GEMMs, not of its datasheet.
@@ -223,7 +225,7 @@ def measure_step(
     """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
     (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
     operators)."""
-    torch.use_deterministic_algorithms(deterministic)  # (fit turns it on: set for every row)
+    torch.use_deterministic_algorithms(deterministic)  # (as fit sets it from its TrainConfig)
     model = _model(name, preset, train)
     run = _Run(model, _config(device, precision, batch, compile, epochs=1), "bench", {})
     keys = model_keys(model)
@@ -296,7 +298,7 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
         n = min(len(view), steps * row.batch)
         config = _config(
             row.device, row.precision, row.batch, row.compile, epochs=1, windows_per_epoch=n,
-            data_on_device=mode,
+            data_on_device=mode, deterministic=row.deterministic,
         )  # fmt: skip
         start = time.perf_counter()
         fit(model, view, config)
@@ -392,7 +394,11 @@ def _parse() -> argparse.Namespace:
     )  # fmt: skip
     p.add_argument(
         "--deterministic", nargs="+", default=["on"], choices=["on", "off"],
-        help="torch.use_deterministic_algorithms of the step (fit always turns it on: off rows skip the fit)",
+        help="TrainConfig.deterministic of the rows; default on",
+    )  # fmt: skip
+    p.add_argument(
+        "--trace-rnn", action="store_true",
+        help="compiled rows trace the LSTM/GRU layers too (torch._dynamo.config.allow_rnn)",
     )  # fmt: skip
     p.add_argument("--json", type=Path, default=None, help="also write the rows as JSON here")
     p.add_argument(
@@ -428,6 +434,10 @@ def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, 
 def main() -> None:
     args = _parse()
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")  # (as fit's: before CUDA's first product)
+    if args.trace_rnn:
+        import torch._dynamo as dynamo  # (bound as dynamo: `import torch._dynamo` would make torch local)
+
+        dynamo.config.allow_rnn = True
     torch.set_num_threads(n_threads())
     with tempfile.TemporaryDirectory() as tmp:
         train = _store_train(args.quick, Path(tmp) / "store")
@@ -442,9 +452,11 @@ def main() -> None:
                     name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp,
                     deterministic=det,
                 )  # fmt: skip
-                # (a compiled row's short fit would time its compilation; fit turns determinism on)
-                if comp == "eager" and det and args.fit_steps > 0:
+                # (a compiled row's short fit would time its compilation)
+                if comp == "eager" and args.fit_steps > 0:
                     measure_fit(row, train, args.fit_steps)
+                if args.trace_rnn and comp != "eager":
+                    row.compile = f"{comp}+rnn"
             except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
                 traceback.print_exc()
                 row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))

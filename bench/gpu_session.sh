@@ -11,12 +11,15 @@
 #   STAGE full     both in one call of about 7 minutes, most telling rows first: per model the paper preset
 #                  eager (fp32/bf16 x batch 64/256, profiled; CaMN bf16 also at 1024), bf16 batch 256 with
 #                  determinism off, compiled with reduce-overhead; then the tiny presets at 64
+#   STAGE tune     after full (about 7 minutes): bf16 with TrainConfig.deterministic off; CaMN paper at 256 (fit
+#                  included) and 1024, eager and reduce-overhead, then with the LSTM traced into the graph
+#                  (--trace-rnn); HA2G paper at 256 and 512
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
 stage=${1:?stage: eager, compile or cpu}
-case "$stage" in eager | compile | full | cpu) ;; *) echo "unknown stage $stage (eager, compile, full or cpu)" >&2; exit 2 ;; esac
+case "$stage" in eager | compile | full | tune | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -26,7 +29,8 @@ if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
 fi
 export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" MPLBACKEND=Agg PYTHONUNBUFFERED=1
 export BEATLITE_THREADS=${BEATLITE_THREADS:-$(( $(nproc) > 8 ? 8 : $(nproc) ))}
-python3 - <<'PY' 2>&1 | tee "$out/$stage.md"
+# (as -c, not a script on stdin: the store's spawned workers re-run __main__, and "<stdin>" is no file)
+setup=$(cat <<'PY'
 import platform, torch
 gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no CUDA"
 print(f"{platform.node()}  torch {torch.__version__}  {gpu}")
@@ -40,19 +44,29 @@ start = time.perf_counter()  # data_samples' store, built once here (outside the
 store = build_store(index_folder(data_dir()), workers=n_threads())
 print(f"store: {len(store.windows('train'))} train windows, {time.perf_counter() - start:.1f} s")
 PY
+)
+python3 -c "$setup" 2>&1 | tee "$out/$stage.md"
 n=0
 parts=$(mktemp -d)
-bench() {  # bench SECONDS MODEL ARGS...  (full: every call's rows merged into $out/full.json after it)
+bench() {  # bench SECONDS MODEL ARGS...  (full, tune: every call's rows merged into $out/$stage.json after it)
     n=$((n + 1))
     local json="$out/$stage-$2.json"
-    [ "$stage" = full ] && json="$parts/$(printf %02d $n).json"
+    case "$stage" in full | tune) json="$parts/$(printf %02d $n).json" ;; esac
     timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$json" 2>&1 | tee -a "$out/$stage.md"
-    [ "$stage" = full ] && python3 -c 'import json, sys
+    case "$stage" in full | tune) python3 -c 'import json, sys
 docs = [json.load(open(p)) for p in sys.argv[2:]]
 json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
-        "$out/full.json" "$parts"/*.json
+        "$out/$stage.json" "$parts"/*.json ;; esac
     return 0
 }
+if [ "$stage" = tune ]; then
+    paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --profile 12)
+    bench 35 camn "${paper[@]}" --batch-sizes 256
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --fit-steps 0 --compile eager reduce-overhead
+    bench 70 ha2g "${paper[@]}" --batch-sizes 256 512 --fit-steps 3
+    bench 180 camn "${paper[@]}" --batch-sizes 1024 --fit-steps 0 --compile reduce-overhead --trace-rnn
+    exit 0
+fi
 if [ "$stage" = full ]; then
     nvidia-smi 2>&1 | tee -a "$out/$stage.md"
     for model in camn ha2g; do

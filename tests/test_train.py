@@ -703,6 +703,19 @@ def test_a_compiled_step_gives_the_losses_and_poses_of_the_eager_one(windows):
         TrainConfig(compile="fast")
 
 
+def test_nondeterministic_training_sets_torch_so_and_changes_nothing_on_the_cpu(windows):
+    """``TrainConfig(deterministic=False)`` turns torch's deterministic algorithms off for the run (the
+    default turns them on); the CPU's kernels are deterministic either way, so the history is the same to the
+    bit (on CUDA it is not: the point of the option)."""
+    train, val = windows
+    a = fit(camn(), train, cfg(deterministic=False), val)
+    assert not torch.are_deterministic_algorithms_enabled()
+    b = fit(camn(), train, cfg(), val)
+    assert torch.are_deterministic_algorithms_enabled()
+    assert [h["train"] for h in a.history] == [h["train"] for h in b.history]
+    assert [h["val"] for h in a.history] == [h["val"] for h in b.history]
+
+
 def test_adam_keeps_the_loop_on_the_cpu_and_the_fused_kernel_takes_the_same_steps():
     """Fused Adam (CUDA's one kernel for all parameters) and torch's default loop: the same updates (to
     float32 rounding), checked on the CPU, where torch has the fused kernel too; the CPU keeps the loop."""

@@ -1,7 +1,7 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
 ``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B]
-[--precision bf16] [--compile MODE] [--val-every N]`` trains one recipe
+[--precision bf16] [--compile MODE] [--nondeterministic] [--val-every N]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
@@ -111,6 +111,11 @@ def _parser() -> argparse.ArgumentParser:
         "--compile",
         choices=COMPILE_MODES + COMPILE_BACKENDS,
         help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs); default eager",
+    )
+    f.add_argument(
+        "--nondeterministic",
+        action="store_true",
+        help="let CUDA use its faster nondeterministic kernels (TrainConfig.deterministic=False)",
     )
     f.add_argument(
         "--extractor-epochs",
@@ -224,6 +229,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         amp=args.precision == "bf16",
         compile=args.compile,
         val_every=args.val_every,
+        deterministic=not args.nondeterministic,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

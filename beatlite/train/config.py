@@ -65,6 +65,13 @@ class TrainConfig:
         Mixed precision: bfloat16 autocast of the forward pass and losses on the training device (CUDA,
         or the CPU, where torch autocasts to bfloat16 too; weights, optimiser and gradients stay
         float32). Off by default: float32 training on the CPU is bitwise deterministic.
+    deterministic : bool
+        ``torch.use_deterministic_algorithms`` during training (default ``True``: with a seed, the same numbers
+        on the same machine, on CUDA too). ``False`` lets CUDA use its faster nondeterministic kernels and skips
+        the filling of every new tensor that deterministic mode does: on an H200 it took CaMN's paper preset
+        (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260 (``bench/bench_train.py
+        --deterministic on off``; README, "Training speed"); the same seed then gives slightly different
+        numbers from run to run on a GPU. No effect on CPU results (its kernels are deterministic).
     checkpoint_every : int or None
         Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
         BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as
@@ -121,6 +128,7 @@ class TrainConfig:
     val_every: int | None = None
     data_on_device: str = "auto"
     compile: str | None = None
+    deterministic: bool = True
 
     def __post_init__(self) -> None:
         if self.epochs < 0:

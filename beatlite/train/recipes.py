@@ -433,6 +433,7 @@ def retrain(
     amp: bool = False,
     compile: str | None = None,  # noqa: A002
     val_every: int | None = None,
+    deterministic: bool = True,
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -476,6 +477,8 @@ def retrain(
     val_every : int, optional
         :attr:`beatlite.train.TrainConfig.val_every`: validate (losses, validation FGD, best weights) every
         this many optimiser steps instead of every epoch.
+    deterministic : bool
+        :attr:`beatlite.train.TrainConfig.deterministic` (``False``: CUDA's faster nondeterministic kernels).
 
     Returns
     -------
@@ -509,6 +512,7 @@ def retrain(
         amp=amp,
         compile=compile,
         val_every=val_every,
+        deterministic=deterministic,
     )
     score = None
     if recipe.select_best and config.epochs > 0:

@@ -167,14 +167,14 @@ def _needed_keys(model: GestureModel, windows: Any, who: str) -> tuple[str, ...]
     return keys
 
 
-def configure_torch(seed: int, threads: int | None) -> None:
-    """Seed torch, force deterministic algorithms and set the CPU thread count."""
+def configure_torch(seed: int, threads: int | None, deterministic: bool = True) -> None:
+    """Seed torch, turn deterministic algorithms on (or off) and set the CPU thread count."""
     import os
 
     # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
     torch.manual_seed(seed)
-    torch.use_deterministic_algorithms(True)
+    torch.use_deterministic_algorithms(deterministic)
     torch.set_num_threads(threads if threads is not None else paths.n_threads())
 
 
@@ -305,7 +305,7 @@ def fit(
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
 
     data = _Data.of(model, train_windows)
-    configure_torch(config.seed, config.threads)
+    configure_torch(config.seed, config.threads, config.deterministic)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
