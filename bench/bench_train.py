@@ -46,7 +46,7 @@ Per row:
 Devices that are not present print ``unmeasured``. Timings on a shared machine are noisy: compare rows of
 one run, on one machine. Issue 28's targets (benchmark, not tests): CaMN paper >= 10,000 windows/s in bf16
 and HA2G paper >= 3,000 on one H100/H200; tiny models on one CPU thread no slower than before (CaMN tiny
-about 150 windows/s).
+about 150 windows/s). Measured on an H200: ``bench/records/bench_train_h200.json`` (README, "Using real BEAT").
 """
 
 from __future__ import annotations

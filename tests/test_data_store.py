@@ -178,6 +178,24 @@ def test_parallel_build_equals_serial(corpus: Path, store: WindowStore, tmp_path
             ).read_bytes()
 
 
+def test_a_main_script_read_from_stdin_builds_and_indexes_in_this_process(
+    corpus: Path, store: WindowStore, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``python - <<EOF`` scripts: spawned workers would re-run ``__main__`` from ``"<stdin>"`` and all fail
+    (``BrokenProcessPool``, seen on the GPU machine); asked for 2 workers, both steps work in this process with
+    a warning and give the serial store's bytes."""
+    import sys
+
+    monkeypatch.setattr(sys.modules["__main__"], "__file__", "<stdin>", raising=False)
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))  # an empty index cache: every take indexed
+    with pytest.warns(RuntimeWarning, match="index_folder: the main script '<stdin>' is not a file"):
+        index = index_folder(corpus, workers=2)
+    with pytest.warns(RuntimeWarning, match="build_store: .* working in this process"):
+        built = build_store(index, tmp_path / "s", vocab=VOCAB, workers=2)
+    a, b = store.windows(None).batch(), built.windows(None).batch()
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
 def test_only_the_asked_streams_are_read(store: WindowStore) -> None:
     for t in store.takes:
         os.remove(t.folder / "mel.npy")

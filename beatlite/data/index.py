@@ -791,6 +791,31 @@ def default_workers(paths: Iterable[Path]) -> int:
     return (os.cpu_count() or 1) if size > PARALLEL_BYTES else 1
 
 
+def spawnable(workers: int, what: str) -> int:
+    """``workers``, or 1 with a warning when spawned processes cannot start here: spawning re-runs the main
+    script from its file, so a script read from standard input (``python - <<EOF``, ``__main__.__file__``
+    ``"<stdin>"``) would fail in every worker (``BrokenProcessPool``); ``what`` names the work in the warning.
+
+    Examples
+    --------
+    >>> spawnable(1, "indexing")
+    1
+    """
+    import sys
+    import warnings
+
+    main = getattr(sys.modules.get("__main__"), "__file__", None)
+    if workers > 1 and main is not None and not Path(main).is_file():
+        warnings.warn(
+            f"{what}: the main script {main!r} is not a file, so worker processes cannot be spawned; "
+            "working in this process (run a script file, or pass workers=0)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return 1
+    return workers
+
+
 def _index_many(
     jobs: list[tuple[str, dict[str, list[Path]], float | None]], workers: int | None
 ) -> list[TakeRecord]:
@@ -800,7 +825,7 @@ def _index_many(
 
     if workers is None:
         workers = default_workers(p for _, files, _ in jobs for paths in files.values() for p in paths)
-    if workers <= 1 or len(jobs) <= 1:
+    if spawnable(workers, "index_folder") <= 1 or len(jobs) <= 1:
         done = [_index_take_job(job) for job in jobs]
     else:
         from concurrent.futures import ProcessPoolExecutor

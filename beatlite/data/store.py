@@ -912,12 +912,12 @@ def _run_builds(
     from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
     from multiprocessing import get_context
 
-    from beatlite.data.index import default_workers
+    from beatlite.data.index import default_workers, spawnable
     from beatlite.notebook import progress as progress_bar
 
     if workers is None:
         workers = default_workers(p for r in todo for p in r.files.values())
-    n = min(len(todo), workers)
+    n = min(len(todo), spawnable(workers, "build_store"))
     todo = sorted(todo, key=lambda r: -r.duration if r.duration else 0.0)  # long takes first: balance
     with progress_bar(total=len(todo), desc="store takes", unit="take", disable=not progress) as bar:
         if n <= 1:
