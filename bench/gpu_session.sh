@@ -14,12 +14,15 @@
 #   STAGE tune     after full (about 7 minutes): bf16 with TrainConfig.deterministic off; CaMN paper at 256 (fit
 #                  included) and 1024, eager and reduce-overhead, then with the LSTM traced into the graph
 #                  (--trace-rnn); HA2G paper at 256 and 512
+#   STAGE next     the leads tune left (about 7 minutes): CaMN paper bf16 at 1024, determinism off, compiled,
+#                  with cuDNN's default algorithms and with cudnn.benchmark (its slow bf16 weight gradient of the
+#                  raw-audio convolutions), then with the LSTM traced into the graph (a longer limit)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
 stage=${1:?stage: eager, compile or cpu}
-case "$stage" in eager | compile | full | tune | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune or cpu)" >&2; exit 2 ;; esac
+case "$stage" in eager | compile | full | tune | next | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -51,14 +54,21 @@ parts=$(mktemp -d)
 bench() {  # bench SECONDS MODEL ARGS...  (full, tune: every call's rows merged into $out/$stage.json after it)
     n=$((n + 1))
     local json="$out/$stage-$2.json"
-    case "$stage" in full | tune) json="$parts/$(printf %02d $n).json" ;; esac
+    case "$stage" in full | tune | next) json="$parts/$(printf %02d $n).json" ;; esac
     timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$json" 2>&1 | tee -a "$out/$stage.md"
-    case "$stage" in full | tune) python3 -c 'import json, sys
+    case "$stage" in full | tune | next) python3 -c 'import json, sys
 docs = [json.load(open(p)) for p in sys.argv[2:]]
 json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
         "$out/$stage.json" "$parts"/*.json ;; esac
     return 0
 }
+if [ "$stage" = next ]; then
+    paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --cudnn-benchmark
+    bench 240 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --trace-rnn --cudnn-benchmark
+    exit 0
+fi
 if [ "$stage" = tune ]; then
     paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --profile 12)
     bench 35 camn "${paper[@]}" --batch-sizes 256

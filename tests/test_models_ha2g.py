@@ -595,3 +595,31 @@ def test_coordinator_weights_of_a_single_audio_level_are_one_hot() -> None:
     with torch.no_grad():
         w = model.coordinator_weights(torch.tensor([0, 1]))
     assert w[:, 1].eq(1).all() and w[:, [0, 2]].eq(0).all()
+
+
+def test_inductor_is_refused_by_name_before_a_step_and_aot_eager_still_trains() -> None:
+    """HA2G's training pass breaks inductor (``HA2G.inductor_failure``: a compiler error on CUDA, a crashed
+    process on the CPU): ``fit`` says so at once for every inductor mode, leaving the weights as they were;
+    ``aot_eager`` (traced, no inductor) still trains it."""
+    from beatlite.train import TrainConfig, fit
+    from beatlite.train.config import COMPILE_MODES
+
+    w, mean = _unit_windows(4)
+    meta = _norms(mean).to_meta()
+    for mode in COMPILE_MODES:
+        torch.manual_seed(0)
+        model = build_model("ha2g", preset="tiny")
+        before = {k: v.detach().clone() for k, v in model.named_parameters()}
+        config = TrainConfig(epochs=1, batch_size=2, progress=False, compile=mode)
+        with pytest.raises(
+            ValueError, match=f"ha2g cannot be compiled with inductor .*'{mode}'.*segmentation"
+        ):
+            fit(model, w, config, meta=meta)
+        assert all(torch.equal(v, before[k]) for k, v in model.named_parameters())  # not one step taken
+    assert build_model("camn", preset="tiny").inductor_failure is None
+    torch.manual_seed(0)
+    model = build_model("ha2g", preset="tiny")
+    history = fit(
+        model, w, TrainConfig(epochs=1, batch_size=2, progress=False, compile="aot_eager"), meta=meta
+    ).history
+    assert np.isfinite(history[0]["train"]["total"])

@@ -260,6 +260,9 @@ class GestureModel(nn.Module):
     config_class: ClassVar[type] = ModelConfig
     input_keys: ClassVar[tuple[str, ...]] = ()
     presets: ClassVar[Mapping[str, Mapping[str, Any]] | None] = None
+    inductor_failure: ClassVar[str | None] = None
+    """Why ``torch.compile``'s inductor cannot compile this model's training pass (``None``: it can);
+    :func:`beatlite.train.fit` then refuses ``TrainConfig.compile`` modes that use it, naming this."""
     n_pre: int = N_PRE
 
     def __init__(self, config: ModelConfig) -> None:

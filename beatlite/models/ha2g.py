@@ -375,6 +375,10 @@ class HA2G(GestureModel):
     name = "ha2g"
     representation = "dirvec126"
     config_class = HA2GConfig
+    inductor_failure = (
+        "torch 2.11's inductor stopped in its randperm-index pattern (BackendCompilerFailed, on an H200) and "
+        "torch 2.13's compiled backward crashed the process (segmentation fault, on the CPU)"
+    )
 
     @classmethod
     def keys_for(cls, config: HA2GConfig) -> tuple[str, ...]:

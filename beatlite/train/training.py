@@ -21,7 +21,7 @@ from beatlite.data.resident import ResidentWindows, fits_on_device
 from beatlite.models.base import GestureModel
 from beatlite.notebook import progress
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
-from beatlite.train.config import COMPILE_BACKENDS, TrainConfig
+from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES, TrainConfig
 from beatlite.train.distributed import (
     distributed_rank,
     local_device,
@@ -495,6 +495,11 @@ class _Run:
         """The step's forward pass and losses: the model's (or its DDP wrappers'), compiled when
         ``config.compile`` says so."""
         mode, model = self.config.compile, self.model
+        if mode in COMPILE_MODES and model.inductor_failure is not None:
+            raise ValueError(
+                f"fit: {model.name} cannot be compiled with inductor (TrainConfig.compile={mode!r}): "
+                f"{model.inductor_failure}; train it eagerly (compile=None)"
+            )
         self.forward = _compiled(self.g_ddp or model, mode)
         self.losses = _compiled(model.losses, mode)
         self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
