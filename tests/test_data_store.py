@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -194,6 +195,9 @@ def test_a_main_script_read_from_stdin_builds_and_indexes_in_this_process(
         built = build_store(index, tmp_path / "s", vocab=VOCAB, workers=2)
     a, b = store.windows(None).batch(), built.windows(None).batch()
     assert all(np.array_equal(a[k], b[k]) for k in a)
+    with warnings.catch_warnings():  # nothing to spawn for (the store is current): no warning
+        warnings.simplefilter("error")
+        build_store(index, tmp_path / "s", vocab=VOCAB, workers=2)
 
 
 def test_only_the_asked_streams_are_read(store: WindowStore) -> None:

@@ -318,6 +318,23 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
         assert stopped.value.args[0].val_every == expected
     with pytest.raises(ValueError, match="val_every must be >= 1"):
         command.main([*argv, "--epochs", "0", "--val-every", "0"])
+    for extra, expected in (([], True), (["--nondeterministic"], False)):
+        with pytest.raises(_Stop) as stopped:
+            command.main([*argv, "--epochs", "0", *extra])
+        assert stopped.value.args[0].deterministic is expected
+
+
+def test_fit_command_refuses_to_compile_ha2g_with_inductor_before_preparing_anything(tmp_path, capsys):
+    """HA2G's ``inductor_failure``: ``fit ha2g_tiny --compile default`` stops at once (exit 2, the reason on
+    stderr), before the data are indexed or anything is written under ``--out``."""
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+
+    out = tmp_path / "run"
+    argv = ["fit", "ha2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
+    assert command.main([*argv, "--compile", "default"]) == 2
+    assert "ha2g cannot be compiled with inductor" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_ablation_table_values_changes_and_paper_rows():

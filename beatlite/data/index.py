@@ -810,7 +810,7 @@ def spawnable(workers: int, what: str) -> int:
             f"{what}: the main script {main!r} is not a file, so worker processes cannot be spawned; "
             "working in this process (run a script file, or pass workers=0)",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=2,
         )
         return 1
     return workers
@@ -825,13 +825,14 @@ def _index_many(
 
     if workers is None:
         workers = default_workers(p for _, files, _ in jobs for paths in files.values() for p in paths)
-    if spawnable(workers, "index_folder") <= 1 or len(jobs) <= 1:
+    n = min(workers, len(jobs))
+    if n <= 1 or spawnable(n, "index_folder") <= 1:
         done = [_index_take_job(job) for job in jobs]
     else:
         from concurrent.futures import ProcessPoolExecutor
         from multiprocessing import get_context
 
-        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=get_context("spawn")) as pool:
+        with ProcessPoolExecutor(n, mp_context=get_context("spawn")) as pool:
             done = list(pool.map(_index_take_job, jobs, chunksize=4))
     for record, digests in done:
         for modality, digest in digests.items():

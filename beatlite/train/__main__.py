@@ -110,7 +110,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument(
         "--compile",
         choices=COMPILE_MODES + COMPILE_BACKENDS,
-        help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs); default eager",
+        help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs; inductor's modes not for HA2G); default eager",
     )
     f.add_argument(
         "--nondeterministic",
@@ -201,6 +201,14 @@ def _fit_command(args: argparse.Namespace) -> int:
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
 
+    from beatlite.models import model_class
+    from beatlite.train.training import check_compilable
+
+    try:  # before anything is prepared or written
+        check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
+    except ValueError as error:
+        print(error, file=sys.stderr)
+        return 2
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
     os.environ.setdefault(

@@ -304,6 +304,7 @@ def fit(
     if not isinstance(config, TrainConfig):
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
 
+    check_compilable(type(model), config.compile)  # before any work
     data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads, config.deterministic)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
@@ -440,6 +441,17 @@ def _adam(params: list[torch.nn.Parameter], lr: float, betas: tuple[float, float
     return torch.optim.Adam(params, lr=lr, betas=betas, fused=fused)
 
 
+def check_compilable(model_class: type[GestureModel], mode: str | None) -> None:
+    """Raise ``ValueError`` when :attr:`TrainConfig.compile` ``mode`` uses inductor and the model class says
+    inductor cannot compile it (:attr:`beatlite.models.base.GestureModel.inductor_failure`)."""
+    if mode in COMPILE_MODES and model_class.inductor_failure is not None:
+        raise ValueError(
+            f"fit: {model_class.name} cannot be compiled with inductor (TrainConfig.compile={mode!r}, "
+            f"fit --compile {mode}): {model_class.inductor_failure}; train it eagerly (compile=None, no "
+            f"--compile) or traced without inductor ('aot_eager')"
+        )
+
+
 def _compiled(fn: Callable[..., Any], mode: str | None) -> Callable[..., Any]:
     """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``)."""
     if mode is None:
@@ -495,11 +507,7 @@ class _Run:
         """The step's forward pass and losses: the model's (or its DDP wrappers'), compiled when
         ``config.compile`` says so."""
         mode, model = self.config.compile, self.model
-        if mode in COMPILE_MODES and model.inductor_failure is not None:
-            raise ValueError(
-                f"fit: {model.name} cannot be compiled with inductor (TrainConfig.compile={mode!r}): "
-                f"{model.inductor_failure}; train it eagerly (compile=None)"
-            )
+        check_compilable(type(model), mode)
         self.forward = _compiled(self.g_ddp or model, mode)
         self.losses = _compiled(model.losses, mode)
         self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
