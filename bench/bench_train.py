@@ -67,6 +67,7 @@ from typing import Any
 
 import numpy as np
 import torch
+import torch._dynamo
 from torch.utils._python_dispatch import TorchDispatchMode
 from torch.utils.flop_counter import FlopCounterMode
 
@@ -186,6 +187,7 @@ class Row:
     peak_fraction: float | None = None
     ops_per_step: int | None = None
     note: str = ""
+    fit_error: str = ""
 
 
 def _model(name: str, preset: str, train: Any, *, prepare: bool = True) -> Any:
@@ -442,9 +444,7 @@ def main() -> None:
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")  # (as fit's: before CUDA's first product)
     torch.backends.cudnn.benchmark = args.cudnn_benchmark
     if args.trace_rnn:
-        import torch._dynamo as dynamo  # (bound as dynamo: `import torch._dynamo` would make torch local)
-
-        dynamo.config.allow_rnn = True
+        torch._dynamo.config.allow_rnn = True
     torch.set_num_threads(n_threads())
     with tempfile.TemporaryDirectory() as tmp:
         train = _store_train(args.quick, Path(tmp) / "store")
@@ -457,24 +457,27 @@ def main() -> None:
             if device == "cuda" and not torch.cuda.is_available():
                 rows.append(Row(name, preset, device, precision, batch, comp, det, note=UNMEASURED))
                 continue
+            label = f"{comp}+rnn" if args.trace_rnn and comp != "eager" else comp
             try:
                 row = measure_step(
                     name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp,
                     deterministic=det,
                 )  # fmt: skip
-                # (a compiled row's short fit would time its compilation)
-                if comp == "eager" and args.fit_steps > 0:
-                    measure_fit(row, train, args.fit_steps)
-                if args.trace_rnn and comp != "eager":
-                    row.compile = f"{comp}+rnn"
             except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
-                traceback.print_exc()
                 row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))
-                if device == "cuda":
-                    torch.cuda.empty_cache()
+                _recover(device)
+            else:  # (a compiled row's short fit would time its compilation)
+                if comp == "eager" and args.fit_steps > 0:
+                    try:
+                        measure_fit(row, train, args.fit_steps)
+                    except Exception as error:  # noqa: BLE001 (the step's columns stay; the fit's say "-")
+                        row.fit_error = _failed(error)
+                        _recover(device)
+            row.compile = label
             rows.append(row)
+            fit_error = f" (fit {row.fit_error})" if row.fit_error else ""
             print(f"  {name} {preset} {device} {precision} b{batch} {comp} det={det}: "
-                  + (row.note or f"{row.step_wps:,.0f} windows/s"), flush=True)  # fmt: skip
+                  + (row.note or f"{row.step_wps:,.0f} windows/s{fit_error}"), flush=True)  # fmt: skip
             _write_json(
                 args.json, rows
             )  # after every row: a run stopped by a time limit keeps what it measured
@@ -482,6 +485,14 @@ def main() -> None:
         print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")
     print(markdown(rows))
     _write_json(args.json, rows)
+
+
+def _recover(device: str) -> None:
+    """After a failed row: print its traceback, forget what ``torch.compile`` cached, free the GPU's cache."""
+    traceback.print_exc()
+    torch._dynamo.reset()
+    if device == "cuda":
+        torch.cuda.empty_cache()
 
 
 def _failed(error: BaseException) -> str:

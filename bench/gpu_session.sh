@@ -21,7 +21,7 @@
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
-stage=${1:?stage: eager, compile or cpu}
+stage=${1:?stage: eager, compile, full, tune, next or cpu}
 case "$stage" in eager | compile | full | tune | next | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"

@@ -81,3 +81,24 @@ def test_a_row_that_fails_is_reported_in_the_table_and_the_others_still_run(monk
     camn = next(line for line in table if line.startswith("| camn"))
     note = "failed: RuntimeError: index_copy_(): self and source expected to have the same dtype / Float"
     assert ha2g.count(note) == 11 and "| 100 | 160 |" in camn  # every measured column says why; camn ran
+
+
+def test_a_fit_that_fails_keeps_the_step_columns_of_its_row(monkeypatch, capsys):
+    bench = _bench()
+    monkeypatch.setattr(
+        bench,
+        "measure_step",
+        lambda name, *a, **k: bench.Row(name, "tiny", "cpu", "fp32", 16, step_wps=100.0, step_ms=160.0),
+    )
+    monkeypatch.setattr(bench, "measure_fit", lambda row, train, steps: 1 / 0)
+    monkeypatch.setattr(bench, "_store_train", lambda quick, folder: [])
+    monkeypatch.setattr(sys, "argv", ["bench_train.py", "--models", "camn", "--devices", "cpu",
+                                      "--batch-sizes", "16", "--precisions", "fp32", "--fit-steps", "1"])  # fmt: skip
+    bench.main()
+    out = capsys.readouterr().out
+    assert (
+        "camn tiny cpu fp32 b16 eager det=True: 100 windows/s (fit failed: ZeroDivisionError: division by zero)"
+        in out
+    )
+    row = next(line for line in out.splitlines() if line.startswith("| camn"))
+    assert "| 100 | 160 | - |" in row

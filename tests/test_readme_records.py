@@ -1,4 +1,4 @@
-"""The README's GPU table and its sentences against the record they come from (``bench/records/``)."""
+"""The README's GPU table and its sentences against the records they come from (``bench/records/``)."""
 
 from __future__ import annotations
 
@@ -7,28 +7,32 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-RECORD = ROOT / "bench" / "records" / "bench_train_h200.json"
+RECORDS = ROOT / "bench" / "records"
+RECORD = RECORDS / "bench_train_h200.json"
 EPOCH_WINDOWS = 80_000  # about BEAT-4english's train windows (README)
+KEY = ("model", "preset", "precision", "batch", "compile", "deterministic")
 
 
-def _readme_rows() -> list[list[str]]:
-    text = (ROOT / "README.md").read_text()
-    table = text.split("<!-- gpu-table: bench/records/bench_train_h200.json -->")[1].split(
-        "<!-- /gpu-table -->"
-    )[0]
-    lines = [line for line in table.strip().splitlines()[2:]]
+def _readme() -> str:
+    return (ROOT / "README.md").read_text()
+
+
+def _table_rows() -> list[list[str]]:
+    table = _readme().split("<!-- gpu-table: bench/records/bench_train_h200.json -->")[1]
+    lines = table.split("<!-- /gpu-table -->")[0].strip().splitlines()[2:]
     return [[cell.strip() for cell in line.strip("|").split("|")] for line in lines]
 
 
-def _record_row(
-    run: str, model: str, preset: str, precision: str, batch: str, compile: str, det: str
-) -> dict:  # noqa: A002
-    runs = {r["name"]: r for r in json.loads(RECORD.read_text())["runs"]}
+def _runs() -> dict[str, dict]:
+    return {r["name"]: r for r in json.loads(RECORD.read_text())["runs"]}
+
+
+def _row(run: str, model: str, preset: str, precision: str, batch: int, compile: str, det: bool) -> dict:  # noqa: A002
     found = [
-        r for r in runs[run]["rows"]
-        if (r["model"], r["preset"], r["precision"], r["batch"], r["compile"], r["deterministic"])
-        == (model, preset, precision, int(batch), compile, det == "on")
-    ]  # fmt: skip
+        r
+        for r in _runs()[run]["rows"]
+        if tuple(r[k] for k in KEY) == (model, preset, precision, batch, compile, det)
+    ]
     assert len(found) == 1, (run, model, preset, precision, batch, compile, det)
     return found[0]
 
@@ -37,71 +41,135 @@ def _n(value: float) -> str:
     return f"{value:,.0f}"
 
 
-def test_every_row_of_the_readme_gpu_table_is_the_record_rounded():
-    rows = _readme_rows()
-    assert len(rows) == 15
-    for run, name, precision, batch, compile, det, wps, ms, fit, mib, epoch in rows:  # noqa: A001
+def test_the_readme_gpu_table_is_every_measured_row_of_the_record_rounded():
+    seen = set()
+    for run, name, precision, batch, compile, det, wps, ms, fit, mib, epoch in _table_rows():  # noqa: A001
         model, preset = name.lower().split()
-        r = _record_row(run, model, preset, precision, batch, compile, det)
+        r = _row(run, model, preset, precision, int(batch), compile, det == "on")
         assert (wps, ms, mib) == (_n(r["step_wps"]), _n(r["step_ms"]), _n(r["peak_mib"])), name
         expected = "-" if r["fit_wps"] is None else f"{_n(r['fit_wps'])} / {_n(r['fit_resident_wps'])}"
         assert fit == expected, name
         assert epoch == f"{EPOCH_WINDOWS / r['step_wps']:.0f} s", name
+        seen.add((run, *(r[k] for k in KEY)))
+    measured = {(n, *(r[k] for k in KEY)) for n, run in _runs().items() for r in run["rows"] if r["step_wps"]}
+    assert seen == measured and len(measured) == 19
 
 
-def test_the_readme_gpu_sentences_match_the_record_and_the_logs():
-    text = " ".join((ROOT / "README.md").read_text().split())
-    row = lambda *key: _record_row(*key)  # noqa: E731
-    camn = ("camn", "paper", "bf16", "256")
-    eager_on, eager_off = row("full", *camn, "eager", "on"), row("full", *camn, "eager", "off")
-    compiled = row("full", *camn, "reduce-overhead", "on")
-    wide_eager, wide = (
-        row("tune", "camn", "paper", "bf16", "1024", "eager", "off"),
-        row("tune", "camn", "paper", "bf16", "1024", "reduce-overhead", "off"),
-    )
-    ha2g_on, ha2g_off = (
-        row("full", "ha2g", "paper", "bf16", "256", "eager", "on"),
-        row("full", "ha2g", "paper", "bf16", "256", "eager", "off"),
-    )
-    best_ha2g = row("tune", "ha2g", "paper", "bf16", "512", "eager", "off")
-    fp32 = row("full", "camn", "paper", "fp32", "64", "eager", "on")
+def _profiles(log: str) -> dict[str, str]:
+    """Each bench row's result line (``"camn paper cuda bf16 b256 eager det=False"``) -> the profile table
+    printed before it."""
+    out, table = {}, ""
+    for line in log.splitlines():
+        match = re.match(r"  (\w+ \w+ cuda \w+ b\d+ [\w-]+ det=\w+): [\d,]+ windows/s", line)
+        if match:
+            out[match.group(1)], table = table, ""
+        else:
+            table += line + "\n"
+    return out
+
+
+def _gpu_ms(table: str, kernel: str | None = None) -> float:
+    """A profile's total GPU time (or ``kernel``'s self GPU time) in ms."""
+    if kernel is None:
+        return float(re.search(r"Self CUDA time total: ([\d.]+)ms", table).group(1))
+    line = next(line for line in table.splitlines() if kernel in line)
+    return float(re.search(r"\s([\d.]+)ms\s+[\d.]+%", line).group(1))  # the first ms followed by a percentage
+
+
+def test_the_readme_gpu_sentences_match_the_records_and_the_logs():
+    text = " ".join(_readme().split())
     ms = lambda r: _n(r["step_ms"])  # noqa: E731
+    wps = lambda r: _n(r["step_wps"])  # noqa: E731
+    camn = ("camn", "paper", "bf16", 256)
+    on, off, compiled = (
+        _row("full", *camn, "eager", True),
+        _row("full", *camn, "eager", False),
+        _row("full", *camn, "reduce-overhead", True),
+    )
+    off_later = _row("tune", *camn, "eager", False)
+    ha2g = ("ha2g", "paper", "bf16", 256)
+    h_on, h_off, h_off_later = (
+        _row("full", *ha2g, "eager", True),
+        _row("full", *ha2g, "eager", False),
+        _row("tune", *ha2g, "eager", False),
+    )
+    wide = ("camn", "paper", "bf16", 1024)
+    wide_on, wide_off, wide_compiled = (
+        _row("full", *wide, "eager", True),
+        _row("tune", *wide, "eager", False),
+        _row("tune", *wide, "reduce-overhead", False),
+    )
+    fp32, fp32_256 = (
+        _row("full", "camn", "paper", "fp32", 64, "eager", True),
+        _row("full", "camn", "paper", "fp32", 256, "eager", True),
+    )
+    bf16_64 = _row("full", "camn", "paper", "bf16", 64, "eager", True)
+    tiny = _row("full", "camn", "tiny", "fp32", 64, "eager", True)
+    best_ha2g = _row("tune", "ha2g", "paper", "bf16", 512, "eager", False)
+    ha2g_fp32 = _row("full", "ha2g", "paper", "fp32", 64, "eager", True)
+    issue = json.loads((RECORDS / "issue28_h200_9fb39d3.json").read_text())
+    before = {(r["model"], r["preset"], r["precision"], r["batch"]): r for r in issue["step"]["rows"]}
+    before_fit = {(r["model"], r["preset"], r["device"], r["batch"]): r["wps"] for r in issue["fit"]["rows"]}
+    b64, b1024 = before["camn", "paper", "fp32", 64], before["camn", "paper", "bf16", 1024]
     for sentence in (
-        f"CaMN paper fp32 at 64: {ms(fp32)} ms",
-        f"(bf16 at 256: {ms(eager_on)} → {ms(eager_off)} ms; HA2G {ms(ha2g_on)} → {ms(ha2g_off)} ms;",
-        f"(bf16 at 256: {ms(eager_on)} → {ms(compiled)} ms; at 1024 with determinism off: {ms(wide_eager)} → {ms(wide)} ms,",
-        f"the best CaMN rate, {_n(wide['step_wps'])} windows/s;",
-        f"autocast's casts add {eager_on['ops_per_step'] - fp32['ops_per_step']} operators",
-        f"CaMN's paper preset is at {_n(wide['step_wps'])} windows/s of the 10,000 asked, HA2G's at {_n(best_ha2g['step_wps'])} of 3,000",
-        f"({_n(row('full', 'ha2g', 'paper', 'fp32', '64', 'eager', 'on')['step_wps'])} against 470 windows/s, fp32, batch 64)",
+        f"steps in {ms(fp32)} ms instead of {b64['ms']} in fp32 at batch 64 ({wps(fp32)} against {_n(b64['wps'])} windows/s)",
+        f"in {ms(wide_on)} instead of {b1024['ms']} ms in bf16 at 1024",
+        f"CaMN tiny at {_n(tiny['fit_wps'])} windows/s (loader) and {_n(tiny['fit_resident_wps'])} (resident) "
+        f"against {before_fit['camn', 'tiny', 'cuda', 64]}",
+        f"CaMN {ms(on)} → {ms(off)} ms, HA2G {ms(h_on)} → {ms(h_off)} ms; {ms(off_later)} and {ms(h_off_later)} ms "
+        "in the later run",
+        f"(CaMN, bf16 at 256: {ms(on)} → {ms(compiled)} ms; at 1024 with determinism off, in the later run: "
+        f"{ms(wide_off)} → {ms(wide_compiled)} ms, the best CaMN rate, {wps(wide_compiled)} windows/s;",
+        f"at batch 64 and 256 ({ms(bf16_64)} against {ms(fp32)} ms, {ms(on)} against {ms(fp32_256)})",
+        f"casts add {on['ops_per_step'] - fp32['ops_per_step']} operators",
+        f"CaMN's paper preset is at {wps(wide_compiled)} windows/s of the 10,000 asked, HA2G's at {wps(best_ha2g)} of 3,000",
+        f"({wps(ha2g_fp32)} against {before['ha2g', 'paper', 'fp32', 64]['wps']} windows/s, fp32, batch 64)",
+        f"gains {h_on['step_ms'] / h_off['step_ms']:.2f} times in bf16 at 256",
     ):
         assert sentence in text, sentence
-    # the profile figures: the compiled CaMN step at 1024 and HA2G's bf16 step at 256 (tune run's log)
-    log = (ROOT / "bench" / "records" / "bench_train_h200_tune.log").read_text()
-    tables = log.split("Self CUDA time total: ")
-    camn_table = next(t for t in tables if "wgrad2d_grouped_direct_kernel" in t and "CompiledFxGraph" in t)
-    wgrad = re.search(r"wgrad2d_grouped_direct_kernel.*?\s(\d+\.\d+)ms\s+\d+\.\d+%", camn_table).group(1)
-    total = tables[tables.index(camn_table) + 1].split("ms")[0]
-    assert f"{float(wgrad):.0f} of its {float(total):.0f} ms of GPU time" in text
-    ha2g_total = [t.split("ms")[0] for t in tables[1:]][3]  # the 4th profile: HA2G bf16 256, determinism off
+    assert wide_on["step_ms"] < b1024["ms"] < 1.01 * wide_on["step_ms"]  # "no change where the GPU is busy"
     assert (
-        f"{float(ha2g_total):.0f} of its {ms(row('tune', 'ha2g', 'paper', 'bf16', '256', 'eager', 'off'))} ms"
-        in text
+        h_on["step_ms"] / h_off["step_ms"]
+        < before["ha2g", "paper", "fp32", 64]["wps"] / ha2g_fp32["step_wps"]
     )
+    # the profile figures (the logs' torch.profiler tables)
+    full = _profiles((RECORDS / "bench_train_h200_full.log").read_text())
+    tune = _profiles((RECORDS / "bench_train_h200_tune.log").read_text())
+    step = tune["camn paper cuda bf16 b1024 reduce-overhead det=False"]
+    wgrad = _gpu_ms(step, "wgrad2d_grouped_direct_kernel")
+    assert f"{wgrad:.0f} of its {_gpu_ms(step):.0f} ms of GPU time" in text
+    fp32_profile = full["camn paper cuda fp32 b64 eager det=True"]
+    tf32_kernel = "wgrad_implicit_gemm_indexed_wo_smem_tf32"
+    tf32_calls = int(next(x for x in fp32_profile.splitlines() if tf32_kernel in x).split()[-1])
+    calls = int(next(x for x in step.splitlines() if "wgrad2d_grouped" in x).split()[-1])
+    assert calls == tf32_calls == 2  # "the two first convolutions", one call each
+    per_call = _gpu_ms(fp32_profile, tf32_kernel) / tf32_calls
+    assert f"TF32 implicit-GEMM kernel does it, {per_call:.1f} ms per call at batch 64" in text
+    h = tune["ha2g paper cuda bf16 b256 eager det=False"]
+    assert f"({_gpu_ms(h):.0f} of its {ms(h_off_later)} ms at 256 in bf16)" in text
+    for profile in (
+        full["camn paper cuda bf16 b64 eager det=True"],
+        full["camn paper cuda bf16 b256 eager det=True"],
+    ):
+        host = float(re.search(r"Self CPU time total: ([\d.]+)ms", profile).group(1))
+        assert host > _gpu_ms(profile)  # "its profiles show more host than GPU time"
 
 
 def test_the_train_config_docstring_quotes_the_record():
     from beatlite.train import TrainConfig
 
     doc = " ".join(TrainConfig.__doc__.split())
-    ms = lambda *key: _n(_record_row(*key)["step_ms"])  # noqa: E731
-    camn, ha2g = ("camn", "paper", "bf16", "256"), ("ha2g", "paper", "bf16", "256")
-    wide = ("camn", "paper", "bf16", "1024")
+    ms = lambda *key: _n(_row(*key)["step_ms"])  # noqa: E731
+    camn, ha2g, wide = (
+        ("camn", "paper", "bf16", 256),
+        ("ha2g", "paper", "bf16", 256),
+        ("camn", "paper", "bf16", 1024),
+    )
     for sentence in (
-        f"from {ms('full', *camn, 'eager', 'on')} to {ms('full', *camn, 'eager', 'off')} ms per step and HA2G's "
-        f"from {ms('full', *ha2g, 'eager', 'on')} to {ms('full', *ha2g, 'eager', 'off')}",
-        f"from {ms('full', *camn, 'eager', 'on')} to {ms('full', *camn, 'reduce-overhead', 'on')} ms per step at "
-        f"batch 256 and, with ``deterministic=False``, from {ms('tune', *wide, 'eager', 'off')} to "
-        f"{ms('tune', *wide, 'reduce-overhead', 'off')} ms at 1024",
+        f"from {ms('full', *camn, 'eager', True)} to {ms('full', *camn, 'eager', False)} ms per step and HA2G's "
+        f"from {ms('full', *ha2g, 'eager', True)} to {ms('full', *ha2g, 'eager', False)}",
+        f"from {ms('full', *camn, 'eager', True)} to {ms('full', *camn, 'reduce-overhead', True)} ms per step at "
+        f"batch 256 and, with ``deterministic=False``, from {ms('tune', *wide, 'eager', False)} to "
+        f"{ms('tune', *wide, 'reduce-overhead', False)} ms at 1024",
     ):
         assert sentence in doc, sentence

@@ -66,12 +66,14 @@ class TrainConfig:
         or the CPU, where torch autocasts to bfloat16 too; weights, optimiser and gradients stay
         float32). Off by default: float32 training on the CPU is bitwise deterministic.
     deterministic : bool
-        ``torch.use_deterministic_algorithms`` during training (default ``True``: with a seed, the same numbers
-        on the same machine, on CUDA too). ``False`` lets CUDA use its faster nondeterministic kernels and skips
-        the filling of every new tensor that deterministic mode does: on an H200 it took CaMN's paper preset
-        (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260 (``bench/bench_train.py
-        --deterministic on off``; README, "Using real BEAT"); the same seed then gives slightly different
-        numbers from run to run on a GPU. No effect on CPU results (its kernels are deterministic).
+        What :func:`beatlite.train.fit` passes to ``torch.use_deterministic_algorithms`` (torch's setting is
+        process-wide: it stays set after ``fit``). ``True`` (default): only deterministic kernels, what repeatable
+        CUDA runs need (whether two CUDA runs repeat to the bit was not measured here). ``False`` lets CUDA use its
+        faster nondeterministic kernels and skips deterministic mode's filling of every new tensor: on an H200 it
+        took CaMN's paper preset (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260
+        (``bench/bench_train.py --deterministic on off``; README, "Using real BEAT"); the same seed may then give
+        slightly different numbers from run to run on a GPU. No effect on CPU results (its kernels are
+        deterministic either way).
     checkpoint_every : int or None
         Also write the full checkpoint every this many optimiser steps inside an epoch (an epoch of real
         BEAT is long on a CPU); ``resume=True`` then continues from that step, with the same numbers as
