@@ -42,6 +42,7 @@ from pathlib import Path
 
 from beatlite import paths
 from beatlite.io.atomic import atomic_write, exclusive_lock
+from beatlite.models import model_class
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
 from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
@@ -201,8 +202,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
 
-    from beatlite.models import model_class
-    from beatlite.train.training import check_compilable
+    from beatlite.train.training import check_compilable  # (imports torch)
 
     try:  # before anything is prepared or written
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
