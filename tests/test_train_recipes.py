@@ -223,10 +223,28 @@ def test_recipe_mismatch_sees_changed_settings_and_model_configs():
     )
     old = _checkpoint_of("camn_tiny")
     del old["train_config"]["lr_schedule"]  # checkpoints from before the option: constant
+    del old["train_config"]["deterministic"]  # ... and before this one: deterministic
     assert recipe_mismatch("camn_tiny", old) is None
+    # trained in bf16 or nondeterministically (fit --precision bf16 / --nondeterministic): not the recipe's
+    assert "amp=True" in recipe_mismatch("camn_tiny", _checkpoint_of("camn_tiny", amp=True))
+    assert "deterministic=False" in recipe_mismatch(
+        "camn_tiny", _checkpoint_of("camn_tiny", deterministic=False)
+    )
     other = _checkpoint_of("ha2g_tiny")
     other["model"]["audio_freq_stride"] = 1  # a preset change since it was trained
     assert "audio_freq_stride" in recipe_mismatch("ha2g_tiny", other)
+    # a checkpoint from before a config field loads with the field's default (load_model does so): current when
+    # that default is the recipe's (audio_order, added after the shipped HA2G checkpoints), stale otherwise
+    older = _checkpoint_of("ha2g_tiny")
+    del older["model"]["audio_order"]
+    assert recipe_mismatch("ha2g_tiny", older) is None
+    changed = _checkpoint_of("ha2g_tiny_no_contrastive")
+    field = next(k for k, v in RECIPES["ha2g_tiny_no_contrastive"].overrides.items())
+    del changed["model"][field]  # its default is the full model's, not the ablation's
+    assert field in recipe_mismatch("ha2g_tiny_no_contrastive", changed)
+    gone = _checkpoint_of("camn_tiny")
+    gone["model"]["retired_option"] = 1
+    assert "does not load" in recipe_mismatch("camn_tiny", gone)
     # an ablation's checkpoint is not the full model's
     assert "use_audio" in recipe_mismatch("camn_tiny", _checkpoint_of("camn_tiny_no_audio"))
 

@@ -167,7 +167,8 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     """Why ``checkpoint`` (a loaded checkpoint dict) was not trained by today's recipe ``name``, or None.
 
     Compares the harness settings stored in its ``"train_config"`` (epochs, batch size, learning
-    rate and schedule) and its model config with what :data:`~beatlite.train.recipes.RECIPES`
+    rate and schedule; float32, deterministic: a checkpoint trained with ``amp`` or
+    ``deterministic=False`` is not the recipe's) and its model config with what :data:`~beatlite.train.recipes.RECIPES`
     builds now (same vocabulary size and seed), so a seed table is never filled with checkpoints of
     an older recipe. Code changes that leave both unchanged are not seen: retrain with ``force``.
     """
@@ -179,8 +180,11 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
         "batch_size": recipe.batch_size,
         "lr": recipe.lr,
         "lr_schedule": recipe.lr_schedule,
+        "amp": False,
+        "deterministic": True,
     }
-    have = {key: stored.get(key, "constant" if key == "lr_schedule" else None) for key in want}
+    missing = {"lr_schedule": "constant", "amp": False, "deterministic": True}  # older checkpoints' defaults
+    have = {key: stored.get(key, missing.get(key)) for key in want}
     if have != want:
         diff = {key: (have[key], want[key]) for key in want if have[key] != want[key]}
         return (
@@ -190,7 +194,12 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     model = dict(checkpoint.get("model") or {})
     kw = dict(recipe.overrides)
     kw.update({key: model[key] for key in ("vocab_size", "seed") if key in model})
-    expected = build_model(recipe.model, preset="tiny", **kw).to_config()
+    built = build_model(recipe.model, preset="tiny", **kw)
+    expected = built.to_config()
+    try:  # the config the checkpoint loads as: fields it predates take their defaults, as load_model does
+        model = type(built).from_config(model).to_config() if model else model
+    except TypeError as error:  # a field that no longer exists
+        return f"its model config does not load: {error}"
     if expected != model:
         fields = sorted(k for k in set(expected) | set(model) if expected.get(k) != model.get(k))
         return f"its model config differs from the recipe's in {fields}"
