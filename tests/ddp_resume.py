@@ -9,8 +9,9 @@ import sys
 
 import torch
 from ddp_model import camn_without_dropout
+from killed_run import step_killed_after
 
-from beatlite.train import TrainConfig, fit, training
+from beatlite.train import TrainConfig, fit
 from beatlite.train.distributed import distributed_rank
 from beatlite.train.recipes import RECIPES, training_data
 
@@ -37,20 +38,11 @@ val = {"val_windows": data.val, "val_score": weight_score} if validate else {}
 
 net = camn_without_dropout(data)
 if mode == "kill":
-    real_step, calls = training._Run.step, {"n": 0}
-
-    def dying_step(self, *args):
-        if calls["n"] == 4:
-            raise KeyboardInterrupt("killed")
-        calls["n"] += 1
-        return real_step(self, *args)
-
-    training._Run.step = dying_step
-    try:
-        fit(net, data.train, config(False), meta=data.meta, **val)
-    except KeyboardInterrupt:
-        pass
-    training._Run.step = real_step
+    with step_killed_after(4):
+        try:
+            fit(net, data.train, config(False), meta=data.meta, **val)
+        except KeyboardInterrupt:
+            pass
     net = camn_without_dropout(data)
 result = fit(net, data.train, config(mode == "kill"), meta=data.meta, **val)
 if distributed_rank()[0] == 0:

@@ -9,6 +9,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+from killed_run import step_killed_after  # noqa: E402
+
 from beatlite.models import build_model  # noqa: E402
 from beatlite.models.base import GestureModel, ModelConfig  # noqa: E402
 from beatlite.models.testing import fake_windows  # noqa: E402
@@ -65,26 +67,13 @@ def test_resume_reproduces_an_uninterrupted_run(windows, tmp_path):
     assert not list(tmp_path.glob("*.tmp"))  # atomic writes leave no temp file
 
 
-def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path, monkeypatch):
+def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path):
     """checkpoint_every=1: a run stopped after 4 optimiser steps (epoch 2, step 1 of 3) resumes there and
     ends with the weights and history of an uninterrupted run."""
-    from beatlite.train import training
-
     train, val = windows
     full = fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "full.pt"), val)
-    calls = {"n": 0}
-    real_step = training._Run.step
-
-    def dying_step(self, *args):
-        if calls["n"] == 4:
-            raise KeyboardInterrupt("killed")
-        calls["n"] += 1
-        return real_step(self, *args)
-
-    monkeypatch.setattr(training._Run, "step", dying_step)
-    with pytest.raises(KeyboardInterrupt):
+    with step_killed_after(4), pytest.raises(KeyboardInterrupt):
         fit(camn(), train, cfg(epochs=2, checkpoint=tmp_path / "part.pt", checkpoint_every=1), val)
-    monkeypatch.setattr(training._Run, "step", real_step)
     saved = torch.load(tmp_path / "part.pt", weights_only=True)
     assert saved["epoch"] == 1 and saved["partial"]["step"] == 1  # 3 steps per epoch: killed in epoch 2
     resumed = fit(
@@ -492,28 +481,15 @@ def test_val_every_keeps_the_weights_of_the_lowest_scoring_step(windows, tmp_pat
     _assert_same_weights(best, _trained_four_steps(train, tmp_path / "four.pt"))
 
 
-def test_a_run_validating_every_n_steps_killed_mid_epoch_resumes_with_the_same_record(
-    windows, tmp_path, monkeypatch
-):
+def test_a_run_validating_every_n_steps_killed_mid_epoch_resumes_with_the_same_record(windows, tmp_path):
     """val_every=2 with checkpoint_every=1: a run stopped after 5 steps (epoch 1, after its validation at step
     4) resumes at step 5 without validating step 4 again, and ends with the history, best and weights of an
     uninterrupted run."""
-    from beatlite.train import training
-
     train, val = windows
     every = {"val_every": 2, "checkpoint_every": 1}
     score = _scripted_scores(3.0, 1.0, 2.0)[0]
     full = fit(camn(), train, cfg(checkpoint=tmp_path / "full.pt", **every), val, val_score=score)
-    calls, real_step = {"n": 0}, training._Run.step
-
-    def dying_step(self, *args):
-        if calls["n"] == 5:
-            raise KeyboardInterrupt("killed")
-        calls["n"] += 1
-        return real_step(self, *args)
-
-    monkeypatch.setattr(training._Run, "step", dying_step)
-    with pytest.raises(KeyboardInterrupt):
+    with step_killed_after(5), pytest.raises(KeyboardInterrupt):
         fit(
             camn(),
             train,
@@ -521,7 +497,6 @@ def test_a_run_validating_every_n_steps_killed_mid_epoch_resumes_with_the_same_r
             val,
             val_score=_scripted_scores(3.0, 1.0)[0],
         )
-    monkeypatch.setattr(training._Run, "step", real_step)
     saved = torch.load(tmp_path / "part.pt", weights_only=True)
     assert (saved["epoch"], saved["partial"]["step"], saved["steps"]) == (1, 2, 5)
     assert [v["step"] for v in saved["partial"]["validations"]] == [4] and saved["best"]["step"] == 4

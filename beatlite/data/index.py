@@ -825,8 +825,8 @@ def _index_many(
 
     if workers is None:
         workers = default_workers(p for _, files, _ in jobs for paths in files.values() for p in paths)
-    n = min(workers, len(jobs))
-    if n <= 1 or spawnable(n, "index_folder") <= 1:
+    n = spawnable(min(workers, len(jobs)), "index_folder")
+    if n <= 1:
         done = [_index_take_job(job) for job in jobs]
     else:
         from concurrent.futures import ProcessPoolExecutor

@@ -917,8 +917,7 @@ def _run_builds(
 
     if workers is None:
         workers = default_workers(p for r in todo for p in r.files.values())
-    n = min(len(todo), workers)
-    n = spawnable(n, "build_store") if n > 1 else n
+    n = spawnable(min(len(todo), workers), "build_store")
     todo = sorted(todo, key=lambda r: -r.duration if r.duration else 0.0)  # long takes first: balance
     with progress_bar(total=len(todo), desc="store takes", unit="take", disable=not progress) as bar:
         if n <= 1:

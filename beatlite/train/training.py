@@ -494,6 +494,7 @@ class _Run:
         self.val_windows: Any = None
         self.val_score: Callable[[GestureModel], float] | None = None
         self.path = None if config.checkpoint is None else Path(config.checkpoint)
+        check_compilable(type(model), config.compile)
         self._bind()
 
     def wrap(self) -> None:
@@ -507,7 +508,6 @@ class _Run:
         """The step's forward pass and losses: the model's (or its DDP wrappers'), compiled when
         ``config.compile`` says so."""
         mode, model = self.config.compile, self.model
-        check_compilable(type(model), mode)
         self.forward = _compiled(self.g_ddp or model, mode)
         self.losses = _compiled(model.losses, mode)
         self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
