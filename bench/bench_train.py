@@ -32,6 +32,10 @@ Per row:
   columns are left out (``-``): a fit of a few steps would time its compilation.
 - **deterministic**: :attr:`beatlite.train.TrainConfig.deterministic` of the row (``--deterministic on off``):
   on CUDA, ``off`` lets torch pick nondeterministic kernels and skips filling new tensors.
+- **audio matmul**: ``--frame-matmul off on``: CaMN's first audio block (two convolutions of the one-channel
+  waveform) as one matrix product of the waveform's frames (:func:`beatlite.models.layers.use_frame_matmul`;
+  the same values to float rounding) or as cuDNN/oneDNN convolutions (``off``, the default); ``-`` for models
+  without such a block.
 - ``--trace-rnn``: compiled rows trace the recurrent layers too (``torch._dynamo.config.allow_rnn``: the LSTM
   and GRU unrolled over time into the compiled graph, instead of a graph break around cuDNN's kernel); their
   compile cell says ``+rnn``.
@@ -72,6 +76,7 @@ from torch.utils._python_dispatch import TorchDispatchMode
 from torch.utils.flop_counter import FlopCounterMode
 
 from beatlite.models import MODELS, build_model, model_class
+from beatlite.models.layers import use_frame_matmul
 from beatlite.paths import data_dir, n_threads
 from beatlite.train import TrainConfig, fit
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
@@ -188,10 +193,14 @@ class Row:
     ops_per_step: int | None = None
     note: str = ""
     fit_error: str = ""
+    frame_matmul: bool | None = None  # (None: the model has no one-channel audio block)
 
 
-def _model(name: str, preset: str, train: Any, *, prepare: bool = True) -> Any:
-    """Model ``name`` at ``preset`` (seed 0) sized for the store's vocabulary, prepared on its windows."""
+def _model(
+    name: str, preset: str, train: Any, *, prepare: bool = True, frame_matmul: bool | None = None
+) -> Any:
+    """Model ``name`` at ``preset`` (seed 0) sized for the store's vocabulary, prepared on its windows (and its
+    one-channel audio blocks switched to ``frame_matmul`` when given)."""
     fields = {f.name for f in dataclasses.fields(model_class(name).config_class)}
     torch.manual_seed(0)
     model = build_model(
@@ -199,6 +208,8 @@ def _model(name: str, preset: str, train: Any, *, prepare: bool = True) -> Any:
     )
     if prepare:
         model.prepare(train, train.normalizers)
+    if frame_matmul is not None:
+        use_frame_matmul(model, frame_matmul)
     return model
 
 
@@ -226,12 +237,13 @@ def measure_step(
     name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0,
     compile: str = "eager",  # noqa: A002
     deterministic: bool = True,
+    frame_matmul: bool = False,
 ) -> Row:  # fmt: skip
     """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
     (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
     operators)."""
     torch.use_deterministic_algorithms(deterministic)  # (as fit sets it from its TrainConfig)
-    model = _model(name, preset, train)
+    model = _model(name, preset, train, frame_matmul=frame_matmul)
     run = _Run(model, _config(device, precision, batch, compile, epochs=1), "bench", {})
     keys = model_keys(model)
     data = train.batch(np.arange(batch) % len(train), keys=keys)
@@ -243,7 +255,12 @@ def measure_step(
     model.train()
     counted = run  # FLOPs and operators of the eager step (a compiled step's kernels are not dispatched)
     if compile != "eager":
-        counted = _Run(_model(name, preset, train), _config(device, precision, batch, epochs=1), "bench", {})
+        counted = _Run(
+            _model(name, preset, train, frame_matmul=frame_matmul),
+            _config(device, precision, batch, epochs=1),
+            "bench",
+            {},
+        )
     with _flop_counter() as counter:
         counted.step(step, 0, {})
     with _CountOps() as ops:
@@ -265,6 +282,7 @@ def measure_step(
         name, preset, device, precision, batch, compile, deterministic, model.n_parameters(), gflop,
         batch / seconds, 1e3 * seconds, ops_per_step=ops.count,
     )  # fmt: skip
+    row.frame_matmul = frame_matmul if use_frame_matmul(model, frame_matmul) else None
     row.peak_mib = memory.mib
     row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
     return row
@@ -297,7 +315,7 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
     of a store view: batches read by the store's loader (``data_on_device="never"``) and gathered on the
     device from resident streams (``"always"``, :class:`beatlite.data.resident.ResidentWindows`)."""
     for mode, field in (("never", "fit_wps"), ("always", "fit_resident_wps")):
-        model = _model(row.model, row.preset, store_train, prepare=False)  # fit prepares it (timed)
+        model = _model(row.model, row.preset, store_train, prepare=False, frame_matmul=bool(row.frame_matmul))
         keys = type(model).batch_keys(model.config)
         view = store_train.store.windows("train", keys=keys, stats=store_train.normalizers)
         n = min(len(view), steps * row.batch)
@@ -313,7 +331,7 @@ def measure_fit(row: Row, store_train: Any, steps: int) -> None:
 # ---------------------------------------------------------------------------- table and command line
 COLUMNS = (
     ("model", "model"), ("preset", "preset"), ("device", "device"), ("precision", "precision"),
-    ("batch", "batch"), ("compile", "compile"), ("deterministic", "deterministic"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
+    ("batch", "batch"), ("compile", "compile"), ("deterministic", "deterministic"), ("frame_matmul", "audio matmul"), ("params", "params (M)"), ("gflop_per_window", "GFLOP/window"),
     ("ops_per_step", "ops/step"),
     ("step_wps", "step windows/s"), ("step_ms", "ms/step"), ("fit_wps", "fit windows/s (loader)"),
     ("fit_ratio", "fit/step"), ("fit_resident_wps", "fit windows/s (resident)"), ("resident_ratio", "resident/loader"), ("peak_mib", "peak MiB"), ("peak_fraction", "% of GEMM peak"),
@@ -329,6 +347,7 @@ def _cell(row: Row, field: str) -> str:
         "batch",
         "compile",
         "deterministic",
+        "frame_matmul",
     ):
         return row.note
     ratios = {"fit_ratio": (row.fit_wps, row.step_wps), "resident_ratio": (row.fit_resident_wps, row.fit_wps)}
@@ -402,6 +421,10 @@ def _parse() -> argparse.Namespace:
         help="TrainConfig.deterministic of the rows; default on",
     )  # fmt: skip
     p.add_argument(
+        "--frame-matmul", nargs="+", default=["off"], choices=["off", "on"],
+        help="CaMN's first audio block as a matrix product of frames (on) or as convolutions (off); default off",
+    )  # fmt: skip
+    p.add_argument(
         "--trace-rnn", action="store_true",
         help="compiled rows trace the LSTM/GRU layers too (torch._dynamo.config.allow_rnn)",
     )  # fmt: skip
@@ -421,9 +444,9 @@ def _parse() -> argparse.Namespace:
     return args
 
 
-def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, bool]]:
-    """(model, preset, device, precision, batch, compile, deterministic) of every row; by default the paper
-    presets on CUDA only."""
+def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, bool, bool]]:
+    """(model, preset, device, precision, batch, compile, deterministic, frame matmul) of every row; by default
+    the paper presets on CUDA only."""
     grid = []
     for name in args.models:
         for device in args.devices:
@@ -432,9 +455,10 @@ def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, 
                 for precision in args.precisions:
                     for b in args.batch_sizes:
                         grid += [
-                            (name, preset, device, precision, b, c, d == "on")
+                            (name, preset, device, precision, b, c, d == "on", m == "on")
                             for c in args.compile
                             for d in args.deterministic
+                            for m in args.frame_matmul
                         ]
     return grid
 
@@ -453,7 +477,7 @@ def main() -> None:
             f"threads={torch.get_num_threads()}  torch {torch.__version__}  {len(train)} train windows{bench}"
         )
         rows = []
-        for name, preset, device, precision, batch, comp, det in _grid(args):
+        for name, preset, device, precision, batch, comp, det, matmul in _grid(args):
             if device == "cuda" and not torch.cuda.is_available():
                 rows.append(Row(name, preset, device, precision, batch, comp, det, note=UNMEASURED))
                 continue
@@ -461,7 +485,7 @@ def main() -> None:
             try:
                 row = measure_step(
                     name, preset, device, precision, batch, train, args.steps, args.profile, compile=comp,
-                    deterministic=det,
+                    deterministic=det, frame_matmul=matmul,
                 )  # fmt: skip
             except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
                 row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))
@@ -476,7 +500,8 @@ def main() -> None:
             row.compile = label
             rows.append(row)
             fit_error = f" (fit {row.fit_error})" if row.fit_error else ""
-            print(f"  {name} {preset} {device} {precision} b{batch} {comp} det={det}: "
+            matmul_label = " matmul" if row.frame_matmul else ""
+            print(f"  {name} {preset} {device} {precision} b{batch} {comp} det={det}{matmul_label}: "
                   + (row.note or f"{row.step_wps:,.0f} windows/s{fit_error}"), flush=True)  # fmt: skip
             _write_json(
                 args.json, rows

@@ -14,9 +14,10 @@
 #   STAGE tune     after full (about 7 minutes): bf16 with TrainConfig.deterministic off; CaMN paper at 256 (fit
 #                  included) and 1024, eager and reduce-overhead, then with the LSTM traced into the graph
 #                  (--trace-rnn); HA2G paper at 256 and 512
-#   STAGE next     the leads tune left (about 7 minutes): CaMN paper bf16 at 1024, determinism off, compiled,
-#                  with cuDNN's default algorithms and with cudnn.benchmark (its slow bf16 weight gradient of the
-#                  raw-audio convolutions), then with the LSTM traced into the graph (a longer limit)
+#   STAGE next     the leads tune left (about 8 minutes): CaMN paper bf16 at 1024, determinism off, eager and
+#                  compiled, its first audio block as convolutions and as one matrix product of the waveform's
+#                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
+#                  compiled with cudnn.benchmark; then with the LSTM traced into the graph (a longer limit)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
@@ -64,9 +65,9 @@ json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r i
 }
 if [ "$stage" = next ]; then
     paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
-    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead
-    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --cudnn-benchmark
-    bench 240 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --trace-rnn --cudnn-benchmark
+    bench 150 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --frame-matmul off on
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul off on --cudnn-benchmark
+    bench 220 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
     exit 0
 fi
 if [ "$stage" = tune ]; then

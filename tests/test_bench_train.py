@@ -38,17 +38,19 @@ def test_the_grid_has_a_row_per_compile_setting_and_compiled_rows_leave_the_fit_
     bench = _bench()
     args = argparse.Namespace(models=["camn"], devices=["cuda"], quick=False, presets=None,
                               precisions=["bf16"], batch_sizes=[256], compile=["eager", "reduce-overhead"],
-                              deterministic=["on", "off"])  # fmt: skip
+                              deterministic=["on", "off"], frame_matmul=["off", "on"])  # fmt: skip
     assert bench._grid(args) == [
-        ("camn", preset, "cuda", "bf16", 256, c, d)
+        ("camn", preset, "cuda", "bf16", 256, c, d, m)
         for preset in ("tiny", "paper")
         for c in ("eager", "reduce-overhead")
         for d in (True, False)
+        for m in (False, True)
     ]
     row = bench.Row("camn", "paper", "cuda", "bf16", 256, "reduce-overhead", step_wps=1000.0, step_ms=256.0)
     cells = bench.markdown([row]).splitlines()[2].split(" | ")
     header = bench.markdown([row]).splitlines()[0].split(" | ")
     assert cells[header.index("compile")] == "reduce-overhead"
+    assert cells[header.index("audio matmul")] == "-"  # (a model without a one-channel audio block)
     assert (
         cells[header.index("fit windows/s (loader)")] == "-"
         and cells[header.index("step windows/s")] == "1,000"

@@ -173,3 +173,16 @@ def test_the_train_config_docstring_quotes_the_record():
         f"{ms('tune', *wide, 'reduce-overhead', False)} ms at 1024",
     ):
         assert sentence in doc, sentence
+
+
+def test_the_frame_conv1d_docstring_quotes_the_profile():
+    from beatlite.models.layers import frame_conv1d
+
+    doc = " ".join(frame_conv1d.__doc__.split())
+    step = _profiles((RECORDS / "bench_train_h200_tune.log").read_text())[
+        "camn paper cuda bf16 b1024 reduce-overhead det=False"
+    ]
+    wgrad = _gpu_ms(step, "wgrad2d_grouped_direct_kernel")
+    assert (
+        f"{wgrad:.0f} of the {_gpu_ms(step):.0f} ms of CaMN's compiled paper-preset step at batch 1024" in doc
+    )

@@ -49,6 +49,11 @@ class BasicBlock1d(nn.Module):
     (B, in_ch, L) -> (B, out_ch, floor((L + 2 padding - kernel) / stride) + 1)
     """
 
+    frames_as_matmul: bool = False
+    """Compute the two first convolutions (``conv1`` and the shortcut's, which read the same one-channel
+    input) as one matrix product of the input's frames (:func:`frame_conv1d`) instead of two convolution
+    kernels: the same values to float rounding, the same parameters. Set by :func:`use_frame_matmul`."""
+
     def __init__(
         self,
         in_ch: int,
@@ -81,9 +86,84 @@ class BasicBlock1d(nn.Module):
         )
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        y = self.act(self.bn1(self.conv1(x)))
-        y = self.bn2(self.conv2(y))
-        return self.act(y + self.shortcut(x))
+        if self.frames_as_matmul:
+            weight = torch.cat([self.conv1.weight, self.shortcut[0].weight])  # (2 out_ch, 1, kernel)
+            y, short = frame_conv1d(x, weight, self.conv1.stride[0], self.conv1.padding[0]).chunk(2, dim=1)
+            short = self.shortcut[1](short)
+        else:
+            y, short = self.conv1(x), self.shortcut(x)
+        y = self.bn2(self.conv2(self.act(self.bn1(y))))
+        return self.act(y + short)
+
+
+def frame_conv1d(x: torch.Tensor, weight: torch.Tensor, stride: int = 1, padding: int = 0) -> torch.Tensor:
+    """``F.conv1d(x, weight, stride=stride, padding=padding)`` of a one-channel signal as one matrix product.
+
+    The padded signal is cut into its ``T`` frames of ``kernel`` samples, ``stride`` apart (a strided view),
+    and ``frames @ weight.T`` gives every output channel at every frame. Its weight gradient is one matrix
+    product too, ``frames.T @ grad``, where cuDNN's bfloat16 weight gradient of a one-input-channel
+    convolution is a slow direct kernel (on an H200: 79 of the 153 ms of CaMN's compiled paper-preset step
+    at batch 1024; ``bench/records/bench_train_h200_tune.log``).
+
+    Parameters
+    ----------
+    x : torch.Tensor
+        (B, 1, L) signal.
+    weight : torch.Tensor
+        (C, 1, kernel) convolution weights (no bias).
+    stride, padding : int
+        As :func:`torch.nn.functional.conv1d`'s (zero padding on both sides).
+
+    Returns
+    -------
+    torch.Tensor
+        (B, C, T) with T = floor((L + 2 padding - kernel) / stride) + 1.
+
+    Examples
+    --------
+    >>> x, w = torch.randn(2, 1, 100), torch.randn(4, 1, 15)
+    >>> y = frame_conv1d(x, w, stride=5, padding=7)
+    >>> y.shape
+    torch.Size([2, 4, 20])
+    >>> torch.allclose(y, nn.functional.conv1d(x, w, stride=5, padding=7), atol=1e-5)
+    True
+    """
+    if x.ndim != 3 or x.shape[1] != 1 or weight.ndim != 3 or weight.shape[1] != 1:
+        raise ValueError(
+            f"frame_conv1d: x must be (B, 1, L) and weight (C, 1, kernel); got {tuple(x.shape)}, {tuple(weight.shape)}"
+        )
+    padded = nn.functional.pad(x[:, 0], (padding, padding))
+    frames = padded.unfold(-1, weight.shape[-1], stride)  # (B, T, kernel), a strided view
+    return (frames @ weight[:, 0].t()).transpose(1, 2)
+
+
+def use_frame_matmul(model: nn.Module, on: bool = True) -> int:
+    """Switch :attr:`BasicBlock1d.frames_as_matmul` in every block of ``model`` that can take it.
+
+    Parameters
+    ----------
+    model : torch.nn.Module
+        Searched through ``modules()`` (e.g. a CaMN, whose WavEncoder's first block reads the raw waveform).
+    on : bool
+        The matrix-product route (True) or the convolution kernels (False, the default of every block).
+
+    Returns
+    -------
+    int
+        Blocks switched: those with a one-channel input and a convolutional shortcut.
+
+    Examples
+    --------
+    >>> use_frame_matmul(WavEncoder((4, 8, 8, 16, 16, 32)))
+    1
+    """
+    blocks = [
+        m for m in model.modules()
+        if isinstance(m, BasicBlock1d) and m.conv1.in_channels == 1 and not isinstance(m.shortcut, nn.Identity)
+    ]  # fmt: skip
+    for block in blocks:
+        block.frames_as_matmul = bool(on)
+    return len(blocks)
 
 
 class WavEncoder(nn.Module):
