@@ -139,6 +139,26 @@ def test_two_processes_validating_every_two_steps_resume_mid_epoch_with_the_same
         assert torch.equal(p, resumed["params"][name]), name
 
 
+@pytest.mark.slow
+def test_two_processes_with_dropout_resume_each_with_its_own_generator(tmp_path):
+    """Process 0's per-epoch validation draws random numbers that process 1 does not draw, so their
+    generators differ by the time of a checkpoint; each process's dropout masks after a resume must be
+    those of an uninterrupted run, so the checkpoint keeps every process's generator (not process 0's
+    for all)."""
+    torchrun = _torchrun()
+    script = Path(__file__).with_name("ddp_resume.py")
+    out = {}
+    for mode in ("whole", "kill"):
+        path = tmp_path / f"{mode}.pt"
+        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, "dropout"]
+        run_ok(cmd, env=_env(), timeout=900)
+        out[mode] = torch.load(str(path) + ".out", weights_only=True)
+    whole, resumed = out["whole"], out["kill"]
+    assert whole["best"] == resumed["best"]
+    for name, p in whole["params"].items():
+        assert torch.equal(p, resumed["params"][name]), name
+
+
 EXIT_CHECK = """
 import atexit, sys
 import torch.distributed as dist

@@ -10,7 +10,8 @@ A checkpoint is a ``torch.save`` dict::
      "meta": {...}                          # e.g. normalisation statistics for generation
      "steps": optimiser steps done over the whole run,
      # training checkpoints only:
-     "optimizer", "d_optimizer", "rng": torch RNG state}
+     "optimizer", "d_optimizer", "rng": torch's CPU generator state (process 0's),
+     "rng_processes": every process's, in rank order (under torchrun; None with one process)}
 
 Files are written to a temporary file in the same folder and moved into place with
 :func:`os.replace`, so a crash never leaves a half-written checkpoint.
@@ -196,7 +197,9 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
     validated every ``TrainConfig.val_every`` steps); otherwise the last epoch's.
     """
     data = load_checkpoint(src)
-    keep = {k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng", "best")}
+    keep = {
+        k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng", "rng_processes", "best")
+    }
     chosen = data.get("best")
     if best and chosen is not None:
         keep["state"] = chosen["state"]

@@ -142,6 +142,23 @@ def wait_for_all(world: int) -> None:
     dist.barrier()
 
 
+def rng_states(world: int) -> list[torch.Tensor]:
+    """Every process's CPU generator state (``torch.get_rng_state()``), in rank order: a collective, every
+    process calls it (one process: its own state alone).
+
+    The processes' generators differ (process 0 alone validates, and a validation may draw random numbers),
+    so a resumed run restores each its own (:meth:`beatlite.train.training._Run.resume`).
+    """
+    state = torch.get_rng_state()
+    if world < 2:
+        return [state]
+    import torch.distributed as dist
+
+    states = [torch.empty_like(state) for _ in range(world)]
+    dist.all_gather(states, state)  # (a CPU tensor: gloo's, also in the group of a CUDA machine)
+    return states
+
+
 def sum_over_processes(sums: dict[str, float], world: int) -> dict[str, float]:
     """The loss sums of all processes (every process has the same keys), in the order of ``sums``
     (reduced in sorted-key order; the model's first loss stays first, as the progress bar shows it)."""

@@ -25,6 +25,7 @@ from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES, TrainConfig
 from beatlite.train.distributed import (
     distributed_rank,
     local_device,
+    rng_states,
     sum_over_processes,
     sync_on_last,
     wait_for_all,
@@ -529,7 +530,10 @@ class _Run:
         for opt, key in ((self.g_opt, "optimizer"), (self.d_opt, "d_optimizer")):
             if opt is not None and data.get(key) is not None:
                 opt.load_state_dict(data[key])
-        if data.get("rng") is not None:
+        states = data.get("rng_processes")
+        if states is not None and len(states) == self.world:  # each process its own generator
+            torch.set_rng_state(states[self.rank])
+        elif data.get("rng") is not None:  # (written by one process, or by another number of them)
             torch.set_rng_state(data["rng"])
         self.history = list(data.get("history", []))
         self.start_epoch = int(data["epoch"])
@@ -665,7 +669,7 @@ class _Run:
         if self.rank == 0 and (self.val_windows is not None or self.val_score is not None):
             # the validation's random draws (HA2G's evaluation losses, a sampled val_score) come from a fork
             # of torch's generators: training draws the same numbers with or without it, in every process,
-            # so a resumed run (which restores process 0's generator) takes the same steps
+            # so a resumed run (which restores each process's generator) takes the same steps
             cuda = [self.device.index or 0] if self.device.type == "cuda" else []
             with torch.random.fork_rng(devices=cuda):
                 self.validations.append({"step": self.steps, **self.validate(epoch, self.steps)})
@@ -698,8 +702,12 @@ class _Run:
         return score
 
     def save(self, epoch_done: int) -> None:
-        """Write the full (resumable) checkpoint, when a path is configured (process 0 only)."""
-        if self.path is None or self.rank != 0:
+        """Write the full (resumable) checkpoint, when a path is configured (process 0 writes; every process
+        calls it, for the generators' states)."""
+        if self.path is None:
+            return
+        states = rng_states(self.world)
+        if self.rank != 0:
             return
         save_checkpoint(
             self.path,
@@ -713,7 +721,8 @@ class _Run:
                 "history": self.history,
                 "fingerprint": self.fingerprint,
                 "train_config": self.config.to_dict(),
-                "rng": torch.get_rng_state(),  # the CPU generator; CUDA kernels are not bitwise reproducible
+                "rng": states[0],  # the CPU generator; CUDA kernels are not bitwise reproducible
+                "rng_processes": states if self.world > 1 else None,  # under torchrun, each process's
                 "meta": self.meta,
                 "best": self.best,
                 "partial": self.partial,
