@@ -289,8 +289,8 @@ def test_fit_command_writes_only_under_out(tmp_path):
         str(repo_root() / "data_samples"),
     ]
     env = {k: v for k, v in __import__("os").environ.items() if k != "BEATLITE_BUILD"}
-    options = ["--epochs", "1", "--device", "cpu", "--batch-size", "24", "--data-on-device", "always",
-               "--precision", "bf16", "--compile", "aot_eager"]  # fmt: skip
+    options = ["--epochs", "1", "--device", "cpu", "--batch-size", "24", "--lr-scaling", "sqrt",
+               "--data-on-device", "always", "--precision", "bf16", "--compile", "aot_eager"]  # fmt: skip
     run_ok([*cmd, "--out", str(out), *options], env=env, timeout=600)
     assert (out / "s2g_tiny.pt").is_file() and (out / "train" / "s2g_tiny.pt").is_file()
     assert list((out / "build" / "cache" / "store").rglob("meta.json"))  # the window store went under --out
@@ -305,7 +305,7 @@ def test_fit_command_writes_only_under_out(tmp_path):
     recipe, used = RECIPES["s2g_tiny"], full["train_config"]
     assert used["batch_size"] == 24 and used["data_on_device"] == "always"
     assert used["amp"] is True and used["compile"] == "aot_eager"
-    assert used["lr"] == (None if recipe.lr is None else pytest.approx(recipe.lr * 24 / recipe.batch_size))
+    assert used["lr"] == pytest.approx(recipe.lr * (24 / recipe.batch_size) ** 0.5)
     assert full["best"] is not None  # the validation FGD scored the epoch
 
 
@@ -554,3 +554,24 @@ def test_seeds_only_records_its_rows_into_the_table_beside_the_others(tmp_path, 
     # without --only the table is the new one alone
     assert cli._seeds_command(argparse.Namespace(**{**vars(args), "only": None}, out=str(out))) == 0
     assert list(recorded_seed_results(f"{out}.json").values) == ["Mine"]
+
+
+def test_scaled_lr_follows_the_batch_linearly_or_by_its_square_root():
+    from beatlite.train import TrainConfig
+    from beatlite.train.recipes import Recipe, scaled_lr
+
+    recipe = Recipe("camn", "CaMN", batch_size=32, lr=2e-3)
+    assert scaled_lr(recipe, 32) == scaled_lr(recipe, 32, "sqrt") == 2e-3
+    assert scaled_lr(recipe, 8) == pytest.approx(2e-3 / 4) and scaled_lr(recipe, 8, "sqrt") == pytest.approx(
+        1e-3
+    )
+    default = Recipe(
+        "ha2g", "HA2G", batch_size=64, lr=None
+    )  # TrainConfig's default rate, linear in the batch
+    assert scaled_lr(default, 256) is None
+    assert TrainConfig(batch_size=256).learning_rate == pytest.approx(
+        4 * TrainConfig(batch_size=64).learning_rate
+    )
+    assert scaled_lr(default, 256, "sqrt") == pytest.approx(2 * TrainConfig(batch_size=64).learning_rate)
+    with pytest.raises(ValueError, match="sqrt"):
+        scaled_lr(recipe, 64, "cubic")

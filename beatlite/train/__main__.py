@@ -1,6 +1,6 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
-``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B]
+``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B [--lr-scaling sqrt]]
 [--precision bf16] [--compile MODE] [--nondeterministic] [--val-every N]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
@@ -94,7 +94,13 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument(
         "--batch-size",
         type=int,
-        help="windows per step (default: the recipe's); learning rates scale linearly",
+        help="windows per step (default: the recipe's); learning rates scale with it (--lr-scaling)",
+    )
+    f.add_argument(
+        "--lr-scaling",
+        choices=("linear", "sqrt"),
+        default="linear",
+        help="how the learning rates follow --batch-size: linearly (default) or by its square root (recipes.scaled_lr)",
     )
     f.add_argument(
         "--data-on-device",
@@ -238,6 +244,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         compile=args.compile,
         val_every=args.val_every,
         deterministic=not args.nondeterministic,
+        lr_scaling=args.lr_scaling,
     )
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)

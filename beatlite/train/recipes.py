@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -416,6 +417,41 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     return model
 
 
+def scaled_lr(recipe: Recipe, batch_size: int, rule: str = "linear") -> float | None:
+    """The generator learning rate of ``recipe`` at another batch size.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        Its ``lr`` belongs to its ``batch_size`` (``None``: :class:`beatlite.train.TrainConfig`'s default,
+        ``5e-4 * batch_size / 256``).
+    batch_size : int
+        Windows per step.
+    rule : {"linear", "sqrt"}
+        ``"linear"``: the rate times ``batch_size / recipe.batch_size`` (Goyal et al. 2017, "Accurate, large
+        minibatch SGD"); ``"sqrt"``: times its square root (the rule Malladi et al. 2022, "On the SDEs and
+        scaling rules for adaptive gradient algorithms", derive for Adam).
+
+    Returns
+    -------
+    float or None
+        None where the recipe has no ``lr`` and the rule is linear (TrainConfig's default is that rule).
+
+    Examples
+    --------
+    >>> recipe = Recipe("camn", "CaMN", batch_size=32, lr=2e-3)
+    >>> scaled_lr(recipe, 128), scaled_lr(recipe, 128, "sqrt")
+    (0.008, 0.004)
+    """
+    if rule not in ("linear", "sqrt"):
+        raise ValueError(f"lr scaling rule must be 'linear' or 'sqrt', got {rule!r}")
+    ratio = int(batch_size) / recipe.batch_size
+    if recipe.lr is None and rule == "linear":
+        return None
+    base = recipe.lr if recipe.lr is not None else TrainConfig(batch_size=recipe.batch_size).learning_rate
+    return base * (ratio if rule == "linear" else math.sqrt(ratio))
+
+
 def retrain(
     name: str,
     *,
@@ -434,6 +470,7 @@ def retrain(
     compile: str | None = None,  # noqa: A002
     val_every: int | None = None,
     deterministic: bool = True,
+    lr_scaling: str = "linear",
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -464,9 +501,8 @@ def retrain(
         :attr:`beatlite.train.TrainConfig.checkpoint_every` (mid-epoch checkpoints, resumable).
     batch_size : int, optional
         Windows per step instead of the recipe's (a GPU takes larger batches at about the same time per
-        step); the learning rates scale with it linearly (Goyal et al. 2017, "Accurate, large minibatch SGD"):
-        ``lr * batch_size / recipe.batch_size``, or the default ``5e-4 * batch_size / 256`` of a recipe without
-        its own ``lr``. Not the recipe the shipped numbers were measured with.
+        step); the learning rates scale with it as ``lr_scaling`` says (:func:`scaled_lr`). Not the recipe the
+        shipped numbers were measured with (``bench/batch_scaling.py`` measures what it changes).
     data_on_device : {"auto", "always", "never"}
         :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
     amp : bool
@@ -479,6 +515,8 @@ def retrain(
         this many optimiser steps instead of every epoch.
     deterministic : bool
         :attr:`beatlite.train.TrainConfig.deterministic` (``False``: CUDA's faster nondeterministic kernels).
+    lr_scaling : {"linear", "sqrt"}
+        How the learning rates follow ``batch_size`` (:func:`scaled_lr`).
 
     Returns
     -------
@@ -500,7 +538,7 @@ def retrain(
     config = TrainConfig(
         epochs=recipe.epochs if epochs is None else epochs,
         batch_size=batch,
-        lr=None if recipe.lr is None else recipe.lr * batch / recipe.batch_size,
+        lr=scaled_lr(recipe, batch, lr_scaling),
         lr_schedule=recipe.lr_schedule,
         seed=seed,
         checkpoint=full,

@@ -1,0 +1,125 @@
+"""Does a larger batch with scaled learning rates keep a recipe's test scores? (issue 28)
+
+A GPU takes larger batches at about the same time per step, and ``retrain(name, batch_size=B, lr_scaling=R)``
+(the ``fit`` command's ``--batch-size B --lr-scaling R``) scales the learning rates with B, linearly or by its
+square root (:func:`beatlite.train.recipes.scaled_lr`). This trains the recipe at each batch size with each
+rule and seed on ``data_samples/`` (the recipe's epochs, best epoch by validation
+FGD, as the shipped checkpoints) and scores every checkpoint on the test split
+(:func:`beatlite.train.evaluate_models`, the results table's protocol: FGD on TED-43 directions, SRGR,
+BeatAlign, BC, Diversity, L1div), all in one run of the same code.
+
+Usage: ``BEATLITE_THREADS=1 python bench/batch_scaling.py [--recipe camn_tiny] [--batches 32 64 128]
+[--rules linear sqrt] [--seeds 2021 2022 2023] [--work DIR] [--json bench/records/batch_scaling_camn_tiny.json]`` (about 2.5 min per
+checkpoint on one CPU thread for ``camn_tiny``; ``--work`` keeps the checkpoints, and a checkpoint already
+there is scored, not trained again).
+
+Scope: ``data_samples/`` has 658 train windows, so batch 128 is 5 steps per epoch; whether larger batches keep
+the scores on real BEAT (80,000 windows at BEAT-4english) is not measured here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from beatlite.train.evaluation import evaluate_models
+from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
+from beatlite.train.testset import load_test_set
+
+METRICS = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div")
+
+
+def _revision() -> str:
+    root = Path(__file__).resolve().parents[1]
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True
+        )
+    except OSError:
+        return "unknown"
+    return out.stdout.strip() or "unknown"
+
+
+def summary(rows: list[dict]) -> dict[str, dict[str, list[float]]]:
+    """Per ``"<batch> <rule>"`` and metric: ``[mean, sample sd]`` over the seeds."""
+    out: dict[str, dict[str, list[float]]] = {}
+    for batch, rule in dict.fromkeys((r["batch"], r["rule"]) for r in rows):
+        values = {m: [r[m] for r in rows if (r["batch"], r["rule"]) == (batch, rule)] for m in METRICS}
+        out[f"{batch} {rule}"] = {
+            m: [statistics.mean(v), statistics.stdev(v) if len(v) > 1 else 0.0]
+            for m, v in values.items()
+            if v
+        }
+    return out
+
+
+def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
+    batches, rules, seeds = (" ".join(map(str, v)) for v in (args.batches, args.rules, args.seeds))
+    return {
+        "recipe": args.recipe,
+        "recipe_batch": recipe.batch_size,
+        "recipe_lr": recipe.lr,
+        "epochs": recipe.epochs if args.epochs is None else args.epochs,
+        "revision": _revision(),
+        "command": f"BEATLITE_THREADS=1 python bench/batch_scaling.py --recipe {args.recipe} --batches {batches} "
+        f"--rules {rules} --seeds {seeds}" + ("" if args.epochs is None else f" --epochs {args.epochs}"),
+        "rows": rows,
+        "summary": summary(rows),
+    }
+
+
+def _write(path: Path | None, record: dict) -> None:
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(record, indent=1) + "\n")
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--recipe", default="camn_tiny", choices=sorted(RECIPES))
+    p.add_argument("--batches", nargs="+", type=int, default=[32, 64, 128])
+    p.add_argument("--rules", nargs="+", default=["linear", "sqrt"], choices=["linear", "sqrt"])
+    p.add_argument("--seeds", nargs="+", type=int, default=[2021, 2022, 2023])
+    p.add_argument("--epochs", type=int, default=None, help="default the recipe's (1: a smoke test)")
+    p.add_argument(
+        "--work", type=Path, default=None, help="where the checkpoints go (default a temporary folder)"
+    )
+    p.add_argument("--json", type=Path, default=None, help="write the record here")
+    args = p.parse_args()
+    recipe = RECIPES[args.recipe]
+    with tempfile.TemporaryDirectory() as tmp:
+        work = args.work or Path(tmp)
+        data, test = training_data(), load_test_set()
+        rows = []
+        runs = [(b, "linear" if b == recipe.batch_size else r) for b in args.batches for r in args.rules]
+        for batch, rule in dict.fromkeys(runs):  # (the recipe's own batch once: both rules give its lr)
+            for seed in args.seeds:
+                folder = work / f"b{batch}_{rule}_s{seed}"
+                start = time.perf_counter()
+                if not (folder / f"{args.recipe}.pt").is_file():
+                    retrain(args.recipe, seed=seed, out_dir=folder, data=data, progress=False, batch_size=batch,
+                            lr_scaling=rule, epochs=args.epochs)  # fmt: skip
+                seconds = time.perf_counter() - start
+                result = evaluate_models([str(folder / f"{args.recipe}.pt")], test=test, ground_truth=False)
+                metrics = {k: float(v) for k, v in result.rows[0].metrics.items() if k in METRICS}
+                lr = scaled_lr(recipe, batch, rule)
+                rows.append({"batch": batch, "rule": rule, "seed": seed, "lr": lr, "train_seconds": seconds,
+                             **metrics})  # fmt: skip
+                print(json.dumps(rows[-1]), flush=True)
+                _write(
+                    args.json, _record(args, recipe, rows)
+                )  # after every row: an interrupted run keeps them
+    record = _record(args, recipe, rows)
+    for key, values in record["summary"].items():
+        cells = "  ".join(f"{m} {mean:.3g} ± {sd:.2g}" for m, (mean, sd) in values.items())
+        print(f"batch {key}: {cells}")
+
+
+if __name__ == "__main__":
+    main()
