@@ -50,11 +50,10 @@ def summary(rows: list[dict]) -> dict[str, dict[str, list[float]]]:
     """Per ``"<batch> <rule>"`` and metric: ``[mean, sample sd]`` over the seeds."""
     out: dict[str, dict[str, list[float]]] = {}
     for batch, rule in dict.fromkeys((r["batch"], r["rule"]) for r in rows):
-        values = {m: [r[m] for r in rows if (r["batch"], r["rule"]) == (batch, rule)] for m in METRICS}
+        group = [r for r in rows if (r["batch"], r["rule"]) == (batch, rule)]
+        values = {m: [r[m] for r in group] for m in METRICS if all(m in r for r in group)}
         out[f"{batch} {rule}"] = {
-            m: [statistics.mean(v), statistics.stdev(v) if len(v) > 1 else 0.0]
-            for m, v in values.items()
-            if v
+            m: [statistics.mean(v), statistics.stdev(v) if len(v) > 1 else 0.0] for m, v in values.items()
         }
     return out
 

@@ -18,12 +18,14 @@
 #                  compiled, its first audio block as convolutions and as one matrix product of the waveform's
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  compiled with cudnn.benchmark; then with the LSTM traced into the graph (a longer limit)
+#   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
+#                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
-stage=${1:?stage: eager, compile, full, tune, next or cpu}
-case "$stage" in eager | compile | full | tune | next | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next or cpu)" >&2; exit 2 ;; esac
+stage=${1:?stage: eager, compile, full, tune, next, repeat or cpu}
+case "$stage" in eager | compile | full | tune | next | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, repeat or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -63,6 +65,10 @@ json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r i
         "$out/$stage.json" "$parts"/*.json ;; esac
     return 0
 }
+if [ "$stage" = repeat ]; then
+    timeout 400 python3 bench/repeat_fit.py --device cuda --epochs 2 --json "$out/repeat.json" 2>&1 | tee -a "$out/$stage.md"
+    exit 0
+fi
 if [ "$stage" = next ]; then
     paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
     bench 150 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --frame-matmul off on
