@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -62,7 +63,18 @@ def main() -> None:
             print(json.dumps(row), flush=True)
             if args.json is not None:
                 args.json.parent.mkdir(parents=True, exist_ok=True)
-                args.json.write_text(json.dumps({"torch": torch.__version__, "rows": rows}, indent=1) + "\n")
+                args.json.write_text(
+                    json.dumps(
+                        {
+                            "command": " ".join(["python", *sys.argv]),
+                            "torch": torch.__version__,
+                            "threads": torch.get_num_threads(),
+                            "rows": rows,
+                        },
+                        indent=1,
+                    )
+                    + "\n"
+                )
 
 
 if __name__ == "__main__":

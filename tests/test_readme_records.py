@@ -186,3 +186,18 @@ def test_the_frame_conv1d_docstring_quotes_the_profile():
     assert (
         f"{wgrad:.0f} of the {_gpu_ms(step):.0f} ms of CaMN's compiled paper-preset step at batch 1024" in doc
     )
+
+
+def test_the_readme_repeat_sentence_is_the_cpu_record():
+    record = json.loads((RECORDS / "repeat_fit_cpu.json").read_text())
+    rows = record["rows"]
+    assert {(r["recipe"], r["deterministic"]) for r in rows} == {
+        (name, det) for name in ("camn_tiny", "ha2g_tiny") for det in (True, False)
+    }
+    assert all(r["device"] == "cpu" and r["epochs"] == 1 for r in rows)
+    assert all(r["tensors_differing"] == 0 and r["histories_equal"] for r in rows)  # "bit-identical"
+    text = " ".join(_readme().split())
+    assert (
+        "on this CPU, camn_tiny and ha2g_tiny trained twice for one epoch gave bit-identical weights and losses, "
+        "determinism on and off" in text
+    )
