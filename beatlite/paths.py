@@ -81,3 +81,20 @@ def on_data_samples() -> bool:
     BEAT-format folder they report the same quantities without asserting them.
     """
     return data_dir().resolve() == (repo_root() / "data_samples").resolve()
+
+
+def code_revision() -> str:
+    """The repository's commit, for the records the benchmarks write: ``git rev-parse --short HEAD``, with
+    ``+changes`` when tracked files differ from it, or ``"unknown"`` outside a git checkout."""
+    import subprocess
+
+    def git(*args: str) -> str:
+        done = subprocess.run(["git", *args], cwd=repo_root(), capture_output=True, text=True, timeout=30)
+        return done.stdout.strip() if done.returncode == 0 else ""
+
+    try:
+        head = git("rev-parse", "--short", "HEAD")
+        changed = bool(git("status", "--porcelain", "--untracked-files=no"))
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return (head + ("+changes" if changed else "")) if head else "unknown"

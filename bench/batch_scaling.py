@@ -22,12 +22,12 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import subprocess
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
+from beatlite.paths import code_revision
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
 from beatlite.train.testset import load_test_set
@@ -35,25 +35,14 @@ from beatlite.train.testset import load_test_set
 METRICS = ("FGD", "SRGR", "BeatAlign", "BC", "Diversity", "L1div")
 
 
-def _revision() -> str:
-    root = Path(__file__).resolve().parents[1]
-    try:
-        out = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True
-        )
-    except OSError:
-        return "unknown"
-    return out.stdout.strip() or "unknown"
-
-
 def summary(rows: list[dict]) -> dict[str, dict[str, list[float]]]:
-    """Per ``"<batch> <rule>"`` and metric: ``[mean, sample sd]`` over the seeds."""
+    """Per ``"<batch> <rule>"`` and metric: ``[mean, sample sd]`` over the seeds (sd None for one seed)."""
     out: dict[str, dict[str, list[float]]] = {}
     for batch, rule in dict.fromkeys((r["batch"], r["rule"]) for r in rows):
         group = [r for r in rows if (r["batch"], r["rule"]) == (batch, rule)]
         values = {m: [r[m] for r in group] for m in METRICS if all(m in r for r in group)}
         out[f"{batch} {rule}"] = {
-            m: [statistics.mean(v), statistics.stdev(v) if len(v) > 1 else 0.0] for m, v in values.items()
+            m: [statistics.mean(v), statistics.stdev(v) if len(v) > 1 else None] for m, v in values.items()
         }
     return out
 
@@ -65,7 +54,7 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "recipe_batch": recipe.batch_size,
         "recipe_lr": recipe.lr,
         "epochs": recipe.epochs if args.epochs is None else args.epochs,
-        "revision": _revision(),
+        "revision": code_revision(),
         "command": f"BEATLITE_THREADS=1 python bench/batch_scaling.py --recipe {args.recipe} --batches {batches} "
         f"--rules {rules} --seeds {seeds}" + ("" if args.epochs is None else f" --epochs {args.epochs}"),
         "rows": rows,
@@ -99,24 +88,29 @@ def main() -> None:
         runs = [(b, "linear" if b == recipe.batch_size else r) for b in args.batches for r in args.rules]
         for batch, rule in dict.fromkeys(runs):  # (the recipe's own batch once: both rules give its lr)
             for seed in args.seeds:
-                folder = work / f"b{batch}_{rule}_s{seed}"
-                start = time.perf_counter()
-                if not (folder / f"{args.recipe}.pt").is_file():
+                epochs = recipe.epochs if args.epochs is None else args.epochs
+                folder = work / f"{args.recipe}_b{batch}_{rule}_e{epochs}_s{seed}"
+                reused, start = (folder / f"{args.recipe}.pt").is_file(), time.perf_counter()
+                if not reused:
                     retrain(args.recipe, seed=seed, out_dir=folder, data=data, progress=False, batch_size=batch,
-                            lr_scaling=rule, epochs=args.epochs)  # fmt: skip
-                seconds = time.perf_counter() - start
+                            lr_scaling=rule, epochs=epochs)  # fmt: skip
+                seconds = (
+                    None if reused else time.perf_counter() - start
+                )  # (a checkpoint of --work: not timed)
                 result = evaluate_models([str(folder / f"{args.recipe}.pt")], test=test, ground_truth=False)
                 metrics = {k: float(v) for k, v in result.rows[0].metrics.items() if k in METRICS}
                 lr = scaled_lr(recipe, batch, rule)
                 rows.append({"batch": batch, "rule": rule, "seed": seed, "lr": lr, "train_seconds": seconds,
-                             **metrics})  # fmt: skip
+                             "reused": reused, **metrics})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
                 _write(
                     args.json, _record(args, recipe, rows)
                 )  # after every row: an interrupted run keeps them
     record = _record(args, recipe, rows)
     for key, values in record["summary"].items():
-        cells = "  ".join(f"{m} {mean:.3g} ± {sd:.2g}" for m, (mean, sd) in values.items())
+        cells = "  ".join(
+            f"{m} {mean:.3g}" + ("" if sd is None else f" ± {sd:.2g}") for m, (mean, sd) in values.items()
+        )
         print(f"batch {key}: {cells}")
 
 

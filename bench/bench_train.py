@@ -35,7 +35,7 @@ Per row:
 - **audio matmul**: ``--frame-matmul off on``: CaMN's first audio block (two convolutions of the one-channel
   waveform) as one matrix product of the waveform's frames (:func:`beatlite.models.layers.use_frame_matmul`;
   the same values to float rounding) or as cuDNN/oneDNN convolutions (``off``, the default); ``-`` for models
-  without such a block.
+  without such a block (a row that failed or was not measured says what it asked for).
 - ``--trace-rnn``: compiled rows trace the recurrent layers too (``torch._dynamo.config.allow_rnn``: the LSTM
   and GRU unrolled over time into the compiled graph, instead of a graph break around cuDNN's kernel); their
   compile cell says ``+rnn``.
@@ -480,6 +480,7 @@ def main() -> None:
         for name, preset, device, precision, batch, comp, det, matmul in _grid(args):
             if device == "cuda" and not torch.cuda.is_available():
                 rows.append(Row(name, preset, device, precision, batch, comp, det, note=UNMEASURED))
+                rows[-1].frame_matmul = matmul
                 continue
             label = f"{comp}+rnn" if args.trace_rnn and comp != "eager" else comp
             try:
@@ -489,6 +490,7 @@ def main() -> None:
                 )  # fmt: skip
             except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
                 row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))
+                row.frame_matmul = matmul  # (what it asked for: the model was not measured)
                 _recover(device)
             else:  # (a compiled row's short fit would time its compilation)
                 if comp == "eager" and args.fit_steps > 0:

@@ -71,9 +71,9 @@ if [ "$stage" = repeat ]; then
 fi
 if [ "$stage" = next ]; then
     paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
-    bench 150 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --frame-matmul off on
-    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul off on --cudnn-benchmark
-    bench 220 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
+    bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --frame-matmul off on
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --cudnn-benchmark
+    bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
     exit 0
 fi
 if [ "$stage" = tune ]; then

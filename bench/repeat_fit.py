@@ -1,20 +1,23 @@
 """Do two trainings with the same seed give the same weights, to the bit? (the determinism a GPU keeps)
 
-Trains a recipe twice on ``data_samples/`` with the same seed, device and ``TrainConfig.deterministic``
-(:func:`beatlite.train.recipes.retrain`) and compares the two full training checkpoints: every parameter and
-buffer bit for bit (and the largest difference where they differ), and the per-epoch losses. On the CPU the
-project's claim is "the same numbers for a seed and thread count"; on CUDA with ``deterministic`` on, torch's
-deterministic algorithms are asked for; with it off (``fit --nondeterministic``) some kernels may add in
-another order each run.
+Runs the ``fit`` command twice per recipe and setting, each in its own process (``python -m beatlite.train fit
+RECIPE --data data_samples --out DIR --epochs E --device D --seed S [--nondeterministic]``; cuDNN's and cuBLAS's
+per-process choices are made afresh each time; the window store is built once, under a shared
+``BEATLITE_BUILD``), and compares the two full training checkpoints: every parameter and buffer bit for bit
+(and the largest difference where they differ), and the per-epoch losses. On the CPU the project's claim is
+"the same numbers for a seed and thread count"; on CUDA with ``deterministic`` on, torch's deterministic
+algorithms are asked for; with it off (``--nondeterministic``) some kernels may add in another order each run.
 
 Usage: ``python bench/repeat_fit.py [--recipes camn_tiny ha2g_tiny] [--device cuda] [--epochs 2]
-[--deterministic on off] [--json FILE]`` (a CPU run of the defaults takes about a minute per recipe).
+[--deterministic on off] [--json FILE]``; the record gives each pair's seconds.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -22,8 +25,9 @@ from pathlib import Path
 
 import torch
 
+from beatlite.paths import code_revision, data_dir
 from beatlite.train.checkpoint import load_checkpoint
-from beatlite.train.recipes import RECIPES, retrain, training_data
+from beatlite.train.recipes import RECIPES
 
 
 def compare(a: dict, b: dict) -> dict:
@@ -38,6 +42,20 @@ def compare(a: dict, b: dict) -> dict:
     }
 
 
+def fit_once(name: str, out: Path, build: Path, args: argparse.Namespace, deterministic: bool) -> dict:
+    """The full training checkpoint of one ``fit`` command run in a child process."""
+    cmd = [sys.executable, "-m", "beatlite.train", "fit", name, "--data", str(data_dir()), "--out", str(out),
+           "--epochs", str(args.epochs), "--device", args.device, "--seed", str(args.seed)]  # fmt: skip
+    if not deterministic:
+        cmd.append("--nondeterministic")
+    done = subprocess.run(
+        cmd, env={**os.environ, "BEATLITE_BUILD": str(build)}, capture_output=True, text=True
+    )
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} exited {done.returncode}:\n{done.stderr[-4000:]}")
+    return load_checkpoint(out / "train" / f"{name}.pt")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--recipes", nargs="+", default=["camn_tiny", "ha2g_tiny"], choices=sorted(RECIPES))
@@ -47,34 +65,21 @@ def main() -> None:
     p.add_argument("--deterministic", nargs="+", default=["on", "off"], choices=["on", "off"])
     p.add_argument("--json", type=Path, default=None)
     args = p.parse_args()
-    data, rows = training_data(), []
-    for name in args.recipes:
-        for det in args.deterministic:
-            with tempfile.TemporaryDirectory() as tmp:
-                runs, start = [], time.perf_counter()
-                for k in range(2):
-                    out = Path(tmp) / str(k)
-                    retrain(name, seed=args.seed, epochs=args.epochs, out_dir=out, data=data, progress=False,
-                            device=args.device, deterministic=det == "on")  # fmt: skip
-                    runs.append(load_checkpoint(out / "train" / f"{name}.pt"))
-                row = {"recipe": name, "device": args.device, "deterministic": det == "on", "epochs": args.epochs,
-                       "seconds": time.perf_counter() - start, **compare(*runs)}  # fmt: skip
-            rows.append(row)
-            print(json.dumps(row), flush=True)
-            if args.json is not None:
-                args.json.parent.mkdir(parents=True, exist_ok=True)
-                args.json.write_text(
-                    json.dumps(
-                        {
-                            "command": " ".join(["python", *sys.argv]),
-                            "torch": torch.__version__,
-                            "threads": torch.get_num_threads(),
-                            "rows": rows,
-                        },
-                        indent=1,
-                    )
-                    + "\n"
-                )
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in args.recipes:
+            for det in args.deterministic:
+                start = time.perf_counter()
+                runs = [fit_once(name, Path(tmp) / f"{name}-{det}-{k}", Path(tmp) / "build", args, det == "on")
+                        for k in range(2)]  # fmt: skip
+                rows.append({"recipe": name, "device": args.device, "deterministic": det == "on",
+                             "epochs": args.epochs, "seconds": time.perf_counter() - start, **compare(*runs)})  # fmt: skip
+                print(json.dumps(rows[-1]), flush=True)
+                if args.json is not None:
+                    record = {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
+                              "torch": torch.__version__, "threads": os.environ.get("BEATLITE_THREADS"), "rows": rows}  # fmt: skip
+                    args.json.parent.mkdir(parents=True, exist_ok=True)
+                    args.json.write_text(json.dumps(record, indent=1) + "\n")
 
 
 if __name__ == "__main__":

@@ -575,3 +575,5 @@ def test_scaled_lr_follows_the_batch_linearly_or_by_its_square_root():
     assert scaled_lr(default, 256, "sqrt") == pytest.approx(2 * TrainConfig(batch_size=64).learning_rate)
     with pytest.raises(ValueError, match="sqrt"):
         scaled_lr(recipe, 64, "cubic")
+    with pytest.raises(ValueError, match="batch_size must be >= 1"):
+        scaled_lr(recipe, 0, "sqrt")

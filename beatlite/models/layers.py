@@ -132,6 +132,8 @@ def frame_conv1d(x: torch.Tensor, weight: torch.Tensor, stride: int = 1, padding
         raise ValueError(
             f"frame_conv1d: x must be (B, 1, L) and weight (C, 1, kernel); got {tuple(x.shape)}, {tuple(weight.shape)}"
         )
+    if stride < 1 or padding < 0:
+        raise ValueError(f"frame_conv1d: stride must be >= 1 and padding >= 0; got {stride}, {padding}")
     padded = nn.functional.pad(x[:, 0], (padding, padding))
     frames = padded.unfold(-1, weight.shape[-1], stride)  # (B, T, kernel), a strided view
     return (frames @ weight[:, 0].t()).transpose(1, 2)

@@ -53,7 +53,9 @@ class TrainConfig:
     grad_clip : float
         Gradient-norm clip of each optimiser step (reference 200).
     checkpoint : str or Path or None
-        Where to save (atomically, after every epoch); ``None`` = do not save.
+        Where to save (atomically, after every epoch); ``None`` = do not save. Under ``torchrun`` every
+        process is given the same (process 0 writes; all of them take part in gathering the random
+        generators' states at each save).
     resume : bool
         Continue from ``checkpoint`` if it exists (same data fingerprint required).
     progress : bool

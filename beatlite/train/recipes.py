@@ -445,6 +445,8 @@ def scaled_lr(recipe: Recipe, batch_size: int, rule: str = "linear") -> float | 
     """
     if rule not in ("linear", "sqrt"):
         raise ValueError(f"lr scaling rule must be 'linear' or 'sqrt', got {rule!r}")
+    if int(batch_size) < 1:
+        raise ValueError(f"batch_size must be >= 1, got {batch_size}")
     ratio = int(batch_size) / recipe.batch_size
     if recipe.lr is None and rule == "linear":
         return None
