@@ -51,3 +51,4 @@ def test_batch_scaling_summarises_each_batch_and_rule_over_the_seeds():
         8.0,
         statistics.stdev([6, 8, 10]),
     ]
+    assert summary(rows[:1]) == {"32 linear": {"FGD": [3.0, None], "SRGR": [3.0, None]}}  # one seed: no sd
