@@ -54,7 +54,7 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "recipe_batch": recipe.batch_size,
         "recipe_lr": recipe.lr,
         "epochs": recipe.epochs if args.epochs is None else args.epochs,
-        "revision": code_revision(),
+        "revision": args.revision,
         "command": f"BEATLITE_THREADS=1 python bench/batch_scaling.py --recipe {args.recipe} --batches {batches} "
         f"--rules {rules} --seeds {seeds}" + ("" if args.epochs is None else f" --epochs {args.epochs}"),
         "rows": rows,
@@ -80,6 +80,7 @@ def main() -> None:
     )
     p.add_argument("--json", type=Path, default=None, help="write the record here")
     args = p.parse_args()
+    args.revision = code_revision()  # (before this run writes its record, a tracked file)
     recipe = RECIPES[args.recipe]
     with tempfile.TemporaryDirectory() as tmp:
         work = args.work or Path(tmp)

@@ -65,7 +65,7 @@ def main() -> None:
     p.add_argument("--deterministic", nargs="+", default=["on", "off"], choices=["on", "off"])
     p.add_argument("--json", type=Path, default=None)
     args = p.parse_args()
-    rows = []
+    rows, revision = [], code_revision()  # (before this run writes its record, a tracked file)
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.recipes:
             for det in args.deterministic:
@@ -76,7 +76,7 @@ def main() -> None:
                              "epochs": args.epochs, "seconds": time.perf_counter() - start, **compare(*runs)})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
                 if args.json is not None:
-                    record = {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
+                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision,
                               "torch": torch.__version__, "threads": os.environ.get("BEATLITE_THREADS"), "rows": rows}  # fmt: skip
                     args.json.parent.mkdir(parents=True, exist_ok=True)
                     args.json.write_text(json.dumps(record, indent=1) + "\n")
