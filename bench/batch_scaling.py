@@ -13,7 +13,7 @@ Usage: ``BEATLITE_THREADS=1 python bench/batch_scaling.py [--recipe camn_tiny] [
 checkpoint on one CPU thread for ``camn_tiny``; ``--work`` keeps the checkpoints, and a checkpoint already
 there is scored, not trained again).
 
-Scope: ``data_samples/`` has 658 train windows, so batch 128 is 5 steps per epoch; whether larger batches keep
+Scope: ``data_samples/`` has 658 train windows, so batch 128 is 6 steps per epoch; whether larger batches keep
 the scores on real BEAT (80,000 windows at BEAT-4english) is not measured here.
 """
 

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import json
+import math
 import re
+import statistics
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDS = ROOT / "bench" / "records"
@@ -201,3 +205,33 @@ def test_the_readme_repeat_sentence_is_the_cpu_record():
         "on this CPU, camn_tiny and ha2g_tiny trained twice for one epoch gave bit-identical weights and losses, "
         "determinism on and off" in text
     )
+
+
+def test_the_readme_batch_scaling_sentences_are_the_record():
+    record = json.loads((RECORDS / "batch_scaling_camn_tiny.json").read_text())
+    assert record["recipe"] == "camn_tiny" and record["epochs"] == 40 and record["recipe_batch"] == 32
+    rows = record["rows"]
+    assert {r["seed"] for r in rows} == {2021, 2022, 2023}
+
+    def fgd(batch: int, rule: str) -> str:  # mean ± sample sd, from the rows (the record's summary agrees)
+        values = [r["FGD"] for r in rows if (r["batch"], r["rule"]) == (batch, rule)]
+        assert len(values) == 3
+        mean, sd = statistics.mean(values), statistics.stdev(values)
+        assert record["summary"][f"{batch} {rule}"]["FGD"] == pytest.approx([mean, sd])
+        return f"{mean:.2f} ± {sd:.2f}"
+
+    seeds = json.loads((ROOT / "checkpoints" / "results_seeds.json").read_text())["rows"]["CaMN"]["FGD"]
+    text = " ".join(_readme().split())
+    for sentence in (
+        f"batch 32, the recipe's, {fgd(32, 'linear')}; batch 64, {fgd(64, 'linear')} with linear scaling and "
+        f"{fgd(64, 'sqrt')} with the square root; batch 128, {fgd(128, 'linear')} and {fgd(128, 'sqrt')}; "
+        f"batch 256, {fgd(256, 'linear')} and {fgd(256, 'sqrt')}.",
+        f"the shipped recipe here: {fgd(32, 'linear')} against the seed table's "
+        f"{seeds['mean']:.2f} ± {seeds['sd']:.2f}",
+    ):
+        assert sentence in text, sentence
+    from beatlite.train.recipes import training_data  # (the data_samples store the recipes train on)
+
+    train = len(training_data(progress=False).train)
+    steps = math.ceil(train / 128)
+    assert f"With its {train} train windows, batch 128 is {steps} steps per epoch" in text
