@@ -94,20 +94,26 @@ def test_two_micro_batches_per_process_give_the_mean_gradient(tmp_path):
     assert all(abs(la[k] - lb[k]) <= 1e-5 * (1 + abs(la[k])) for k in la)
 
 
-@pytest.mark.slow
-def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path):
-    """Under torchrun, process 0 checkpoints after every step; a run stopped in epoch 2 resumes there and
-    ends with the weights of an uninterrupted run, and logs the same mean losses (the checkpoint keeps
-    the loss sums of both processes)."""
+def _whole_and_resumed(tmp_path: Path, *options: str) -> tuple[dict, dict]:
+    """tests/ddp_resume.py under torchrun (2 processes), uninterrupted and killed-then-resumed: the
+    ``.out`` records (final parameters, history, best) of both runs."""
     torchrun = _torchrun()
     script = Path(__file__).with_name("ddp_resume.py")
     out = {}
     for mode in ("whole", "kill"):
         path = tmp_path / f"{mode}.pt"
-        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode]
+        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, *options]
         run_ok(cmd, env=_env(), timeout=900)
         out[mode] = torch.load(str(path) + ".out", weights_only=True)
-    whole, resumed = out["whole"], out["kill"]
+    return out["whole"], out["kill"]
+
+
+@pytest.mark.slow
+def test_a_two_process_run_killed_mid_epoch_resumes_from_its_last_step(tmp_path):
+    """Under torchrun, process 0 checkpoints after every step; a run stopped in epoch 2 resumes there and
+    ends with the weights of an uninterrupted run, and logs the same mean losses (the checkpoint keeps
+    the loss sums of both processes)."""
+    whole, resumed = _whole_and_resumed(tmp_path)
     for name, p in whole["params"].items():
         assert torch.equal(p, resumed["params"][name]), name
     for a, b in zip(whole["history"], resumed["history"], strict=True):
@@ -121,15 +127,7 @@ def test_two_processes_validating_every_two_steps_resume_mid_epoch_with_the_same
     step) while process 1 goes on: the steps' collectives still meet, validations fall on the global steps
     2, 4 and 6 (3 steps per epoch), and a run stopped in epoch 2 resumes to the validations, best and
     weights of an uninterrupted one."""
-    torchrun = _torchrun()
-    script = Path(__file__).with_name("ddp_resume.py")
-    out = {}
-    for mode in ("whole", "kill"):
-        path = tmp_path / f"{mode}.pt"
-        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, "val"]
-        run_ok(cmd, env=_env(), timeout=900)
-        out[mode] = torch.load(str(path) + ".out", weights_only=True)
-    whole, resumed = out["whole"], out["kill"]
+    whole, resumed = _whole_and_resumed(tmp_path, "val")
     assert [[v["step"] for v in h["validations"]] for h in whole["history"]] == [[2], [4, 6]]
     assert whole["history"][1]["validations"][0]["val"]["rec"] > 0
     for a, b in zip(whole["history"], resumed["history"], strict=True):
@@ -145,15 +143,7 @@ def test_two_processes_with_dropout_resume_each_with_its_own_generator(tmp_path)
     generators differ by the time of a checkpoint; each process's dropout masks after a resume must be
     those of an uninterrupted run, so the checkpoint keeps every process's generator (not process 0's
     for all)."""
-    torchrun = _torchrun()
-    script = Path(__file__).with_name("ddp_resume.py")
-    out = {}
-    for mode in ("whole", "kill"):
-        path = tmp_path / f"{mode}.pt"
-        cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, "dropout"]
-        run_ok(cmd, env=_env(), timeout=900)
-        out[mode] = torch.load(str(path) + ".out", weights_only=True)
-    whole, resumed = out["whole"], out["kill"]
+    whole, resumed = _whole_and_resumed(tmp_path, "dropout")
     assert whole["best"] == resumed["best"]
     for name, p in whole["params"].items():
         assert torch.equal(p, resumed["params"][name]), name
