@@ -233,5 +233,19 @@ def test_the_readme_batch_scaling_sentences_are_the_record():
     from beatlite.train.recipes import training_data  # (the data_samples store the recipes train on)
 
     train = len(training_data(progress=False).train)
-    steps = math.ceil(train / 128)
+    steps = math.ceil(train / 128)  # (fit keeps a last, shorter batch of 2 windows or more)
     assert f"With its {train} train windows, batch 128 is {steps} steps per epoch" in text
+    equal = json.loads((RECORDS / "batch_scaling_camn_tiny_equal_steps.json").read_text())
+    assert {(r["batch"], r["rule"], r["seed"]) for r in equal["rows"]} == {
+        (128, "linear", s) for s in (2021, 2022, 2023)
+    }
+    values = [r["FGD"] for r in equal["rows"]]
+    epochs, recipe_steps = equal["epochs"], math.ceil(train / 32) * record["epochs"]
+    assert steps * epochs == recipe_steps  # "840 steps, as batch 32's 40 epochs"
+    assert (
+        f"(batch 128, linear, {epochs} epochs: {recipe_steps} steps, as batch 32's {record['epochs']} epochs;"
+        in text
+        and f"FGD is {statistics.mean(values):.2f} ± {statistics.stdev(values):.2f} (its best epoch chosen among "
+        f"{epochs} validated ones, not {record['epochs']})"
+        in text
+    )
