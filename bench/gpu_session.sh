@@ -14,7 +14,7 @@
 #   STAGE tune     after full (about 7 minutes): bf16 with TrainConfig.deterministic off; CaMN paper at 256 (fit
 #                  included) and 1024, eager and reduce-overhead, then with the LSTM traced into the graph
 #                  (--trace-rnn); HA2G paper at 256 and 512
-#   STAGE next     the leads tune left (about 8 minutes): CaMN paper bf16 at 1024, determinism off, eager and
+#   STAGE next     the leads tune left (about 9 minutes): CaMN paper bf16 at 1024, determinism off, eager and
 #                  compiled, its first audio block as convolutions and as one matrix product of the waveform's
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  compiled with cudnn.benchmark; then with the LSTM traced into the graph (a longer limit)
