@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from beatlite.io.atomic import atomic_write
 from beatlite.paths import code_revision
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
@@ -66,7 +67,8 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
 def _write(path: Path | None, record: dict) -> None:
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(record, indent=1) + "\n")
+        with atomic_write(path) as f:  # (a run stopped mid-write keeps its last whole record)
+            f.write(json.dumps(record, indent=1) + "\n")
 
 
 def main() -> None:

@@ -75,6 +75,7 @@ import torch._dynamo
 from torch.utils._python_dispatch import TorchDispatchMode
 from torch.utils.flop_counter import FlopCounterMode
 
+from beatlite.io.atomic import atomic_write
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.models.layers import use_frame_matmul
 from beatlite.paths import data_dir, n_threads
@@ -478,9 +479,9 @@ def main() -> None:
         )
         rows = []
         for name, preset, device, precision, batch, comp, det, matmul in _grid(args):
+            key = (name, preset, device, precision, batch, comp, det)  # (a row that is not measured)
             if device == "cuda" and not torch.cuda.is_available():
-                rows.append(Row(name, preset, device, precision, batch, comp, det, note=UNMEASURED))
-                rows[-1].frame_matmul = matmul
+                rows.append(Row(*key, note=UNMEASURED, frame_matmul=matmul))
                 continue
             label = f"{comp}+rnn" if args.trace_rnn and comp != "eager" else comp
             try:
@@ -489,8 +490,7 @@ def main() -> None:
                     deterministic=det, frame_matmul=matmul,
                 )  # fmt: skip
             except Exception as error:  # noqa: BLE001 (a row that fails is reported and the others run)
-                row = Row(name, preset, device, precision, batch, comp, det, note=_failed(error))
-                row.frame_matmul = matmul  # (what it asked for: the model was not measured)
+                row = Row(*key, note=_failed(error), frame_matmul=matmul)  # (as asked: not measured)
                 _recover(device)
             else:  # (a compiled row's short fit would time its compilation)
                 if comp == "eager" and args.fit_steps > 0:
@@ -534,7 +534,8 @@ def _write_json(path: Path | None, rows: list[Row]) -> None:
         return
     path.parent.mkdir(parents=True, exist_ok=True)
     peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
-    path.write_text(json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1))
+    with atomic_write(path) as f:  # (a run stopped mid-write keeps its last whole record)
+        f.write(json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1))
 
 
 if __name__ == "__main__":
