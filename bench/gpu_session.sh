@@ -62,7 +62,7 @@ bench() {  # bench SECONDS MODEL ARGS...  (full, tune: every call's rows merged 
     case "$stage" in full | tune | next) python3 -c 'import json, sys
 docs = [json.load(open(p)) for p in sys.argv[2:]]
 json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
-        "$out/$stage.json" "$parts"/*.json ;; esac
+        "$out/$stage.json.tmp" "$parts"/*.json && mv "$out/$stage.json.tmp" "$out/$stage.json" ;; esac  # (whole or not at all)
     return 0
 }
 if [ "$stage" = repeat ]; then
