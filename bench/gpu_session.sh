@@ -14,18 +14,21 @@
 #   STAGE tune     after full (about 7 minutes): bf16 with TrainConfig.deterministic off; CaMN paper at 256 (fit
 #                  included) and 1024, eager and reduce-overhead, then with the LSTM traced into the graph
 #                  (--trace-rnn); HA2G paper at 256 and 512
-#   STAGE next     the leads tune left (about 9 minutes): CaMN paper bf16 at 1024, determinism off, eager and
+#   STAGE next     the leads tune left (about 8 minutes), bf16 with determinism off: CaMN paper at 1024, eager and
 #                  compiled, its first audio block as convolutions and as one matrix product of the waveform's
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
-#                  compiled with cudnn.benchmark; then with the LSTM traced into the graph (a longer limit)
+#                  HA2G paper at 512, eager and compiled (reduce-overhead; its training pass compiles since the
+#                  style loss's permutation runs eagerly), both profiled
+#   STAGE later    after next (about 6 minutes): CaMN paper bf16 at 1024 compiled with cudnn.benchmark, then with
+#                  the LSTM traced into the graph (a longer limit)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
 # Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
 # after every row, so a run stopped by its time limit keeps the rows it measured).
 set -u -o pipefail
-stage=${1:?stage: eager, compile, full, tune, next, repeat or cpu}
-case "$stage" in eager | compile | full | tune | next | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, repeat or cpu)" >&2; exit 2 ;; esac
+stage=${1:?stage: eager, compile, full, tune, next, later, repeat or cpu}
+case "$stage" in eager | compile | full | tune | next | later | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, repeat or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -57,9 +60,9 @@ parts=$(mktemp -d)
 bench() {  # bench SECONDS MODEL ARGS...  (full, tune: every call's rows merged into $out/$stage.json after it)
     n=$((n + 1))
     local json="$out/$stage-$2.json"
-    case "$stage" in full | tune | next) json="$parts/$(printf %02d $n).json" ;; esac
+    case "$stage" in full | tune | next | later) json="$parts/$(printf %02d $n).json" ;; esac
     timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$json" 2>&1 | tee -a "$out/$stage.md"
-    case "$stage" in full | tune | next) python3 -c 'import json, sys
+    case "$stage" in full | tune | next | later) python3 -c 'import json, sys
 docs = [json.load(open(p)) for p in sys.argv[2:]]
 json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
         "$out/$stage.json.tmp" "$parts"/*.json && mv "$out/$stage.json.tmp" "$out/$stage.json" ;; esac  # (whole or not at all)
@@ -69,15 +72,19 @@ if [ "$stage" = repeat ]; then
     timeout 400 python3 bench/repeat_fit.py --device cuda --epochs 2 --json "$out/repeat.json" 2>&1 | tee -a "$out/$stage.md"
     exit 0
 fi
+paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
 if [ "$stage" = next ]; then
-    paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --fit-steps 0 --profile 12)
     bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile eager reduce-overhead --frame-matmul off on
+    bench 240 ha2g "${paper[@]}" --batch-sizes 512 --compile eager reduce-overhead
+    exit 0
+fi
+if [ "$stage" = later ]; then
     bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --cudnn-benchmark
     bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
     exit 0
 fi
 if [ "$stage" = tune ]; then
-    paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --profile 12)
+    paper=(--presets paper --devices cuda --precisions bf16 --deterministic off --profile 12)  # (fit steps too)
     bench 35 camn "${paper[@]}" --batch-sizes 256
     bench 90 camn "${paper[@]}" --batch-sizes 1024 --fit-steps 0 --compile eager reduce-overhead
     bench 70 ha2g "${paper[@]}" --batch-sizes 256 512 --fit-steps 3

@@ -678,6 +678,27 @@ def test_a_compiled_step_gives_the_losses_and_poses_of_the_eager_one(windows):
         TrainConfig(compile="fast")
 
 
+def test_a_model_that_states_an_inductor_failure_is_refused_by_name_before_a_step(windows, monkeypatch):
+    """``GestureModel.inductor_failure`` (a model whose training pass breaks inductor says why): ``fit``
+    refuses every inductor mode at once, naming it and leaving the weights as they were; ``aot_eager``
+    (traced, no inductor) still trains. No shipped model states one (all compile on the CPU here)."""
+    from beatlite.models.camn import CaMN
+    from beatlite.train.config import COMPILE_MODES
+
+    train, val = windows
+    monkeypatch.setattr(CaMN, "inductor_failure", "a stated reason")
+    for mode in COMPILE_MODES:
+        model = camn()
+        before = {k: v.detach().clone() for k, v in model.named_parameters()}
+        with pytest.raises(
+            ValueError, match=f"camn cannot be compiled with inductor .*'{mode}'.*a stated reason"
+        ):
+            fit(model, train, cfg(compile=mode), val)
+        assert all(torch.equal(v, before[k]) for k, v in model.named_parameters())  # not one step taken
+    history = fit(camn(), train, cfg(epochs=1, compile="aot_eager"), val).history
+    assert np.isfinite(history[0]["train"]["total"])
+
+
 def test_nondeterministic_training_sets_torch_so_and_changes_nothing_on_the_cpu(windows):
     """``TrainConfig(deterministic=False)`` turns torch's deterministic algorithms off for the run (the
     default turns them on); the CPU's kernels are deterministic either way, so the history is the same to the

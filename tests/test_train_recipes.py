@@ -342,16 +342,22 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
         assert stopped.value.args[0].deterministic is expected
 
 
-def test_fit_command_refuses_to_compile_ha2g_with_inductor_before_preparing_anything(tmp_path, capsys):
-    """HA2G's ``inductor_failure``: ``fit ha2g_tiny --compile default`` stops at once (exit 2, the reason on
-    stderr), before the data are indexed or anything is written under ``--out``."""
+def test_fit_command_refuses_inductor_for_a_model_stating_a_failure_before_preparing_anything(
+    tmp_path, capsys, monkeypatch
+):
+    """A model's ``inductor_failure`` (none ships one; stated here for HA2G): ``fit ha2g_tiny --compile
+    default`` stops at once (exit 2, the reason on stderr), before the data are indexed or anything is
+    written under ``--out``."""
+    from beatlite.models.ha2g import HA2G
     from beatlite.paths import repo_root
     from beatlite.train import __main__ as command
 
+    monkeypatch.setattr(HA2G, "inductor_failure", "a stated reason")
     out = tmp_path / "run"
     argv = ["fit", "ha2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
     assert command.main([*argv, "--compile", "default"]) == 2
-    assert "ha2g cannot be compiled with inductor" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "ha2g cannot be compiled with inductor" in err and "a stated reason" in err
     assert not out.exists()
 
 

@@ -346,6 +346,13 @@ class HA2GDiscriminator(ConvDiscriminator):
         )
 
 
+@torch.compiler.disable
+def _permutation(n: int, device: torch.device) -> torch.Tensor:
+    """``torch.randperm(n)`` run eagerly under ``torch.compile``: inductor's pattern for indexing with a
+    random permutation fails on a whole one (``BackendCompilerFailed`` in torch 2.11 and 2.13)."""
+    return torch.randperm(n, device=device)
+
+
 class HA2G(GestureModel):
     """Hierarchical Audio-to-Gesture on TED-43 direction vectors (see the module docstring).
 
@@ -375,10 +382,6 @@ class HA2G(GestureModel):
     name = "ha2g"
     representation = "dirvec126"
     config_class = HA2GConfig
-    inductor_failure = (
-        "torch 2.11's inductor stopped in its randperm-index pattern (BackendCompilerFailed, on an H200) and "
-        "torch 2.13's compiled backward crashed the process (segmentation fault, on the CPU)"
-    )
 
     @classmethod
     def keys_for(cls, config: HA2GConfig) -> tuple[str, ...]:
@@ -708,7 +711,7 @@ class HA2G(GestureModel):
             ids = torch.randint(0, self.config.n_speakers, speaker.shape, device=speaker.device)
             other = self._styles(ids, sample)
             return other["coord"], other
-        other = self._styles(speaker[torch.randperm(speaker.shape[0], device=speaker.device)], sample)
+        other = self._styles(speaker[_permutation(speaker.shape[0], speaker.device)], sample)
         return style["coord"], other
 
     @torch.no_grad()

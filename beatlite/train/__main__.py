@@ -117,7 +117,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument(
         "--compile",
         choices=COMPILE_MODES + COMPILE_BACKENDS,
-        help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs; inductor's modes not for HA2G); default eager",
+        help="torch.compile the forward pass and losses (reduce-overhead: CUDA graphs); default eager",
     )
     f.add_argument(
         "--nondeterministic",

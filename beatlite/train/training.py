@@ -453,12 +453,22 @@ def check_compilable(model_class: type[GestureModel], mode: str | None) -> None:
         )
 
 
-def _compiled(fn: Callable[..., Any], mode: str | None) -> Callable[..., Any]:
-    """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``)."""
+def _compiled(fn: Callable[..., Any], mode: str | None, device: torch.device) -> Callable[..., Any]:
+    """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``).
+
+    On the CPU, inductor's modes run without its layout optimisation: it stores 2-D convolutions'
+    activations channels-last, and oneDNN's weight gradient of a strided 1x1 convolution on channels-last
+    tensors corrupts memory in torch 2.13 (a crash in HA2G's audio encoder; eager channels-last tensors
+    crash the same way, torch and oneDNN issues of this kind: pytorch#136348).
+    """
     if mode is None:
         return fn
     if mode in COMPILE_BACKENDS:
         return torch.compile(fn, backend=mode)
+    if device.type == "cpu":
+        from torch._inductor import list_mode_options
+
+        return torch.compile(fn, options={**list_mode_options(mode), "layout_optimization": False})
     return torch.compile(fn, mode=mode)
 
 
@@ -508,10 +518,10 @@ class _Run:
     def _bind(self) -> None:
         """The step's forward pass and losses: the model's (or its DDP wrappers'), compiled when
         ``config.compile`` says so."""
-        mode, model = self.config.compile, self.model
-        self.forward = _compiled(self.g_ddp or model, mode)
-        self.losses = _compiled(model.losses, mode)
-        self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode)
+        mode, model, device = self.config.compile, self.model, self.device
+        self.forward = _compiled(self.g_ddp or model, mode, device)
+        self.losses = _compiled(model.losses, mode, device)
+        self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode, device)
 
     def resume(self, train: _Data) -> None:
         """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``).
