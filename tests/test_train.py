@@ -678,6 +678,24 @@ def test_a_compiled_step_gives_the_losses_and_poses_of_the_eager_one(windows):
         TrainConfig(compile="fast")
 
 
+def test_a_compiled_pass_draws_its_own_dropout_masks_repeatably_from_the_seed():
+    """``TrainConfig.compile``'s docstring: under inductor a pass draws dropout masks with inductor's own
+    generator, seeded from torch's, so one seed repeats them to the bit, but they are not the eager masks."""
+    from beatlite.train.training import _compiled
+
+    x = torch.ones(4096)
+    drop = _compiled(
+        lambda t: torch.nn.functional.dropout(t, 0.5, training=True), "default", torch.device("cpu")
+    )
+    masks = []
+    for fn in (drop, drop, lambda t: torch.nn.functional.dropout(t, 0.5, training=True)):
+        torch.manual_seed(11)
+        masks.append(fn(x) != 0)
+    assert torch.equal(masks[0], masks[1])
+    assert not torch.equal(masks[0], masks[2])  # 4096 coin flips agreeing by chance: 2^-4096
+    assert 0.4 < masks[0].float().mean() < 0.6  # kept with probability 1/2 (sd 0.008 over 4096)
+
+
 def test_a_model_that_states_an_inductor_failure_is_refused_by_name_before_a_step(windows, monkeypatch):
     """``GestureModel.inductor_failure`` (a model whose training pass breaks inductor says why): ``fit``
     refuses every inductor mode at once, naming it and leaving the weights as they were; ``aot_eager``
