@@ -18,14 +18,15 @@
 #                  compiled, its first audio block as convolutions and as one matrix product of the waveform's
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  HA2G paper at 512, eager and compiled (reduce-overhead; its training pass compiles since the
-#                  style loss's permutation runs eagerly), both profiled
+#                  style loss gathers its permutation: a new lead, not one tune left), both profiled
 #   STAGE later    after next (about 6 minutes): CaMN paper bf16 at 1024 compiled with cudnn.benchmark, then with
-#                  the LSTM traced into the graph (a longer limit)
+#                  the LSTM traced into the graph and the frame matmul on (a longer limit)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
-# Results: $OUT/<stage>.md (the log and tables) and $OUT/<stage>-<model>.json (bench_train's rows, written
-# after every row, so a run stopped by its time limit keeps the rows it measured).
+# Results: $OUT/<stage>.md (the log and tables) and bench_train's rows, written after every row, so a run
+# stopped by its time limit keeps the rows it measured: $OUT/<stage>.json for full, tune, next and later (all
+# of the stage's calls merged), $OUT/<stage>-<model>.json for the others.
 set -u -o pipefail
 stage=${1:?stage: eager, compile, full, tune, next, later, repeat or cpu}
 case "$stage" in eager | compile | full | tune | next | later | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, repeat or cpu)" >&2; exit 2 ;; esac
@@ -57,7 +58,7 @@ PY
 python3 -c "$setup" 2>&1 | tee "$out/$stage.md"
 n=0
 parts=$(mktemp -d)
-bench() {  # bench SECONDS MODEL ARGS...  (full, tune: every call's rows merged into $out/$stage.json after it)
+bench() {  # bench SECONDS MODEL ARGS...  (full, tune, next, later: every call's rows merged into $out/$stage.json)
     n=$((n + 1))
     local json="$out/$stage-$2.json"
     case "$stage" in full | tune | next | later) json="$parts/$(printf %02d $n).json" ;; esac

@@ -678,6 +678,32 @@ def test_a_compiled_step_gives_the_losses_and_poses_of_the_eager_one(windows):
         TrainConfig(compile="fast")
 
 
+def test_compiling_on_the_cpu_keeps_each_mode_s_options_without_inductor_s_layout_optimisation(monkeypatch):
+    """``training._compiled``: on the CPU an inductor mode becomes its own options plus
+    ``layout_optimization=False`` (channels-last 2-D convolutions crash torch 2.13's oneDNN backward); on CUDA
+    the mode is passed as it is; backends and ``None`` are unchanged."""
+    from torch._inductor import list_mode_options
+
+    from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
+    from beatlite.train.training import _compiled
+
+    calls = []
+    monkeypatch.setattr(torch, "compile", lambda fn, **kw: calls.append(kw) or fn)
+    fn = lambda x: x  # noqa: E731
+    assert _compiled(fn, None, torch.device("cpu")) is fn and not calls
+    for mode in COMPILE_MODES:
+        _compiled(fn, mode, torch.device("cpu"))
+        _compiled(fn, mode, torch.device("cuda"))
+        assert calls[-2:] == [
+            {"options": {**list_mode_options(mode), "layout_optimization": False}},
+            {"mode": mode},
+        ]
+    for backend in COMPILE_BACKENDS:
+        _compiled(fn, backend, torch.device("cpu"))
+        assert calls[-1] == {"backend": backend}
+    assert list_mode_options("reduce-overhead")["triton.cudagraphs"]  # (a mode's options are kept)
+
+
 def test_a_compiled_pass_draws_its_own_dropout_masks_repeatably_from_the_seed():
     """``TrainConfig.compile``'s docstring: under inductor a pass draws dropout masks with inductor's own
     generator, seeded from torch's, so one seed repeats them to the bit, but they are not the eager masks."""

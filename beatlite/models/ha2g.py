@@ -346,13 +346,6 @@ class HA2GDiscriminator(ConvDiscriminator):
         )
 
 
-@torch.compiler.disable
-def _permutation(n: int, device: torch.device) -> torch.Tensor:
-    """``torch.randperm(n)`` run eagerly under ``torch.compile``: inductor's pattern for indexing with a
-    random permutation fails on a whole one (``BackendCompilerFailed`` in torch 2.11 and 2.13)."""
-    return torch.randperm(n, device=device)
-
-
 class HA2G(GestureModel):
     """Hierarchical Audio-to-Gesture on TED-43 direction vectors (see the module docstring).
 
@@ -711,7 +704,10 @@ class HA2G(GestureModel):
             ids = torch.randint(0, self.config.n_speakers, speaker.shape, device=speaker.device)
             other = self._styles(ids, sample)
             return other["coord"], other
-        other = self._styles(speaker[_permutation(speaker.shape[0], speaker.device)], sample)
+        # gather, the same values as speaker[perm]: inductor's pattern for indexing with a whole random
+        # permutation fails (BackendCompilerFailed, torch 2.11 on an H200 and 2.13 on the CPU)
+        perm = torch.randperm(speaker.shape[0], device=speaker.device)
+        other = self._styles(speaker.gather(0, perm), sample)
         return style["coord"], other
 
     @torch.no_grad()

@@ -104,8 +104,8 @@ class TrainConfig:
         from the device (a model contract), which capturing a step in a CUDA graph needs. On an H200,
         ``"reduce-overhead"`` took CaMN's paper preset (bf16) from 112 to 57 ms per step at batch 256 and,
         with ``deterministic=False``, from 235 to 146 ms at 1024 (README, "Using real BEAT"). Every
-        registered model's training pass compiles with inductor on the CPU (HA2G since its style loss's
-        permutation runs eagerly; on a GPU, HA2G compiled is unmeasured). A compiled pass draws dropout
+        trainable model's pass compiled with inductor on the CPU (README; HA2G's since its style loss gathers
+        its permutation, tested; on a GPU, HA2G compiled is unmeasured). A compiled pass draws dropout
         masks with inductor's own generator: seeded, repeatable, but not the eager run's masks.
     micro_batches : int
         Split every batch into this many micro-batches whose gradients are averaged before the step
