@@ -238,7 +238,7 @@ def measure_step(
     name: str, preset: str, device: str, precision: str, batch: int, train: Any, steps: int, profile: int = 0,
     compile: str = "eager",  # noqa: A002
     deterministic: bool = True,
-    frame_matmul: bool = False,
+    frame_matmul: bool | None = False,
 ) -> Row:  # fmt: skip
     """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
     (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
@@ -283,7 +283,7 @@ def measure_step(
         name, preset, device, precision, batch, compile, deterministic, model.n_parameters(), gflop,
         batch / seconds, 1e3 * seconds, ops_per_step=ops.count,
     )  # fmt: skip
-    row.frame_matmul = frame_matmul if use_frame_matmul(model, frame_matmul) else None
+    row.frame_matmul = bool(frame_matmul) if use_frame_matmul(model, bool(frame_matmul)) else None
     row.peak_mib = memory.mib
     row.peak_fraction = gflop * 1e9 * row.step_wps / _peak(run.device, dtype)
     return row
@@ -445,21 +445,25 @@ def _parse() -> argparse.Namespace:
     return args
 
 
-def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, bool, bool]]:
+def _grid(args: argparse.Namespace) -> list[tuple[str, str, str, str, int, str, bool, bool | None]]:
     """(model, preset, device, precision, batch, compile, deterministic, frame matmul) of every row; by default
-    the paper presets on CUDA only."""
+    the paper presets on CUDA only; frame matmul ``None`` (one row) for a model without a one-channel audio
+    block."""
     grid = []
     for name in args.models:
+        matmul = [m == "on" for m in args.frame_matmul]
+        if use_frame_matmul(build_model(name, preset="tiny"), False) == 0:
+            matmul = [None]
         for device in args.devices:
             paper = name in ("camn", "ha2g") and device == "cuda" and not args.quick
             for preset in args.presets or (["tiny", "paper"] if paper else ["tiny"]):
                 for precision in args.precisions:
                     for b in args.batch_sizes:
                         grid += [
-                            (name, preset, device, precision, b, c, d == "on", m == "on")
+                            (name, preset, device, precision, b, c, d == "on", m)
                             for c in args.compile
                             for d in args.deterministic
-                            for m in args.frame_matmul
+                            for m in matmul
                         ]
     return grid
 
