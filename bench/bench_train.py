@@ -195,6 +195,7 @@ class Row:
     note: str = ""
     fit_error: str = ""
     frame_matmul: bool | None = None  # (None: the model has no one-channel audio block)
+    cudnn_benchmark: bool = False  # (--cudnn-benchmark: cuDNN timed its algorithms for each shape first)
 
 
 def _model(
@@ -503,7 +504,7 @@ def main() -> None:
                     except Exception as error:  # noqa: BLE001 (the step's columns stay; the fit's say "-")
                         row.fit_error = _failed(error)
                         _recover(device)
-            row.compile = label
+            row.compile, row.cudnn_benchmark = label, args.cudnn_benchmark
             rows.append(row)
             fit_error = f" (fit {row.fit_error})" if row.fit_error else ""
             matmul_label = " matmul" if row.frame_matmul else ""

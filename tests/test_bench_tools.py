@@ -52,3 +52,78 @@ def test_batch_scaling_summarises_each_batch_and_rule_over_the_seeds():
         statistics.stdev([6, 8, 10]),
     ]
     assert summary(rows[:1]) == {"32 linear": {"FGD": [3.0, None], "SRGR": [3.0, None]}}  # one seed: no sd
+
+
+def test_gpu_record_renders_the_readme_table_from_the_shipped_record():
+    """bench/gpu_record.py's table of bench/records/bench_train_h200.json is the README's block, to the byte."""
+    import json
+
+    gpu_record = _load("gpu_record")
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split("<!-- gpu-table: bench/records/bench_train_h200.json -->\n")[1]
+    block = block.split("\n<!-- /gpu-table -->")[0]
+    record = json.loads((ROOT / "bench" / "records" / "bench_train_h200.json").read_text())
+    assert gpu_record.table(record) == block
+
+
+def _stage_row(model: str, compile: str, wps: float | None, **kw):  # noqa: A002
+    row = {"model": model, "preset": "paper", "device": "cuda", "precision": "bf16", "batch": 512,
+           "compile": compile, "deterministic": False, "step_wps": wps, "step_ms": None if wps is None else 512e3 / wps,
+           "fit_wps": None, "fit_resident_wps": None, "peak_mib": 1234.4, "note": "", "frame_matmul": None}  # fmt: skip
+    return {**row, **kw}
+
+
+def test_gpu_record_adds_a_stage_to_a_new_record_and_rewrites_the_readme_block(tmp_path):
+    """A stage folder (NAME.json, NAME.md) becomes a run of a new record: measured rows kept, the failed one
+    named with its note, machine and torch from the log's first line, the log beside the record read-only; adding
+    it again replaces it; the README block is rewritten with the rows' rounded cells (epoch = 80,000 / rate)."""
+    import json
+
+    gpu_record = _load("gpu_record")
+    stage = tmp_path / "out"
+    stage.mkdir()
+    rows = [
+        _stage_row("camn", "reduce-overhead", 10240.0, frame_matmul=True),
+        _stage_row("ha2g", "eager", 1600.0),
+        _stage_row("ha2g", "reduce-overhead", None, note="failed: BackendCompilerFailed: x"),
+        _stage_row("camn", "reduce-overhead", 5120.0, cudnn_benchmark=True),
+    ]
+    (stage / "next.json").write_text(json.dumps({"peaks": [{"cuda torch.bfloat16": 7e14}], "rows": rows}))
+    (stage / "next.md").write_text(
+        "gpu-host  torch 2.11.0+cu130  NVIDIA H100 80GB HBM3\nstore: 658 train windows\n"
+    )
+    record = tmp_path / "records" / "bench_train_h100.json"
+    record.parent.mkdir()
+    for _ in range(2):
+        assert (
+            gpu_record.main(["add", "next", str(stage), "--commit", "abc1234", "--record", str(record)]) == 0
+        )
+    data = json.loads(record.read_text())
+    (run,) = data["runs"]
+    assert (run["name"], run["commit"], run["device"], run["torch"]) == (
+        "next", "abc1234", "NVIDIA H100 80GB HBM3", "2.11.0+cu130"
+    )  # fmt: skip
+    assert [r["model"] for r in run["rows"]] == ["camn", "ha2g", "camn"]
+    assert run["not measured"] == "HA2G paper bf16 b512 reduce-overhead: failed: BackendCompilerFailed: x"
+    log = Path(data["logs"]["next"])
+    assert log.read_text() == (stage / "next.md").read_text() and not log.stat().st_mode & 0o222
+    readme = tmp_path / "README.md"
+    marker = f"<!-- gpu-table: {record.as_posix()} -->"
+    readme.write_text(f"before\n{marker}\nold table\n<!-- /gpu-table -->\nafter\n")
+    assert gpu_record.main(["table", "--readme", str(readme), "--record", str(record)]) == 0
+    lines = readme.read_text().splitlines()
+    assert lines[0] == "before" and lines[-1] == "after" and "old table" not in lines
+    assert lines[4:7] == [
+        "| next | CaMN paper | bf16 | 512 | reduce-overhead + audio matmul | off | 10,240 | 50 | - | 1,234 | 8 s |",
+        "| next | HA2G paper | bf16 | 512 | eager | off | 1,600 | 320 | - | 1,234 | 50 s |",
+        "| next | CaMN paper | bf16 | 512 | reduce-overhead + cudnn.benchmark | off | 5,120 | 100 | - | 1,234 | 16 s |",
+    ]
+
+
+def test_gpu_record_refuses_a_log_without_its_machine_line(tmp_path, capsys):
+    gpu_record = _load("gpu_record")
+    (tmp_path / "next.json").write_text('{"peaks": [], "rows": []}')
+    (tmp_path / "next.md").write_text("Traceback (most recent call last):\n")
+    assert gpu_record.main(["add", "next", str(tmp_path), "--record", str(tmp_path / "r.json")]) == 2
+    assert "first line is not 'HOST  torch VERSION  GPU'" in capsys.readouterr().err
+    assert not (tmp_path / "r.json").exists()

@@ -15,6 +15,7 @@ RECORDS = ROOT / "bench" / "records"
 RECORD = RECORDS / "bench_train_h200.json"
 EPOCH_WINDOWS = 80_000  # about BEAT-4english's train windows (README)
 KEY = ("model", "preset", "precision", "batch", "compile", "deterministic")
+SWITCHES = {"frame_matmul": " + audio matmul", "cudnn_benchmark": " + cudnn.benchmark"}  # (the compile cell)
 
 
 def _readme() -> str:
@@ -31,13 +32,17 @@ def _runs() -> dict[str, dict]:
     return {r["name"]: r for r in json.loads(RECORD.read_text())["runs"]}
 
 
-def _row(run: str, model: str, preset: str, precision: str, batch: int, compile: str, det: bool) -> dict:  # noqa: A002
+def _row(
+    run: str, model: str, preset: str, precision: str, batch: int, compile: str, det: bool, *on: str
+) -> dict:  # noqa: A002
+    """The record's row of ``run`` with these settings (``on``: the :data:`SWITCHES` that were on)."""
     found = [
         r
         for r in _runs()[run]["rows"]
         if tuple(r[k] for k in KEY) == (model, preset, precision, batch, compile, det)
+        and {k for k in SWITCHES if r.get(k)} == set(on)
     ]
-    assert len(found) == 1, (run, model, preset, precision, batch, compile, det)
+    assert len(found) == 1, (run, model, preset, precision, batch, compile, det, on)
     return found[0]
 
 
@@ -49,13 +54,21 @@ def test_the_readme_gpu_table_is_every_measured_row_of_the_record_rounded():
     seen = set()
     for run, name, precision, batch, compile, det, wps, ms, fit, mib, epoch in _table_rows():  # noqa: A001
         model, preset = name.lower().split()
-        r = _row(run, model, preset, precision, int(batch), compile, det == "on")
+        on = [k for k, suffix in SWITCHES.items() if suffix in compile]  # (bench/gpu_record.py's cell)
+        for k in on:
+            compile = compile.replace(SWITCHES[k], "")  # noqa: A001
+        r = _row(run, model, preset, precision, int(batch), compile, det == "on", *on)
         assert (wps, ms, mib) == (_n(r["step_wps"]), _n(r["step_ms"]), _n(r["peak_mib"])), name
         expected = "-" if r["fit_wps"] is None else f"{_n(r['fit_wps'])} / {_n(r['fit_resident_wps'])}"
         assert fit == expected, name
         assert epoch == f"{EPOCH_WINDOWS / r['step_wps']:.0f} s", name
-        seen.add((run, *(r[k] for k in KEY)))
-    measured = {(n, *(r[k] for k in KEY)) for n, run in _runs().items() for r in run["rows"] if r["step_wps"]}
+        seen.add((run, *(r[k] for k in KEY), *(bool(r.get(k)) for k in SWITCHES)))
+    measured = {
+        (n, *(r[k] for k in KEY), *(bool(r.get(k)) for k in SWITCHES))
+        for n, run in _runs().items()
+        for r in run["rows"]
+        if r["step_wps"]
+    }
     assert seen == measured and len(measured) == 19
 
 
