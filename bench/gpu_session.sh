@@ -24,7 +24,8 @@
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
-# Back here: python bench/gpu_record.py add STAGE FOLDER (into bench/records/bench_train_h200.json), then
+# Back here: python bench/gpu_record.py add STAGE FOLDER (full, tune, next, later: into
+#             bench/records/bench_train_h200.json), then
 #             python bench/gpu_record.py table (the README's GPU table from the record)
 # Results: $OUT/<stage>.md (the log and tables) and bench_train's rows, written after every row, so a run
 # stopped by its time limit keeps the rows it measured: $OUT/<stage>.json for full, tune, next and later (all

@@ -84,38 +84,40 @@ def test_gpu_record_adds_a_stage_to_a_new_record_and_rewrites_the_readme_block(t
     stage.mkdir()
     rows = [
         _stage_row("camn", "reduce-overhead", 10240.0, frame_matmul=True),
-        _stage_row("ha2g", "eager", 1600.0),
+        _stage_row("ha2g", "eager", 1600.0, fit_wps=500.0),  # (a fit whose resident half failed)
         _stage_row("ha2g", "reduce-overhead", None, note="failed: BackendCompilerFailed: x"),
         _stage_row("camn", "reduce-overhead", 5120.0, cudnn_benchmark=True),
     ]
     (stage / "next.json").write_text(json.dumps({"peaks": [{"cuda torch.bfloat16": 7e14}], "rows": rows}))
     (stage / "next.md").write_text(
-        "gpu-host  torch 2.11.0+cu130  NVIDIA H100 80GB HBM3\nstore: 658 train windows\n"
+        "UserWarning: printed first\ngpu-host  torch 2.11.0+cu130  NVIDIA H100 80GB HBM3\nstore: 658 windows\n"
     )
     record = tmp_path / "records" / "bench_train_h100.json"
     record.parent.mkdir()
+    argv = ["add", "next", str(stage), "--commit", "abc1234", "--record", str(record)]
     for _ in range(2):
-        assert (
-            gpu_record.main(["add", "next", str(stage), "--commit", "abc1234", "--record", str(record)]) == 0
-        )
+        assert gpu_record.main([*argv, "--not-measured", "CaMN paper bf16 b1024 eager: its time limit"]) == 0
     data = json.loads(record.read_text())
     (run,) = data["runs"]
     assert (run["name"], run["commit"], run["device"], run["torch"]) == (
         "next", "abc1234", "NVIDIA H100 80GB HBM3", "2.11.0+cu130"
     )  # fmt: skip
     assert [r["model"] for r in run["rows"]] == ["camn", "ha2g", "camn"]
-    assert run["not measured"] == "HA2G paper bf16 b512 reduce-overhead: failed: BackendCompilerFailed: x"
-    log = Path(data["logs"]["next"])
+    assert run["not measured"] == (
+        "HA2G paper bf16 b512 reduce-overhead: failed: BackendCompilerFailed: x; "
+        "CaMN paper bf16 b1024 eager: its time limit"
+    )
+    log = ROOT / data["logs"]["next"]  # (paths in the record are relative to the repository)
     assert log.read_text() == (stage / "next.md").read_text() and not log.stat().st_mode & 0o222
     readme = tmp_path / "README.md"
-    marker = f"<!-- gpu-table: {record.as_posix()} -->"
+    marker = f"<!-- gpu-table: {gpu_record.repo_path(record)} -->"
     readme.write_text(f"before\n{marker}\nold table\n<!-- /gpu-table -->\nafter\n")
     assert gpu_record.main(["table", "--readme", str(readme), "--record", str(record)]) == 0
     lines = readme.read_text().splitlines()
     assert lines[0] == "before" and lines[-1] == "after" and "old table" not in lines
     assert lines[4:7] == [
         "| next | CaMN paper | bf16 | 512 | reduce-overhead + audio matmul | off | 10,240 | 50 | - | 1,234 | 8 s |",
-        "| next | HA2G paper | bf16 | 512 | eager | off | 1,600 | 320 | - | 1,234 | 50 s |",
+        "| next | HA2G paper | bf16 | 512 | eager | off | 1,600 | 320 | 500 / - | 1,234 | 50 s |",
         "| next | CaMN paper | bf16 | 512 | reduce-overhead + cudnn.benchmark | off | 5,120 | 100 | - | 1,234 | 16 s |",
     ]
 
@@ -125,5 +127,5 @@ def test_gpu_record_refuses_a_log_without_its_machine_line(tmp_path, capsys):
     (tmp_path / "next.json").write_text('{"peaks": [], "rows": []}')
     (tmp_path / "next.md").write_text("Traceback (most recent call last):\n")
     assert gpu_record.main(["add", "next", str(tmp_path), "--record", str(tmp_path / "r.json")]) == 2
-    assert "first line is not 'HOST  torch VERSION  GPU'" in capsys.readouterr().err
+    assert capsys.readouterr().err.startswith("gpu_record: the log has no line 'HOST  torch VERSION  GPU'")
     assert not (tmp_path / "r.json").exists()
