@@ -457,9 +457,9 @@ def _compiled(fn: Callable[..., Any], mode: str | None, device: torch.device) ->
     """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``).
 
     On the CPU, inductor's modes run without its layout optimisation (the mode's other options kept): it
-    stores 2-D convolutions' activations channels-last, and oneDNN's float32 weight gradient of a strided 1x1
-    convolution on channels-last tensors with few input channels corrupts memory in torch 2.13 (a crash in
-    HA2G's audio encoder; eager channels-last tensors crash the same way).
+    stores 2-D convolutions' activations channels-last, and oneDNN's float32 gradient of a strided 1x1
+    convolution on channels-last tensors corrupts memory in torch 2.13 (seen with 4 input channels, stride 2:
+    a crash in HA2G's audio encoder; eager channels-last tensors crash the same way).
     """
     if mode is None:
         return fn
