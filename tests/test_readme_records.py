@@ -165,6 +165,10 @@ def test_the_readme_gpu_sentences_match_the_records_and_the_logs():
     assert f"TF32 implicit-GEMM kernel does it, {per_call:.1f} ms per call at batch 64" in text
     h = tune["ha2g paper cuda bf16 b256 eager det=False"]
     assert f"({_gpu_ms(h):.0f} of its {ms(h_off_later)} ms at 256 in bf16)" in text
+    h64 = full["ha2g paper cuda fp32 b64 eager det=True"]
+    host = float(re.search(r"Self CPU time total: ([\d.]+)ms", h64).group(1))
+    fills = int(next(x for x in h64.splitlines() if "aten::fill_" in x).split()[-1])
+    assert f"{host:.0f} ms of CPU time against {_gpu_ms(h64):.0f} ms of GPU time, {fills:,} of its" in text
     for profile in (
         full["camn paper cuda bf16 b64 eager det=True"],
         full["camn paper cuda bf16 b256 eager det=True"],
