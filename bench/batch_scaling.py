@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from beatlite.io.atomic import atomic_write
+from beatlite.io.atomic import write_json
 from beatlite.paths import code_revision
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
@@ -62,13 +62,6 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "rows": rows,
         "summary": summary(rows),
     }
-
-
-def _write(path: Path | None, record: dict) -> None:
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_write(path) as f:  # (a run stopped mid-write keeps its last whole record)
-            f.write(json.dumps(record, indent=1) + "\n")
 
 
 def main() -> None:
@@ -107,9 +100,8 @@ def main() -> None:
                 rows.append({"batch": batch, "rule": rule, "seed": seed, "lr": lr, "train_seconds": seconds,
                              "reused": reused, **metrics})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
-                _write(
-                    args.json, _record(args, recipe, rows)
-                )  # after every row: an interrupted run keeps them
+                if args.json is not None:  # after every row: an interrupted run keeps them
+                    write_json(args.json, _record(args, recipe, rows))
     record = _record(args, recipe, rows)
     for key, values in record["summary"].items():
         cells = "  ".join(

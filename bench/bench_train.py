@@ -60,7 +60,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
 import tempfile
@@ -75,7 +74,7 @@ import torch._dynamo
 from torch.utils._python_dispatch import TorchDispatchMode
 from torch.utils.flop_counter import FlopCounterMode
 
-from beatlite.io.atomic import atomic_write
+from beatlite.io.atomic import write_json
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.models.layers import use_frame_matmul
 from beatlite.paths import data_dir, n_threads
@@ -537,10 +536,8 @@ def _write_json(path: Path | None, rows: list[Row]) -> None:
     """The rows (and the GEMM peaks measured so far) as JSON at ``path`` (nothing without one)."""
     if path is None:
         return
-    path.parent.mkdir(parents=True, exist_ok=True)
     peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
-    with atomic_write(path) as f:  # (a run stopped mid-write keeps its last whole record)
-        f.write(json.dumps({"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]}, indent=1))
+    write_json(path, {"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]})
 
 
 if __name__ == "__main__":

@@ -30,7 +30,7 @@ import re
 import sys
 from pathlib import Path
 
-from beatlite.io.atomic import atomic_write
+from beatlite.io.atomic import atomic_write, write_json
 from beatlite.paths import code_revision, repo_root
 
 RECORD = repo_root() / "bench" / "records" / "bench_train_h200.json"
@@ -93,8 +93,7 @@ def add(record_path: Path, run: dict, log: str) -> Path:
     with atomic_write(log_path) as f:  # (replaces a read-only log of an earlier add)
         f.write(log)
     log_path.chmod(0o444)
-    with atomic_write(record_path) as f:
-        f.write(json.dumps(record, indent=1) + "\n")
+    write_json(record_path, record)
     return log_path
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import torch
 
-from beatlite.io.atomic import atomic_write
+from beatlite.io.atomic import write_json
 from beatlite.paths import code_revision, data_dir
 from beatlite.train.checkpoint import load_checkpoint
 from beatlite.train.recipes import RECIPES
@@ -79,11 +79,7 @@ def main() -> None:
                 if args.json is not None:
                     record = {"command": " ".join(["python", *sys.argv]), "revision": revision,
                               "torch": torch.__version__, "threads": os.environ.get("BEATLITE_THREADS"), "rows": rows}  # fmt: skip
-                    args.json.parent.mkdir(parents=True, exist_ok=True)
-                    with atomic_write(
-                        args.json
-                    ) as f:  # (a run stopped mid-write keeps its last whole record)
-                        f.write(json.dumps(record, indent=1) + "\n")
+                    write_json(args.json, record)
 
 
 if __name__ == "__main__":

@@ -117,6 +117,31 @@ def atomic_write(
         raise
 
 
+def write_json(path: str | os.PathLike[str], data: Any, *, indent: int = 1) -> Path:
+    """Write ``data`` as JSON text (a newline at the end) to ``path`` with :func:`atomic_write`, creating its
+    folders: the benchmarks' records, rewritten after every row, so a run stopped mid-write keeps its last whole one.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> out = write_json(Path(tempfile.mkdtemp()) / "records" / "r.json", {"rows": [1, 2]})
+    >>> json.loads(out.read_text()), out.read_text().endswith("\\n")
+    ({'rows': [1, 2]}, True)
+    """
+    import json
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path) as f:
+        f.write(json.dumps(data, indent=indent) + "\n")
+    return path
+
+
 def _copy_mode(target: Path, tmp: Path) -> None:
     """Give the temp file the permissions of the file it replaces (``0o644`` for a new file)."""
     try:
