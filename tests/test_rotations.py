@@ -15,6 +15,7 @@ from beatlite.skeleton.rotations import (
     matrix_to_6d,
     matrix_to_axis_angle,
     matrix_to_euler,
+    nearest_euler,
     matrix_to_quat,
     quat_to_matrix,
     sixd_to_matrix,
@@ -230,3 +231,24 @@ def test_euler_to_6d_is_the_6d_of_each_triplet(rng):
     assert np.abs(np.diff(euler_to_6d(track), axis=0)).max() < np.radians(2.0) + 1e-12
     with pytest.raises(ValueError, match="triplets"):
         euler_to_6d(np.zeros((2, 4)))
+
+
+@pytest.mark.parametrize("order", ALL_ORDERS)
+def test_nearest_euler_finds_the_equivalent_triple_of_the_reference(order, rng):
+    """A reference that is the other branch of the same rotations, with random 360° turns per angle, is found
+    exactly; for any reference the result gives the same rotations and is no farther than either branch."""
+    angles = matrix_to_euler(random_matrices(rng, 300), order)  # the principal branch, |middle| <= 90
+    other = np.stack([angles[:, 0] + 180, 180 - angles[:, 1], angles[:, 2] + 180], axis=-1)
+    turns = 360.0 * rng.integers(-7, 8, size=angles.shape)
+    flip = rng.random(len(angles)) < 0.5
+    reference = np.where(flip[:, None], other, angles) + turns
+    np.testing.assert_allclose(euler_to_matrix(other, order), euler_to_matrix(angles, order), atol=1e-12)
+    np.testing.assert_allclose(nearest_euler(angles, reference), reference, atol=1e-9)
+    np.testing.assert_allclose(nearest_euler(other, reference), reference, atol=1e-9)
+    anywhere = rng.uniform(-2000, 2000, size=angles.shape)
+    near = nearest_euler(angles, anywhere)
+    np.testing.assert_allclose(euler_to_matrix(near, order), euler_to_matrix(angles, order), atol=1e-9)
+    cost = np.abs(near - anywhere).sum(axis=-1)
+    for cand in (angles, other):  # each branch at its own best 360° turns
+        best = cand - 360.0 * np.round((cand - anywhere) / 360.0)
+        assert (cost <= np.abs(best - anywhere).sum(axis=-1) + 1e-9).all()

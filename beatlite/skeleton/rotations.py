@@ -34,6 +34,7 @@ __all__ = [
     "matrix_to_axis_angle",
     "matrix_to_euler",
     "matrix_to_quat",
+    "nearest_euler",
     "quat_to_matrix",
     "sixd_to_matrix",
     "unwrap_degrees",
@@ -280,6 +281,50 @@ def unwrap_degrees(angles: np.ndarray, axis: int = 0) -> np.ndarray:
     if arr.ndim == 0:
         raise ValueError(f"angles must have at least one (time) dimension, got shape {arr.shape}")
     return np.unwrap(arr, period=360.0, axis=axis)
+
+
+def nearest_euler(angles: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Of the Euler triples that give each rotation of ``angles``, the one nearest ``reference``.
+
+    Every Tait-Bryan order writes one rotation as ``(a, b, c)`` and as ``(a + 180, 180 - b, c + 180)``
+    (the two branches of the middle angle), each angle also up to any multiple of 360°. A file written
+    from rotation matrices (``scipy``'s ``as_euler``, :func:`matrix_to_euler`) lands on
+    ``|b| <= 90°`` in ``(-180, 180]``, where motion capture keeps continuous, unwrapped tracks
+    (real BEAT: values such as 397° or -2482°). Comparing Euler angles channel by channel needs both
+    on one representation: this returns, per triple, the candidate whose summed absolute difference
+    to ``reference`` is smallest (``angles`` itself on a tie). The rotations are unchanged, whatever the order.
+
+    Parameters
+    ----------
+    angles : (..., 3) float, degrees
+        Euler triples in any one Tait-Bryan order (intrinsic or extrinsic: the middle angle is the
+        second either way).
+    reference : (..., 3) float, degrees
+        Triples of the same order, broadcastable with ``angles`` (e.g. the ground truth's, frame by frame).
+
+    Returns
+    -------
+    (..., 3) float64, degrees
+
+    Examples
+    --------
+    >>> nearest_euler(np.array([10.0, 80.0, -20.0]), np.array([370.0, 80.0, -20.0]))
+    array([370.,  80., -20.])
+    >>> nearest_euler(np.array([-170.0, 60.0, 170.0]), np.array([10.0, 120.0, -10.0]))
+    array([ 10., 120., -10.])
+    """
+    a = _as_float_array(angles, "angles", (3,))
+    ref = _as_float_array(reference, "reference", (3,))
+    other = np.stack([a[..., 0] + 180.0, 180.0 - a[..., 1], a[..., 2] + 180.0], axis=-1)
+    best, best_cost = None, None
+    for cand in (a, other):
+        cand = cand - 360.0 * np.round((cand - ref) / 360.0)
+        cost = np.abs(cand - ref).sum(axis=-1, keepdims=True)
+        if best is None:
+            best, best_cost = cand, cost
+        else:
+            best = np.where(cost < best_cost, cand, best)
+    return best
 
 
 # ----------------------------------------------------------------------------- quaternions
