@@ -111,7 +111,11 @@ def _malformed(tmp_path: Path) -> dict[str, tuple[Path, str]]:
     )
     out["zero frame rate"] = (
         _save(tmp_path / "zero.npz", {**a, "mocap_frame_rate": np.array(0)}),
-        "not positive",
+        "frame rate 0 fps is outside 1..100000 fps",
+    )
+    out["a frame rate below a BVH's"] = (  # resampled to 15 fps it would be 1,500 times as long: unbounded
+        _save(tmp_path / "slow.npz", {**a, "mocap_frame_rate": np.array(0.01)}),
+        "field 'mocap_frame_rate': frame rate 0.01 fps",
     )
     good = _save(tmp_path / "good.npz", a).read_bytes()
     p = tmp_path / "cut.npz"
@@ -122,7 +126,7 @@ def _malformed(tmp_path: Path) -> dict[str, tuple[Path, str]]:
 
 def test_read_smplx_gives_one_format_error_per_malformed_file(tmp_path):
     cases = _malformed(tmp_path)
-    assert len(cases) == 10
+    assert len(cases) == 11
     for name, (path, expected) in cases.items():
         with pytest.raises(FormatError) as err:
             read_smplx(path)

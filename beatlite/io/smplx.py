@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from beatlite.io.bvh import FRAME_TIME_RANGE
 from beatlite.io.errors import FormatError
 from beatlite.io.textfile import GZIP_MAX_RATIO, describe_bytes
 
@@ -176,7 +177,8 @@ def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
     Raises
     ------
     FormatError
-        Naming the file and the key.
+        Naming the file and the key: a missing or misshapen array, non-finite values, a pickled object, a
+        member too large, a frame rate outside the range a BVH's frame time may give (1 to 100,000 fps).
 
     Examples
     --------
@@ -212,8 +214,12 @@ def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
     trans = _numeric(p, "trans", raw["trans"], f"({n}, 3)", raw["trans"].shape == (n, 3))
     rate = raw["mocap_frame_rate"]
     fps = float(_numeric(p, "mocap_frame_rate", rate, "a positive scalar", rate.size == 1).ravel()[0])
-    if fps <= 0:
-        raise FormatError(p, f"frame rate {fps:g} is not positive", field="mocap_frame_rate")
+    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))  # the frame rates a BVH may have
+    if not low <= fps <= high:
+        raise FormatError(
+            p, f"frame rate {fps:g} fps is outside {low:g}..{high:g} fps (as a BVH's frame time)",
+            field="mocap_frame_rate",
+        )  # fmt: skip
     betas = expressions = None
     if "betas" in raw:
         b = raw["betas"]
