@@ -9,7 +9,8 @@ take (matched by stem, everything before the first dot):
                        channel order (converted through rotation matrices), or a subset of BEAT's joints that
                        holds the 47 joints of ``spine_neck_141`` (the others at rest). Only the rotations
                        are read (and the root position): they are applied to beatlite's BEAT skeleton, as the
-                       in-library evaluation of Euler models does.
+                       in-library evaluation of Euler models does. Joints above Hips (a ``Reference`` root)
+                       are not BEAT's: their rotation is folded into Hips' (the body turns as in the file).
 ``{stem}.npz``         BEAT2's SMPL-X parameters (:func:`beatlite.io.smplx.read_smplx`: ``poses``, ``trans``,
                        ``mocap_frame_rate``), retargeted to BEAT's skeleton
                        (:func:`beatlite.skeleton.smplx.smplx_to_beat`, the approximate rest skeleton) and
@@ -32,8 +33,14 @@ Every prediction becomes the :class:`~beatlite.metrics.scoring.Takes` of one row
 common space, extractor features of the 34-frame windows, the 141 Euler channels where the file has them),
 and is scored against the split's ground truth by :func:`beatlite.metrics.scoring.evaluate`.
 
+The Euler metrics read each predicted rotation as its Euler angles nearest the ground truth's (of the
+equivalent ones: the other branch of the middle angle, 360° turns; :func:`beatlite.skeleton.rotations.nearest_euler`),
+so angles written from rotation matrices score as the same motion; the warning and ``info["euler_rewritten"]``
+count the rotations so rewritten (0 for beatlite's own exports).
+
 Checks, each one line on stderr: a missing take is an error (``--allow-missing`` scores the takes that are
-there); an extra file is listed and ignored; a prediction longer than its take is cut to it, one shorter is
+there); an extra file is listed and ignored (hidden files such as macOS' ``._*`` are skipped; suffixes match in
+any case); a prediction longer than its take is cut to it, one shorter is
 scored against the take cut to the same length (one warning each saying by how many frames), and one shorter
 than a window (34 frames) is an error. A file that cannot be converted (another skeleton, NaN, another shape)
 is a :class:`~beatlite.io.FormatError` naming the file and the field. Errors end the command with exit code 2
@@ -173,6 +180,7 @@ def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
             field="HIERARCHY",
         )
     _check_parents(src, beat, path)
+    above = _above_beat(src, beat, motion)
     out = np.zeros((motion.n_frames, beat.n_channels))
     for j, name in enumerate(beat.names):
         if name not in names:
@@ -184,20 +192,43 @@ def beat_channels(motion: Any, path: str | Path) -> np.ndarray:
                 path, f"joint {name} has {len(order)} rotation channels, not 3", field="CHANNELS"
             )
         angles = motion.channels[:, src.rotation_channel_indices(k)]
-        if order != want:  # the branch of the middle angle kept continuous over time (BEAT's tracks are)
+        if k in above:  # under joints BEAT lacks that turn it: their rotation becomes part of this joint's
+            angles = continuous_euler(matrix_to_euler(above[k][0] @ euler_to_matrix(angles, order), want))
+        elif order != want:  # the branch of the middle angle kept continuous over time (BEAT's tracks are)
             angles = continuous_euler(matrix_to_euler(euler_to_matrix(angles, order), want))
         out[:, beat.rotation_channel_indices(j)] = angles
-    root = src.position_channel_indices(src.index("Hips")) if "Hips" in names else []
-    if len(root):
-        out[:, beat.position_channel_indices(0)] = motion.channels[:, root]
+    hips = src.index("Hips") if "Hips" in names else -1
+    if hips in above:
+        out[:, beat.position_channel_indices(0)] = above[hips][1]
+    elif hips >= 0 and len(src.position_channel_indices(hips)):
+        out[:, beat.position_channel_indices(0)] = motion.channels[:, src.position_channel_indices(hips)]
     extra = [n for n in src.names if n not in set(beat.names)]
     if extra:
+        turned = [src.names[k] for k in above]
         warnings.warn(
-            f"{path}: {len(extra)} joints that BEAT lacks ignored ({', '.join(extra[:3])})",
+            f"{path}: {len(extra)} joints that BEAT lacks ignored ({', '.join(extra[:3])})"
+            + (f"; the rotation of those above {', '.join(turned)} is folded into it" if turned else ""),
             ScoreWarning,
             stacklevel=2,
         )
     return out
+
+
+def _above_beat(src: Any, beat: Any, motion: Any) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """``{k: (world rotations (T, 3, 3) of its parent, its world positions (T, 3))}`` for each BEAT joint ``k``
+    of ``src`` that hangs under joints BEAT lacks (a root above Hips) whose rotation is not the identity."""
+    from beatlite.skeleton.kinematics import global_transforms
+
+    tops = [k for k in range(src.n_joints)
+            if src.names[k] in beat.names and src.parents[k] >= 0 and src.names[src.parents[k]] not in beat.names]  # fmt: skip
+    if not tops:
+        return {}
+    rotations, positions = global_transforms(src, motion.channels)
+    return {
+        k: (rotations[:, src.parents[k]], positions[:, k])
+        for k in tops
+        if np.abs(rotations[:, src.parents[k]] - np.eye(3)).max() > 1e-12
+    }
 
 
 def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
@@ -260,10 +291,7 @@ def _npy_prediction(path: Path) -> Prediction:
     from beatlite.io import FormatError
     from beatlite.skeleton.ted import euler_to_directions
 
-    try:
-        x = np.load(path, allow_pickle=False)
-    except (ValueError, OSError, EOFError) as exc:
-        raise FormatError(path, f"not a readable .npy array ({' '.join(str(exc).split())})") from None
+    x = _load_npy(path)
     if not isinstance(x, np.ndarray) or x.dtype.kind not in "iuf":
         raise FormatError(
             path, f"dtype {getattr(x, 'dtype', type(x).__name__)} is not a real number type", field="dtype"
@@ -283,6 +311,38 @@ def _npy_prediction(path: Path) -> Prediction:
     )  # fmt: skip
 
 
+def _load_npy(path: Path) -> np.ndarray:
+    """``np.load`` of a ``.npy`` file whose header is checked first: its magic, and a shape whose bytes the file
+    holds (a header may claim any size: read as is, it would allocate it)."""
+    from beatlite.io import FormatError
+    from beatlite.io.textfile import describe_bytes
+
+    with open(path, "rb") as fh:
+        head = fh.read(64)
+        fh.seek(0)
+        if not head.startswith(b"\x93NUMPY"):
+            raise FormatError(path, f"not a .npy array: {describe_bytes(head)}")
+        try:
+            fmt = np.lib.format
+            read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
+            shape, _, dtype = read(fh)
+        except (ValueError, OSError, EOFError) as exc:
+            raise FormatError(path, f"not a readable .npy header ({' '.join(str(exc).split())})") from None
+        if dtype.hasobject:
+            raise FormatError(path, "a pickled object array (never loaded: it could run code)", field="dtype")
+        need, have = math.prod(shape) * dtype.itemsize, path.stat().st_size - fh.tell()
+    if need > have:
+        raise FormatError(
+            path,
+            f"the header's shape {shape} {dtype} needs {need} bytes, the file holds {have}",
+            field="shape",
+        )
+    try:
+        return np.load(path, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise FormatError(path, f"not a readable .npy array ({' '.join(str(exc).split())})") from None
+
+
 def _check_finite(x: np.ndarray, path: Path) -> None:
     from beatlite.io import FormatError
 
@@ -299,7 +359,13 @@ def _unit_directions(d: np.ndarray, path: Path) -> np.ndarray:
     """``d`` divided by its norms; zero vectors are an error, norms off 1 by more than 1e-3 a warning."""
     from beatlite.io import FormatError
 
-    norms = np.linalg.norm(d, axis=-1, keepdims=True)
+    with np.errstate(over="ignore"):  # too long to normalise: refused below
+        norms = np.linalg.norm(d, axis=-1, keepdims=True)
+    if not np.isfinite(norms).all():
+        frame, bone = (int(i) for i in np.argwhere(~np.isfinite(norms[..., 0]))[0])
+        raise FormatError(
+            path, f"bone {bone} of frame {frame} has a direction too long to normalise", field="values"
+        )
     if norms.min() < 1e-6:
         frame, bone = (int(i) for i in np.argwhere(norms[..., 0] < 1e-6)[0])
         raise FormatError(path, f"bone {bone} of frame {frame} has a zero direction vector", field="values")
@@ -323,11 +389,12 @@ def read_prediction(path: str | Path) -> Prediction:
     from beatlite.io import FormatError
 
     p = Path(path)
-    if p.name.endswith((".bvh", ".bvh.gz")):
+    name = p.name.lower()
+    if name.endswith((".bvh", ".bvh.gz")):
         return _bvh_prediction(p)
-    if p.name.endswith(".npy"):
+    if name.endswith(".npy"):
         return _npy_prediction(p)
-    if p.name.endswith(".npz"):
+    if name.endswith(".npz"):
         return _smplx_prediction(p)
     raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
 
@@ -339,8 +406,10 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     Returns
     -------
     (files, missing, extra)
-        ``{stem: path}`` for the takes of ``takes`` that have a file, the takes without one, and the
-        prediction files whose stem is no take of the split (ignored).
+        ``{stem: path}`` for the takes of ``takes`` that have a file, the takes without one, and the names of
+        the other files (ignored): predictions whose stem is no take of the split and files of no prediction
+        suffix (suffixes are matched in any case, ``.BVH`` too). Hidden files (``.DS_Store``, macOS' ``._*``)
+        are skipped.
 
     Raises
     ------
@@ -351,20 +420,25 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     if not folder.is_dir():
         raise ScoreInputError([f"{folder}: not a folder of predictions"])
     by_stem: dict[str, list[Path]] = {}
+    extra = []
     for p in sorted(folder.iterdir()):
-        if p.is_file() and p.name.endswith(_SUFFIXES):
+        if not p.is_file() or p.name.startswith("."):
+            continue
+        if p.name.lower().endswith(_SUFFIXES):
             by_stem.setdefault(p.name.split(".")[0], []).append(p)
+        else:
+            extra.append(p.name)
+    wanted = set(takes)
     twice = [
         f"{stem}: several predictions ({', '.join(p.name for p in ps)})"
         for stem, ps in by_stem.items()
-        if len(ps) > 1
+        if len(ps) > 1 and stem in wanted
     ]
     if twice:
         raise ScoreInputError(twice)
-    wanted = set(takes)
     files = {t: by_stem[t][0] for t in takes if t in by_stem}
-    extra = [ps[0].name for stem, ps in by_stem.items() if stem not in wanted]
-    return files, [t for t in takes if t not in by_stem], extra
+    extra += [p.name for stem, ps in by_stem.items() if stem not in wanted for p in ps]
+    return files, [t for t in takes if t not in by_stem], sorted(extra)
 
 
 def trim_test_set(test: Any, frames: Sequence[int]) -> Any:
@@ -551,9 +625,15 @@ def load_split(data: str | Path | None = None, split: str = "test", *, protocol:
     folder = Path(data_dir() if data is None else data)
     if not folder.is_dir():
         raise ScoreInputError([f"{folder}: no such data folder"])
-    test = load_test_set(index_folder(folder), split=split)
-    if not test.takes:
-        raise ScoreInputError([f"{folder}: no usable takes in the {split!r} split"])
+    index = index_folder(folder)
+    usable = sorted({r.split for r in index if r.usable and r.split})
+    if split not in usable:
+        raise ScoreInputError(
+            [
+                f"{folder}: no usable takes in the {split!r} split (splits with usable takes: {', '.join(usable) or 'none'})"
+            ]
+        )
+    test = load_test_set(index, split=split)
     if protocol == "clips":
         test = clip_test_set(test)
     test.folder = str(folder.resolve())
@@ -613,7 +693,7 @@ def score_folder(
     problems = []
     if extra:
         warnings.warn(
-            f"{pred}: {len(extra)} files are no take of the split, ignored: {', '.join(extra)}",
+            f"{pred}: {len(extra)} files are no prediction of a take of the split, ignored: {', '.join(extra)}",
             ScoreWarning,
             stacklevel=2,
         )
@@ -621,10 +701,15 @@ def score_folder(
         message = (
             f"{pred}: no prediction for {len(missing)} of the {len(test.takes)} takes: {', '.join(missing)}"
         )
+        near = [name for name in extra if name.split(".")[0] in set(missing)]
+        if near:
+            message += f" (files of no prediction suffix {', '.join(_SUFFIXES)}: {', '.join(near)})"
         if not allow_missing:
             problems.append(message + " (--allow-missing scores the others)")
         else:
             warnings.warn(message + ": scored without them", ScoreWarning, stacklevel=2)
+    if not files and allow_missing:
+        problems.append(f"{pred}: no prediction for any of the {len(test.takes)} takes")
     preds = _read_all(files, problems, progress)
     frames, trimmed = _frames(test, files, preds, problems)
     if problems:
@@ -632,9 +717,19 @@ def score_folder(
     if frames != [len(d) for d in test.gt_directions]:
         test = trim_test_set(test, frames)
     chosen = [preds[stem] for stem in test.takes]
-    euler = None
+    euler, moved = None, 0
     if all(p.euler is not None for p in chosen):
         euler = [p.euler[: len(d)] for p, d in zip(chosen, test.gt_directions, strict=True)]
+        euler, moved = _truth_euler_branch(euler, test.gt_euler)
+        if moved:
+            n = sum(e.size // 3 for e in euler)
+            warnings.warn(
+                f"{pred}: {moved} of {n} joint rotations (frames x joints) are written as other Euler angles "
+                "than the ground truth's for such a rotation (the other branch of the middle angle, or 360° "
+                "turns): the Euler metrics read the equivalent angles nearest the ground truth's",
+                ScoreWarning,
+                stacklevel=2,
+            )
     elif any(p.euler is not None for p in chosen):
         warnings.warn(
             "some predictions are directions: the Euler metrics are skipped for all",
@@ -648,8 +743,51 @@ def score_folder(
         "missing": missing,
         "extra": extra,
         "trimmed": trimmed,
+        "euler_rewritten": moved,
     }
     return _score(directions, euler, test, metrics, bootstrap, seed, extractor, progress, info)
+
+
+def _truth_euler_branch(
+    euler: Sequence[np.ndarray], truth: Sequence[np.ndarray]
+) -> tuple[list[np.ndarray], int]:
+    """Predicted Euler channels written as the equivalent angles nearest the ground truth's.
+
+    One rotation has many Euler triples (:func:`beatlite.skeleton.rotations.nearest_euler`): a model that
+    writes its rotations from matrices gets ``|Y| <= 90°`` in ``(-180, 180]`` where BEAT's tracks are
+    continuous and unwrapped, and the Euler metrics (FGD of the Euler autoencoder, the reference SRGR and
+    L1div) would score that representation, not the motion. Each triple is replaced by its equivalent nearest
+    the ground truth's at that frame; a prediction already on the ground truth's representation is unchanged.
+
+    Parameters
+    ----------
+    euler, truth : sequences of (T_k, 141) float, degrees
+        Per take, ``spine_neck_141`` channels (47 joints, ``Xrotation Yrotation Zrotation``) of the prediction
+        and of the ground truth, same lengths.
+
+    Returns
+    -------
+    (list of (T_k, 141) float64, int)
+        The channels, and how many triples (frames x joints) changed by more than 1e-6 degrees.
+
+    Examples
+    --------
+    >>> truth = np.zeros((2, 141)); truth[:, 0] = 370.0
+    >>> pred = truth.copy(); pred[:, 0] = 10.0
+    >>> out, moved = _truth_euler_branch([pred], [truth])
+    >>> out[0][:, 0], moved
+    (array([370., 370.]), 2)
+    """
+    from beatlite.skeleton.rotations import nearest_euler
+
+    out, moved = [], 0
+    for e, g in zip(euler, truth, strict=True):
+        e = np.asarray(e, dtype=np.float64)
+        triples = e.reshape(len(e), -1, 3)
+        near = nearest_euler(triples, np.asarray(g, dtype=np.float64).reshape(triples.shape))
+        moved += int((np.abs(near - triples).max(axis=-1) > 1e-6).sum())
+        out.append(near.reshape(e.shape))
+    return out, moved
 
 
 def _read_all(files: dict[str, Path], problems: list[str], progress: bool) -> dict[str, Prediction]:
@@ -1040,6 +1178,11 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.export and not args.pred:
         raise ScoreInputError(["--export needs PRED, the folder to write"])
+    for flag, out in (("--json", args.json), ("--md", args.md)):
+        if out and (Path(out).is_dir() or not Path(out).parent.is_dir()):
+            raise ScoreInputError([f"{flag} {out}: not a file in an existing folder"])
+    if args.bootstrap < 0:
+        raise ScoreInputError([f"--bootstrap {args.bootstrap}: give 0 (none) or a number of resamples"])
     if not (args.export or args.self_check or args.pred):
         raise ScoreInputError(["give PRED (a folder of predictions) or --self-check"])
     test = load_split(args.data, args.split, protocol=args.protocol)
@@ -1078,7 +1221,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(args)
         except ScoreInputError as exc:
             lines = exc.lines
-        except (FormatError, FileNotFoundError, NotADirectoryError) as exc:
+        except (FormatError, OSError) as exc:  # (FileNotFoundError, PermissionError, IsADirectoryError, ...)
             lines = [" ".join(str(exc).split())]
     for line in lines:
         print(f"error: {line}", file=sys.stderr)

@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -24,12 +25,15 @@ from beatlite.score import (  # noqa: E402
     bootstrap_intervals,
     export_checkpoint_takes,
     export_ground_truth,
+    main,
+    match_predictions,
     read_prediction,
     score_folder,
     self_check,
 )
-from beatlite.skeleton.beat import beat_skeleton  # noqa: E402
+from beatlite.skeleton.beat import JOINT_SUBSETS, beat_skeleton  # noqa: E402
 from beatlite.skeleton.core import Skeleton  # noqa: E402
+from beatlite.skeleton.rotations import euler_to_matrix, matrix_to_euler  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 KEYS = list(METRICS)
@@ -263,7 +267,7 @@ def test_npy_representations(test_set, tmp_path):
     [
         (np.zeros((40, 40)), "shape"),
         (np.full((40, 141), np.nan), "values"),
-        (np.array([{"a": 1}], dtype=object), None),  # a pickled object: refused, never unpickled
+        (np.array([{"a": 1}], dtype=object), "dtype"),  # a pickled object: refused, never unpickled
         (np.zeros((40, 42, 3)), "values"),  # zero direction vectors
     ],
 )
@@ -273,6 +277,138 @@ def test_bad_npy_files_are_format_errors(array, field, tmp_path):
     with pytest.raises(FormatError) as info:
         read_prediction(path)
     assert info.value.field == field and info.value.path == path
+
+
+def test_npy_files_whose_header_or_values_cannot_be_read_are_format_errors(tmp_path):
+    import gzip
+    import io
+
+    header = io.BytesIO()  # a header claiming 10^11 frames in a 250 kB file: refused before allocating 113 TB
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (10**11, 141)}
+    )
+    (tmp_path / "huge.npy").write_bytes(header.getvalue() + bytes(250_000))
+    np.save(tmp_path / "long.npy", np.ones((40, 42, 3)) * 1e200)  # finite, but its norms overflow
+    np.save(tmp_path / "plain.npy", np.ones((40, 141)))
+    (tmp_path / "gz.npy").write_bytes(gzip.compress((tmp_path / "plain.npy").read_bytes()))
+    cases = {"huge": ("shape", "needs 112800000000000 bytes, the file holds 250000"),
+             "long": ("values", "too long to normalise"), "gz": (None, "gzip")}  # fmt: skip
+    for name, (field, text) in cases.items():
+        with pytest.raises(FormatError) as info:
+            read_prediction(tmp_path / f"{name}.npy")
+        assert info.value.field == field and text in str(info.value), (name, str(info.value))
+
+
+def _rewritten(src: Path, dst: Path, change: Any) -> None:
+    """Every BVH of ``src`` written to ``dst`` with ``change(skeleton, channels)`` applied."""
+    dst.mkdir()
+    for path in sorted(src.glob("*.bvh")):
+        m = read_bvh(path)
+        write_bvh(dst / path.name, Motion(*change(m.skeleton, m.channels.copy()), m.fps), precision=12)
+
+
+def test_euler_angles_written_from_matrices_score_as_the_ground_truth(truth_files, test_set, tmp_path):
+    """A model that writes its rotations through matrices (scipy's as_euler) puts every joint on |Y| <= 90° in
+    (-180, 180], where the ground truth's tracks are continuous: the same motion must score as the ground truth in
+    the Euler metrics too (before: FGD (BEAT AE) 5.5e7, the reference L1div 472 against 311)."""
+
+    def principal(skel: Skeleton, ch: np.ndarray) -> tuple[Skeleton, np.ndarray]:
+        for j in range(skel.n_joints):
+            cols = skel.rotation_channel_indices(j)
+            ch[:, cols] = matrix_to_euler(euler_to_matrix(ch[:, cols], "XYZ"), "XYZ")
+        for name in JOINT_SUBSETS["spine_neck_141"][3:5]:  # and 360° turns of two joints, every other frame
+            ch[::2, skel.rotation_channel_indices(skel.index(name))] += 360.0
+        return skel, ch
+
+    _rewritten(truth_files, tmp_path / "pred", principal)
+    keys = ["FGD (BEAT AE)", "SRGR (reference)", "L1div (reference)", "MPJPE"]
+    with pytest.warns(ScoreWarning, match="equivalent angles nearest the ground truth's"):
+        result = score_folder(tmp_path / "pred", test=test_set, metrics=keys)
+    n_frames = sum(len(d) for d in test_set.gt_directions)
+    assert n_frames < result.info["euler_rewritten"] < 47 * n_frames  # the turns, and some other branches
+    got, own = result.evaluation.values(), result.truth.values()
+    assert got["FGD (BEAT AE)"] < 1e-6 and got["MPJPE"] < 1e-4
+    for key in ("SRGR (reference)", "L1div (reference)"):
+        assert got[key] == pytest.approx(own[key], rel=1e-6), key
+    plain = score_folder(
+        truth_files, test=test_set, metrics=keys[:1]
+    )  # already the truth's angles: untouched
+    assert plain.info["euler_rewritten"] == 0
+
+
+def test_a_rotated_root_above_hips_turns_the_body(truth_files, test_set, tmp_path):
+    """A root joint above Hips (e.g. a Z-up to Y-up correction) turns the whole body: read as the same turn on
+    Hips. A root at rest changes nothing."""
+    stem = test_set.takes[0]
+    m = read_bvh(truth_files / f"{stem}.bvh")
+    skel, zxy = m.skeleton, ("Zrotation", "Xrotation", "Yrotation")
+    above = Skeleton(("Reference", *skel.names), np.concatenate([[-1], np.asarray(skel.parents) + 1]),
+                     np.vstack([[0.0, 0.0, 0.0], skel.offsets]), (zxy, *skel.channels))  # fmt: skip
+    for turn in (0.0, 90.0):
+        rows = np.hstack([np.tile([turn, 0.0, 0.0], (m.n_frames, 1)), m.channels])  # Z by `turn` degrees
+        write_bvh(tmp_path / "above.bvh", Motion(above, rows, m.fps), precision=12)
+        on_hips = m.channels.copy()
+        hips = skel.rotation_channel_indices(0)
+        rz = euler_to_matrix(np.array([turn, 0.0, 0.0]), "ZXY")
+        on_hips[:, hips] = matrix_to_euler(rz @ euler_to_matrix(on_hips[:, hips], "XYZ"), "XYZ")
+        write_bvh(tmp_path / "hips.bvh", Motion(skel, on_hips, m.fps), precision=12)
+        with pytest.warns(ScoreWarning, match="Reference"):
+            got = read_prediction(tmp_path / "above.bvh")
+        want = read_prediction(tmp_path / "hips.bvh")
+        np.testing.assert_allclose(got.directions, want.directions, atol=1e-9, err_msg=f"{turn}°")
+        if turn == 0.0:
+            np.testing.assert_allclose(got.directions, test_set.gt_directions[0], atol=1e-5)
+        else:
+            assert np.abs(got.directions - test_set.gt_directions[0]).max() > 0.5  # turned, not ignored
+
+
+def test_match_predictions_skips_hidden_files_and_lists_the_rest(tmp_path):
+    names = [
+        "a.bvh",
+        "b.BVH",
+        "._a.bvh",
+        "._c.bvh",
+        ".DS_Store",
+        "model.bvh",
+        "model.npy",
+        "c.bvh.bak",
+        "x.txt",
+    ]
+    for name in names:
+        (tmp_path / name).write_bytes(b"")
+    files, missing, extra = match_predictions(tmp_path, ["a", "b", "c"])
+    assert {k: p.name for k, p in files.items()} == {"a": "a.bvh", "b": "b.BVH"} and missing == ["c"]
+    assert extra == ["c.bvh.bak", "model.bvh", "model.npy", "x.txt"]  # two of a stem of no take: no error
+    (tmp_path / "a.npy").write_bytes(b"")
+    with pytest.raises(ScoreInputError, match="several predictions"):
+        match_predictions(tmp_path, ["a", "b", "c"])
+
+
+def test_cli_mistakes_are_one_error_line(truth_files, tmp_path, capsys):
+    data = str(REPO / "data_samples")
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "a_folder").mkdir()
+    cases = {
+        "--json a folder": (
+            [str(truth_files), "--data", data, "--json", str(tmp_path / "a_folder")],
+            "--json",
+        ),
+        "--md in no folder": (
+            [str(truth_files), "--data", data, "--md", str(tmp_path / "no" / "x.md")],
+            "--md",
+        ),
+        "--bootstrap -1": ([str(truth_files), "--data", data, "--bootstrap", "-1"], "--bootstrap -1"),
+        "no such split": ([str(truth_files), "--data", data, "--split", "nosuch"], "'nosuch' split"),
+        "nothing to score": (
+            [str(tmp_path / "empty"), "--data", data, "--allow-missing"],
+            "any of the 8 takes",
+        ),
+    }
+    for label, (argv, text) in cases.items():
+        assert main(argv) == 2, label
+        err = capsys.readouterr().err.strip().splitlines()
+        errors = [line for line in err if line.startswith("error: ")]
+        assert len(errors) == 1 and text in errors[0] and "Traceback" not in "\n".join(err), (label, err)
 
 
 # ----------------------------------------------------------------------------- the folder
