@@ -168,6 +168,20 @@ def test_incremental_rebuild(corpus: Path, store: WindowStore, tmp_path: Path) -
     assert all(v != times[s] for s, v in _meta_times(WindowStore.open(folder)).items())
 
 
+def test_takes_used_despite_a_readers_warning_are_named(corpus: Path, tmp_path: Path) -> None:
+    """A BVH missing half its rows (header unchanged) is read at half the rate (index_folder's warning): the build
+    says so, naming the take, instead of training on it silently."""
+    stem = "2_scott_0_9_9"
+    lines = (corpus / f"{stem}.bvh").read_text().splitlines()
+    start = lines.index("MOTION") + 3
+    (corpus / f"{stem}.bvh").write_text("\n".join(lines[: start + (len(lines) - start) // 2]) + "\n")
+    with pytest.warns(
+        UserWarning, match=rf"1 takes are used although their readers warned \({stem}\).*7.5 fps"
+    ):
+        store = build_store(index_folder(corpus), tmp_path / "store", vocab=VOCAB, workers=0)
+    assert stem in [t.stem for t in store.takes]  # used: the warning is the only sign
+
+
 def test_parallel_build_equals_serial(corpus: Path, store: WindowStore, tmp_path: Path) -> None:
     par = build_store(index_folder(corpus), tmp_path / "par", vocab=VOCAB, workers=2, progress=True)
     a, b = store.windows(None).batch(), par.windows(None).batch()

@@ -946,6 +946,16 @@ def _usable_records(index: TakeIndex) -> list[TakeRecord]:
         warnings.warn(f"build_store: skipping {len(skipped)} unusable takes: {skipped[:5]}", stacklevel=3)
     if not records:
         raise ValueError(f"build_store: no usable takes ({len(index)} takes indexed)")
+    noted = [
+        (r.stem, p.removeprefix("warning: ")) for r in records for p in r.problems if p.startswith("warning:")
+    ]
+    if noted:  # e.g. a BVH with fewer rows than its header says, read at the rate its audio implies
+        stems = sorted({stem for stem, _ in noted})
+        warnings.warn(
+            f"build_store: {len(stems)} takes are used although their readers warned ({', '.join(stems[:5])}); "
+            f"the first: {noted[0][1]}",
+            stacklevel=3,
+        )
     return records
 
 
