@@ -309,6 +309,41 @@ def test_fit_command_writes_only_under_out(tmp_path):
     assert full["best"] is not None  # the validation FGD scored the epoch
 
 
+def small_corpus(root, stems):
+    """The ``data_samples/`` takes ``stems`` copied into the new folder ``root``."""
+    import shutil
+
+    from beatlite.paths import repo_root
+
+    root.mkdir()
+    for stem in stems:
+        for src in (repo_root() / "data_samples").glob(f"{stem}.*"):
+            shutil.copy(src, root)
+    return root
+
+
+def test_training_data_reads_the_words_of_usable_takes_only(tmp_path, monkeypatch):
+    """A malformed TextGrid makes its take unusable; ``training_data`` (what ``fit`` prepares) then skips its
+    words as the windows skip its frames, instead of failing to read them: the vocabulary is that of the
+    other takes' TextGrids, read here one by one."""
+    from beatlite.data.vocab import vocab_from_sentences
+    from beatlite.io import read_words
+    from beatlite.train.recipes import training_data
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    good, bad = ["2_scott_0_9_9", "2_scott_0_57_57"], "2_scott_0_10_10"
+    root = small_corpus(tmp_path / "corpus", [*good, bad])
+    (root / f"{bad}.TextGrid").write_text(
+        'File type = "ooTextFile"\nObject class = "TextGrid"\nxmin = 0\nxmax = garbage\n'
+    )
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        data = training_data(root)
+    assert not data.index[bad].usable and all(data.index[stem].usable for stem in good)
+    expected = [list(read_words(root / f"{stem}.TextGrid").words) for stem in good]
+    assert data.vocab.itos == vocab_from_sentences(expected).itos
+    assert len(data.sentences) == 2
+
+
 class _Stop(Exception):
     """Raised by a stand-in ``fit``, with the config it was given."""
 

@@ -379,12 +379,14 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     """Index ``data`` (default ``$BEATLITE_DATA``; cached), build or update its window store
     (:func:`beatlite.data.store.build_store`, only changed takes) and open its train/val windows.
 
-    ``progress`` shows the store's tqdm bar over the takes it builds.
+    ``progress`` shows the store's tqdm bar over the takes it builds. The vocabulary and the word vectors'
+    sentences come from the usable takes only, as the windows do (an unusable take's TextGrid may not read).
     """
 
     root = Path(data) if data is not None else paths.data_dir()
     index = index_folder(root)
-    vocab = build_vocab(index)
+    usable = index.where(usable=True)
+    vocab = build_vocab(usable)
     store = build_store(index, vocab=vocab, progress=progress)
     train = store.windows("train", vocab=vocab)
     val = store.windows("val", vocab=vocab, stats=train.normalizers)
@@ -393,7 +395,7 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
         "vocab": list(vocab.itos),
         "data": str(root),
     }
-    return TrainingData(index, vocab, train, val, take_sentences(index), meta, store)
+    return TrainingData(index, vocab, train, val, take_sentences(usable), meta, store)
 
 
 def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> Any:
