@@ -377,6 +377,29 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
         assert stopped.value.args[0].deterministic is expected
 
 
+def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkeypatch, capsys):
+    """A ``ResumeError`` of ``fit --resume`` (data, model or batch plan changed) ends the command with exit 2 and
+    its message on one ``error:`` line, no traceback (data and training stood in for)."""
+    import types
+
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+    from beatlite.train import recipes, training
+
+    def refusing_fit(model, train, config, val=None, **kw):
+        raise training.ResumeError("fit: cannot resume from x.pt: changed: batch_size 32 -> 64")
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = types.SimpleNamespace(train=None, val=None, meta={})
+    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
+    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
+    monkeypatch.setattr(training, "fit", refusing_fit)
+    argv = ["fit", "s2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(tmp_path / "run")]
+    assert command.main([*argv, "--epochs", "0", "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
+
+
 def test_fit_command_refuses_inductor_for_a_model_stating_a_failure_before_preparing_anything(
     tmp_path, capsys, monkeypatch
 ):

@@ -208,13 +208,12 @@ def _fit_command(args: argparse.Namespace) -> int:
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
 
-    from beatlite.train.training import check_compilable  # (imports torch)
+    from beatlite.train.training import ResumeError, check_compilable  # (imports torch)
 
     try:  # before anything is prepared or written
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
     except ValueError as error:
-        print(error, file=sys.stderr)
-        return 2
+        return _refused(error)
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
     os.environ.setdefault(
@@ -228,27 +227,36 @@ def _fit_command(args: argparse.Namespace) -> int:
         with exclusive_lock(out / ".fgd_dirvec.lock"):
             if not extractor.is_file():
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
-    seconds = retrain(
-        args.recipe,
-        seed=args.seed,
-        epochs=args.epochs,
-        out_dir=out,
-        data=data,
-        resume=args.resume,
-        device=args.device,
-        extractor=extractor,
-        checkpoint_every=args.checkpoint_every,
-        batch_size=args.batch_size,
-        data_on_device=args.data_on_device,
-        amp=args.precision == "bf16",
-        compile=args.compile,
-        val_every=args.val_every,
-        deterministic=not args.nondeterministic,
-        lr_scaling=args.lr_scaling,
-    )
+    try:
+        seconds = retrain(
+            args.recipe,
+            seed=args.seed,
+            epochs=args.epochs,
+            out_dir=out,
+            data=data,
+            resume=args.resume,
+            device=args.device,
+            extractor=extractor,
+            checkpoint_every=args.checkpoint_every,
+            batch_size=args.batch_size,
+            data_on_device=args.data_on_device,
+            amp=args.precision == "bf16",
+            compile=args.compile,
+            val_every=args.val_every,
+            deterministic=not args.nondeterministic,
+            lr_scaling=args.lr_scaling,
+        )
+    except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
+        return _refused(error)
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
     return 0
+
+
+def _refused(error: Exception) -> int:
+    """Print why ``fit`` refuses to run as one ``error:`` line on stderr; the exit status 2."""
+    print(f"error: {error}", file=sys.stderr)
+    return 2
 
 
 def _train_extractor(data_dir: object, path: object, epochs: int) -> None:
