@@ -952,15 +952,17 @@ def _usable_records(index: TakeIndex) -> list[TakeRecord]:
 def _write_manifest(
     folder: Path, index: TakeIndex, records: list[TakeRecord], params: dict, vocab: Vocab | None
 ) -> None:
-    """``store.json``: version, parameters, takes and vocabulary (``build_vocab(index)``, reused while no
-    TextGrid of the index changed)."""
+    """``store.json``: version, parameters, takes and vocabulary (``build_vocab`` of the stored (usable) takes,
+    reused while none of their TextGrids changed; an unusable take's may not read)."""
+    from beatlite.data.index import TakeIndex
     from beatlite.data.vocab import build_vocab
     from beatlite.io.atomic import atomic_write
 
     text_fp = None
     if vocab is None:
-        text_fp = _text_fingerprint(index)
-        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(index)
+        stored = TakeIndex(records, index.root)
+        text_fp = _text_fingerprint(stored)
+        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(stored)
     manifest = {
         "version": STORE_VERSION,
         "params": params,
@@ -1003,7 +1005,7 @@ def build_store(
     word_rule : {"span", "onset", "beat"}
         Word-to-frame rule.
     vocab : Vocab, optional
-        Default :func:`beatlite.data.vocab.build_vocab` of the whole index (as ``build_windows``).
+        Default :func:`beatlite.data.vocab.build_vocab` of the usable takes (the ones stored).
     workers : int, optional
         Worker processes (spawned; 0 or 1: in this process). Default
         :func:`beatlite.data.index.default_workers` of the files to read: ``os.cpu_count()`` for a
