@@ -400,6 +400,52 @@ def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkey
     assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
 
 
+def test_fit_command_trains_the_extractor_again_for_other_data_or_epochs(tmp_path, monkeypatch, capsys):
+    """``<out>/fgd_dirvec.pt`` is kept while its recorded data fingerprint and epochs are this run's train
+    windows' and ``--extractor-epochs``, trained again (saying why) when either changes (data, extractor
+    training and model training stood in for)."""
+    import types
+
+    from beatlite.metrics.extractor import ExtractorConfig, MotionAutoencoder, save_extractor
+    from beatlite.train import __main__ as command
+
+    trained = []
+
+    def stand_in_train_extractor(data_dir, path, epochs):
+        trained.append((data.train.fingerprint, epochs))
+        model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8, epochs=epochs))
+        info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}
+        save_extractor(path, model, info, space="dirvec", meta={"data_fingerprint": data.train.fingerprint})
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = types.SimpleNamespace(train=types.SimpleNamespace(fingerprint="a" * 16), val=None, meta={})
+    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
+    monkeypatch.setattr(command, "_train_extractor", stand_in_train_extractor)
+    monkeypatch.setattr(command, "retrain", lambda name, **kw: 0.0)
+    out = tmp_path / "run"
+    argv = [
+        "fit",
+        "s2g_tiny",
+        "--data",
+        str(tmp_path / "corpus"),
+        "--out",
+        str(out),
+        "--extractor-epochs",
+        "3",
+    ]
+    for _ in range(2):
+        assert command.main(argv) == 0
+    assert trained == [("a" * 16, 3)]  # once, then kept
+    assert "stale" not in capsys.readouterr().out
+    data.train.fingerprint = "b" * 16  # another corpus fitted into the same --out
+    assert command.main(argv) == 0
+    assert trained[-1] == ("b" * 16, 3)
+    assert f"trained on data {'a' * 16}, the train windows are {'b' * 16}" in capsys.readouterr().out
+    assert command.main([*argv[:-1], "5"]) == 0
+    assert trained[-1] == ("b" * 16, 5) and len(trained) == 3
+    assert "trained for 3 epochs, --extractor-epochs is 5" in capsys.readouterr().out
+
+
 def test_fit_command_refuses_inductor_for_a_model_stating_a_failure_before_preparing_anything(
     tmp_path, capsys, monkeypatch
 ):

@@ -6,7 +6,8 @@
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
 float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
-are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
+are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once;
+again when the train windows' fingerprint or ``--extractor-epochs`` changed)
 for the per-epoch validation FGD (``--val-every N``: every N optimiser steps instead).
 
 ``retrain-all [--only NAME ...] [--seed S] [--jobs J]`` rebuilds every shipped checkpoint of
@@ -128,7 +129,7 @@ def _parser() -> argparse.ArgumentParser:
         "--extractor-epochs",
         type=int,
         default=100,
-        help="epochs of the FGD extractor trained for new data (once)",
+        help="epochs of the FGD extractor trained for new data (once; again for other data or epochs)",
     )
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
     p.add_argument("--seed", type=int, help="default: each recipe's shipped seed in the recorded seed table")
@@ -203,7 +204,8 @@ def _fit_command(args: argparse.Namespace) -> int:
     """``fit``: one recipe on ``--data``, every file under ``--out``.
 
     The data are prepared before any process group exists: the window store (built once, then only
-    changed takes) and, for data other than ``data_samples/``, the FGD extractor (trained once). Under
+    changed takes) and, for data other than ``data_samples/``, the FGD extractor (trained once, again for other
+    data or ``--extractor-epochs``). Under
     ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
@@ -225,7 +227,10 @@ def _fit_command(args: argparse.Namespace) -> int:
     if data_dir != (paths.repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
         with exclusive_lock(out / ".fgd_dirvec.lock"):
-            if not extractor.is_file():
+            stale = _stale_extractor(extractor, data.train.fingerprint, args.extractor_epochs)
+            if stale is not None:
+                if extractor.is_file():
+                    print(f"{extractor} is stale ({stale}): training it again", flush=True)
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
     try:
         seconds = retrain(
@@ -257,6 +262,22 @@ def _refused(error: Exception) -> int:
     """Print why ``fit`` refuses to run as one ``error:`` line on stderr; the exit status 2."""
     print(f"error: {error}", file=sys.stderr)
     return 2
+
+
+def _stale_extractor(path: Path, fingerprint: str, epochs: int) -> str | None:
+    """Why the FGD extractor at ``path`` is not the one ``fit`` would train on train windows of data
+    ``fingerprint`` for ``epochs`` epochs (none yet, other data, other epochs); None when it is."""
+    if not path.is_file():
+        return "none yet"
+    from beatlite.metrics.extractor import load_extractor
+
+    found = load_extractor("dirvec", path)
+    trained_on, trained_for = found.meta.get("data_fingerprint"), found.model.config.epochs
+    if trained_on != fingerprint:
+        return f"trained on data {trained_on}, the train windows are {fingerprint}"
+    if trained_for != epochs:
+        return f"trained for {trained_for} epochs, --extractor-epochs is {epochs}"
+    return None
 
 
 def _train_extractor(data_dir: object, path: object, epochs: int) -> None:
