@@ -364,17 +364,48 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
     monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
     monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
     monkeypatch.setattr(training, "fit", stand_in_fit)
-    argv = ["fit", "s2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(tmp_path / "run")]
+    # (a recipe without best-epoch selection: no extractor or validation takes to stand in for)
+    argv = [
+        "fit",
+        "diffgesture_tiny",
+        "--data",
+        str(repo_root() / "data_samples"),
+        "--out",
+        str(tmp_path / "run"),
+    ]
     for extra, expected in (([], None), (["--val-every", "25"], 25)):
         with pytest.raises(_Stop) as stopped:
-            command.main([*argv, "--epochs", "0", *extra])
+            command.main([*argv, "--epochs", "1", *extra])
         assert stopped.value.args[0].val_every == expected
-    with pytest.raises(ValueError, match="val_every must be >= 1"):
-        command.main([*argv, "--epochs", "0", "--val-every", "0"])
     for extra, expected in (([], True), (["--nondeterministic"], False)):
         with pytest.raises(_Stop) as stopped:
-            command.main([*argv, "--epochs", "0", *extra])
+            command.main([*argv, "--epochs", "1", *extra])
         assert stopped.value.args[0].deterministic is expected
+
+
+def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path, monkeypatch, capsys):
+    """Values ``TrainConfig`` refuses, zero epochs of a recipe that trains and CUDA on a machine without it stop
+    ``fit`` at once: exit 2, one ``error:`` line naming the value, nothing indexed or written under ``--out``."""
+    torch = pytest.importorskip("torch")
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+
+    def no_data(folder, progress):
+        raise AssertionError("the data were prepared")
+
+    monkeypatch.setattr(command, "training_data", no_data)
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    out = tmp_path / "run"
+    argv = ["fit", "camn_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
+    cases = ((["--checkpoint-every", "0"], "checkpoint_every must be >= 1"),
+             (["--batch-size", "1"], "batch_size must be >= 2"), (["--val-every", "0"], "val_every must be >= 1"),
+             (["--epochs", "-1"], "epochs must be >= 0"),
+             (["--device", "cuda"], "device 'cuda' asked for CUDA"))  # fmt: skip
+    for extra, said in cases:
+        assert command.main([*argv, *extra]) == 2, extra
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and said in err and err.count("\n") == 1, (extra, err)
+    assert not out.exists()
 
 
 def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkeypatch, capsys):
@@ -394,8 +425,15 @@ def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkey
     monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
     monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
     monkeypatch.setattr(training, "fit", refusing_fit)
-    argv = ["fit", "s2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(tmp_path / "run")]
-    assert command.main([*argv, "--epochs", "0", "--resume"]) == 2
+    argv = [
+        "fit",
+        "diffgesture_tiny",
+        "--data",
+        str(repo_root() / "data_samples"),
+        "--out",
+        str(tmp_path / "run"),
+    ]
+    assert command.main([*argv, "--epochs", "1", "--resume"]) == 2
     err = capsys.readouterr().err
     assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
 

@@ -46,7 +46,7 @@ from beatlite.io.atomic import atomic_write, exclusive_lock
 from beatlite.models import model_class
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
-from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
+from beatlite.train.recipes import RECIPES, SEED, recipe_train_config, retrain, retrain_many, training_data
 from beatlite.train.seeds import (
     evaluate_seeds,
     recorded_seed_results,
@@ -212,7 +212,22 @@ def _fit_command(args: argparse.Namespace) -> int:
 
     from beatlite.train.training import ResumeError, check_compilable  # (imports torch)
 
-    try:  # before anything is prepared or written
+    options = {
+        "seed": args.seed,
+        "epochs": args.epochs,
+        "resume": args.resume,
+        "device": args.device,
+        "checkpoint_every": args.checkpoint_every,
+        "batch_size": args.batch_size,
+        "data_on_device": args.data_on_device,
+        "amp": args.precision == "bf16",
+        "compile": args.compile,
+        "val_every": args.val_every,
+        "deterministic": not args.nondeterministic,
+        "lr_scaling": args.lr_scaling,
+    }
+    try:  # before anything is prepared or written: the flags' values, the device, the compiler
+        recipe_train_config(args.recipe, **options)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
     except ValueError as error:
         return _refused(error)
@@ -233,24 +248,7 @@ def _fit_command(args: argparse.Namespace) -> int:
                     print(f"{extractor} is stale ({stale}): training it again", flush=True)
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
     try:
-        seconds = retrain(
-            args.recipe,
-            seed=args.seed,
-            epochs=args.epochs,
-            out_dir=out,
-            data=data,
-            resume=args.resume,
-            device=args.device,
-            extractor=extractor,
-            checkpoint_every=args.checkpoint_every,
-            batch_size=args.batch_size,
-            data_on_device=args.data_on_device,
-            amp=args.precision == "bf16",
-            compile=args.compile,
-            val_every=args.val_every,
-            deterministic=not args.nondeterministic,
-            lr_scaling=args.lr_scaling,
-        )
+        seconds = retrain(args.recipe, out_dir=out, data=data, extractor=extractor, **options)
     except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
         return _refused(error)
     if rank == 0:

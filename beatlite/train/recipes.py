@@ -456,6 +456,64 @@ def scaled_lr(recipe: Recipe, batch_size: int, rule: str = "linear") -> float | 
     return base * (ratio if rule == "linear" else math.sqrt(ratio))
 
 
+def recipe_train_config(
+    name: str,
+    *,
+    seed: int = SEED,
+    epochs: int | None = None,
+    checkpoint: str | Path | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    device: str = "cpu",
+    checkpoint_every: int | None = None,
+    batch_size: int | None = None,
+    data_on_device: str = "auto",
+    amp: bool = False,
+    compile: str | None = None,  # noqa: A002
+    val_every: int | None = None,
+    deterministic: bool = True,
+    lr_scaling: str = "linear",
+) -> TrainConfig:
+    """The :class:`~beatlite.train.TrainConfig` :func:`retrain` trains recipe ``name`` with (its parameters;
+    ``checkpoint``: the full checkpoint's path), with the device resolved: what the ``fit`` command checks
+    before it indexes anything.
+
+    Raises
+    ------
+    ValueError
+        An unknown recipe, a value ``TrainConfig`` refuses or a device this machine lacks
+        (:meth:`~beatlite.train.TrainConfig.torch_device`).
+
+    Examples
+    --------
+    >>> config = recipe_train_config("camn_tiny", batch_size=64, lr_scaling="sqrt")
+    >>> config.epochs == RECIPES["camn_tiny"].epochs, config.lr == scaled_lr(RECIPES["camn_tiny"], 64, "sqrt")
+    (True, True)
+    """
+    recipe = _recipe(name)
+    epochs = recipe.epochs if epochs is None else int(epochs)
+    batch = recipe.batch_size if batch_size is None else int(batch_size)
+    config = TrainConfig(
+        epochs=epochs,
+        batch_size=batch,
+        lr=scaled_lr(recipe, batch, lr_scaling),
+        lr_schedule=recipe.lr_schedule,
+        seed=seed,
+        checkpoint=checkpoint,
+        resume=resume,
+        progress=progress,
+        device=device,
+        checkpoint_every=checkpoint_every,
+        data_on_device=data_on_device,
+        amp=amp,
+        compile=compile,
+        val_every=val_every,
+        deterministic=deterministic,
+    )
+    config.torch_device()
+    return config
+
+
 def retrain(
     name: str,
     *,
@@ -532,30 +590,29 @@ def retrain(
     from beatlite.train.training import fit
 
     recipe = _recipe(name)
-    data = training_data() if data is None else data
-    model = build_recipe_model(name, data, seed=seed)
     if out_dir is None:
         export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
     else:
         export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
-    batch = recipe.batch_size if batch_size is None else int(batch_size)
-    config = TrainConfig(
-        epochs=recipe.epochs if epochs is None else epochs,
-        batch_size=batch,
-        lr=scaled_lr(recipe, batch, lr_scaling),
-        lr_schedule=recipe.lr_schedule,
+    config = recipe_train_config(
+        name,
         seed=seed,
+        epochs=epochs,
         checkpoint=full,
         resume=resume,
         progress=progress,
         device=device,
         checkpoint_every=checkpoint_every,
+        batch_size=batch_size,
         data_on_device=data_on_device,
         amp=amp,
         compile=compile,
         val_every=val_every,
         deterministic=deterministic,
-    )
+        lr_scaling=lr_scaling,
+    )  # bad values raise here, before any data work
+    data = training_data() if data is None else data
+    model = build_recipe_model(name, data, seed=seed)
     score = None
     if recipe.select_best and config.epochs > 0:
         from beatlite.metrics.extractor import load_extractor
