@@ -389,6 +389,7 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
     torch = pytest.importorskip("torch")
     from beatlite.paths import repo_root
     from beatlite.train import __main__ as command
+    from beatlite.train.recipes import recipe_train_config
 
     def no_data(folder, progress):
         raise AssertionError("the data were prepared")
@@ -399,13 +400,14 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
     argv = ["fit", "camn_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
     cases = ((["--checkpoint-every", "0"], "checkpoint_every must be >= 1"),
              (["--batch-size", "1"], "batch_size must be >= 2"), (["--val-every", "0"], "val_every must be >= 1"),
-             (["--epochs", "-1"], "epochs must be >= 0"),
+             (["--epochs", "-1"], "epochs must be >= 0"), (["--epochs", "0"], "camn_tiny: epochs must be >= 1"),
              (["--device", "cuda"], "device 'cuda' asked for CUDA"))  # fmt: skip
     for extra, said in cases:
         assert command.main([*argv, *extra]) == 2, extra
         err = capsys.readouterr().err
         assert err.startswith("error: ") and said in err and err.count("\n") == 1, (extra, err)
     assert not out.exists()
+    assert recipe_train_config("random_clip", epochs=0).epochs == 0  # an untrained baseline: nothing to train
 
 
 def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkeypatch, capsys):

@@ -82,7 +82,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("recipe", choices=sorted(RECIPES))
     f.add_argument("--data", required=True, help="BEAT-format folder ({speaker_id}/{stem}.bvh, .wav, ...)")
     f.add_argument("--out", required=True, help="output folder (created; the repository is never written)")
-    f.add_argument("--epochs", type=int, help="default: the recipe's")
+    f.add_argument("--epochs", type=int, help="default: the recipe's (>= 1 for a recipe that trains)")
     f.add_argument("--seed", type=int, default=SEED)
     f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")

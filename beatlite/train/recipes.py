@@ -481,17 +481,26 @@ def recipe_train_config(
     Raises
     ------
     ValueError
-        An unknown recipe, a value ``TrainConfig`` refuses or a device this machine lacks
-        (:meth:`~beatlite.train.TrainConfig.torch_device`).
+        An unknown recipe, a value ``TrainConfig`` refuses, a device this machine lacks
+        (:meth:`~beatlite.train.TrainConfig.torch_device`), or ``epochs < 1`` for a recipe that trains (its
+        ``epochs > 0``: zero epochs would export weights never trained).
 
     Examples
     --------
     >>> config = recipe_train_config("camn_tiny", batch_size=64, lr_scaling="sqrt")
     >>> config.epochs == RECIPES["camn_tiny"].epochs, config.lr == scaled_lr(RECIPES["camn_tiny"], 64, "sqrt")
     (True, True)
+    >>> recipe_train_config("camn_tiny", epochs=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: camn_tiny: epochs must be >= 1 (the recipe's: 40); 0 epochs would export untrained weights
     """
     recipe = _recipe(name)
     epochs = recipe.epochs if epochs is None else int(epochs)
+    if recipe.epochs > 0 and epochs == 0:
+        raise ValueError(
+            f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); 0 epochs would export untrained weights"
+        )
     batch = recipe.batch_size if batch_size is None else int(batch_size)
     config = TrainConfig(
         epochs=epochs,
