@@ -641,6 +641,9 @@ class StoreWindows:
         positions = {t.stem: i for i, t in enumerate(store.takes)}
         ids, starts = [], []
         chosen = store._select(split) if stems is None else [store.take(stem) for stem in stems]
+        self._stems = [
+            t.stem for t in chosen
+        ]  # windows or not: a short train take still feeds the statistics
         for t in chosen:
             s = window_starts(t.n_frames, int(length), int(stride))
             ids.append(np.full(len(s), positions[t.stem], np.int64))
@@ -665,10 +668,11 @@ class StoreWindows:
         parameters (:func:`beatlite.data.fingerprint.windows_fingerprint`: the takes' files by content,
         overrides, store parameters, split, length, stride, vocabulary). What
         :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data.
-        The statistics are left out (their float bits vary across machines; they derive from the takes)."""
-        stems = [self.store.takes[int(i)].stem for i in np.unique(self.take_ids)]
+        The takes are all those of the view, a take shorter than one window too (a train take feeds the
+        statistics). The statistics are left out (their float bits vary across machines; they derive from the
+        takes)."""
         return self.store.windows_fingerprint(
-            stems,
+            self._stems,
             split=self.params["split"],
             length=self.length,
             stride=self.params["stride"],
