@@ -86,12 +86,12 @@ def test_both_window_routes_give_one_fingerprint(tmp_path: Path) -> None:
 
 
 def test_a_train_take_shorter_than_one_window_is_in_the_fingerprint(tmp_path: Path) -> None:
-    """A 25-frame train take gives no 34-frame window but enters the train statistics: the windows it is added
+    """A 30-frame train take gives no 34-frame window but enters the train statistics: the windows it is added
     to are the same windows with other values, so they get another fingerprint (a checkpoint does not resume on
     them), the same on both routes."""
     root = make_corpus(tmp_path / "corpus")
     before = build_store(index_folder(root), tmp_path / "a", vocab=VOCAB, workers=0).windows("train")
-    write_take(root, "2_scott_0_66_66", 25)
+    write_take(root, "2_scott_0_66_66", 30)
     index = index_folder(root)
     assert index["2_scott_0_66_66"].usable and index["2_scott_0_66_66"].split == "train"
     after = build_store(index, tmp_path / "b", vocab=VOCAB, workers=0).windows("train")
