@@ -655,6 +655,22 @@ def test_a_save_killed_midway_leaves_no_temp_file_after_the_next_save(windows, t
     assert load_checkpoint(tmp_path / "c.pt")["state"] == {}
 
 
+def test_a_truncated_checkpoint_is_said_to_be_truncated_not_legacy(windows, tmp_path):
+    """A checkpoint cut short (a copy or a write that stopped) or empty: a FormatError naming the file that says
+    so, not the advice to convert a legacy pickle (which fails on it too)."""
+    from beatlite.io import FormatError
+    from beatlite.train.checkpoint import load_checkpoint
+
+    train, _ = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "full.pt"))
+    whole = (tmp_path / "full.pt").read_bytes()
+    for size in (len(whole) // 2, len(whole) - 10, 100, 0):
+        (tmp_path / "cut.pt").write_bytes(whole[:size])
+        with pytest.raises(FormatError, match="truncated or corrupted file") as refused:
+            load_checkpoint(tmp_path / "cut.pt")
+        assert str(tmp_path / "cut.pt") in str(refused.value) and "convert_legacy" not in str(refused.value)
+
+
 def test_convert_legacy_needs_trust_and_writes_a_plain_copy(windows, tmp_path):
     import pathlib
 
