@@ -344,6 +344,23 @@ def test_training_data_reads_the_words_of_usable_takes_only(tmp_path, monkeypatc
     assert len(data.sentences) == 2
 
 
+def test_fit_command_says_when_the_corpus_has_no_val_take(tmp_path, monkeypatch, capsys):
+    """Two train takes and no val take: ``fit`` stops with one ``error:`` line saying the val split is empty
+    and which takes BEAT's names put there (not a window store's "no take ... is at least 34 frames long")."""
+    from beatlite.train import __main__ as command
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    root = small_corpus(tmp_path / "corpus", ["2_scott_0_9_9", "2_scott_0_10_10"])
+    out = tmp_path / "run"
+    assert command.main(["fit", "s2g_tiny", "--data", str(root), "--out", str(out), "--epochs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith(f"error: training_data: {root} has no usable take of the 'val' split")
+        and err.count("\n") == 1
+    )
+    assert "57-64" in err and not (out / "fgd_dirvec.pt").exists()
+
+
 class _Stop(Exception):
     """Raised by a stand-in ``fit``, with the config it was given."""
 

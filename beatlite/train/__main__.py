@@ -237,7 +237,10 @@ def _fit_command(args: argparse.Namespace) -> int:
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
     rank = int(os.environ.get("RANK", "0"))
-    data = training_data(data_dir, progress=rank == 0)
+    try:
+        data = training_data(data_dir, progress=rank == 0)
+    except ValueError as error:  # no val takes, no usable take, a file that cannot be read (FormatError)
+        return _refused(error)
     extractor = None
     if data_dir != (paths.repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"

@@ -379,13 +379,21 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     """Index ``data`` (default ``$BEATLITE_DATA``; cached), build or update its window store
     (:func:`beatlite.data.store.build_store`, only changed takes) and open its train/val windows.
 
-    ``progress`` shows the store's tqdm bar over the takes it builds. The vocabulary and the word vectors'
+    ``progress`` shows the store's tqdm bar over the takes it builds. ``ValueError`` when no usable take is in
+    the val split (or a reader's ``FormatError``). The vocabulary and the word vectors'
     sentences come from the usable takes only, as the windows do (an unusable take's TextGrid may not read).
     """
 
     root = Path(data) if data is not None else paths.data_dir()
     index = index_folder(root)
     usable = index.where(usable=True)
+    if len(usable) and not len(usable.where(split="val")):
+        raise ValueError(
+            f"training_data: {root} has no usable take of the 'val' split, which training validates on (the "
+            "validation FGD picks the best epoch); BEAT's names put in it speech sequences 57-64 and the last of each "
+            "emotion block of the 4-hour speakers, their conversation 12, and speech 5-8 and the '_b' halves of the "
+            "other speakers (beatlite.io.names.split_of; BEAT2: train_test_split.csv)"
+        )
     vocab = build_vocab(usable)
     store = build_store(index, vocab=vocab, progress=progress)
     train = store.windows("train", vocab=vocab)
