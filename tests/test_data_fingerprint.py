@@ -85,6 +85,22 @@ def test_both_window_routes_give_one_fingerprint(tmp_path: Path) -> None:
     assert len(fps) == 4
 
 
+def test_a_train_take_shorter_than_one_window_is_in_the_fingerprint(tmp_path: Path) -> None:
+    """A 30-frame train take gives no 34-frame window but enters the train statistics: the windows it is added
+    to are the same windows with other values, so they get another fingerprint (a checkpoint does not resume on
+    them), the same on both routes."""
+    root = make_corpus(tmp_path / "corpus")
+    before = build_store(index_folder(root), tmp_path / "a", vocab=VOCAB, workers=0).windows("train")
+    write_take(root, "2_scott_0_66_66", 30)
+    index = index_folder(root)
+    assert index["2_scott_0_66_66"].usable and index["2_scott_0_66_66"].split == "train"
+    after = build_store(index, tmp_path / "b", vocab=VOCAB, workers=0).windows("train")
+    assert np.array_equal(after.starts, before.starts) and len(after) == len(before)
+    assert not np.allclose(after.normalizers.pose.mean, before.normalizers.pose.mean)
+    assert after.fingerprint != before.fingerprint
+    assert build_windows(index, split="train", vocab=VOCAB, cache=False).fingerprint == after.fingerprint
+
+
 def test_the_store_rebuilds_a_take_whose_override_changed(tmp_path: Path) -> None:
     """The store's fingerprint used to omit ``bvh_fps``: the old motion stayed after the override changed."""
     root = make_corpus(tmp_path / "corpus")

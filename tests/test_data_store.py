@@ -318,6 +318,24 @@ def test_default_vocabulary_follows_the_textgrids(corpus: Path, tmp_path: Path) 
     assert again.vocab["giraffe"] in word.tolist()  # the changed take was rebuilt with the new word
 
 
+def test_default_vocabulary_reads_the_textgrids_of_usable_takes_only(corpus: Path, tmp_path: Path) -> None:
+    """A take whose TextGrid does not read is unusable: the store skips it, and its default vocabulary is that
+    of the stored takes' TextGrids (read here one by one) instead of failing on the broken one."""
+    from beatlite.data.vocab import vocab_from_sentences
+    from beatlite.io import read_words
+
+    bad = "2_scott_0_10_10"
+    (corpus / f"{bad}.TextGrid").write_text('File type = "ooTextFile"\nObject class = "TextGrid"\nxmin = 0\n')
+    index = index_folder(corpus)
+    assert not index[bad].usable
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        store = build_store(index, tmp_path / "v", workers=0)
+    stems = [stem for stem in TAKES if stem != bad]
+    assert [t.stem for t in store.takes] == [r.stem for r in index if r.stem in stems]
+    words = [list(read_words(corpus / f"{stem}.TextGrid").words) for stem in stems]
+    assert store.vocab.itos == vocab_from_sentences(words).itos
+
+
 def test_whole_take_equals_the_takes_features(corpus: Path, store: WindowStore) -> None:
     """A whole take: the take's features at full length (audio cut to ``audio_samples(T)``, the mel to
     ``mel_frames`` of that), normalised with the given statistics; ``build_windows(whole_takes=True)`` holds the

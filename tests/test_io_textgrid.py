@@ -142,6 +142,18 @@ def test_truncated_and_missing_tier(tmp_path: Path) -> None:
     assert read_words(p, tier=0).words == ("café", 'say "hi"')
 
 
+def test_a_file_that_ends_early_names_its_last_line(tmp_path: Path) -> None:
+    """The header's ``xmax`` is not a number (a label to the reader): the values end on line 4, the file's last
+    line, whatever blank lines follow it."""
+    p = tmp_path / "t.TextGrid"
+    head = 'File type = "ooTextFile"\nObject class = "TextGrid"\nxmin = 0\nxmax = garbage'
+    for tail in ("", "\n", "\n\n  \n"):
+        p.write_text(head + tail)
+        with pytest.raises(FormatError, match="ends early: expected xmax") as info:
+            read_textgrid(p)
+        assert info.value.line == 4, (tail, info.value.line)
+
+
 def test_real_textgrid(real_samples: Path) -> None:
     p = real_samples / "2_scott_0_2_2.TextGrid"
     tiers = read_textgrid(p)

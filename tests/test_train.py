@@ -16,6 +16,7 @@ from beatlite.models.base import GestureModel, ModelConfig  # noqa: E402
 from beatlite.models.testing import fake_windows  # noqa: E402
 from beatlite.train import TrainConfig, data_fingerprint, export_checkpoint, fit, generate, load_model  # noqa: E402
 from beatlite.train.generation import generate_sequence, generate_sequences  # noqa: E402
+from beatlite.train.training import ResumeError  # noqa: E402
 
 V = 50
 
@@ -85,6 +86,30 @@ def test_a_run_killed_mid_epoch_resumes_from_its_last_step(windows, tmp_path):
     for (name, p), q in zip(a.state_dict().items(), b.state_dict().values(), strict=True):
         assert torch.equal(p, q), name
     assert torch.load(tmp_path / "part.pt", weights_only=True)["partial"] is None
+
+
+def test_a_mid_epoch_checkpoint_resumes_only_with_the_same_batch_plan(windows, tmp_path):
+    """A run killed at step 1 of epoch 2 (24 windows, batch 8, seed 3) refuses to resume with another batch size,
+    seed or windows_per_epoch (its step 1 would be a step of another plan), naming the old and new values and
+    writing nothing; a checkpoint at an epoch's end resumes with another batch size."""
+    train, val = windows
+    part = tmp_path / "part.pt"
+    with step_killed_after(4), pytest.raises(KeyboardInterrupt):
+        fit(camn(), train, cfg(epochs=2, checkpoint=part, checkpoint_every=1), val)
+    before = part.read_bytes()
+    changes = (({"batch_size": 6}, "batch_size 8 -> 6"), ({"seed": 4}, "seed 3 -> 4"),
+               ({"windows_per_epoch": 16}, "windows_per_epoch None -> 16"))  # fmt: skip
+    for change, said in changes:
+        again = cfg(epochs=2, checkpoint=part, checkpoint_every=1, resume=True, **change)
+        with pytest.raises(ResumeError, match="stopped at step 1 of epoch 2") as refused:
+            fit(camn(), train, again, val)
+        assert f"changed: {said} (" in str(refused.value)
+    assert part.read_bytes() == before
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "end.pt"), val)
+    resumed = fit(
+        camn(), train, cfg(epochs=2, batch_size=6, checkpoint=tmp_path / "end.pt", resume=True), val
+    )
+    assert [entry["epoch"] for entry in resumed.history] == [0, 1]
 
 
 def test_cosine_schedule_factors_closed_form():
@@ -628,6 +653,22 @@ def test_a_save_killed_midway_leaves_no_temp_file_after_the_next_save(windows, t
     save_checkpoint(tmp_path / "c.pt", {"format": "beatlite-checkpoint/1", "model": {}, "state": {}})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.pt"]
     assert load_checkpoint(tmp_path / "c.pt")["state"] == {}
+
+
+def test_a_truncated_checkpoint_is_said_to_be_truncated_not_legacy(windows, tmp_path):
+    """A checkpoint cut short (a copy or a write that stopped) or empty: a FormatError naming the file that says
+    so, not the advice to convert a legacy pickle (which fails on it too)."""
+    from beatlite.io import FormatError
+    from beatlite.train.checkpoint import load_checkpoint
+
+    train, _ = windows
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "full.pt"))
+    whole = (tmp_path / "full.pt").read_bytes()
+    for size in (len(whole) // 2, len(whole) - 10, 100, 0):
+        (tmp_path / "cut.pt").write_bytes(whole[:size])
+        with pytest.raises(FormatError, match="truncated or corrupted file") as refused:
+            load_checkpoint(tmp_path / "cut.pt")
+        assert str(tmp_path / "cut.pt") in str(refused.value) and "convert_legacy" not in str(refused.value)
 
 
 def test_convert_legacy_needs_trust_and_writes_a_plain_copy(windows, tmp_path):

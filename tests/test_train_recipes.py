@@ -309,6 +309,58 @@ def test_fit_command_writes_only_under_out(tmp_path):
     assert full["best"] is not None  # the validation FGD scored the epoch
 
 
+def small_corpus(root, stems):
+    """The ``data_samples/`` takes ``stems`` copied into the new folder ``root``."""
+    import shutil
+
+    from beatlite.paths import repo_root
+
+    root.mkdir()
+    for stem in stems:
+        for src in (repo_root() / "data_samples").glob(f"{stem}.*"):
+            shutil.copy(src, root)
+    return root
+
+
+def test_training_data_reads_the_words_of_usable_takes_only(tmp_path, monkeypatch):
+    """A malformed TextGrid makes its take unusable; ``training_data`` (what ``fit`` prepares) then skips its
+    words as the windows skip its frames, instead of failing to read them: the vocabulary is that of the
+    other takes' TextGrids, read here one by one."""
+    from beatlite.data.vocab import vocab_from_sentences
+    from beatlite.io import read_words
+    from beatlite.train.recipes import training_data
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    good, bad = ["2_scott_0_9_9", "2_scott_0_57_57"], "2_scott_0_10_10"
+    root = small_corpus(tmp_path / "corpus", [*good, bad])
+    (root / f"{bad}.TextGrid").write_text(
+        'File type = "ooTextFile"\nObject class = "TextGrid"\nxmin = 0\nxmax = garbage\n'
+    )
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        data = training_data(root)
+    assert not data.index[bad].usable and all(data.index[stem].usable for stem in good)
+    expected = [list(read_words(root / f"{stem}.TextGrid").words) for stem in good]
+    assert data.vocab.itos == vocab_from_sentences(expected).itos
+    assert len(data.sentences) == 2
+
+
+def test_fit_command_says_when_the_corpus_has_no_val_take(tmp_path, monkeypatch, capsys):
+    """Two train takes and no val take: ``fit`` stops with one ``error:`` line saying the val split is empty
+    and which takes BEAT's names put there (not a window store's "no take ... is at least 34 frames long")."""
+    from beatlite.train import __main__ as command
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    root = small_corpus(tmp_path / "corpus", ["2_scott_0_9_9", "2_scott_0_10_10"])
+    out = tmp_path / "run"
+    assert command.main(["fit", "s2g_tiny", "--data", str(root), "--out", str(out), "--epochs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith(f"error: training_data: {root} has no usable take of the 'val' split")
+        and err.count("\n") == 1
+    )
+    assert "57-64" in err and not (out / "fgd_dirvec.pt").exists()
+
+
 class _Stop(Exception):
     """Raised by a stand-in ``fit``, with the config it was given."""
 
@@ -329,17 +381,126 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
     monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
     monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
     monkeypatch.setattr(training, "fit", stand_in_fit)
-    argv = ["fit", "s2g_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(tmp_path / "run")]
+    # (a recipe without best-epoch selection: no extractor or validation takes to stand in for)
+    argv = [
+        "fit",
+        "diffgesture_tiny",
+        "--data",
+        str(repo_root() / "data_samples"),
+        "--out",
+        str(tmp_path / "run"),
+    ]
     for extra, expected in (([], None), (["--val-every", "25"], 25)):
         with pytest.raises(_Stop) as stopped:
-            command.main([*argv, "--epochs", "0", *extra])
+            command.main([*argv, "--epochs", "1", *extra])
         assert stopped.value.args[0].val_every == expected
-    with pytest.raises(ValueError, match="val_every must be >= 1"):
-        command.main([*argv, "--epochs", "0", "--val-every", "0"])
     for extra, expected in (([], True), (["--nondeterministic"], False)):
         with pytest.raises(_Stop) as stopped:
-            command.main([*argv, "--epochs", "0", *extra])
+            command.main([*argv, "--epochs", "1", *extra])
         assert stopped.value.args[0].deterministic is expected
+
+
+def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path, monkeypatch, capsys):
+    """Values ``TrainConfig`` refuses, zero epochs of a recipe that trains and CUDA on a machine without it stop
+    ``fit`` at once: exit 2, one ``error:`` line naming the value, nothing indexed or written under ``--out``."""
+    torch = pytest.importorskip("torch")
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+    from beatlite.train.recipes import recipe_train_config
+
+    def no_data(folder, progress):
+        raise AssertionError("the data were prepared")
+
+    monkeypatch.setattr(command, "training_data", no_data)
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    out = tmp_path / "run"
+    argv = ["fit", "camn_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
+    cases = ((["--checkpoint-every", "0"], "checkpoint_every must be >= 1"),
+             (["--batch-size", "1"], "batch_size must be >= 2"), (["--val-every", "0"], "val_every must be >= 1"),
+             (["--epochs", "-1"], "epochs must be >= 0"), (["--epochs", "0"], "camn_tiny: epochs must be >= 1"),
+             (["--device", "cuda"], "device 'cuda' asked for CUDA"))  # fmt: skip
+    for extra, said in cases:
+        assert command.main([*argv, *extra]) == 2, extra
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and said in err and err.count("\n") == 1, (extra, err)
+    assert not out.exists()
+    assert recipe_train_config("random_clip", epochs=0).epochs == 0  # an untrained baseline: nothing to train
+
+
+def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkeypatch, capsys):
+    """A ``ResumeError`` of ``fit --resume`` (data, model or batch plan changed) ends the command with exit 2 and
+    its message on one ``error:`` line, no traceback (data and training stood in for)."""
+    import types
+
+    from beatlite.paths import repo_root
+    from beatlite.train import __main__ as command
+    from beatlite.train import recipes, training
+
+    def refusing_fit(model, train, config, val=None, **kw):
+        raise training.ResumeError("fit: cannot resume from x.pt: changed: batch_size 32 -> 64")
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = types.SimpleNamespace(train=None, val=None, meta={})
+    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
+    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
+    monkeypatch.setattr(training, "fit", refusing_fit)
+    argv = [
+        "fit",
+        "diffgesture_tiny",
+        "--data",
+        str(repo_root() / "data_samples"),
+        "--out",
+        str(tmp_path / "run"),
+    ]
+    assert command.main([*argv, "--epochs", "1", "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
+
+
+def test_fit_command_trains_the_extractor_again_for_other_data_or_epochs(tmp_path, monkeypatch, capsys):
+    """``<out>/fgd_dirvec.pt`` is kept while its recorded data fingerprint and epochs are this run's train
+    windows' and ``--extractor-epochs``, trained again (saying why) when either changes (data, extractor
+    training and model training stood in for)."""
+    import types
+
+    from beatlite.metrics.extractor import ExtractorConfig, MotionAutoencoder, save_extractor
+    from beatlite.train import __main__ as command
+
+    trained = []
+
+    def stand_in_train_extractor(data_dir, path, epochs):
+        trained.append((data.train.fingerprint, epochs))
+        model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8, epochs=epochs))
+        info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}
+        save_extractor(path, model, info, space="dirvec", meta={"data_fingerprint": data.train.fingerprint})
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = types.SimpleNamespace(train=types.SimpleNamespace(fingerprint="a" * 16), val=None, meta={})
+    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
+    monkeypatch.setattr(command, "_train_extractor", stand_in_train_extractor)
+    monkeypatch.setattr(command, "retrain", lambda name, **kw: 0.0)
+    out = tmp_path / "run"
+    argv = [
+        "fit",
+        "s2g_tiny",
+        "--data",
+        str(tmp_path / "corpus"),
+        "--out",
+        str(out),
+        "--extractor-epochs",
+        "3",
+    ]
+    for _ in range(2):
+        assert command.main(argv) == 0
+    assert trained == [("a" * 16, 3)]  # once, then kept
+    assert "stale" not in capsys.readouterr().out
+    data.train.fingerprint = "b" * 16  # another corpus fitted into the same --out
+    assert command.main(argv) == 0
+    assert trained[-1] == ("b" * 16, 3)
+    assert f"trained on data {'a' * 16}, the train windows are {'b' * 16}" in capsys.readouterr().out
+    assert command.main([*argv[:-1], "5"]) == 0
+    assert trained[-1] == ("b" * 16, 5) and len(trained) == 3
+    assert "trained for 3 epochs, --extractor-epochs is 5" in capsys.readouterr().out
 
 
 def test_fit_command_refuses_inductor_for_a_model_stating_a_failure_before_preparing_anything(

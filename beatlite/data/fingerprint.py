@@ -205,7 +205,8 @@ def windows_fingerprint(
     Parameters
     ----------
     take_fingerprints : iterable of str
-        :func:`beatlite.data.store.take_fingerprint` of each take that has windows, in index order.
+        :func:`beatlite.data.store.take_fingerprint` of each take the windows were cut from, in index order (one
+        shorter than a window too: a train take feeds the statistics).
     split : str or None
     length, stride : int
         Window length and stride in frames.

@@ -641,6 +641,9 @@ class StoreWindows:
         positions = {t.stem: i for i, t in enumerate(store.takes)}
         ids, starts = [], []
         chosen = store._select(split) if stems is None else [store.take(stem) for stem in stems]
+        self._stems = [
+            t.stem for t in chosen
+        ]  # windows or not: a short train take still feeds the statistics
         for t in chosen:
             s = window_starts(t.n_frames, int(length), int(stride))
             ids.append(np.full(len(s), positions[t.stem], np.int64))
@@ -665,10 +668,11 @@ class StoreWindows:
         parameters (:func:`beatlite.data.fingerprint.windows_fingerprint`: the takes' files by content,
         overrides, store parameters, split, length, stride, vocabulary). What
         :func:`beatlite.train.training.data_fingerprint` reads, so training can resume on the same data.
-        The statistics are left out (their float bits vary across machines; they derive from the takes)."""
-        stems = [self.store.takes[int(i)].stem for i in np.unique(self.take_ids)]
+        The takes are all those of the view, a take shorter than one window too (a train take feeds the
+        statistics). The statistics are left out (their float bits vary across machines; they derive from the
+        takes)."""
         return self.store.windows_fingerprint(
-            stems,
+            self._stems,
             split=self.params["split"],
             length=self.length,
             stride=self.params["stride"],
@@ -962,15 +966,17 @@ def _usable_records(index: TakeIndex) -> list[TakeRecord]:
 def _write_manifest(
     folder: Path, index: TakeIndex, records: list[TakeRecord], params: dict, vocab: Vocab | None
 ) -> None:
-    """``store.json``: version, parameters, takes and vocabulary (``build_vocab(index)``, reused while no
-    TextGrid of the index changed)."""
+    """``store.json``: version, parameters, takes and vocabulary (``build_vocab`` of the stored (usable) takes,
+    reused while none of their TextGrids changed; an unusable take's may not read)."""
+    from beatlite.data.index import TakeIndex
     from beatlite.data.vocab import build_vocab
     from beatlite.io.atomic import atomic_write
 
     text_fp = None
     if vocab is None:
-        text_fp = _text_fingerprint(index)
-        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(index)
+        stored = TakeIndex(records, index.root)
+        text_fp = _text_fingerprint(stored)
+        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(stored)
     manifest = {
         "version": STORE_VERSION,
         "params": params,
@@ -1013,7 +1019,7 @@ def build_store(
     word_rule : {"span", "onset", "beat"}
         Word-to-frame rule.
     vocab : Vocab, optional
-        Default :func:`beatlite.data.vocab.build_vocab` of the whole index (as ``build_windows``).
+        Default :func:`beatlite.data.vocab.build_vocab` of the usable takes (the ones stored).
     workers : int, optional
         Worker processes (spawned; 0 or 1: in this process). Default
         :func:`beatlite.data.index.default_workers` of the files to read: ``os.cpu_count()`` for a

@@ -650,11 +650,8 @@ def _windows(
             f"build_windows: no take of split {params['split']!r} is at least {params['length']} frames long "
             f"({len(stems)} takes)"
         ) from None
-    have = [
-        store.takes[int(i)].stem for i in np.unique(view.take_ids)
-    ]  # (the view's split is None: the split's)
-    fingerprint = store.windows_fingerprint(
-        have, split=params["split"], length=params["length"], stride=params["stride"], vocab=vocab
+    fingerprint = store.windows_fingerprint(  # (the view's split is None: the split's)
+        stems, split=params["split"], length=params["length"], stride=params["stride"], vocab=vocab
     )
     return view.batch(None), fingerprint
 

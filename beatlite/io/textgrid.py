@@ -134,6 +134,7 @@ class _Values:
     def __init__(self, text: str, path: Path) -> None:
         self.path = path
         self.line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
+        self.last_line = self.line_of(max(len(text.rstrip()) - 1, 0))  # where a file that ends early ends
         self.items: list[tuple[str, str | float, int]] = []  # (kind, value, offset)
         for m in _TOKEN_RE.finditer(text):
             tok = m.group(0)
@@ -156,11 +157,11 @@ class _Values:
     def current_line(self) -> int:
         if self.pos < len(self.items):
             return self.line_of(self.items[self.pos][2])
-        return len(self.line_starts)
+        return self.last_line
 
     def take(self, kind: str, what: str) -> tuple[str | float, int]:
         if self.pos >= len(self.items):
-            raise FormatError(self.path, f"file ends early: expected {what}", line=len(self.line_starts))
+            raise FormatError(self.path, f"file ends early: expected {what}", line=self.last_line)
         k, value, offset = self.items[self.pos]
         if k != kind:
             raise FormatError(

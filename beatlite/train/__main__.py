@@ -6,7 +6,8 @@
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
 float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
-are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once)
+are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once;
+again when the train windows' fingerprint or ``--extractor-epochs`` changed)
 for the per-epoch validation FGD (``--val-every N``: every N optimiser steps instead).
 
 ``retrain-all [--only NAME ...] [--seed S] [--jobs J]`` rebuilds every shipped checkpoint of
@@ -45,7 +46,7 @@ from beatlite.io.atomic import atomic_write, exclusive_lock
 from beatlite.models import model_class
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
-from beatlite.train.recipes import RECIPES, SEED, retrain, retrain_many, training_data
+from beatlite.train.recipes import RECIPES, SEED, recipe_train_config, retrain, retrain_many, training_data
 from beatlite.train.seeds import (
     evaluate_seeds,
     recorded_seed_results,
@@ -81,7 +82,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("recipe", choices=sorted(RECIPES))
     f.add_argument("--data", required=True, help="BEAT-format folder ({speaker_id}/{stem}.bvh, .wav, ...)")
     f.add_argument("--out", required=True, help="output folder (created; the repository is never written)")
-    f.add_argument("--epochs", type=int, help="default: the recipe's")
+    f.add_argument("--epochs", type=int, help="default: the recipe's (>= 1 for a recipe that trains)")
     f.add_argument("--seed", type=int, default=SEED)
     f.add_argument("--device", default="auto", help="cpu, cuda or auto (CUDA when available)")
     f.add_argument("--resume", action="store_true", help="continue <out>/train/<recipe>.pt")
@@ -128,7 +129,7 @@ def _parser() -> argparse.ArgumentParser:
         "--extractor-epochs",
         type=int,
         default=100,
-        help="epochs of the FGD extractor trained for new data (once)",
+        help="epochs of the FGD extractor trained for new data (once; again for other data or epochs)",
     )
     p = sub.add_parser("retrain-all", help="retrain every shipped checkpoint on data_samples/")
     p.add_argument("--seed", type=int, help="default: each recipe's shipped seed in the recorded seed table")
@@ -203,52 +204,81 @@ def _fit_command(args: argparse.Namespace) -> int:
     """``fit``: one recipe on ``--data``, every file under ``--out``.
 
     The data are prepared before any process group exists: the window store (built once, then only
-    changed takes) and, for data other than ``data_samples/``, the FGD extractor (trained once). Under
+    changed takes) and, for data other than ``data_samples/``, the FGD extractor (trained once, again for other
+    data or ``--extractor-epochs``). Under
     ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
     the first builds, the others wait (no time limit, no collective) and find it done.
     """
 
-    from beatlite.train.training import check_compilable  # (imports torch)
+    from beatlite.train.training import ResumeError, check_compilable  # (imports torch)
 
-    try:  # before anything is prepared or written
+    options = {
+        "seed": args.seed,
+        "epochs": args.epochs,
+        "resume": args.resume,
+        "device": args.device,
+        "checkpoint_every": args.checkpoint_every,
+        "batch_size": args.batch_size,
+        "data_on_device": args.data_on_device,
+        "amp": args.precision == "bf16",
+        "compile": args.compile,
+        "val_every": args.val_every,
+        "deterministic": not args.nondeterministic,
+        "lr_scaling": args.lr_scaling,
+    }
+    try:  # before anything is prepared or written: the flags' values, the device, the compiler
+        recipe_train_config(args.recipe, **options)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
     except ValueError as error:
-        print(error, file=sys.stderr)
-        return 2
+        return _refused(error)
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
     out.mkdir(parents=True, exist_ok=True)
     os.environ.setdefault(
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
     rank = int(os.environ.get("RANK", "0"))
-    data = training_data(data_dir, progress=rank == 0)
+    try:
+        data = training_data(data_dir, progress=rank == 0)
+    except ValueError as error:  # no val takes, no usable take, a file that cannot be read (FormatError)
+        return _refused(error)
     extractor = None
     if data_dir != (paths.repo_root() / "data_samples").resolve():
         extractor = out / "fgd_dirvec.pt"
         with exclusive_lock(out / ".fgd_dirvec.lock"):
-            if not extractor.is_file():
+            stale = _stale_extractor(extractor, data.train.fingerprint, args.extractor_epochs)
+            if stale is not None:
+                if extractor.is_file():
+                    print(f"{extractor} is stale ({stale}): training it again", flush=True)
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
-    seconds = retrain(
-        args.recipe,
-        seed=args.seed,
-        epochs=args.epochs,
-        out_dir=out,
-        data=data,
-        resume=args.resume,
-        device=args.device,
-        extractor=extractor,
-        checkpoint_every=args.checkpoint_every,
-        batch_size=args.batch_size,
-        data_on_device=args.data_on_device,
-        amp=args.precision == "bf16",
-        compile=args.compile,
-        val_every=args.val_every,
-        deterministic=not args.nondeterministic,
-        lr_scaling=args.lr_scaling,
-    )
+    try:
+        seconds = retrain(args.recipe, out_dir=out, data=data, extractor=extractor, **options)
+    except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
+        return _refused(error)
     if rank == 0:
         print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
     return 0
+
+
+def _refused(error: Exception) -> int:
+    """Print why ``fit`` refuses to run as one ``error:`` line on stderr; the exit status 2."""
+    print(f"error: {error}", file=sys.stderr)
+    return 2
+
+
+def _stale_extractor(path: Path, fingerprint: str, epochs: int) -> str | None:
+    """Why the FGD extractor at ``path`` is not the one ``fit`` would train on train windows of data
+    ``fingerprint`` for ``epochs`` epochs (none yet, other data, other epochs); None when it is."""
+    if not path.is_file():
+        return "none yet"
+    from beatlite.metrics.extractor import load_extractor
+
+    found = load_extractor("dirvec", path)
+    trained_on, trained_for = found.meta.get("data_fingerprint"), found.model.config.epochs
+    if trained_on != fingerprint:
+        return f"trained on data {trained_on}, the train windows are {fingerprint}"
+    if trained_for != epochs:
+        return f"trained for {trained_for} epochs, --extractor-epochs is {epochs}"
+    return None
 
 
 def _train_extractor(data_dir: object, path: object, epochs: int) -> None:

@@ -106,8 +106,8 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     FileNotFoundError
         No file at ``path``.
     beatlite.io.FormatError
-        The file is not a beatlite checkpoint, or it holds anything but tensors and plain values
-        (a pickled object that would run code when loaded is refused, never executed).
+        The file is truncated or corrupted, is not a beatlite checkpoint, or holds anything but tensors and
+        plain values (a pickled object that would run code when loaded is refused, never executed).
     """
 
     path = Path(path)
@@ -117,6 +117,12 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         with torch.serialization.safe_globals(NUMPY_ARRAY_GLOBALS):
             data = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # noqa: BLE001 - any unpickling failure is a format problem
+        if isinstance(exc, EOFError | OSError) or "zip archive" in str(exc):  # cut short, or bytes damaged
+            reason = (str(exc).splitlines() or [""])[0].split(". ")[0] or type(exc).__name__
+            raise FormatError(
+                path,
+                f"truncated or corrupted file ({reason}): write it again, e.g. train again or copy it anew",
+            ) from None
         lines = [
             ln.strip()
             for ln in str(exc).splitlines()

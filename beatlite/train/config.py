@@ -57,7 +57,9 @@ class TrainConfig:
         process is given the same (process 0 writes; all of them take part in gathering the random
         generators' states at each save).
     resume : bool
-        Continue from ``checkpoint`` if it exists (same data fingerprint required).
+        Continue from ``checkpoint`` if it exists (same data fingerprint and model config required; from a
+        mid-epoch checkpoint also the same :data:`beatlite.train.training.PLAN_FIELDS`, else
+        :class:`beatlite.train.training.ResumeError`).
     progress : bool
         Show a tqdm bar.
     device : {"cpu", "cuda", "auto"} or str

@@ -379,12 +379,22 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     """Index ``data`` (default ``$BEATLITE_DATA``; cached), build or update its window store
     (:func:`beatlite.data.store.build_store`, only changed takes) and open its train/val windows.
 
-    ``progress`` shows the store's tqdm bar over the takes it builds.
+    ``progress`` shows the store's tqdm bar over the takes it builds. ``ValueError`` when no usable take is in
+    the val split (or a reader's ``FormatError``). The vocabulary and the word vectors'
+    sentences come from the usable takes only, as the windows do (an unusable take's TextGrid may not read).
     """
 
     root = Path(data) if data is not None else paths.data_dir()
     index = index_folder(root)
-    vocab = build_vocab(index)
+    usable = index.where(usable=True)
+    if len(usable) and not len(usable.where(split="val")):
+        raise ValueError(
+            f"training_data: {root} has no usable take of the 'val' split, which training validates on (the "
+            "validation FGD picks the best epoch); BEAT's names put in it speech sequences 57-64 and the last of each "
+            "emotion block of the 4-hour speakers, their conversation 12, and speech 5-8 and the '_b' halves of the "
+            "other speakers (beatlite.io.names.split_of; BEAT2: train_test_split.csv)"
+        )
+    vocab = build_vocab(usable)
     store = build_store(index, vocab=vocab, progress=progress)
     train = store.windows("train", vocab=vocab)
     val = store.windows("val", vocab=vocab, stats=train.normalizers)
@@ -393,7 +403,7 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
         "vocab": list(vocab.itos),
         "data": str(root),
     }
-    return TrainingData(index, vocab, train, val, take_sentences(index), meta, store)
+    return TrainingData(index, vocab, train, val, take_sentences(usable), meta, store)
 
 
 def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> Any:
@@ -452,6 +462,73 @@ def scaled_lr(recipe: Recipe, batch_size: int, rule: str = "linear") -> float | 
         return None
     base = recipe.lr if recipe.lr is not None else TrainConfig(batch_size=recipe.batch_size).learning_rate
     return base * (ratio if rule == "linear" else math.sqrt(ratio))
+
+
+def recipe_train_config(
+    name: str,
+    *,
+    seed: int = SEED,
+    epochs: int | None = None,
+    checkpoint: str | Path | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    device: str = "cpu",
+    checkpoint_every: int | None = None,
+    batch_size: int | None = None,
+    data_on_device: str = "auto",
+    amp: bool = False,
+    compile: str | None = None,  # noqa: A002
+    val_every: int | None = None,
+    deterministic: bool = True,
+    lr_scaling: str = "linear",
+) -> TrainConfig:
+    """The :class:`~beatlite.train.TrainConfig` :func:`retrain` trains recipe ``name`` with (its parameters;
+    ``checkpoint``: the full checkpoint's path), with the device resolved: what the ``fit`` command checks
+    before it indexes anything.
+
+    Raises
+    ------
+    ValueError
+        An unknown recipe, a value ``TrainConfig`` refuses, a device this machine lacks
+        (:meth:`~beatlite.train.TrainConfig.torch_device`), or ``epochs < 1`` for a recipe that trains (its
+        ``epochs > 0``: zero epochs would export weights never trained).
+
+    Examples
+    --------
+    >>> config = recipe_train_config("camn_tiny", batch_size=64, lr_scaling="sqrt")
+    >>> config.epochs == RECIPES["camn_tiny"].epochs, config.lr == scaled_lr(RECIPES["camn_tiny"], 64, "sqrt")
+    (True, True)
+    >>> recipe_train_config("camn_tiny", epochs=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: camn_tiny: epochs must be >= 1 (the recipe's: 40); 0 epochs would export untrained weights
+    """
+    recipe = _recipe(name)
+    epochs = recipe.epochs if epochs is None else int(epochs)
+    if recipe.epochs > 0 and epochs == 0:
+        raise ValueError(
+            f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); 0 epochs would export untrained weights"
+        )
+    batch = recipe.batch_size if batch_size is None else int(batch_size)
+    config = TrainConfig(
+        epochs=epochs,
+        batch_size=batch,
+        lr=scaled_lr(recipe, batch, lr_scaling),
+        lr_schedule=recipe.lr_schedule,
+        seed=seed,
+        checkpoint=checkpoint,
+        resume=resume,
+        progress=progress,
+        device=device,
+        checkpoint_every=checkpoint_every,
+        data_on_device=data_on_device,
+        amp=amp,
+        compile=compile,
+        val_every=val_every,
+        deterministic=deterministic,
+    )
+    config.torch_device()
+    return config
 
 
 def retrain(
@@ -530,30 +607,29 @@ def retrain(
     from beatlite.train.training import fit
 
     recipe = _recipe(name)
-    data = training_data() if data is None else data
-    model = build_recipe_model(name, data, seed=seed)
     if out_dir is None:
         export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
     else:
         export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
-    batch = recipe.batch_size if batch_size is None else int(batch_size)
-    config = TrainConfig(
-        epochs=recipe.epochs if epochs is None else epochs,
-        batch_size=batch,
-        lr=scaled_lr(recipe, batch, lr_scaling),
-        lr_schedule=recipe.lr_schedule,
+    config = recipe_train_config(
+        name,
         seed=seed,
+        epochs=epochs,
         checkpoint=full,
         resume=resume,
         progress=progress,
         device=device,
         checkpoint_every=checkpoint_every,
+        batch_size=batch_size,
         data_on_device=data_on_device,
         amp=amp,
         compile=compile,
         val_every=val_every,
         deterministic=deterministic,
-    )
+        lr_scaling=lr_scaling,
+    )  # bad values raise here, before any data work
+    data = training_data() if data is None else data
+    model = build_recipe_model(name, data, seed=seed)
     score = None
     if recipe.select_best and config.epochs > 0:
         from beatlite.metrics.extractor import load_extractor

@@ -32,8 +32,23 @@ from beatlite.train.distributed import (
     wrap_for_ddp,
 )
 
+PLAN_FIELDS = ("batch_size", "seed", "windows_per_epoch")
+"""The :class:`TrainConfig` fields that decide an epoch's batch plan (which windows each step trains on): a
+mid-epoch checkpoint resumes only with the same values (micro-batches and processes split a step, not the plan)."""
+
 TENSOR_KEYS = ("pose", "dirvec", "audio", "mel", "face", "word", "emotion", "semantic", "speaker")
 """Window keys converted to tensors for the models (others, e.g. ``"take"``, are ignored)."""
+
+
+class ResumeError(ValueError):
+    """A checkpoint cannot be resumed by this run: other data, another model config, or (inside an epoch)
+    other :data:`PLAN_FIELDS`. The message names the checkpoint and what differs.
+
+    Examples
+    --------
+    >>> isinstance(ResumeError("fit: cannot resume from run.pt: batch_size 32 -> 64"), ValueError)
+    True
+    """
 
 
 @dataclasses.dataclass
@@ -524,18 +539,33 @@ class _Run:
         self.d_losses = _compiled(self.d_ddp or model.discriminator_losses, mode, device)
 
     def resume(self, train: _Data) -> None:
-        """Load the full checkpoint at :attr:`path` (same data and model config, or ``ValueError``).
+        """Load the full checkpoint at :attr:`path` (same data and model config, or :class:`ResumeError`).
 
+        A mid-epoch checkpoint also needs the same :data:`PLAN_FIELDS` (its step counts steps of that
+        epoch's batch plan; another batch size or seed would train some windows twice and others never).
         A checkpoint written before the global step was stored counts ``train``'s steps per epoch instead.
         """
         data = load_checkpoint(self.path)
         if data.get("fingerprint") != self.fingerprint:
-            raise ValueError(
+            raise ResumeError(
                 f"fit: cannot resume from {self.path}: it was trained on data {data.get('fingerprint')!r}, "
                 f"these windows are {self.fingerprint!r}"
             )
         if data["model"] != self.model.to_config():
-            raise ValueError(f"fit: cannot resume from {self.path}: model config differs ({data['model']})")
+            raise ResumeError(f"fit: cannot resume from {self.path}: model config differs ({data['model']})")
+        stored = data.get("train_config") or {}
+        changed = [
+            f"{k} {stored[k]!r} -> {getattr(self.config, k)!r}"
+            for k in PLAN_FIELDS
+            if k in stored and stored[k] != getattr(self.config, k)
+        ]
+        if data.get("partial") is not None and changed:
+            step = data["partial"]["step"]
+            raise ResumeError(
+                f"fit: cannot resume from {self.path}: it stopped at step {step} of epoch {data['epoch'] + 1}, "
+                f"whose batches depend on {', '.join(PLAN_FIELDS)}; changed: {', '.join(changed)} "
+                "(resume with the old values, or start a new run)"
+            )
         self.model.load_state_dict(data["state"])  # load_state_dict copies onto the model's device
         for opt, key in ((self.g_opt, "optimizer"), (self.d_opt, "d_optimizer")):
             if opt is not None and data.get(key) is not None:
