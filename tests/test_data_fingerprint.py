@@ -139,6 +139,23 @@ def test_a_second_index_of_an_unchanged_corpus_reads_no_file(tmp_path: Path, mon
     assert calls == [other]
 
 
+def test_a_same_size_edit_with_its_modification_time_set_back_is_read_again(tmp_path: Path) -> None:
+    """``touch -r`` after an edit of the same size restores (size, mtime): the change time still tells."""
+    root = make_corpus(tmp_path / "corpus")
+    stem = next(iter(TAKES))
+    params = {"fps": 15.0}
+    before = takes_fingerprint(index_folder(root), params)  # indexed, cached and hashed
+    path = root / f"{stem}.TextGrid"
+    text, stat = path.read_text(), path.stat()
+    assert "zebra" in text
+    time.sleep(0.05)  # past the file system's timestamp granularity
+    path.write_text(text.replace("zebra", "zebre"))
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    assert (path.stat().st_size, path.stat().st_mtime_ns) == (stat.st_size, stat.st_mtime_ns)
+    fresh = takes_fingerprint(index_folder(root, cache=False), params)
+    assert takes_fingerprint(index_folder(root), params) == fresh != before
+
+
 def test_fresh_files_are_never_cached_and_a_broken_cache_is_ignored(tmp_path: Path, monkeypatch) -> None:
     from beatlite.data.index_cache import cache_path
 

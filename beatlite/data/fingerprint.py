@@ -41,11 +41,15 @@ FINGERPRINT_VERSION = 2
 #: its digest and index entry are not remembered.
 SETTLE_S = 2.0
 _CHUNK = 1 << 20
-_DIGESTS: dict[tuple[str, int, int], str] = {}
+_DIGESTS: dict[tuple[str, int, int, int], str] = {}
 
 
-def file_key(path: str | os.PathLike[str]) -> tuple[str, int, int]:
-    """(resolved path, size, mtime_ns): what decides whether a remembered digest still holds.
+def file_key(path: str | os.PathLike[str]) -> tuple[str, int, int, int]:
+    """(resolved path, size, mtime_ns, ctime_ns): what decides whether a remembered digest still holds.
+
+    The change time is there because the modification time can be set back (``touch -r``, ``os.utime``,
+    an archive or a copy that keeps times) after a same-size edit, which then looked unchanged; setting it
+    back changes the change time, which no user call sets.
 
     Examples
     --------
@@ -54,15 +58,15 @@ def file_key(path: str | os.PathLike[str]) -> tuple[str, int, int]:
     >>> p = Path(tmp.name) / "a.txt"
     >>> _ = p.write_bytes(b"beat")
     >>> key = file_key(p)
-    >>> key[0] == str(p.resolve()), key[1]  # (resolved path, size in bytes, mtime_ns)
-    (True, 4)
+    >>> key[0] == str(p.resolve()), key[1], len(key)  # (resolved path, size in bytes, mtime_ns, ctime_ns)
+    (True, 4, 4)
     >>> tmp.cleanup()
     """
     st = Path(path).stat()
-    return (str(Path(path).resolve()), int(st.st_size), int(st.st_mtime_ns))
+    return (str(Path(path).resolve()), int(st.st_size), int(st.st_mtime_ns), int(st.st_ctime_ns))
 
 
-def settled(key: tuple[str, int, int], now_ns: int | None = None) -> bool:
+def settled(key: tuple[str, int, int] | tuple[str, int, int, int], now_ns: int | None = None) -> bool:
     """Whether a file with this :func:`file_key` was last modified at least :data:`SETTLE_S` ago.
 
     Examples
@@ -105,7 +109,7 @@ def file_digest(path: str | os.PathLike[str]) -> str:
     return digest
 
 
-def remember_digest(key: tuple[str, int, int], digest: str) -> None:
+def remember_digest(key: tuple[str, int, int, int], digest: str) -> None:
     """Prime :func:`file_digest` with a digest computed earlier for the file of this :func:`file_key`.
 
     Examples
@@ -121,7 +125,7 @@ def remember_digest(key: tuple[str, int, int], digest: str) -> None:
     >>> tmp.cleanup()
     """
     if settled(key):
-        _DIGESTS[(str(key[0]), int(key[1]), int(key[2]))] = str(digest)
+        _DIGESTS[(str(key[0]), *(int(k) for k in key[1:]))] = str(digest)  # (JSON gives lists: a tuple again)
 
 
 def _params_hash(params: Mapping[str, Any]) -> Any:

@@ -51,11 +51,11 @@ def take_key(files: dict[str, list[Path]], bvh_fps: float | None) -> list[Any] |
     >>> from beatlite.paths import repo_root
     >>> files = {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]}
     >>> key = take_key(files, None)
-    >>> key[0] == INDEX_VERSION, key[1], key[2][0][0]  # version, bvh_fps override, (modality, path, size, mtime)
+    >>> key[0] == INDEX_VERSION, key[1], key[2][0][0]  # version, bvh_fps override, (modality, *file_key)
     (True, None, 'motion')
     """
     keys = sorted([modality, *file_key(p)] for modality, paths in files.items() for p in paths)
-    if not all(settled((k[1], k[2], k[3])) for k in keys):
+    if not all(settled(tuple(k[1:])) for k in keys):
         return None
     return [INDEX_VERSION, None if bvh_fps is None else float(bvh_fps), keys]
 
