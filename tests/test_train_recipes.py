@@ -342,6 +342,12 @@ def test_training_data_reads_the_words_of_usable_takes_only(tmp_path, monkeypatc
     expected = [list(read_words(root / f"{stem}.TextGrid").words) for stem in good]
     assert data.vocab.itos == vocab_from_sentences(expected).itos
     assert len(data.sentences) == 2
+    # the evaluation set's default vocabulary is the same (a model trained by fit is scored with its word ids)
+    from beatlite.data.index import index_folder
+    from beatlite.train.testset import load_test_set
+
+    with pytest.warns(UserWarning, match="skipping 1 unusable"):
+        assert load_test_set(index_folder(root), split="val").vocab == data.vocab.itos
 
 
 def test_fit_command_says_when_the_corpus_has_no_val_take(tmp_path, monkeypatch, capsys):

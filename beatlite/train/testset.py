@@ -139,7 +139,8 @@ def load_test_set(
     split : {"test", "val", "train"}
         Takes to evaluate on.
     vocab : Vocab, optional
-        Default :func:`beatlite.data.vocab.build_vocab` of ``index`` (what ``retrain-all`` uses).
+        Default :func:`beatlite.data.vocab.build_vocab` of ``index``'s usable takes (what ``fit`` and ``retrain-all``
+        train with).
     store : WindowStore, optional
         Default :func:`beatlite.data.store.build_store` of ``index`` (built once, then only takes
         whose files changed are rebuilt). The statistics are the store's train statistics
@@ -150,7 +151,7 @@ def load_test_set(
     EvaluationSet
     """
     index = index_folder(paths.data_dir()) if index is None else index
-    vocab = build_vocab(index) if vocab is None else vocab
+    vocab = build_vocab(index.where(usable=True)) if vocab is None else vocab  # (as training_data)
     store = build_store(index, vocab=vocab) if store is None else store
     train = store.windows("train", vocab=vocab)  # an index of (take, start): read in batches below
     norms = train.normalizers
