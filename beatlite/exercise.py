@@ -47,6 +47,7 @@ Used by the Exercises section at the end of every notebook (first in notebooks/0
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import numbers
 from collections.abc import Callable, Mapping
@@ -180,25 +181,46 @@ def check(
         True when every case matches, False when one does not, None when the
         exercise is not done yet. A wrong answer prints the case (numbered from 1)
         with its inputs and :func:`difference`'s line; an exception raised by the
-        student's function is re-raised after the same case line.
+        student's function is re-raised after the same case line. Each function gets
+        its own copy of the inputs (:func:`copy.deepcopy`), so a function that changes
+        its arguments in place changes neither the other's inputs nor the notebook's
+        variables.
+
+    Examples
+    --------
+    >>> def shift(x):
+    ...     x -= x.mean()  # in place: the caller's array would change
+    ...     return x
+    >>> data = np.array([1.0, 2.0, 6.0])
+    >>> check("shift", shift, lambda x: x - x.mean(), [(data,)]), data
+    [exercise] shift: correct on 1 cases ✓
+    (True, array([1., 2., 6.]))
     """
     for i, case in enumerate(cases, start=1):
         args, kwargs = case if (len(case) == 2 and isinstance(case[1], dict)) else (case, {})
         where = f"case {i} of {len(cases)}"
         try:
-            got = student_fn(*args, **kwargs)
+            got = student_fn(*_copied(args), **_copied(kwargs))
         except NotImplementedError:
             print(f"[exercise] {name}: not done yet (the stub raises NotImplementedError)")
             return None
         except Exception as exc:
             print(f"[exercise] {name}: {where} raised {type(exc).__name__}: {_call_text(name, args, kwargs)}")
             raise
-        why = difference(got, reference_fn(*args, **kwargs), rtol=rtol, atol=atol)
+        why = difference(got, reference_fn(*_copied(args), **_copied(kwargs)), rtol=rtol, atol=atol)
         if why is not None:
             print(f"[exercise] {name}: {where} differs: {_call_text(name, args, kwargs)}\n    {why}")
             return False
     print(f"[exercise] {name}: correct on {len(cases)} cases ✓")
     return True
+
+
+def _copied(values: Any) -> Any:
+    """A deep copy of a case's arguments (the objects themselves where one cannot be copied)."""
+    try:
+        return copy.deepcopy(values)
+    except Exception:  # noqa: BLE001 - e.g. a handle to a file: passed as it is
+        return values
 
 
 #: The course's salt for :func:`choice` keys (see the module docstring: it keeps answers out of sight, not secret).
@@ -330,7 +352,7 @@ def predict(
     Only the tolerance given counts: ``atol=5`` is 5 samples, with no 10 % of 36,545 (3,654.5 samples) added:
 
     >>> predict("audio for 35 frames", 36266, 36545, atol=5, unit="samples")  # 36266 samples give 34 frames
-    [exercise] audio for 35 frames: predicted 36266 samples, measured 36545 samples: too low, 0.99x the measured value (within ±5 samples counts as right)
+    [exercise] audio for 35 frames: predicted 36266 samples, measured 36545 samples: too low by 279 samples (within ±5 samples counts as right)
     False
     >>> predict("audio for 35 frames", 36545, 36545, atol=5, unit="samples")
     [exercise] audio for 35 frames: predicted 36545 samples, measured 36545 samples ✓
@@ -351,9 +373,11 @@ def predict(
         print(f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit} ✓")
         return True
     side = "high" if guess > actual else "low"
-    ratio = f", {abs(guess / actual):.2g}x the measured value" if actual != 0 and guess != 0 else ""
+    gap = f" by {abs(guess - actual):.3g}{unit}"
+    far = actual != 0 and guess != 0 and abs(guess / actual - 1) >= 0.1  # a ratio near 1 would print as "1x"
+    ratio = f", {abs(guess / actual):.2g}x the measured value" if far else ""
     print(
-        f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit}: too {side}{ratio} "
+        f"[exercise] {name}: predicted {guess:.6g}{unit}, measured {actual:.6g}{unit}: too {side}{gap}{ratio} "
         f"(within ±{tolerance:.3g}{unit} counts as right)"
     )
     return False

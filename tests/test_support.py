@@ -98,6 +98,26 @@ def test_exercise_inputs_are_described_not_dumped(capsys):
     assert exercise.describe("x" * 200).endswith("...") and len(exercise.describe("x" * 200)) == 60
 
 
+def test_exercise_check_gives_each_function_its_own_inputs(capsys):
+    """A student's function that changes its input in place: the reference still sees the case's inputs, the
+    feedback prints them, and the caller's arrays are unchanged (before: "got 1.0, expected 0.02")."""
+
+    def in_place(a, b):
+        a -= b
+        return float(np.abs(a).sum())
+
+    def wrong_in_place(a, b):
+        a -= b
+        return float(np.abs(a).max())
+
+    a, b = np.array([1.0, 5.0, 2.0]), np.array([0.5, 1.0, 4.0])
+    reference = lambda a, b: float(np.abs(a - b).sum())  # noqa: E731
+    assert exercise.check("l1", in_place, reference, [(a, b)]) is True
+    assert exercise.check("l1", wrong_in_place, reference, [(a, b)]) is False
+    assert "l1(array([1., 5., 2.]), array([0.5, 1. , 4. ]))" in capsys.readouterr().out
+    np.testing.assert_array_equal(a, [1.0, 5.0, 2.0])
+
+
 def test_exercise_tolerance_and_nan_and_errors(capsys):
     assert exercise.difference(np.array([1.0, np.nan]), np.array([1.0 + 1e-9, np.nan])) is None
     assert exercise.difference((3, 4), [3, 4]) is None  # a tuple answers an array question
@@ -144,7 +164,9 @@ def test_exercise_predict(capsys):
     assert "35" not in capsys.readouterr().out  # the measured value stays hidden until a prediction is made
     assert exercise.predict("frames", 36, 35, rtol=0.05) is True
     assert exercise.predict("FGD", 10, 25.0, unit="") is False
-    assert "too low, 0.4x the measured value" in capsys.readouterr().out
+    assert "too low by 15, 0.4x the measured value" in capsys.readouterr().out
+    assert exercise.predict("n", 36539, 36545, atol=5, unit="samples") is False  # a near miss: by how much
+    assert "too low by 6 samples (within ±5 samples" in capsys.readouterr().out
     assert exercise.predict("lag", 0.2, 0.0, atol=0.05, unit="s") is False
     assert "too high" in capsys.readouterr().out
 
