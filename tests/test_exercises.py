@@ -12,7 +12,9 @@ exercise, in notebook order:
 1. the stub cell as the student gets it: every check returns ``None`` (not done yet);
 2. for each wrong answer of :data:`WRONG`: its definition, then the stub cell without the stub, up to its last
    check: every check of that answer returns ``False``;
-3. the solution cell: every check of the exercise returns ``True``.
+3. for each right answer of :data:`RIGHT` (written otherwise than the solution: another dtype, an in-place
+   update, another formula): the same, and every check of that answer returns ``True``;
+4. the solution cell: every check of the exercise returns ``True``.
 
 A new exercise needs a row in :data:`WRONG` (``test_every_exercise_has_a_wrong_answer`` says which).
 """
@@ -45,6 +47,14 @@ def _sheet_module():
 
 sheet = _sheet_module()
 
+_SPAN = (
+    "def span_word_ids(words, n_frames, fps, vocab):\n    t = np.arange(n_frames) / fps\n"
+    "    ids = np.array([vocab.get(w, {unk}) for w in words.words], dtype=np.int64)\n"
+    "    k = np.searchsorted(words.starts, t, side='{side}') - 1\n"
+    "    inside = (k >= 0) & (t {before} words.ends[np.maximum(k, 0)])\n"
+    "    out = np.zeros(n_frames, dtype=np.int64)\n    out[inside] = ids[k[inside]]\n    return out"
+)
+
 #: (notebook number, the student's name) -> plausible wrong answers (source defining that name).
 WRONG: dict[tuple[str, str], list[str]] = {
     ("00", "emotion_of_sequence"): [  # the block's last id counted in the next block
@@ -68,7 +78,11 @@ WRONG: dict[tuple[str, str], list[str]] = {
         "def span_word_ids(words, n_frames, fps, vocab):\n    t = np.arange(n_frames) / fps\n"
         "    ids = np.array([vocab.get(w, 3) for w in words.words], dtype=np.int64)\n"
         "    k = np.searchsorted(words.starts, t, side='right') - 1\n"
-        "    return np.where(k >= 0, ids[np.maximum(k, 0)], 0).astype(np.int64)"
+        "    return np.where(k >= 0, ids[np.maximum(k, 0)], 0).astype(np.int64)",
+        # the closed interval [start, end]; the word starting at t not yet counted; PAD for an unknown word
+        _SPAN.format(side="right", unk=3, before="<="),
+        _SPAN.format(side="left", unk=3, before="<"),
+        _SPAN.format(side="right", unk=0, before="<"),
     ],
     ("01", "beat_decimate"): ["def beat_decimate(channels, ratio):\n    return channels[::ratio]"],  # phase 0
     ("01", "rodrigues"): [  # the sine term flipped (the inverse rotation); K of v, not of the unit axis
@@ -88,7 +102,11 @@ WRONG: dict[tuple[str, str], list[str]] = {
     ("02", "eta_squared"): [  # group means not weighted by the group sizes
         "def eta_squared(values, labels):\n    x = np.asarray(values, dtype=float)\n"
         "    total = ((x - x.mean()) ** 2).sum()\n"
-        "    return float(sum((x[labels == g].mean() - x.mean()) ** 2 for g in np.unique(labels)) / total)"
+        "    return float(sum((x[labels == g].mean() - x.mean()) ** 2 for g in np.unique(labels)) / total)",
+        # nan, not 0, when all values are equal
+        "def eta_squared(values, labels):\n    x = np.asarray(values, dtype=float)\n    total = ((x - x.mean()) ** 2).sum()\n"
+        "    between = sum((labels == g).sum() * (x[labels == g].mean() - x.mean()) ** 2 for g in np.unique(labels))\n"
+        "    return float(between / total)",
     ],
     ("02", "window_stats"): [  # the sample standard deviation (ddof=1)
         "def window_stats(windows):\n    x = np.asarray(windows, dtype=float)\n"
@@ -100,7 +118,14 @@ WRONG: dict[tuple[str, str], list[str]] = {
     ("03", "nearest_words"): [  # the word itself left among its neighbours
         "def nearest_words(vectors, word_id, k):\n    v = vectors.astype(np.float64)\n"
         "    n = np.linalg.norm(v, axis=1, keepdims=True)\n    u = np.divide(v, n, out=np.zeros_like(v), where=n > 0)\n"
-        "    sim = u @ u[word_id]\n    sim[:4] = -np.inf\n    return np.argsort(-sim, kind='stable')[:k]"
+        "    sim = u @ u[word_id]\n    sim[:4] = -np.inf\n    return np.argsort(-sim, kind='stable')[:k]",
+        # dot products of rows not normalised
+        "def nearest_words(vectors, word_id, k):\n    v = vectors.astype(np.float64)\n    sim = v @ v[word_id]\n"
+        "    sim[:4] = -np.inf\n    sim[word_id] = -np.inf\n    return np.argsort(-sim, kind='stable')[:k]",
+        # the special tokens left among the neighbours
+        "def nearest_words(vectors, word_id, k):\n    v = vectors.astype(np.float64)\n"
+        "    n = np.linalg.norm(v, axis=1, keepdims=True)\n    u = np.divide(v, n, out=np.zeros_like(v), where=n > 0)\n"
+        "    sim = u @ u[word_id]\n    sim[word_id] = -np.inf\n    return np.argsort(-sim, kind='stable')[:k]",
     ],
     ("03", "window_audio_span"): [  # rounded instead of floored
         "def window_audio_span(i, stride, length, fps, sr):\n    start = int(round(i * stride * sr / fps))\n"
@@ -155,7 +180,10 @@ WRONG: dict[tuple[str, str], list[str]] = {
     ],
     ("07", "per_class_accuracy"): [  # precision, not recall
         "def per_class_accuracy(predicted, labels):\n"
-        "    return np.array([np.mean(labels[predicted == c] == c) if np.any(predicted == c) else 0.0 for c in np.unique(labels)])"
+        "    return np.array([np.mean(labels[predicted == c] == c) if np.any(predicted == c) else 0.0 for c in np.unique(labels)])",
+        # the classes of the predictions, not of the labels
+        "def per_class_accuracy(predicted, labels):\n"
+        "    return np.array([np.mean(predicted[labels == c] == c) for c in np.unique(predicted)])",
     ],
     ("08", "speed_minima"): [  # frame indices, not seconds
         "def speed_minima(positions, fps):\n    speed = np.linalg.norm(np.gradient(positions, 1 / fps, axis=0), axis=-1)\n"
@@ -171,7 +199,7 @@ WRONG: dict[tuple[str, str], list[str]] = {
         "    total = np.array([sum(n[i, j] / (p[i] + p[j]) for j in range(len(p)) if j != i) for i in range(len(p))])\n"
         "    return wins.sum(axis=1) / total"
     ],
-    ("09", "left_out"): ["left_out = 0.5", "left_out = 1 / K"],
+    ("09", "left_out"): ["left_out = 0.5", "left_out = 1 / K", "left_out = 1 / np.e"],  # 1/e: K large, not 8
     ("09", "take_interval"): [  # a 90 % interval
         "def take_interval(per_take, n, seed):\n    rng = np.random.default_rng(seed)\n    x = np.asarray(per_take, dtype=float)\n"
         "    means = [x[rng.integers(len(x), size=len(x))].mean() for _ in range(n)]\n    return np.percentile(means, [5, 95])"
@@ -188,6 +216,26 @@ WRONG: dict[tuple[str, str], list[str]] = {
         # the amplitude ratio sqrt(abar / (1 - abar))
         "def snr_at(steps, beta_1, beta_T, t):\n    ab = np.prod(1 - np.linspace(beta_1, beta_T, steps)[:t])\n"
         "    return float(np.sqrt(ab / (1 - ab)))",
+    ],
+}
+
+
+#: (notebook number, the student's name) -> right answers written otherwise than the solution, which must pass.
+RIGHT: dict[tuple[str, str], list[str]] = {
+    ("02", "window_stats"): [  # no cast to float64 (the windows are float32)
+        "def window_stats(windows):\n    return np.concatenate([windows.mean(axis=1), windows.std(axis=1), "
+        "np.abs(np.diff(windows, axis=1)).mean(axis=1)], axis=1)"
+    ],
+    ("04", "my_pck"): [  # changes its input in place (check gives each function its own copy)
+        "def my_pck(generated, ground_truth, delta):\n    generated -= ground_truth\n"
+        "    return float(np.mean(np.linalg.norm(generated, axis=-1) < delta))"
+    ],
+    ("08", "speed_minima"): [  # np.gradient over the frame times instead of a spacing
+        "def speed_minima(positions, fps):\n    t = np.arange(len(positions)) / fps\n"
+        "    speed = np.linalg.norm(np.gradient(positions, t, axis=0), axis=-1)\n"
+        "    n = len(speed)\n    idx = np.arange(n)\n    keep = np.ones(n, dtype=bool)\n    for k in (1, 2):\n"
+        "        keep &= speed < speed[np.minimum(idx + k, n - 1)]\n        keep &= speed < speed[np.maximum(idx - k, 0)]\n"
+        "    return np.flatnonzero(keep) / fps"
     ],
 }
 
@@ -224,6 +272,7 @@ def test_every_exercise_has_a_wrong_answer():
     assert needed == set(WRONG), (
         f"missing wrong answers: {sorted(needed - set(WRONG))}, stale: {sorted(set(WRONG) - needed)}"
     )
+    assert set(RIGHT) <= needed, f"right answers of no exercise: {sorted(set(RIGHT) - needed)}"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
@@ -330,6 +379,7 @@ def _run(path: Path, tmp: Path) -> list[tuple[str, str, str, object]]:
     found = sheet.exercises(path)
     every = [src for ex in found for _, src in ex.stubs + ex.solutions]
     every += [w for ex in found for n in ex.names for w in WRONG.get((path.name[:2], n), [])]
+    every += [r for ex in found for n in ex.names for r in RIGHT.get((path.name[:2], n), [])]
     needed = set().union(*(_free_names(src) for src in every))
     setup = _setup_cells(cells, min(i for ex in found for i, _ in ex.stubs), needed)
 
@@ -362,9 +412,11 @@ def _run(path: Path, tmp: Path) -> list[tuple[str, str, str, object]]:
             for i, src in ex.stubs:
                 exec(compile(sheet._python(src), f"{path.name}[{i}]", "exec"), ns)
             for name in ex.names:
-                for k, wrong in enumerate(WRONG[path.name[:2], name]):
-                    step["step"] = f"wrong {name} #{k + 1}"
-                    exec(wrong, ns)
+                answers = [("wrong", w) for w in WRONG[path.name[:2], name]]
+                answers += [("right", r) for r in RIGHT.get((path.name[:2], name), [])]
+                for k, (kind, answer) in enumerate(answers):
+                    step["step"] = f"{kind} {name} #{k + 1}"
+                    exec(answer, ns)
                     for i, src in ex.stubs:
                         if name in sheet.student_names(src):
                             exec(compile(_without_stubs(src, [name]), f"{path.name}[{i}]", "exec"), ns)
@@ -408,4 +460,10 @@ def test_exercises_accept_the_solution_and_reject_wrong_answers(path, tmp_path):
                 )
                 assert all(r is False for _, r in got), (
                     f"{ex.title}: wrong {name} #{k + 1} was accepted: {got}"
+                )
+            n_wrong = len(WRONG[path.name[:2], name])
+            for k in range(len(RIGHT.get((path.name[:2], name), []))):
+                got = [(c, r) for _, step, c, r in mine if step == f"right {name} #{n_wrong + k + 1}"]
+                assert got and all(r is True for _, r in got), (
+                    f"{ex.title}: right {name} #{k + 1} refused: {got}"
                 )
