@@ -950,15 +950,25 @@ def bootstrap_intervals(
     Returns
     -------
     dict of str -> (low, high)
+        Over the resamples that give the metric a value: one that draws only takes it cannot score (no window,
+        no audio beat) counts as none, and a :class:`ScoreWarning` says how many of the ``n`` that were; ``(nan,
+        nan)`` when none does. Fewer than 2 takes: no intervals (``{}``, with a warning: every resample would be
+        the same takes).
     """
     from tqdm import tqdm
 
     from beatlite.data.windows import window_starts
-    from beatlite.metrics.scoring import evaluate
 
     if n <= 0:
         return {}
     counts = [len(window_starts(len(p))) for p in truth.takes.positions]
+    if len(counts) < 2:
+        warnings.warn(
+            f"bootstrap intervals need at least 2 takes to resample, got {len(counts)}: none given",
+            ScoreWarning,
+            stacklevel=2,
+        )
+        return {}
     bounds = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     if generated.features is not None and len(generated.features) != bounds[-1]:
         raise ValueError(f"features have {len(generated.features)} rows, the takes {bounds[-1]} windows")
@@ -972,11 +982,40 @@ def bootstrap_intervals(
             audio=_pick(truth.audio, idx), audio_beats=_pick(beats, idx),
             onsets={key: _pick(v, idx) for key, v in truth.onsets.items()},
         )  # fmt: skip
-        scores = evaluate(_draw(generated, idx, bounds), draw_truth, metrics=metrics, seed=seed).values()
+        scores = _resample_scores(_draw(generated, idx, bounds), draw_truth, metrics, seed)
         for key in metrics:
             values[key].append(scores[key])
-    q = 50 * (1 - level)
-    return {key: tuple(float(x) for x in np.percentile(v, [q, 100 - q])) for key, v in values.items()}
+    q, out = 50 * (1 - level), {}
+    for key, v in values.items():
+        scored = np.asarray(v)[np.isfinite(v)]
+        if len(scored) < n:
+            warnings.warn(
+                f"bootstrap: {n - len(scored)} of {n} resamples gave no {key} (they drew only takes it cannot "
+                f"score: too few windows, no beats): its interval is over the other {len(scored)}",
+                ScoreWarning,
+                stacklevel=2,
+            )
+        out[key] = (
+            tuple(float(x) for x in np.percentile(scored, [q, 100 - q])) if len(scored) else (math.nan,) * 2
+        )
+    return out
+
+
+def _resample_scores(generated: Any, truth: Any, metrics: Sequence[str], seed: int) -> dict[str, float]:
+    """``evaluate``'s values on one resample; a metric that cannot be computed on it (e.g. an FGD of fewer than
+    2 windows) is NaN, the others keep their values."""
+    from beatlite.metrics.scoring import evaluate
+
+    try:
+        return evaluate(generated, truth, metrics=metrics, seed=seed).values()
+    except ValueError:  # one metric could not: each one alone
+        out = {}
+        for key in metrics:
+            try:
+                out[key] = evaluate(generated, truth, metrics=[key], seed=seed).values()[key]
+            except ValueError:
+                out[key] = math.nan
+        return out
 
 
 def _pick(xs: list[Any] | None, idx: np.ndarray) -> list[Any] | None:

@@ -466,3 +466,43 @@ def test_every_metric_key_names_its_variant_and_where_it_comes_from():
         assert m.describe and len(m.source) > 40, key
         assert any(w in m.source for w in ("et al.", "code", "metric.py", "genea")), (key, m.source)
         assert m.source in describe([key], sources=True) and m.source not in describe([key]), key
+
+
+# ----------------------------------------------------------------------------- edge cases a user's outputs produce
+def test_equal_speed_histograms_are_exactly_0_apart_and_negative_counts_are_refused():
+    from beatlite.metrics.extras import hellinger_distance
+
+    h = np.arange(49.0)
+    assert hellinger_distance(h, 3 * h) == 0.0  # sqrt(1 - sum sqrt(pq)) left 1.05e-08 here
+    assert hellinger_distance(np.array([1.0, 0.0]), np.array([0.0, 1.0])) == pytest.approx(1.0, abs=1e-15)
+    with pytest.raises(ValueError, match="counts >= 0"):
+        hellinger_distance(np.array([-1.0, 2.0]), np.array([1.0, 1.0]))  # was 0.0, "perfect"
+    with pytest.raises(ValueError, match="no value inside its bins"):
+        hellinger_distance(np.zeros(49), h)
+
+
+def test_zero_frames_are_refused_or_left_out_never_nan():
+    empty, take = np.zeros((0, 5, 3)), np.random.default_rng(0).normal(size=(10, 5, 3))
+    for metric in (pck, mpjpe):
+        with pytest.raises(ValueError, match="no frames"):
+            metric(empty, empty)  # was nan, with numpy's "mean of empty slice"
+    assert l1_diversity([np.zeros((0, 15)), take.reshape(10, 15)]) == l1_diversity(
+        take
+    )  # was a reshape error
+
+
+def test_batch_pairing_refuses_batches_of_other_sizes():
+    """Batches of 16 and 10 rows: with every batch used the stacked shapes match, the rows paired do not."""
+    rng = np.random.default_rng(0)
+    batches = [rng.normal(size=(16, 8)), rng.normal(size=(10, 8))]
+    with pytest.raises(ValueError, match=r"equal batch sizes, got batches of \[10, 16\] rows"):
+        diversity(batches, n_pairs=2, batch_pairing=True, seed=3)
+
+
+def test_a_metric_undefined_on_the_takes_is_skipped_with_its_reason():
+    """No audio onset in any take: BeatAlign is NaN by definition, listed as skipped (was a NaN result)."""
+    rng = np.random.default_rng(0)
+    takes = Takes(positions=[np.cumsum(rng.normal(size=(60, 43, 3)), axis=0)])
+    ev = evaluate(takes, GroundTruth(takes, audio_beats=[np.array([])]), metrics=["BeatAlign", "MPJPE"])
+    assert [r.key for r in ev.results] == ["MPJPE"] and "no audio onset" in ev.skipped["BeatAlign"]
+    assert math.isnan(ev.values()["BeatAlign"])

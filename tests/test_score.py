@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -493,6 +494,33 @@ def test_bootstrap_of_two_takes_spans_their_own_values():
     truth = GroundTruth(Takes(positions=real))
     low, high = bootstrap_intervals(Takes(positions=gen), truth, ["MPJPE"], n=400, seed=3)["MPJPE"]
     assert low == pytest.approx(min(own), rel=1e-12) and high == pytest.approx(max(own), rel=1e-12)
+
+
+def test_bootstrap_resamples_that_cannot_score_a_metric_are_left_out_and_counted():
+    """Takes of 20, 80 and 90 frames: the first has no window, so a resample drawing only it has no FGD (was: the
+    whole bootstrap failed, "needs at least 2 samples"); one take without audio beats: BeatAlign likewise (was
+    (nan, nan)). A resample draws only take 0 with probability (1/3)^3 = 1/27."""
+    from beatlite.data.windows import window_starts
+
+    rng = np.random.default_rng(8)
+    real = [np.cumsum(rng.normal(size=(n, 43, 3)) * 0.3, axis=0) for n in (20, 80, 90)]
+    n_windows = sum(len(window_starts(len(p))) for p in real)
+    truth = GroundTruth(Takes(positions=real, features=rng.normal(size=(n_windows, 16))),
+                        audio_beats=[np.array([]), np.array([1.0, 2.0, 4.0]), np.array([0.5, 3.0])])  # fmt: skip
+    gen = Takes(positions=[p + 1.0 for p in real], features=rng.normal(size=(n_windows, 16)))
+    with pytest.warns(ScoreWarning) as record:
+        out = bootstrap_intervals(gen, truth, ["FGD", "BeatAlign", "MPJPE"], n=300, seed=0)
+    messages = " ".join(str(w.message) for w in record)
+    fgd_missing = int(re.search(r"(\d+) of 300 resamples gave no FGD", messages).group(1))
+    assert 0 < fgd_missing < 40  # binomial(300, 1/27): mean 11, sd 3.3
+    assert "no BeatAlign" in messages and "no MPJPE" not in messages
+    assert all(np.isfinite(out[k]).all() for k in out) and out["MPJPE"][0] < out["MPJPE"][1]
+    one = GroundTruth(
+        Takes(positions=real[1:2], features=truth.takes.features[:5]), audio_beats=truth.audio_beats[1:2]
+    )
+    one_gen = Takes(positions=gen.positions[1:2], features=gen.features[:5])
+    with pytest.warns(ScoreWarning, match="at least 2 takes"):  # one take: every resample is that take
+        assert bootstrap_intervals(one_gen, one, ["MPJPE"], n=10) == {}
 
 
 def test_bootstrap_intervals_are_seeded_and_contain_the_estimate(test_set, tmp_path):

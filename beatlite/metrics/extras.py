@@ -194,20 +194,24 @@ def speed_histogram(
 def hellinger_distance(hist1: np.ndarray, hist2: np.ndarray) -> float:
     """Hellinger distance ``sqrt(1 - sum_i sqrt(p_i q_i))`` of two histograms normalised to sum 1.
 
-    GENEA's ``hellinger_distance.py``: 0 for equal distributions, 1 for disjoint ones.
+    GENEA's ``hellinger_distance.py``: 0 for equal distributions, 1 for disjoint ones. Computed as the equal
+    ``sqrt(sum_i (sqrt(p_i) - sqrt(q_i))^2 / 2)``, which keeps equal histograms at 0 (``1 - sum`` leaves 1e-8).
 
     Examples
     --------
     >>> round(hellinger_distance(np.array([0, 4, 0]), np.array([0, 1, 1])), 4)  # sqrt(1 - sqrt(1/2))
     0.5412
+    >>> hellinger_distance(np.arange(49.0), np.arange(49.0))
+    0.0
     """
     p = as_array(hist1, "hist1", ndim=1)
     q = as_array(hist2, "hist2", ndim=1)
-    if p.shape != q.shape or p.sum() <= 0 or q.sum() <= 0:
-        raise ValueError(
-            f"histograms must have the same shape and positive sums, got {p.shape} and {q.shape}"
-        )
-    return float(np.sqrt(max(0.0, 1.0 - np.sum(np.sqrt(p / p.sum() * q / q.sum())))))
+    if p.shape != q.shape:
+        raise ValueError(f"histograms must have the same shape, got {p.shape} and {q.shape}")
+    for name, h in (("hist1", p), ("hist2", q)):
+        if (h < 0).any() or h.sum() <= 0:
+            raise ValueError(f"{name} must have counts >= 0 and a positive sum (no value inside its bins?)")
+    return float(np.sqrt(0.5 * np.sum((np.sqrt(p / p.sum()) - np.sqrt(q / q.sum())) ** 2)))
 
 
 def _derivative_norm(positions: np.ndarray, fps: float, order: int) -> np.ndarray:
@@ -222,4 +226,6 @@ def _pair(generated: np.ndarray, ground_truth: np.ndarray) -> tuple[np.ndarray, 
     t = as_array(ground_truth, "ground_truth", ndim=3, last=3)
     if g.shape != t.shape:
         raise ValueError(f"generated and ground_truth must have the same shape, got {g.shape} and {t.shape}")
+    if g.shape[0] == 0 or g.shape[1] == 0:
+        raise ValueError(f"generated has no frames or no joints, shape {g.shape}")
     return g, t

@@ -296,6 +296,9 @@ def evaluate(
         except TooFewWindows as e:  # a defined metric that this test set is too small for: skipped, said why
             skipped[key] = str(e)
             continue
+        if not math.isfinite(value):  # e.g. BeatAlign without audio onsets, BC of a system that never moves
+            skipped[key] = f"undefined on these takes ({UNDEFINED.get(m.name, 'the metric gave NaN')})"
+            continue
         results.append(MetricResult(key, m.name, value, m.variant, m.higher_is_better, m.describe))
     return Evaluation(results, skipped)
 
@@ -708,6 +711,11 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "Diversity": (0.0, math.inf), "L1div": (0.0, math.inf), "PCK": (0.0, 1.0), "MPJPE": (0.0, math.inf),
     "Acceleration": (0.0, math.inf), "Jerk": (0.0, math.inf), "Speed Hellinger": (0.0, 1.0),
 }  # fmt: skip
+#: Why a built-in metric may be undefined (NaN) on some takes, by name: :func:`evaluate` lists it as skipped with this.
+UNDEFINED: dict[str, str] = {
+    "BeatAlign": "no audio onset in any take",
+    "BC": "no motion beat in any take, as for a system that never moves, or no audio beat",
+}
 #: Built-in metrics whose value for the ground truth itself is a constant, by name.
 PERFECT: dict[str, float] = {"FGD": 0.0, "PCK": 1.0, "MPJPE": 0.0, "Speed Hellinger": 0.0}
 

@@ -65,7 +65,7 @@ def l1_diversity(
     total, frames = 0.0, 0
     for i, m in enumerate(items):
         x = as_array(m, f"motion[{i}]", ndim=(2, 3))
-        x = x.reshape(x.shape[0], -1)
+        x = x.reshape(x.shape[0], int(np.prod(x.shape[1:])))  # (-1 cannot be inferred from 0 frames)
         if windowed:
             x = sliding_windows(x, length, stride).reshape(-1, x.shape[1])
         if x.shape[0] == 0:
@@ -131,6 +131,9 @@ def diversity(
         if not isinstance(generated, (list, tuple)) or not generated:
             raise TypeError("batch_pairing=True needs generated as a non-empty list of batches")
         batches = [_features(b, extractor, f"generated[{i}]") for i, b in enumerate(generated)]
+        sizes = sorted({len(b) for b in batches})
+        if len(sizes) > 1:  # (stacked shapes match when every batch is used, the pairs would not)
+            raise ValueError(f"batch pairing needs equal batch sizes, got batches of {sizes} rows")
         f1 = np.vstack(batches[:n_pairs])
         perm = rng.permutation(len(batches))[:n_pairs]
         f2 = np.vstack([batches[k] for k in perm])
