@@ -358,6 +358,52 @@ def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
     assert values["BC (emage)"] == pytest.approx(result.truth.values()["BC (emage)"], abs=1e-9)
 
 
+def test_a_take_moved_to_another_split_by_the_csv_moves_in_the_store(tmp_path, monkeypatch):
+    """train_test_split.csv changes a take's split without changing its files: the store built before must follow
+    (it kept the old split, so a test take went on training)."""
+    from beatlite.data.beat2 import write_beat2_folder
+    from beatlite.data.examples import example_corpus
+    from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    src, root = example_corpus(), tmp_path / "beat2"
+    write_beat2_folder(src.name, root)
+    src.cleanup()
+    csv = root / "train_test_split.csv"
+    csv.write_text("id,type\n2_scott_0_1_1,train\n2_scott_0_9_9,test\n")
+    first = build_store(index_folder(root), workers=0)
+    assert {t.stem: t.meta["split"] for t in first.takes} == {
+        "2_scott_0_1_1": "train",
+        "2_scott_0_9_9": "test",
+    }
+    csv.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_9_9,train\n")
+    again = build_store(index_folder(root), workers=0)
+    assert {t.stem: t.meta["split"] for t in again.takes} == {
+        "2_scott_0_1_1": "test",
+        "2_scott_0_9_9": "train",
+    }
+    assert [again.takes[int(i)].stem for i in np.unique(again.windows("train").take_ids)] == ["2_scott_0_9_9"]
+
+
+def test_writing_into_an_existing_beat2_folder_extends_its_split_list(tmp_path):
+    """The destination "to create or extend": rows of other takes stay, the takes written replace theirs (the
+    list was rewritten with this call's takes only)."""
+    from beatlite.data.beat2 import write_beat2_folder
+    from beatlite.data.examples import example_corpus
+    from beatlite.data.index import index_folder
+    from beatlite.io.smplx import read_beat2_split
+
+    src, root = example_corpus(), tmp_path / "beat2"
+    root.mkdir()
+    (root / "train_test_split.csv").write_text("id,type\n7_sophie_0_1_1,val\n2_scott_0_1_1,additional\n")
+    written = write_beat2_folder(src.name, root)
+    want = {r.stem: r.split for r in index_folder(src.name)}
+    src.cleanup()
+    assert read_beat2_split(root / "train_test_split.csv") == {"7_sophie_0_1_1": "val", **want}
+    assert written == list(want)
+
+
 # ------------------------------------------------------------------------------------------ conversion
 def test_convert_command_round_trip_and_one_line_errors(tmp_path, capsys):
     from beatlite.convert import main

@@ -34,7 +34,8 @@ def write_beat2_folder(
         A BEAT-format folder (:func:`beatlite.data.index_folder` reads it; its index cache is used).
     dst : str or PathLike
         The BEAT2 root to create or extend (``smplxflame_30/``, ``wave16k/``, ``textgrid/``,
-        ``train_test_split.csv``; every file written atomically).
+        ``train_test_split.csv``; every file written atomically). An existing ``train_test_split.csv`` keeps its
+        rows; the takes written here replace theirs or are added.
     rest : SMPLXRest, optional
         The SMPL-X body (default :func:`beatlite.skeleton.smplx.approximate_rest`).
 
@@ -58,13 +59,17 @@ def write_beat2_folder(
     from beatlite.data.index import index_folder
     from beatlite.io import load_take, write_wav
     from beatlite.io.atomic import atomic_write
-    from beatlite.io.smplx import SMPLXMotion, write_smplx
+    from beatlite.io.smplx import SMPLXMotion, read_beat2_split, write_smplx
     from beatlite.skeleton.smplx import beat_to_smplx
 
     out = Path(dst)
+    split_csv = out / "train_test_split.csv"
+    splits = (
+        read_beat2_split(split_csv) if split_csv.is_file() else {}
+    )  # (a bad one: FormatError, nothing written)
     for folder in ("smplxflame_30", "wave16k", "textgrid"):
         (out / folder).mkdir(parents=True, exist_ok=True)
-    rows, stems = ["id,type"], []
+    stems = []
     for record in index_folder(src):
         if not record.usable:
             continue
@@ -79,8 +84,8 @@ def write_beat2_folder(
             with atomic_write(out / "textgrid" / (record.stem + source.name[len(record.stem) :]), "wb") as f:
                 with open(source, "rb") as g:
                     shutil.copyfileobj(g, f)
-        rows.append(f"{record.stem},{record.split or 'train'}")
+        splits[record.stem] = record.split or "train"
         stems.append(record.stem)
-    with atomic_write(out / "train_test_split.csv") as f:
-        f.write("\n".join(rows) + "\n")
+    with atomic_write(split_csv) as f:
+        f.write("\n".join(["id,type", *(f"{stem},{split}" for stem, split in splits.items())]) + "\n")
     return stems

@@ -833,10 +833,11 @@ def default_store_folder(index: TakeIndex, params: Mapping[str, Any]) -> Path:
 
 
 def _is_current(folder: Path, record: TakeRecord, params: Mapping[str, Any]) -> bool:
-    """Whether ``folder`` holds a complete entry of ``record`` built from the same files and parameters."""
+    """Whether ``folder`` holds a complete entry of ``record`` built from the same files and parameters, in the
+    split the index gives it now (BEAT2's ``train_test_split.csv`` can move a take without changing its files)."""
     try:
         take = StoreTake.open(folder)
-        if take.meta["fingerprint"] != take_fingerprint(record, params):
+        if take.meta["fingerprint"] != take_fingerprint(record, params) or take.meta["split"] != record.split:
             return False
         for name in take.meta["shapes"]:
             take.stream(name)
