@@ -344,6 +344,25 @@ def test_index_and_load_a_beat2_folder(beat2_folder):
     np.testing.assert_allclose(take.positions()[:, cols], beat.positions()[:, cols], atol=0.05)
 
 
+def test_a_bvh_and_its_converted_npz_index_and_load_the_same_file(tmp_path):
+    """A take with its .bvh.gz and a converted .npz beside it: the index used the .npz (plain files sorted before
+    .gz) while load_take(stem) read the .bvh.gz; both now read BEAT's own file, the .npz noted as a duplicate."""
+    from beatlite.convert import convert
+    from beatlite.data.index import index_folder
+
+    for name in ("2_scott_0_1_1.bvh.gz", "2_scott_0_1_1.wav"):
+        shutil.copy(SAMPLES / name, tmp_path)
+    convert(tmp_path / "2_scott_0_1_1.bvh.gz", tmp_path / "2_scott_0_1_1.npz")
+    record = index_folder(tmp_path, cache=False)["2_scott_0_1_1"]
+    take = load_take(tmp_path / "2_scott_0_1_1")
+    assert record.files["motion"] == take.paths[".bvh"] == tmp_path / "2_scott_0_1_1.bvh.gz"
+    assert record.format == take.format == "beat" and record.usable
+    assert (
+        f"duplicate motion files: using {tmp_path / '2_scott_0_1_1.bvh.gz'}, ignoring {tmp_path / '2_scott_0_1_1.npz'}"
+        in record.problems
+    )
+
+
 @pytest.mark.slow
 def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
     from beatlite.score import read_prediction, score_folder

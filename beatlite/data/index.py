@@ -496,7 +496,8 @@ _CHECKS: dict[str, Callable[[Path], float | None]] = {
 
 # ---------------------------------------------------------------------- index
 def _scan(root: Path, recursive: bool) -> dict[str, dict[str, list[Path]]]:
-    """stem -> modality -> paths (sorted, plain files before ``.gz``)."""
+    """stem -> modality -> paths (sorted: BEAT's ``.bvh[.gz]`` before an ``.npz``, as :func:`beatlite.io.take.take_files`
+    prefers it; plain files before ``.gz``)."""
     found: dict[str, dict[str, list[Path]]] = {}
     if recursive:
         walker = (
@@ -514,7 +515,7 @@ def _scan(root: Path, recursive: bool) -> dict[str, dict[str, list[Path]]]:
             found.setdefault(stem, {}).setdefault(MODALITIES[ext], []).append(folder / name)
     for by_modality in found.values():
         for paths in by_modality.values():
-            paths.sort(key=lambda p: (p.suffix.lower() == ".gz", str(p)))
+            paths.sort(key=lambda p: (split_take_file(p.name)[1] == "npz", p.suffix.lower() == ".gz", str(p)))
     return found
 
 
