@@ -363,6 +363,21 @@ def test_a_bvh_and_its_converted_npz_index_and_load_the_same_file(tmp_path):
     )
 
 
+def test_the_split_list_of_a_beat2_root_nested_in_the_indexed_folder_sets_its_takes_splits(
+    beat2_folder, tmp_path
+):
+    """Indexing a folder that holds a BEAT2 root: its train_test_split.csv was ignored (BEAT's name rule used)."""
+    from beatlite.data.index import index_folder
+
+    nested = tmp_path / "nest" / "beat_english_v2.0.0"
+    shutil.copytree(beat2_folder, nested)
+    # by BEAT's rule 2_scott_0_1_1 is test and 2_scott_0_9_9 train: the list says otherwise
+    (nested / "train_test_split.csv").write_text("id,type\n2_scott_0_1_1,train\n2_scott_0_9_9,additional\n")
+    for root in (nested, tmp_path / "nest", tmp_path):
+        index = index_folder(root, cache=False)
+        assert {r.stem: r.split for r in index} == {"2_scott_0_1_1": "train", "2_scott_0_9_9": "additional"}
+
+
 @pytest.mark.slow
 def test_score_a_folder_of_beat2_predictions(beat2_folder, tmp_path):
     from beatlite.score import read_prediction, score_folder

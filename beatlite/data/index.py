@@ -88,8 +88,9 @@ class TakeRecord:
     emotion_name : str or None
         ``"neutral"``, ``"happiness"``, ...
     split : str or None
-        ``"train"``, ``"val"``, ``"test"`` (BEAT's rule) or ``None``; for a take listed in a BEAT2
-        ``train_test_split.csv`` at the indexed root, its ``type`` there (also ``"additional"``).
+        ``"train"``, ``"val"``, ``"test"`` (BEAT's rule) or ``None``; for a take listed in the
+        ``train_test_split.csv`` of its BEAT2 root (the nearest folder holding one above its motion file, up to the
+        indexed folder), its ``type`` there (also ``"additional"``).
     files : dict str -> Path
         Modality (``"motion"``, ``"audio"``, ``"face"``, ``"text"``, ``"semantic"``,
         ``"emotion"``) -> file path.
@@ -742,16 +743,27 @@ def index_folder(
 
 
 def _beat2_splits(root: Path, records: list[TakeRecord]) -> None:
-    """Splits from BEAT2's ``train_test_split.csv`` at ``root`` (if there is one), over the name rule's."""
+    """Splits from BEAT2's ``train_test_split.csv`` over the name rule's: for each take, the list of its BEAT2 root,
+    the nearest folder holding one above its (motion) file, up to ``root`` (a BEAT2 root may be nested in it)."""
     from beatlite.io.smplx import read_beat2_split
 
-    path = root / "train_test_split.csv"
-    if not path.is_file():
-        return
-    listed = read_beat2_split(path)
+    lists: dict[Path, dict[str, str] | None] = {}
+
+    def split_list(folder: Path) -> dict[str, str] | None:
+        if folder not in lists:
+            path = folder / "train_test_split.csv"
+            lists[folder] = read_beat2_split(path) if path.is_file() else None
+        return lists[folder]
+
     for record in records:
-        if record.stem in listed:
-            record.split = listed[record.stem]
+        file = record.files.get("motion") or next(iter(record.files.values()), None)
+        folders = [] if file is None else list(file.parents)
+        for folder in folders[: folders.index(root) + 1] if root in folders else [root]:
+            listed = split_list(folder)
+            if listed is not None:
+                if record.stem in listed:
+                    record.split = listed[record.stem]
+                break
 
 
 def _index_with_cache(
