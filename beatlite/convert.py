@@ -9,7 +9,8 @@
 ``take.npz -> take.bvh``               BEAT2 retargeted to BEAT's skeleton (:func:`~beatlite.skeleton.smplx
                                        .smplx_to_beat`); ``--skeleton smplx`` writes SMPL-X's own skeleton
                                        instead (no retargeting: to open BEAT2 files in Blender)
-``BEAT folder -> BEAT2 folder``        :func:`beatlite.data.beat2.write_beat2_folder`
+``BEAT folder -> BEAT2 folder``        :func:`beatlite.data.beat2.write_beat2_folder` (30 fps: ``--fps`` is refused);
+                                       each take that is not usable is skipped and named with its problems
 =====================================  ==================================================================
 
 ``--model SMPLX_NEUTRAL.npz`` (and the file's ``betas``) gives the body's rest skeleton
@@ -56,7 +57,8 @@ def convert(
     src, dst : str or Path
         ``.bvh``/``.bvh.gz`` <-> ``.npz``, or a BEAT folder -> a BEAT2 folder.
     fps : float
-        Frame rate of a written ``.npz`` (the BVH is resampled; rotations along the shorter arc).
+        Frame rate of a written ``.npz`` (the BVH is resampled; rotations along the shorter arc); a folder is
+        written at BEAT2's 30 fps (another ``fps`` is a ``ValueError``).
     skeleton : {"beat", "smplx"}
         The skeleton of a written ``.bvh``.
     model : str or Path, optional
@@ -66,8 +68,8 @@ def convert(
     -------
     dict
         ``{"frames", "fps", "bone_errors_deg": {bone: (mean, max)}, "no_counterpart": [...]}`` for BVH -> npz
-        (the SMPL-X joints without a BEAT joint), ``{"frames", "fps"}`` for npz -> BVH, ``{"takes": [...]}`` for
-        a folder.
+        (the SMPL-X joints without a BEAT joint), ``{"frames", "fps"}`` for npz -> BVH, ``{"takes": [...],
+        "skipped": {stem: [problem, ...]}}`` for a folder (the takes written; those not usable, with their problems).
 
     Examples
     --------
@@ -89,9 +91,15 @@ def convert(
     if skeleton not in ("beat", "smplx"):
         raise ValueError(f"convert: skeleton must be 'beat' or 'smplx', got {skeleton!r}")
     if src.is_dir():
-        from beatlite.data.beat2 import write_beat2_folder
+        from beatlite.data.beat2 import BEAT2_FPS, write_beat2_folder
+        from beatlite.data.index import index_folder
 
-        return {"takes": write_beat2_folder(src, dst, rest=_rest(model))}
+        if fps != BEAT2_FPS:
+            raise ValueError(
+                f"convert: a folder is written at BEAT2's {BEAT2_FPS} fps; fps={fps!r} is for a file"
+            )
+        skipped = {r.stem: list(r.problems) for r in index_folder(src) if not r.usable}
+        return {"takes": write_beat2_folder(src, dst, rest=_rest(model)), "skipped": skipped}
     if _is_bvh(src) and dst.suffix == ".npz":
         return _bvh_to_npz(src, dst, fps, _rest(model))
     if src.suffix == ".npz" and _is_bvh(dst):
@@ -144,7 +152,9 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m beatlite.convert", description=__doc__.split("\n")[0])
     p.add_argument("src", help="a .bvh[.gz], a BEAT2 .npz, or a BEAT folder")
     p.add_argument("dst", help="a .npz, a .bvh, or the BEAT2 folder to write")
-    p.add_argument("--fps", type=float, default=30.0, help="frame rate of a written .npz (default 30)")
+    p.add_argument(
+        "--fps", type=float, help="frame rate of a written .npz file (default 30; a folder is always 30)"
+    )
     p.add_argument("--skeleton", choices=("beat", "smplx"), default="beat", help="skeleton of a written .bvh")
     p.add_argument(
         "--model", help="an SMPL-X model .npz for the rest skeleton (default: beatlite's approximation)"
@@ -158,12 +168,15 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     args = _parser().parse_args(argv)
     try:
-        report = convert(args.src, args.dst, fps=args.fps, skeleton=args.skeleton, model=args.model)
+        fps = 30.0 if args.fps is None else args.fps
+        report = convert(args.src, args.dst, fps=fps, skeleton=args.skeleton, model=args.model)
     except (FormatError, FileNotFoundError, ValueError) as exc:
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
     if "takes" in report:
-        print(f"{len(report['takes'])} takes written to {args.dst}")
+        for stem, problems in report["skipped"].items():
+            print(f"skipped {stem} (not usable): {'; '.join(problems)}")
+        print(f"{len(report['takes'])} takes written to {args.dst}, {len(report['skipped'])} skipped")
     else:
         print(f"{args.dst}: {report['frames']} frames at {report['fps']:g} fps")
     if "bone_errors_deg" in report:

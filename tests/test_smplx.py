@@ -463,3 +463,27 @@ def test_convert_command_round_trip_and_one_line_errors(tmp_path, capsys):
     assert main([str(SAMPLES / "2_scott_0_1_1.wav"), str(tmp_path / "x.npz")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and "2_scott_0_1_1.wav" in err[0]
+
+
+def test_convert_folder_names_each_skipped_take_and_refuses_another_fps(tmp_path, capsys, monkeypatch):
+    """A folder conversion skipped unusable takes silently ("1 takes written") and ignored --fps."""
+    from beatlite.convert import main
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    src = tmp_path / "src"
+    src.mkdir()
+    for path in SAMPLES.glob("2_scott_0_1_1.*"):
+        shutil.copy(path, src)
+    shutil.copy(SAMPLES / "2_scott_0_9_9.wav", src)  # audio without motion: not usable
+    assert main([str(src), str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out == [
+        "skipped 2_scott_0_9_9 (not usable): missing motion (.bvh or .npz) file; missing face (.json) file; "
+        "missing text (.TextGrid) file; missing semantic (.txt) file; missing emotion (.csv) file",
+        f"1 takes written to {tmp_path / 'out'}, 1 skipped",
+    ]
+    assert sorted(p.name for p in (tmp_path / "out" / "smplxflame_30").iterdir()) == ["2_scott_0_1_1.npz"]
+    assert main([str(src), str(tmp_path / "out60"), "--fps", "60"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:") and "30 fps" in err[0] and "fps=60.0" in err[0]
+    assert not (tmp_path / "out60").exists()
