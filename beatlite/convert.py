@@ -57,8 +57,8 @@ def convert(
     src, dst : str or Path
         ``.bvh``/``.bvh.gz`` <-> ``.npz``, or a BEAT folder -> a BEAT2 folder.
     fps : float
-        Frame rate of a written ``.npz`` (the BVH is resampled; rotations along the shorter arc); a folder is
-        written at BEAT2's 30 fps (another ``fps`` is a ``ValueError``).
+        Frame rate of a written ``.npz``, finite and > 0 (the BVH is resampled; rotations along the shorter
+        arc); a folder is written at BEAT2's 30 fps (another ``fps`` is a ``ValueError``).
     skeleton : {"beat", "smplx"}
         The skeleton of a written ``.bvh``.
     model : str or Path, optional
@@ -83,6 +83,10 @@ def convert(
     True
     >>> convert(Path(tmp.name) / "t.npz", Path(tmp.name) / "t.bvh")
     {'frames': 444, 'fps': 30.0}
+    >>> convert(Path(tmp.name) / "t.bvh", Path(tmp.name) / "t0.npz", fps=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: convert: fps must be finite and > 0, got 0
     >>> tmp.cleanup()
     """
     from beatlite.io import FormatError
@@ -90,6 +94,8 @@ def convert(
     src, dst = Path(src), Path(dst)
     if skeleton not in ("beat", "smplx"):
         raise ValueError(f"convert: skeleton must be 'beat' or 'smplx', got {skeleton!r}")
+    if not (np.isfinite(fps) and fps > 0):
+        raise ValueError(f"convert: fps must be finite and > 0, got {fps!r}")
     if src.is_dir():
         from beatlite.data.beat2 import BEAT2_FPS, write_beat2_folder
         from beatlite.data.index import index_folder
@@ -170,7 +176,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         fps = 30.0 if args.fps is None else args.fps
         report = convert(args.src, args.dst, fps=fps, skeleton=args.skeleton, model=args.model)
-    except (FormatError, FileNotFoundError, ValueError) as exc:
+    except (
+        FormatError,
+        OSError,
+        ValueError,
+    ) as exc:  # OSError: a missing file, a folder given as a file, ...
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
     if "takes" in report:

@@ -487,3 +487,27 @@ def test_convert_folder_names_each_skipped_take_and_refuses_another_fps(tmp_path
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and "30 fps" in err[0] and "fps=60.0" in err[0]
     assert not (tmp_path / "out60").exists()
+
+
+@pytest.mark.parametrize("fps", ["0", "-5", "nan", "inf"])
+def test_convert_refuses_a_frame_rate_that_is_not_finite_and_positive(tmp_path, capsys, fps):
+    """--fps 0 was a ZeroDivisionError traceback (nan and inf went on into the resampler)."""
+    from beatlite.convert import main
+
+    assert main([str(SAMPLES / "2_scott_0_1_1.bvh.gz"), str(tmp_path / "a.npz"), "--fps", fps]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: convert: fps must be finite and > 0, got {float(fps)!r}"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_convert_to_a_folder_given_as_the_output_file_is_one_error_line(tmp_path, capsys):
+    """An output path that is a folder was an IsADirectoryError traceback."""
+    from beatlite.convert import main
+
+    (tmp_path / "out.npz").mkdir()
+    assert main([str(SAMPLES / "2_scott_0_1_1.bvh.gz"), str(tmp_path / "out.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:") and str(tmp_path / "out.npz") in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.npz"] and not any(
+        (tmp_path / "out.npz").iterdir()
+    )
