@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import re
 import shutil
 import zipfile
 from pathlib import Path
@@ -133,6 +134,18 @@ def test_read_smplx_gives_one_format_error_per_malformed_file(tmp_path):
         message = str(err.value)
         assert path.name in message and expected in message, (name, message)
         assert "\n" not in message, (name, message)
+
+
+@pytest.mark.parametrize("shape", [(5, 3, 55), (5 * 165,), (5, 5, 33), (5, 1, 165)])
+def test_smplx_motion_takes_poses_as_t_165_or_t_55_3_only(shape):
+    """Any array of 5 * 165 numbers was reshaped to (5, 55, 3): a transposed (T, 3, 55) became garbage rotations."""
+    with pytest.raises(
+        ValueError, match=re.escape(f"SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got {shape}")
+    ):
+        SMPLXMotion(np.zeros(shape), np.zeros((5, 3)), fps=30)
+    rows = np.arange(5 * 165.0).reshape(5, 165) / 1000
+    a, b = SMPLXMotion(rows, np.zeros((5, 3)), 30), SMPLXMotion(rows.reshape(5, 55, 3), np.zeros((5, 3)), 30)
+    assert a.poses.shape == (5, 55, 3) and np.array_equal(a.poses, b.poses) and a.poses[0, 1, 2] == rows[0, 5]
 
 
 def test_read_smplx_refuses_a_decompression_bomb_before_decompressing(tmp_path):

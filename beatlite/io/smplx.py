@@ -62,7 +62,7 @@ class SMPLXMotion:
     ----------
     poses : (T, 55, 3) float64
         Axis-angle rotations in radians, each joint relative to its parent
-        (:data:`beatlite.skeleton.smplx.SMPLX_JOINTS` order).
+        (:data:`beatlite.skeleton.smplx.SMPLX_JOINTS` order); given as (T, 165) or (T, 55, 3).
     trans : (T, 3) float64, metres
     fps : float
     betas : (B,) float64 or None
@@ -75,6 +75,10 @@ class SMPLXMotion:
     >>> m = SMPLXMotion(np.zeros((30, 55, 3)), np.zeros((30, 3)), fps=30)
     >>> m.n_frames, m.duration, m.to_beat().channels.shape
     (30, 1.0, (30, 228))
+    >>> SMPLXMotion(np.zeros((30, 3, 55)), np.zeros((30, 3)), fps=30)  # joints must be the rows
+    Traceback (most recent call last):
+    ...
+    ValueError: SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got (30, 3, 55)
     """
 
     poses: np.ndarray
@@ -86,7 +90,10 @@ class SMPLXMotion:
     gender: str = ""
 
     def __post_init__(self) -> None:
-        self.poses = np.asarray(self.poses, dtype=np.float64).reshape(-1, 55, 3)
+        poses = np.asarray(self.poses, dtype=np.float64)
+        if poses.ndim not in (2, 3) or poses.shape[1:] not in ((165,), (55, 3)):
+            raise ValueError(f"SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got {poses.shape}")
+        self.poses = poses.reshape(-1, 55, 3)
         self.trans = np.asarray(self.trans, dtype=np.float64).reshape(-1, 3)
         if self.trans.shape[0] != self.poses.shape[0]:
             raise ValueError(f"SMPLXMotion: {self.poses.shape[0]} poses but {self.trans.shape[0]} trans rows")
