@@ -136,11 +136,52 @@ def test_read_smplx_gives_one_format_error_per_malformed_file(tmp_path):
         assert "\n" not in message, (name, message)
 
 
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("mocap_frame_rate", np.array(0.5)),
+        ("expressions", np.zeros((7, 100), np.float32)),
+        ("poses", np.full((5, 165), np.nan, np.float32)),
+        ("betas", np.arange(600, dtype=np.float32).reshape(2, 300)),
+        ("trans", np.full((5, 3), 1e39)),  # finite in float64, inf in the float32 file
+    ],
+)
+def test_what_read_smplx_refuses_smplx_motion_or_write_smplx_refuses(tmp_path, key, value):
+    """write_smplx wrote files read_smplx refuses (fps 0.5, expressions of another length, NaN poses, per-frame
+    betas that differ, trans beyond float32): each is now refused before a file is written."""
+    arrays = {**_beat2_like(n=5), key: value}
+    with np.errstate(over="ignore"):  # the file as the writer would write it (float32)
+        raw = {k: v.astype(np.float32) if k == "trans" else v for k, v in arrays.items()}
+    with pytest.raises(FormatError, match=f"field '{key}'"):  # the oracle: the reader refuses the file
+        read_smplx(_save(tmp_path / "raw.npz", raw))
+    path = tmp_path / "written.npz"
+    args = [
+        arrays["poses"],
+        arrays["trans"],
+        arrays["mocap_frame_rate"],
+        arrays["betas"],
+        arrays["expressions"],
+    ]
+    field = "fps" if key == "mocap_frame_rate" else key
+    with pytest.raises(ValueError, match=rf"^(SMPLXMotion|write_smplx: .*written\.npz): {field}\b"):
+        write_smplx(path, SMPLXMotion(*args))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["raw.npz"]
+
+
+def test_write_smplx_refuses_a_motion_changed_after_it_was_made(tmp_path):
+    motion = SMPLXMotion(np.zeros((5, 55, 3)), np.zeros((5, 3)), fps=30)
+    motion.fps = 0.5
+    with pytest.raises(ValueError, match="mocap_frame_rate as written .*0.5 fps is outside 1..100000"):
+        write_smplx(tmp_path / "a.npz", motion)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("shape", [(5, 3, 55), (5 * 165,), (5, 5, 33), (5, 1, 165)])
 def test_smplx_motion_takes_poses_as_t_165_or_t_55_3_only(shape):
     """Any array of 5 * 165 numbers was reshaped to (5, 55, 3): a transposed (T, 3, 55) became garbage rotations."""
     with pytest.raises(
-        ValueError, match=re.escape(f"SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got {shape}")
+        ValueError,
+        match=re.escape(f"SMPLXMotion: poses: expected (T, 165) or (T, 55, 3) numbers, got {shape}"),
     ):
         SMPLXMotion(np.zeros(shape), np.zeros((5, 3)), fps=30)
     rows = np.arange(5 * 165.0).reshape(5, 165) / 1000

@@ -37,6 +37,7 @@ import csv
 import dataclasses
 import os
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -70,6 +71,13 @@ class SMPLXMotion:
     model, gender : str
         As the file says (``"smplx2020"``, ``"neutral"`` in BEAT2); ``""`` if absent.
 
+    Raises
+    ------
+    ValueError
+        Naming the field, for what :func:`read_smplx` refuses in a file (so that what :func:`write_smplx` writes
+        reads back): another shape, a non-finite value, ``fps`` outside 1..100,000, expressions of another
+        length, per-frame ``betas`` that differ (equal ones become one ``(B,)`` row).
+
     Examples
     --------
     >>> m = SMPLXMotion(np.zeros((30, 55, 3)), np.zeros((30, 3)), fps=30)
@@ -78,7 +86,7 @@ class SMPLXMotion:
     >>> SMPLXMotion(np.zeros((30, 3, 55)), np.zeros((30, 3)), fps=30)  # joints must be the rows
     Traceback (most recent call last):
     ...
-    ValueError: SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got (30, 3, 55)
+    ValueError: SMPLXMotion: poses: expected (T, 165) or (T, 55, 3) numbers, got (30, 3, 55) float64
     """
 
     poses: np.ndarray
@@ -90,15 +98,11 @@ class SMPLXMotion:
     gender: str = ""
 
     def __post_init__(self) -> None:
-        poses = np.asarray(self.poses, dtype=np.float64)
-        if poses.ndim not in (2, 3) or poses.shape[1:] not in ((165,), (55, 3)):
-            raise ValueError(f"SMPLXMotion: poses must be (T, 165) or (T, 55, 3), got {poses.shape}")
-        self.poses = poses.reshape(-1, 55, 3)
-        self.trans = np.asarray(self.trans, dtype=np.float64).reshape(-1, 3)
-        if self.trans.shape[0] != self.poses.shape[0]:
-            raise ValueError(f"SMPLXMotion: {self.poses.shape[0]} poses but {self.trans.shape[0]} trans rows")
-        if not (np.isfinite(self.fps) and self.fps > 0):
-            raise ValueError(f"SMPLXMotion: fps must be positive, got {self.fps}")
+        def fail(key: str, message: str) -> ValueError:
+            return ValueError(f"SMPLXMotion: {'fps' if key == 'mocap_frame_rate' else key}: {message}")
+
+        checked = _motion_arrays(self.poses, self.trans, self.fps, self.betas, self.expressions, fail)
+        self.poses, self.trans, self.fps, self.betas, self.expressions = checked
 
     @property
     def n_frames(self) -> int:
@@ -159,14 +163,52 @@ def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:
     return value
 
 
-def _numeric(path: Path, key: str, value: np.ndarray, shape: str, ok: bool) -> np.ndarray:
+def _numeric(
+    fail: Callable[[str, str], Exception], key: str, value: np.ndarray, shape: str, ok: bool
+) -> np.ndarray:
     if value.dtype.kind not in "fiu" or not ok:
-        raise FormatError(path, f"expected {shape} numbers, got {value.shape} {value.dtype}", field=key)
+        raise fail(key, f"expected {shape} numbers, got {value.shape} {value.dtype}")
     value = value.astype(np.float64)
     if not np.isfinite(value).all():
         bad = np.argwhere(~np.isfinite(value))[0].tolist()
-        raise FormatError(path, f"non-finite value at index {bad}", field=key)
+        raise fail(key, f"non-finite value at index {bad}")
     return value
+
+
+def _motion_arrays(
+    poses: object,
+    trans: object,
+    fps: object,
+    betas: object,
+    expressions: object,
+    fail: Callable[[str, str], Exception],
+) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None, np.ndarray | None]:
+    """The rules of a BEAT2 motion, one set for :func:`read_smplx`, :class:`SMPLXMotion` and :func:`write_smplx`:
+    ``(poses (T, 55, 3), trans (T, 3), fps, betas (B,) or None, expressions (T, E) or None)``, float64, or
+    ``fail(key, message)`` raised, ``key`` the file's (``"mocap_frame_rate"`` for the rate)."""
+    poses, trans, rate = np.asarray(poses), np.asarray(trans), np.asarray(fps)
+    n = poses.shape[0] if poses.ndim else 0
+    poses = _numeric(fail, "poses", poses, "(T, 165) or (T, 55, 3)", poses.ndim in (2, 3) and n >= 1
+                     and poses.shape[1:] in ((165,), (55, 3)))  # fmt: skip
+    trans = _numeric(fail, "trans", trans, f"({n}, 3)", trans.shape == (n, 3))
+    fps = float(_numeric(fail, "mocap_frame_rate", rate, "a positive scalar", rate.size == 1).ravel()[0])
+    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))  # the frame rates a BVH may have
+    if not low <= fps <= high:
+        raise fail(
+            "mocap_frame_rate",
+            f"frame rate {fps:g} fps is outside {low:g}..{high:g} fps (as a BVH's frame time)",
+        )
+    if betas is not None:
+        b = np.asarray(betas)
+        betas = _numeric(fail, "betas", b, "(B,) or (T, B)", b.ndim in (1, 2) and b.size > 0)
+        if betas.ndim == 2:  # per-frame copies of one shape
+            if not np.allclose(betas, betas[:1]):
+                raise fail("betas", "per-frame betas differ between frames (one body shape expected)")
+            betas = betas[0]
+    if expressions is not None:
+        e = np.asarray(expressions)
+        expressions = _numeric(fail, "expressions", e, f"({n}, E)", e.ndim == 2 and e.shape[0] == n)
+    return poses.reshape(n, 55, 3), trans, fps, betas, expressions  # type: ignore[return-value]
 
 
 def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
@@ -214,39 +256,19 @@ def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
         raise FormatError(p, f"not a readable npz ({exc})") from None
     with z:
         raw = {key: _array(z, p, key) for key in infos}
-    poses = raw["poses"]
-    n = poses.shape[0] if poses.ndim else 0
-    poses = _numeric(p, "poses", poses, "(T, 165)", poses.ndim in (2, 3) and n >= 1
-                     and poses.shape[1:] in ((165,), (55, 3)))  # fmt: skip
-    trans = _numeric(p, "trans", raw["trans"], f"({n}, 3)", raw["trans"].shape == (n, 3))
-    rate = raw["mocap_frame_rate"]
-    fps = float(_numeric(p, "mocap_frame_rate", rate, "a positive scalar", rate.size == 1).ravel()[0])
-    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))  # the frame rates a BVH may have
-    if not low <= fps <= high:
-        raise FormatError(
-            p, f"frame rate {fps:g} fps is outside {low:g}..{high:g} fps (as a BVH's frame time)",
-            field="mocap_frame_rate",
-        )  # fmt: skip
-    betas = expressions = None
-    if "betas" in raw:
-        b = raw["betas"]
-        betas = _numeric(p, "betas", b, "(B,) or (T, B)", b.ndim in (1, 2) and b.size > 0)
-        if betas.ndim == 2:  # per-frame copies of one shape
-            if not np.allclose(betas, betas[:1]):
-                raise FormatError(
-                    p, "per-frame betas differ between frames (one body shape expected)", field="betas"
-                )
-            betas = betas[0]
-    if "expressions" in raw:
-        e = raw["expressions"]
-        expressions = _numeric(p, "expressions", e, f"({n}, E)", e.ndim == 2 and e.shape[0] == n)
+
+    def fail(key: str, message: str) -> FormatError:
+        return FormatError(p, message, field=key)
+
+    motion = _motion_arrays(raw["poses"], raw["trans"], raw["mocap_frame_rate"], raw.get("betas"),
+                            raw.get("expressions"), fail)  # fmt: skip
     strings = {}
     for key in _STRINGS:
         value = raw.get(key, np.array(""))
         if value.dtype.kind not in "US" or value.size != 1:
             raise FormatError(p, f"expected a string, got {value.shape} {value.dtype}", field=key)
         strings[key] = str(value.ravel()[0].decode() if value.dtype.kind == "S" else value.ravel()[0])
-    return SMPLXMotion(poses.reshape(n, 55, 3), trans, fps, betas, expressions, **strings)
+    return SMPLXMotion(*motion, **strings)
 
 
 def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
@@ -260,6 +282,12 @@ def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
         ``betas`` default ``zeros(300)``, ``expressions`` default ``zeros((T, 100))``, ``model`` default
         ``"smplx2020"``, ``gender`` default ``"neutral"`` (BEAT2's values).
 
+    Raises
+    ------
+    ValueError
+        Before anything is written, for what :func:`read_smplx` would refuse in the file: a value beyond float32
+        (it would be written as inf), or a field changed since ``motion`` was made (e.g. ``fps = 0.5``).
+
     Examples
     --------
     >>> import tempfile
@@ -269,6 +297,10 @@ def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
     >>> with np.load(path) as z:
     ...     sorted(z.files), z["poses"].shape, z["poses"].dtype, int(z["mocap_frame_rate"])
     (['betas', 'expressions', 'gender', 'mocap_frame_rate', 'model', 'poses', 'trans'], (2, 165), dtype('float32'), 30)
+    >>> write_smplx(path, SMPLXMotion(np.zeros((2, 55, 3)), np.full((2, 3), 1e39), fps=30))  # inf as float32
+    Traceback (most recent call last):
+    ...
+    ValueError: write_smplx: ...take.npz: trans as written (float32): non-finite value at index [0, 0]
     >>> tmp.cleanup()
     """
     from beatlite.io.atomic import atomic_write
@@ -280,10 +312,17 @@ def write_smplx(path: str | os.PathLike[str], motion: SMPLXMotion) -> None:
         "expressions": np.zeros((n, 100)) if motion.expressions is None else motion.expressions,
         "trans": motion.trans,
     }
+    with np.errstate(over="ignore"):  # a value beyond float32 becomes inf: refused below
+        arrays = {k: np.asarray(v, dtype=np.float32) for k, v in arrays.items()}
+
+    def fail(key: str, message: str) -> ValueError:
+        return ValueError(f"write_smplx: {path}: {key} as written (float32): {message}")
+
+    _motion_arrays(arrays["poses"], arrays["trans"], motion.fps, arrays["betas"], arrays["expressions"], fail)
     with atomic_write(path, "wb") as f:  # np.savez writes its ZIP straight into the temporary file
         np.savez(
             f,
-            **{k: np.asarray(v, dtype=np.float32) for k, v in arrays.items()},
+            **arrays,
             model=np.array(motion.model or "smplx2020"),
             gender=np.array(motion.gender or "neutral"),
             mocap_frame_rate=np.array(int(motion.fps) if float(motion.fps).is_integer() else motion.fps),
