@@ -398,6 +398,27 @@ def test_index_and_load_a_beat2_folder(beat2_folder):
     np.testing.assert_allclose(take.positions()[:, cols], beat.positions()[:, cols], atol=0.05)
 
 
+@pytest.mark.parametrize("phase, first", [("start", 0), ("beat", 1)])
+def test_a_beat2_takes_expressions_keep_its_motions_frames(beat2_folder, tmp_path, phase, first):
+    """With phase="beat" the motion kept 30 fps frames 1, 3, 5, ... and the expressions 0, 2, 4, ...: one frame
+    out of step. Frame i is written into both (pelvis rotation i / 1000 rad about y, expression 0 = i)."""
+    folder = tmp_path / "beat2"
+    shutil.copytree(beat2_folder, folder)
+    path = folder / "smplxflame_30" / "2_scott_0_1_1.npz"
+    m = read_smplx(path)
+    poses, expressions = np.zeros_like(m.poses), np.zeros((m.n_frames, 100))
+    poses[:, 0, 1] = np.arange(m.n_frames) / 1000
+    expressions[:, 0] = np.arange(m.n_frames)
+    write_smplx(path, SMPLXMotion(poses, m.trans, 30, m.betas, expressions))
+    take = load_take(path, fps=15, phase=phase)
+    skeleton = take.motion.skeleton  # the root's rotation about y (BEAT2's y axis is BEAT's: up)
+    hips_y = int(skeleton.channel_starts[0]) + list(skeleton.channels[0]).index("Yrotation")
+    frames = np.radians(take.motion.channels[:, hips_y]) * 1000
+    want = first + 2 * np.arange(take.n_frames)  # 30 -> 15 fps: every second frame from `first`
+    np.testing.assert_allclose(frames, want, atol=1e-6)
+    np.testing.assert_array_equal(take.expressions[:, 0], want)
+
+
 def test_a_bvh_and_its_converted_npz_index_and_load_the_same_file(tmp_path):
     """A take with its .bvh.gz and a converted .npz beside it: the index used the .npz (plain files sorted before
     .gz) while load_take(stem) read the .bvh.gz; both now read BEAT's own file, the .npz noted as a duplicate."""

@@ -21,7 +21,8 @@ Resampling phase
 - ``phase="beat"``: BEAT's preprocessing (docs/reference_code.md#downsampling): motion keeps source frames
   1, 1 + r, 1 + 2r, ... (120 -> 15 fps keeps frames 1, 9, 17, ...), i.e. output
   frame ``i`` is at ``t = i / fps + 1 / source_fps``; the face is decimated from
-  frame 0 (frames 0, 4, 8, ... at 60 fps), as BEAT does.
+  frame 0 (frames 0, 4, 8, ... at 60 fps), as BEAT does. BEAT2's expressions, rows of the motion's
+  ``.npz``, keep the motion's frames.
 
 Modalities of different lengths are truncated to the shortest, with an
 :class:`~beatlite.io.errors.AlignmentWarning` (a ``UserWarning``) naming each
@@ -588,7 +589,8 @@ def load_take(
     if ".npz" in paths:
         source, flame = _beat2_motion(paths[".npz"], bvh_fps)
         if flame is not None:
-            expressions = resample_frames(flame, source.fps, fps, shift=0).astype(np.float32)
+            shift = 1 if phase == "beat" else 0  # the motion's frames: they are rows of the same file
+            expressions = resample_frames(flame, source.fps, fps, shift=shift).astype(np.float32)
     else:
         source = read_take_motion(paths[".bvh"], bvh_fps=bvh_fps, reference_s=reference)
     motion, audio, face = _align(stem.name, source, audio, int(audio_sr), facial, fps, phase)
