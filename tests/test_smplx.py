@@ -419,6 +419,28 @@ def test_a_beat2_takes_expressions_keep_its_motions_frames(beat2_folder, tmp_pat
     np.testing.assert_array_equal(take.expressions[:, 0], want)
 
 
+def test_an_audio_file_load_take_would_not_find_makes_the_take_unusable(beat2_folder, tmp_path):
+    """wave16k/ renamed audio/: the index found the .wav anyway and called the take usable, load_take did not find
+    it, and the store build failed on a take without audio. The index now lists the files loading reads."""
+    from beatlite.data.index import index_folder
+
+    folder = tmp_path / "beat2"
+    shutil.copytree(beat2_folder, folder)
+    (folder / "wave16k").rename(folder / "audio")
+    record = index_folder(folder, cache=False)["2_scott_0_1_1"]
+    take = load_take(record.path("motion"))
+    assert (
+        take.audio is None and ".wav" not in take.paths and "audio" not in record.files and not record.usable
+    )
+    wav = folder / "audio" / "2_scott_0_1_1.wav"
+    assert record.problems[:2] == [
+        f"audio file {wav} is not beside the motion file or in wave16k/ beside its folder, where load_take looks: "
+        "not used",
+        "missing audio (.wav) file",
+    ]
+    assert record.files["text"] == take.paths[".TextGrid"] == folder / "textgrid" / "2_scott_0_1_1.TextGrid"
+
+
 def test_a_bvh_and_its_converted_npz_index_and_load_the_same_file(tmp_path):
     """A take with its .bvh.gz and a converted .npz beside it: the index used the .npz (plain files sorted before
     .gz) while load_take(stem) read the .bvh.gz; both now read BEAT's own file, the .npz noted as a duplicate."""

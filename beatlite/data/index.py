@@ -8,7 +8,10 @@ flat folder, and on BEAT2's (``smplxflame_30/{stem}.npz``, ``wave16k/``, ``textg
 ``train_test_split.csv``, :func:`beatlite.io.smplx.read_beat2_split`). :attr:`TakeRecord.format` says which
 format each take is in.
 
-Every file is checked by the code :func:`beatlite.io.load_take` runs: the BVH is
+A take's files are those :func:`beatlite.io.load_take` reads given its motion file
+(:func:`beatlite.io.take.take_files`: beside it; a BEAT2 take's audio and TextGrid also in ``wave16k/`` and
+``textgrid/`` beside its folder); a file of the take elsewhere is a problem, not used. Every file is checked by
+the code :func:`beatlite.io.load_take` runs: the BVH is
 read (rows included) at the frame rate loading will use
 (:func:`beatlite.io.take.read_take_motion`: clean-factor rates reconciled with the
 audio), the WAV header is sniffed and bounded (:func:`beatlite.io.audio.audio_info`,
@@ -543,9 +546,38 @@ def _name_fields(stem: str) -> tuple[dict[str, Any], str | None]:
     return fields, None
 
 
+def _loaded_files(files: dict[str, list[Path]]) -> dict[str, Path]:
+    """Modality -> the file :func:`beatlite.io.load_take` reads for the take of this motion file
+    (:func:`beatlite.io.take.take_files`); ``{}`` without a motion file."""
+    from beatlite.io.take import take_files
+
+    if "motion" not in files:
+        return {}
+    try:
+        _, paths = take_files(files["motion"][0])
+    except FileNotFoundError:  # removed since the scan
+        return {}
+    return {MODALITIES[ext[1:].lower()]: path for ext, path in paths.items()}
+
+
 def _list_files(record: TakeRecord, files: dict[str, list[Path]]) -> None:
-    """Fill ``record.files``; duplicates and missing files become problems."""
+    """Fill ``record.files`` with the files loading reads; duplicates, files loading would not find and missing
+    files become problems."""
+    from beatlite.io.take import BEAT2_FOLDERS
+
+    loaded = _loaded_files(files)
     for modality, paths in files.items():
+        if loaded and modality not in loaded:
+            where = "beside the motion file"
+            folder = {MODALITIES[e[1:].lower()]: f for e, f in BEAT2_FOLDERS.items()}.get(modality)
+            if folder and files["motion"][0].name.endswith(".npz"):
+                where += f" or in {folder}/ beside its folder"
+            record.problems.append(
+                f"{modality} file {paths[0]} is not {where}, where load_take looks: not used"
+            )
+            continue
+        if loaded:
+            paths = [loaded[modality], *(p for p in paths if p != loaded[modality])]
         record.files[modality] = paths[0]
         if len(paths) > 1:
             others = ", ".join(str(p) for p in paths[1:])
@@ -623,7 +655,10 @@ def index_take(
     stem : str
         Take name without extensions.
     files : dict str -> list of Path
-        Modality -> candidate files (the first is used, the rest flagged as duplicates).
+        Modality -> candidate files. The ones :func:`beatlite.io.load_take` reads given the motion file
+        (:func:`beatlite.io.take.take_files`: beside it, BEAT2's audio and TextGrid also in ``wave16k/`` and
+        ``textgrid/`` beside its folder) are used, the rest flagged as duplicates; a modality whose files
+        loading would not find is a problem (without motion: the first of each is used).
     read_durations : bool
         Read every file as loading would (default True); False lists files only.
     bvh_fps : float, optional

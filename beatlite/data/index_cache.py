@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from beatlite.data.index import TakeRecord
 
 #: Bump when what indexing records changes (every cached record is then recomputed).
-INDEX_VERSION = 3
+INDEX_VERSION = 4
 
 
 def cache_path(root: Path, recursive: bool) -> Path:
