@@ -371,24 +371,22 @@ class _Stop(Exception):
     """Raised by a stand-in ``fit``, with the config it was given."""
 
 
-def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypatch):
-    """``fit --val-every N`` reaches ``TrainConfig.val_every`` (data, model and training stood in for)."""
+def _fit_command_with(fit, tmp_path, monkeypatch) -> list[str]:
+    """The arguments of ``fit diffgesture_tiny`` on data_samples with its data, model and training stood in for
+    (``fit`` replaces :func:`beatlite.train.training.fit`); a recipe without best-epoch selection: no extractor or
+    validation takes to stand in for."""
     import types
 
     from beatlite.paths import repo_root
     from beatlite.train import __main__ as command
     from beatlite.train import recipes, training
 
-    def stand_in_fit(model, train, config, val=None, **kw):
-        raise _Stop(config)
-
     monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
     data = types.SimpleNamespace(train=None, val=None, meta={})
     monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
     monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
-    monkeypatch.setattr(training, "fit", stand_in_fit)
-    # (a recipe without best-epoch selection: no extractor or validation takes to stand in for)
-    argv = [
+    monkeypatch.setattr(training, "fit", fit)
+    return [
         "fit",
         "diffgesture_tiny",
         "--data",
@@ -396,6 +394,16 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
         "--out",
         str(tmp_path / "run"),
     ]
+
+
+def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypatch):
+    """``fit --val-every N`` reaches ``TrainConfig.val_every`` (data, model and training stood in for)."""
+    from beatlite.train import __main__ as command
+
+    def stand_in_fit(model, train, config, val=None, **kw):
+        raise _Stop(config)
+
+    argv = _fit_command_with(stand_in_fit, tmp_path, monkeypatch)
     for extra, expected in (([], None), (["--val-every", "25"], 25)):
         with pytest.raises(_Stop) as stopped:
             command.main([*argv, "--epochs", "1", *extra])
@@ -436,28 +444,13 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
 def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkeypatch, capsys):
     """A ``ResumeError`` of ``fit --resume`` (data, model or batch plan changed) ends the command with exit 2 and
     its message on one ``error:`` line, no traceback (data and training stood in for)."""
-    import types
-
-    from beatlite.paths import repo_root
     from beatlite.train import __main__ as command
-    from beatlite.train import recipes, training
+    from beatlite.train import training
 
     def refusing_fit(model, train, config, val=None, **kw):
         raise training.ResumeError("fit: cannot resume from x.pt: changed: batch_size 32 -> 64")
 
-    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
-    data = types.SimpleNamespace(train=None, val=None, meta={})
-    monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
-    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
-    monkeypatch.setattr(training, "fit", refusing_fit)
-    argv = [
-        "fit",
-        "diffgesture_tiny",
-        "--data",
-        str(repo_root() / "data_samples"),
-        "--out",
-        str(tmp_path / "run"),
-    ]
+    argv = _fit_command_with(refusing_fit, tmp_path, monkeypatch)
     assert command.main([*argv, "--epochs", "1", "--resume"]) == 2
     err = capsys.readouterr().err
     assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
