@@ -33,10 +33,11 @@ Every prediction becomes the :class:`~beatlite.metrics.scoring.Takes` of one row
 common space, extractor features of the 34-frame windows, the 141 Euler channels where the file has them),
 and is scored against the split's ground truth by :func:`beatlite.metrics.scoring.evaluate`.
 
-The Euler metrics read each predicted rotation as its Euler angles nearest the ground truth's (of the
-equivalent ones: the other branch of the middle angle, 360° turns; :func:`beatlite.skeleton.rotations.nearest_euler`),
-so angles written from rotation matrices score as the same motion; the warning and ``info["euler_rewritten"]``
-count the rotations so rewritten (0 for beatlite's own exports).
+The Euler metrics read each predicted track on the ground truth's representation (of a rotation's equivalent
+Euler angles, the other branch of the middle angle and 360° turns: at the first frame those nearest the ground
+truth's, :func:`beatlite.skeleton.rotations.nearest_euler`, then continuous over time), so angles written from
+rotation matrices score as the same motion; the warning and ``info["euler_rewritten"]`` count the rotations so
+rewritten (0 for the shipped checkpoints' exports on ``data_samples/``).
 
 Checks, each one line on stderr: a missing take is an error (``--allow-missing`` scores the takes that are
 there); an extra file is listed and ignored (hidden files such as macOS' ``._*`` are skipped; suffixes match in
@@ -724,9 +725,9 @@ def score_folder(
         if moved:
             n = sum(e.size // 3 for e in euler)
             warnings.warn(
-                f"{pred}: {moved} of {n} joint rotations (frames x joints) are written as other Euler angles "
-                "than the ground truth's for such a rotation (the other branch of the middle angle, or 360° "
-                "turns): the Euler metrics read the equivalent angles nearest the ground truth's",
+                f"{pred}: {moved} of {n} joint rotations (frames x joints) are read as equivalent Euler angles "
+                "(the other branch of the middle angle, or 360° turns) on the ground truth's representation: "
+                "from its first frame's, continuous over time",
                 ScoreWarning,
                 stacklevel=2,
             )
@@ -756,8 +757,12 @@ def _truth_euler_branch(
     One rotation has many Euler triples (:func:`beatlite.skeleton.rotations.nearest_euler`): a model that
     writes its rotations from matrices gets ``|Y| <= 90°`` in ``(-180, 180]`` where BEAT's tracks are
     continuous and unwrapped, and the Euler metrics (FGD of the Euler autoencoder, the reference SRGR and
-    L1div) would score that representation, not the motion. Each triple is replaced by its equivalent nearest
-    the ground truth's at that frame; a prediction already on the ground truth's representation is unchanged.
+    L1div) would score that representation, not the motion. Per take and joint, the first frame's triple becomes
+    its equivalent nearest the ground truth's first frame, and each later one the equivalent continuing the
+    track (:func:`beatlite.synth.motion.continuous_euler`): the prediction's motion, on the ground truth's
+    representation (not pulled towards the ground truth frame by frame, which would add 360° jumps to a
+    motion that is not the ground truth's). A continuous prediction within 180° of the ground truth's first
+    frame is unchanged.
 
     Parameters
     ----------
@@ -779,12 +784,16 @@ def _truth_euler_branch(
     (array([370., 370.]), 2)
     """
     from beatlite.skeleton.rotations import nearest_euler
+    from beatlite.synth.motion import continuous_euler
 
     out, moved = [], 0
     for e, g in zip(euler, truth, strict=True):
         e = np.asarray(e, dtype=np.float64)
         triples = e.reshape(len(e), -1, 3)
-        near = nearest_euler(triples, np.asarray(g, dtype=np.float64).reshape(triples.shape))
+        near = np.empty_like(triples)
+        near[0] = nearest_euler(triples[0], np.asarray(g, dtype=np.float64).reshape(triples.shape)[0])
+        for j in range(triples.shape[1]):  # from there the prediction's own track, kept continuous
+            near[:, j] = continuous_euler(np.vstack([near[:1, j], triples[1:, j]]))
         moved += int((np.abs(near - triples).max(axis=-1) > 1e-6).sum())
         out.append(near.reshape(e.shape))
     return out, moved
@@ -958,6 +967,7 @@ def bootstrap_intervals(
     from tqdm import tqdm
 
     from beatlite.data.windows import window_starts
+    from beatlite.metrics.scoring import evaluate
 
     if n <= 0:
         return {}
@@ -982,7 +992,7 @@ def bootstrap_intervals(
             audio=_pick(truth.audio, idx), audio_beats=_pick(beats, idx),
             onsets={key: _pick(v, idx) for key, v in truth.onsets.items()},
         )  # fmt: skip
-        scores = _resample_scores(_draw(generated, idx, bounds), draw_truth, metrics, seed)
+        scores = evaluate(_draw(generated, idx, bounds), draw_truth, metrics=metrics, seed=seed).values()
         for key in metrics:
             values[key].append(scores[key])
     q, out = 50 * (1 - level), {}
@@ -990,8 +1000,8 @@ def bootstrap_intervals(
         scored = np.asarray(v)[np.isfinite(v)]
         if len(scored) < n:
             warnings.warn(
-                f"bootstrap: {n - len(scored)} of {n} resamples gave no {key} (they drew only takes it cannot "
-                f"score: too few windows, no beats): its interval is over the other {len(scored)}",
+                f"bootstrap: {n - len(scored)} of {n} resamples gave no {key} (evaluate skipped it on the takes "
+                f"they drew: too few windows, no beats): its interval is over the other {len(scored)}",
                 ScoreWarning,
                 stacklevel=2,
             )
@@ -999,23 +1009,6 @@ def bootstrap_intervals(
             tuple(float(x) for x in np.percentile(scored, [q, 100 - q])) if len(scored) else (math.nan,) * 2
         )
     return out
-
-
-def _resample_scores(generated: Any, truth: Any, metrics: Sequence[str], seed: int) -> dict[str, float]:
-    """``evaluate``'s values on one resample; a metric that cannot be computed on it (e.g. an FGD of fewer than
-    2 windows) is NaN, the others keep their values."""
-    from beatlite.metrics.scoring import evaluate
-
-    try:
-        return evaluate(generated, truth, metrics=metrics, seed=seed).values()
-    except ValueError:  # one metric could not: each one alone
-        out = {}
-        for key in metrics:
-            try:
-                out[key] = evaluate(generated, truth, metrics=[key], seed=seed).values()[key]
-            except ValueError:
-                out[key] = math.nan
-        return out
 
 
 def _pick(xs: list[Any] | None, idx: np.ndarray) -> list[Any] | None:

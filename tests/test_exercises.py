@@ -464,6 +464,7 @@ def test_exercises_accept_the_solution_and_reject_wrong_answers(path, tmp_path):
             n_wrong = len(WRONG[path.name[:2], name])
             for k in range(len(RIGHT.get((path.name[:2], name), []))):
                 got = [(c, r) for _, step, c, r in mine if step == f"right {name} #{n_wrong + k + 1}"]
-                assert got and all(r is True for _, r in got), (
-                    f"{ex.title}: right {name} #{k + 1} refused: {got}"
+                assert got and {c for c, _ in got} == _answer_of(ex, name), (
+                    f"{ex.title}: right {name} #{k + 1}: {got}"
                 )
+                assert all(r is True for _, r in got), f"{ex.title}: right {name} #{k + 1} refused: {got}"

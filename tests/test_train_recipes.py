@@ -431,8 +431,8 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
     argv = ["fit", "camn_tiny", "--data", str(repo_root() / "data_samples"), "--out", str(out)]
     cases = ((["--checkpoint-every", "0"], "checkpoint_every must be >= 1"),
              (["--batch-size", "1"], "batch_size must be >= 2"), (["--val-every", "0"], "val_every must be >= 1"),
-             (["--epochs", "-1"], "epochs must be >= 0"), (["--epochs", "0"], "camn_tiny: epochs must be >= 1"),
-             (["--device", "cuda"], "device 'cuda' asked for CUDA"))  # fmt: skip
+             (["--epochs", "-1"], "camn_tiny: epochs must be >= 1"), (["--epochs", "0"], "camn_tiny: epochs must be >= 1"),
+             (["--device", "cuda"], "device 'cuda' asked for CUDA"), (["--device", "gpu"], "not a torch device"))  # fmt: skip
     for extra, said in cases:
         assert command.main([*argv, *extra]) == 2, extra
         err = capsys.readouterr().err

@@ -19,7 +19,7 @@ from __future__ import annotations
 from beatlite.data.index import TakeIndex, TakeRecord, index_folder
 from beatlite.data.normalize import Normalizer
 from beatlite.data.store import StoreWindows, WindowStore, build_store
-from beatlite.data.vocab import EOS, PAD, SOS, UNK, Vocab, build_vocab, word_vectors
+from beatlite.data.vocab import EOS, PAD, SOS, UNK, Vocab, build_vocab, corpus_vocab, word_vectors
 from beatlite.data.windows import WINDOW_KEYS, Windows, build_windows, window_starts
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "Windows",
     "build_store",
     "build_vocab",
+    "corpus_vocab",
     "build_windows",
     "index_folder",
     "window_starts",

@@ -439,7 +439,7 @@ class WindowStore:
     takes : list of StoreTake
         In index order.
     vocab : Vocab
-        The vocabulary the ``word`` key maps to (``build_vocab(index)`` at build time).
+        The vocabulary the ``word`` key maps to (default ``corpus_vocab(index)`` at build time).
 
     Examples
     --------
@@ -970,14 +970,14 @@ def _write_manifest(
     """``store.json``: version, parameters, takes and vocabulary (``build_vocab`` of the stored (usable) takes,
     reused while none of their TextGrids changed; an unusable take's may not read)."""
     from beatlite.data.index import TakeIndex
-    from beatlite.data.vocab import build_vocab
+    from beatlite.data.vocab import corpus_vocab
     from beatlite.io.atomic import atomic_write
 
     text_fp = None
     if vocab is None:
-        stored = TakeIndex(records, index.root)
+        stored = TakeIndex(records, index.root)  # the usable takes
         text_fp = _text_fingerprint(stored)
-        vocab = _stored_vocab(folder / "store.json", text_fp) or build_vocab(stored)
+        vocab = _stored_vocab(folder / "store.json", text_fp) or corpus_vocab(stored)
     manifest = {
         "version": STORE_VERSION,
         "params": params,

@@ -244,6 +244,21 @@ def build_vocab(index: TakeIndex, *, splits: Iterable[str] | None = None, min_co
     return vocab_from_sentences(take_sentences(index, splits=splits), min_count=min_count)
 
 
+def corpus_vocab(index: TakeIndex) -> Vocab:
+    """The vocabulary ``fit``, the window store and the evaluation set use by default: :func:`build_vocab` of the
+    index's usable takes (an unusable take's TextGrid may not read; its words feed no window).
+
+    Examples
+    --------
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> from beatlite.paths import repo_root
+    >>> record = index_take("2_scott_0_1_1", {"text": [repo_root() / "data_samples" / "2_scott_0_1_1.TextGrid"]})
+    >>> len(corpus_vocab(TakeIndex([record])))  # a take without motion or audio is not usable: no words
+    4
+    """
+    return build_vocab(index.where(usable=True))
+
+
 def cooccurrence(sentences: Iterable[Sequence[str]], vocab: Vocab, *, window: int = 4):
     """Symmetric word-word co-occurrence counts within ``window`` tokens, weighted 1/distance.
 

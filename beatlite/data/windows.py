@@ -537,7 +537,7 @@ def build_windows(
     whole_takes : bool
         One item per take, full length (evaluation mode); ``length``/``stride`` unused.
     vocab : Vocab, optional
-        Word ids; default :func:`beatlite.data.vocab.build_vocab` of the index's usable takes (an unusable take's
+        Word ids; default :func:`beatlite.data.vocab.corpus_vocab` of the index (its usable takes: an unusable take's
         TextGrid may not read), the vocabulary ``fit`` trains with.
     stats : Normalizers, optional
         Statistics to use instead of fitting them on the index's train split (e.g. the training
@@ -573,7 +573,7 @@ def build_windows(
     (1, (222, 141))
     >>> tmp.cleanup()
     """
-    from beatlite.data.vocab import build_vocab
+    from beatlite.data.vocab import corpus_vocab
 
     _check_window_params(split, length, stride, fps, sr)
     records = _usable(index, split)
@@ -585,9 +585,7 @@ def build_windows(
         raise TypeError(
             f"build_windows: stats must be Normalizers (e.g. train.normalizers), got {type(stats).__name__}"
         )
-    vocab = (
-        build_vocab(index.where(usable=True)) if vocab is None else vocab
-    )  # (as training_data and the store)
+    vocab = corpus_vocab(index) if vocab is None else vocab
     params: dict[str, Any] = {
         "split": split, "length": int(length), "stride": int(stride), "fps": float(fps), "sr": int(sr),
         "whole_takes": bool(whole_takes), "positions": bool(positions), "word_rule": word_rule,

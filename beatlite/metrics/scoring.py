@@ -297,7 +297,7 @@ def evaluate(
             skipped[key] = str(e)
             continue
         if not math.isfinite(value):  # e.g. BeatAlign without audio onsets, BC of a system that never moves
-            skipped[key] = f"undefined on these takes ({UNDEFINED.get(m.name, 'the metric gave NaN')})"
+            skipped[key] = f"undefined on these takes ({UNDEFINED.get(m.name, f'the metric gave {value}')})"
             continue
         results.append(MetricResult(key, m.name, value, m.variant, m.higher_is_better, m.describe))
     return Evaluation(results, skipped)
@@ -459,22 +459,30 @@ def _check_pairing(gen: Takes, truth: GroundTruth) -> None:
 
 
 # --------------------------------------------------------------------------- the metrics
+def _windows(features: np.ndarray, need: int = 2) -> np.ndarray:
+    """``features`` of the windows, or :class:`TooFewWindows` when there are fewer than ``need`` (a covariance or a
+    pair needs two)."""
+    if len(features) < need:
+        raise TooFewWindows(f"needs at least {need} windows, got {len(features)}")
+    return features
+
+
 def _fgd(reference: bool) -> Callable[[Takes, GroundTruth, int], float]:
     from beatlite.metrics.frechet import fgd
 
-    return lambda g, t, seed: fgd(g.features, t.takes.features, reference=reference)
+    return lambda g, t, seed: fgd(_windows(g.features), _windows(t.takes.features), reference=reference)
 
 
 def _fgd_euler(g: Takes, t: GroundTruth, seed: int) -> float:
     from beatlite.metrics.frechet import fgd
 
-    return fgd(g.euler_features, t.takes.euler_features)
+    return fgd(_windows(g.euler_features), _windows(t.takes.euler_features))
 
 
 def _fgd_rot6d(g: Takes, t: GroundTruth, seed: int) -> float:
     from beatlite.metrics.frechet import fgd
 
-    return fgd(g.rot6d_features, t.takes.rot6d_features)
+    return fgd(_windows(g.rot6d_features), _windows(t.takes.rot6d_features))
 
 
 def _srgr_paper(g: Takes, t: GroundTruth, seed: int) -> float:
@@ -572,7 +580,7 @@ def _speed_hellinger(g: Takes, t: GroundTruth, seed: int) -> float:
 def _diversity(g: Takes, t: GroundTruth, seed: int) -> float:
     from beatlite.metrics.variation import diversity
 
-    return diversity(g.features, n_pairs=500, seed=seed)
+    return diversity(_windows(g.features), n_pairs=500, seed=seed)
 
 
 #: Windows per batch of ``Diversity (ha2g)``: HA2G's loader holds 96 clips, but data_samples' 143 test windows would

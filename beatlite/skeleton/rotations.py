@@ -292,7 +292,9 @@ def nearest_euler(angles: np.ndarray, reference: np.ndarray) -> np.ndarray:
     ``|b| <= 90°`` in ``(-180, 180]``, where motion capture keeps continuous, unwrapped tracks
     (real BEAT: values such as 397° or -2482°). Comparing Euler angles channel by channel needs both
     on one representation: this returns, per triple, the candidate whose summed absolute difference
-    to ``reference`` is smallest (``angles`` itself on a tie). The rotations are unchanged, whatever the order.
+    to ``reference`` is smallest (on a tie the first branch, ``(a, b, c)`` up to 360° turns). The rotations
+    are unchanged, whatever the order. :func:`beatlite.synth.motion.continuous_euler` applies it frame by frame
+    with the previous frame as the reference.
 
     Parameters
     ----------

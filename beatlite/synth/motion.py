@@ -33,7 +33,13 @@ from typing import NamedTuple
 import numpy as np
 
 from beatlite.skeleton.core import Skeleton
-from beatlite.skeleton.rotations import axis_angle_to_matrix, euler_to_matrix, matrix_to_euler, unwrap_degrees
+from beatlite.skeleton.rotations import (
+    axis_angle_to_matrix,
+    euler_to_matrix,
+    matrix_to_euler,
+    nearest_euler,
+    unwrap_degrees,
+)
 from beatlite.synth.plan import Gesture, Plan
 from beatlite.synth.styles import EMOTION_STYLES, SpeakerStyle
 
@@ -623,15 +629,7 @@ def continuous_euler(angles: np.ndarray) -> np.ndarray:
         return out
     fixed = out.copy()
     for i in range(1, fixed.shape[0]):
-        prev = fixed[i - 1]
-        a, b, c = out[i]
-        cands = (out[i], np.array([a + 180.0, 180.0 - b, c + 180.0]))
-        best = None
-        for cand in cands:
-            cand = cand - 360.0 * np.round((cand - prev) / 360.0)
-            if best is None or np.abs(cand - prev).sum() < np.abs(best - prev).sum():
-                best = cand
-        fixed[i] = best
+        fixed[i] = nearest_euler(out[i], fixed[i - 1])
     return fixed
 
 

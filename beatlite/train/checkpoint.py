@@ -116,6 +116,8 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     try:
         with torch.serialization.safe_globals(NUMPY_ARRAY_GLOBALS):
             data = torch.load(path, map_location="cpu", weights_only=True)
+    except PermissionError:
+        raise  # unreadable, not damaged
     except Exception as exc:  # noqa: BLE001 - any unpickling failure is a format problem
         if isinstance(exc, EOFError | OSError) or "zip archive" in str(exc):  # cut short, or bytes damaged
             reason = (str(exc).splitlines() or [""])[0].split(". ")[0] or type(exc).__name__

@@ -178,11 +178,15 @@ class TrainConfig:
         self.betas = (float(self.betas[0]), float(self.betas[1]))
 
     def torch_device(self) -> Any:
-        """The resolved ``torch.device`` (imports torch); ``ValueError`` for CUDA on a machine without it."""
+        """The resolved ``torch.device`` (imports torch); ``ValueError`` for a name torch does not know or CUDA on a
+        machine without it."""
         import torch
 
         name = ("cuda" if torch.cuda.is_available() else "cpu") if self.device == "auto" else self.device
-        device = torch.device(name)
+        try:
+            device = torch.device(name)
+        except RuntimeError as exc:  # e.g. "gpu", "cuda:x"
+            raise ValueError(f"TrainConfig: device {self.device!r} is not a torch device ({exc})") from None
         if device.type == "cuda" and not torch.cuda.is_available():
             raise ValueError(
                 f"TrainConfig: device {self.device!r} asked for CUDA, which this machine does not have"

@@ -38,7 +38,7 @@ from typing import Any, NamedTuple
 from beatlite import models, paths
 from beatlite.data.index import index_folder
 from beatlite.data.store import build_store
-from beatlite.data.vocab import build_vocab, take_sentences, word_vectors
+from beatlite.data.vocab import corpus_vocab, take_sentences, word_vectors
 from beatlite.metrics.beats import warm_up
 from beatlite.models import build_model, model_class, presets
 from beatlite.models.ha2g_ablations import ABLATIONS as HA2G_SWITCHES
@@ -394,7 +394,7 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
             "emotion block of the 4-hour speakers, their conversation 12, and speech 5-8 and the '_b' halves of the "
             "other speakers (beatlite.io.names.split_of; BEAT2: train_test_split.csv)"
         )
-    vocab = build_vocab(usable)
+    vocab = corpus_vocab(index)
     store = build_store(index, vocab=vocab, progress=progress)
     train = store.windows("train", vocab=vocab)
     val = store.windows("val", vocab=vocab, stats=train.normalizers)
@@ -501,13 +501,13 @@ def recipe_train_config(
     >>> recipe_train_config("camn_tiny", epochs=0)
     Traceback (most recent call last):
     ...
-    ValueError: camn_tiny: epochs must be >= 1 (the recipe's: 40); 0 epochs would export untrained weights
+    ValueError: camn_tiny: epochs must be >= 1 (the recipe's: 40); 0 would export untrained weights
     """
     recipe = _recipe(name)
     epochs = recipe.epochs if epochs is None else int(epochs)
-    if recipe.epochs > 0 and epochs == 0:
+    if recipe.epochs > 0 and epochs < 1:
         raise ValueError(
-            f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); 0 epochs would export untrained weights"
+            f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); {epochs} would export untrained weights"
         )
     batch = recipe.batch_size if batch_size is None else int(batch_size)
     config = TrainConfig(

@@ -26,7 +26,7 @@ from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
 from beatlite.data.index import index_folder
 from beatlite.data.normalize import Normalizers
 from beatlite.data.store import build_store
-from beatlite.data.vocab import build_vocab
+from beatlite.data.vocab import corpus_vocab
 from beatlite.data.windows import sliding_windows
 from beatlite.metrics.beats import audio_beats, mean_angle_change, position_speed
 from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
@@ -139,7 +139,7 @@ def load_test_set(
     split : {"test", "val", "train"}
         Takes to evaluate on.
     vocab : Vocab, optional
-        Default :func:`beatlite.data.vocab.build_vocab` of ``index``'s usable takes (what ``fit`` and ``retrain-all``
+        Default :func:`beatlite.data.vocab.corpus_vocab` of ``index`` (what ``fit`` and ``retrain-all``
         train with).
     store : WindowStore, optional
         Default :func:`beatlite.data.store.build_store` of ``index`` (built once, then only takes
@@ -151,7 +151,7 @@ def load_test_set(
     EvaluationSet
     """
     index = index_folder(paths.data_dir()) if index is None else index
-    vocab = build_vocab(index.where(usable=True)) if vocab is None else vocab  # (as training_data)
+    vocab = corpus_vocab(index) if vocab is None else vocab
     store = build_store(index, vocab=vocab) if store is None else store
     train = store.windows("train", vocab=vocab)  # an index of (take, start): read in batches below
     norms = train.normalizers
