@@ -154,3 +154,20 @@ def test_validation_losses_of_a_store_view_equal_those_of_the_windows_in_memory(
     model = build_model("trimodal", preset="tiny", vocab_size=len(train.vocab))
     got = evaluate_losses(model, train, epoch=0, batch_size=8)
     assert got == evaluate_losses(model, reference, epoch=0, batch_size=8) and set(got) >= {"rec", "total"}
+
+
+def test_batches_of_ids_and_numbers_of_the_wrong_kind_are_named():
+    """Float word ids and integer poses are refused naming the key (they failed deep inside torch, or not at all)."""
+    import torch
+
+    from beatlite.models.base import check_batch
+
+    with pytest.raises(
+        TypeError, match=r"batch\['speaker'\] holds ids: an integer tensor, got torch.float64"
+    ):
+        check_batch({"speaker": torch.zeros(2, dtype=torch.float64)}, ("speaker",), "X")
+    with pytest.raises(TypeError, match=r"batch\['pose'\] holds numbers: a floating tensor, got torch.int64"):
+        check_batch({"pose": torch.zeros(2, 34, 141, dtype=torch.int64)}, ("pose",), "X")
+    check_batch(
+        {"word": torch.zeros(2, 34, dtype=torch.int32), "audio": torch.zeros(2, 9)}, ("word", "audio"), "X"
+    )

@@ -250,3 +250,14 @@ def test_a_long_take_is_generated_by_chaining_seeded_windows() -> None:
     assert np.array_equal(out, generate_sequence(model, streams))
     other = dict(streams, dirvec=streams["dirvec"] + 0.5)
     assert np.abs(generate_sequence(model, other) - out).max() > 1e-3
+
+
+def test_a_negative_eta_is_refused():
+    """DDIM's eta is >= 0 (0 deterministic, 1 DDPM's variance); a negative one shrank the eps term and drew no
+    noise, silently another sampler."""
+    from beatlite.models.diffgesture import DiffGestureConfig, NoiseSchedule, ddim_sample
+
+    with pytest.raises(ValueError, match="eta must be >= 0"):
+        DiffGestureConfig(eta=-1.0)
+    with pytest.raises(ValueError, match="eta must be >= 0"):
+        ddim_sample(NoiseSchedule(10, 1e-4, 0.02), lambda x, t: x, torch.zeros(1, 4, 2), steps=5, eta=-1.0)

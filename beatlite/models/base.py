@@ -55,6 +55,7 @@ Taught in notebooks/05_camn.ipynb, sections 2 (the seed input) and 3 (the semant
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any, ClassVar
@@ -190,13 +191,56 @@ def huber(pred: torch.Tensor, target: torch.Tensor, beta: float = 0.1) -> torch.
     return nn.functional.smooth_l1_loss(pred / beta, target / beta) * beta
 
 
+#: Batch keys that hold ids (integer tensors); the others hold numbers (floating tensors).
+ID_KEYS = frozenset({"word", "speaker", "emotion"})
+
+
 def check_batch(batch: Mapping[str, Any], keys: tuple[str, ...], who: str) -> None:
-    """Raise ``KeyError``/``TypeError`` naming ``who`` when ``batch`` lacks a key or is not a tensor."""
+    """Raise ``KeyError``/``TypeError`` naming ``who`` when ``batch`` lacks a key, is not a tensor, or holds ids
+    that are not integers (:data:`ID_KEYS`) or numbers that are not floating point.
+
+    Examples
+    --------
+    >>> check_batch({"word": torch.zeros(2, 34)}, ("word",), "CaMN.forward")
+    Traceback (most recent call last):
+    ...
+    TypeError: CaMN.forward: batch['word'] holds ids: an integer tensor, got torch.float32
+    """
     for key in keys:
         if key not in batch:
             raise KeyError(f"{who}: batch has no {key!r} (keys: {sorted(batch)})")
-        if not isinstance(batch[key], torch.Tensor):
-            raise TypeError(f"{who}: batch[{key!r}] must be a torch.Tensor, got {type(batch[key]).__name__}")
+        value = batch[key]
+        if not isinstance(value, torch.Tensor):
+            raise TypeError(f"{who}: batch[{key!r}] must be a torch.Tensor, got {type(value).__name__}")
+        if key in ID_KEYS and (value.is_floating_point() or value.is_complex() or value.dtype == torch.bool):
+            raise TypeError(f"{who}: batch[{key!r}] holds ids: an integer tensor, got {value.dtype}")
+        if key not in ID_KEYS and not value.is_floating_point():
+            raise TypeError(f"{who}: batch[{key!r}] holds numbers: a floating tensor, got {value.dtype}")
+
+
+@contextlib.contextmanager
+def evaluating(model: nn.Module) -> Iterator[None]:
+    """``model`` in eval mode inside; after, every submodule back in its own mode (one frozen in eval while the
+    rest trains stays in eval, one training in an eval model trains again).
+
+    Examples
+    --------
+    >>> net = nn.Sequential(nn.Linear(2, 2), nn.BatchNorm1d(2))
+    >>> _ = net[1].eval()  # frozen while the rest trains
+    >>> with evaluating(net):
+    ...     net.training, net[0].training
+    (False, False)
+    >>> net.training, net[0].training, net[1].training
+    (True, True, False)
+    """
+    modes = [(m, m.training) for m in model.modules()]
+    if any(training for _, training in modes):
+        model.eval()
+    try:
+        yield
+    finally:
+        for m, training in modes:
+            m.training = training
 
 
 def _reads_by_batch(windows: Any) -> bool:
@@ -386,18 +430,12 @@ class GestureModel(nn.Module):
             The generated pose in the normalised representation.
         """
         check_batch(batch, (self.target_key,), f"{type(self).__name__}.generate")
-        was_training = self.training
-        if was_training:  # toggling walks every submodule: skip it in the usual eval-mode loop
-            self.eval()
-        try:
+        with evaluating(self):
             seeded = dict(batch)
             target = batch[self.target_key].clone()
             target[:, self.n_pre :] = 0.0
             seeded[self.target_key] = target
             return self.forward(seeded)["pose"]
-        finally:
-            if was_training:
-                self.train()
 
     # ---------------------------------------------------------------- (de)serialisation
     def to_config(self) -> dict[str, Any]:

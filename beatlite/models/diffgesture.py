@@ -65,7 +65,7 @@ import torch
 from torch import nn
 
 from beatlite.constants import WINDOW_LENGTH
-from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch, seed_input
+from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch, evaluating, seed_input
 from beatlite.models.layers import PlainWavEncoder, match_length
 
 POSE_DIM = 126
@@ -170,6 +170,8 @@ class DiffGestureConfig(ModelConfig):
             raise ValueError(f"hidden ({self.hidden}) must divide by heads ({self.heads}), time_dim be even")
         if not 0.0 <= self.null_cond_prob < 1.0:
             raise ValueError(f"null_cond_prob must be in [0, 1), got {self.null_cond_prob}")
+        if not self.eta >= 0.0:
+            raise ValueError(f"eta must be >= 0 (0: deterministic DDIM, 1: DDPM's variance), got {self.eta}")
         if not 1 <= self.sample_steps <= self.diffusion_steps:
             raise ValueError(f"sample_steps must be in [1, {self.diffusion_steps}], got {self.sample_steps}")
 
@@ -313,6 +315,8 @@ def ddim_sample(
     -------
     (B, T, D) tensor, x_0
     """
+    if not eta >= 0.0:  # (a negative eta would shrink the eps term and draw no noise: another sampler)
+        raise ValueError(f"eta must be >= 0 (0: deterministic DDIM, 1: DDPM's variance), got {eta}")
     times = schedule.ddim_timesteps(steps)
     x = x_T
     for i in range(len(times) - 1, -1, -1):
@@ -529,9 +533,8 @@ class DiffGesture(GestureModel):
         if sampler == "ddpm" and steps not in (None, self.schedule.steps):
             raise ValueError(f"DDPM takes all {self.schedule.steps} steps; use sampler='ddim' for {steps}")
         scale = c.guidance_scale if guidance_scale is None else float(guidance_scale)
-        was_training = self.training
-        self.eval()
-        try:
+        check_batch(batch, self.input_keys, "DiffGesture.generate")
+        with evaluating(self):
             seeded = dict(batch)
             seeded["dirvec"] = batch["dirvec"].clone()
             seeded["dirvec"][:, self.n_pre :] = 0.0
@@ -550,6 +553,3 @@ class DiffGesture(GestureModel):
                     eta=c.eta if eta is None else float(eta), generator=g, stabilizer_t0=c.stabilizer_t0,
                 )  # fmt: skip
             return x0 / c.x_scale
-        finally:
-            if was_training:
-                self.train()

@@ -72,6 +72,7 @@ from beatlite.models.base import (
     GestureModel,
     TextConfig,
     check_batch,
+    evaluating,
     window_chunks,
 )
 from beatlite.models.ha2g_ablations import ABLATIONS
@@ -756,13 +757,8 @@ class HA2G(GestureModel):
         seeded["dirvec"][:, self.n_pre :] = 0.0
         pick = torch.randint(0, pool.numel(), (seeded["dirvec"].shape[0],), generator=generator)
         seeded["speaker"] = pool[pick].to(seeded["dirvec"].device)
-        was_training = self.training
-        self.eval()
-        try:
+        with evaluating(self):
             return self.forward(seeded, sample_style=True, generator=generator)["pose"]
-        finally:
-            if was_training:
-                self.train()
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any]) -> GestureModel:

@@ -248,6 +248,25 @@ def check_determinism(case: ModelCase) -> None:
     _expect(all(torch.equal(l1[k], l2[k]) for k in l1), case, "two loss evaluations with one seed differ")
 
 
+def check_generate_modes(case: ModelCase) -> None:
+    """``generate`` leaves every submodule in the mode it found it in: a submodule frozen in eval while the rest
+    trains stays in eval, one training inside an eval model trains again; and it changes no weight or buffer."""
+    model = _prepared(case, case.build(seed=0))
+    batch = case.batch(model)
+    first = next(model.children(), None)
+    for top in (True, False):
+        model.train(top)
+        if first is not None:
+            first.train(not top)
+        before = {m: m.training for m in model.modules()}
+        state = {k: v.clone() for k, v in model.state_dict().items()}
+        _reset(model).generate(batch)
+        _expect({m: m.training for m in model.modules()} == before, case,
+                f"generate changed the modes of submodules (model {'training' if top else 'in eval'})")  # fmt: skip
+        _expect(all(torch.equal(state[k], v) for k, v in model.state_dict().items()), case,
+                "generate changed a weight or buffer")  # fmt: skip
+
+
 def check_checkpoint(case: ModelCase) -> None:
     """save_checkpoint -> export_checkpoint (float32) -> ``torch.load(weights_only=True)`` ->
     model_from_checkpoint generates exactly what the model generates."""
@@ -426,6 +445,7 @@ CHECKS = {
     "shapes": check_shapes,
     "gradients": check_gradients,
     "determinism": check_determinism,
+    "generate_modes": check_generate_modes,
     "checkpoint": check_checkpoint,
     "no_host_reads": check_no_host_reads,
 }

@@ -150,8 +150,11 @@ def generate_sequences(
     """:func:`generate_sequence` for several takes at once, their units batched in lock-step.
 
     Unit ``i`` of every take that has one goes through the model in one batch (B = number of
-    takes still running), so a test set is generated several times faster than take by take;
-    each take's result equals :func:`generate_sequence` on it alone (up to float rounding).
+    takes still running), so a test set is generated several times faster than take by take. For a model that
+    does not sample, each take's result equals :func:`generate_sequence` on it alone (up to float rounding); a
+    model that samples (random clip, A2G, the joint embedding, DiffGesture) draws the noise of a whole batch from
+    one generator, so a take's draws depend on the other takes of the set and their order (the same set, order
+    and seed give the same numbers).
 
     Parameters
     ----------
