@@ -146,8 +146,37 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def model_from_checkpoint(data: Mapping[str, Any]) -> GestureModel:
-    """Rebuild the model of a checkpoint dict and load its (float32) weights, in eval mode."""
+def _state_mismatch(model: torch.nn.Module, state: Mapping[str, Any]) -> str | None:
+    """The first difference between ``model``'s state dict and ``state`` (names and shapes), or None."""
+    own = model.state_dict()
+    for key, value in own.items():
+        if key not in state:
+            return f"no weights {key!r} (the model's shape {tuple(value.shape)})"
+        shape = tuple(state[key].shape) if torch.is_tensor(state[key]) else type(state[key]).__name__
+        if shape != tuple(value.shape):
+            return f"{key!r} of shape {shape}, the model's is {tuple(value.shape)}"
+    extra = [k for k in state if k not in own]
+    return f"unexpected weights {extra[0]!r} (not in the model)" if extra else None
+
+
+def model_from_checkpoint(data: Mapping[str, Any], path: str | Path | None = None) -> GestureModel:
+    """Rebuild the model of a checkpoint dict and load its (float32) weights, in eval mode.
+
+    The model is first built on torch's ``meta`` device (no memory, no initialisation) and its parameter and
+    buffer names and shapes compared with ``data["state"]``, so a small file whose config asks for a huge
+    model is refused before anything is allocated.
+
+    Raises
+    ------
+    beatlite.io.FormatError
+        ``field="state"``: weights of other names or shapes than the model its config builds (the first
+        such key and both shapes named); ``path`` names the file (None: in memory).
+    """
+    with torch.device("meta"):
+        skeleton = GestureModel.from_config(data["model"])
+    why = _state_mismatch(skeleton, data["state"])
+    if why is not None:
+        raise FormatError(path, f"the weights do not fit the model its config builds: {why}", field="state")
     model = GestureModel.from_config(data["model"])
     state = {
         k: v.float() if torch.is_tensor(v) and v.is_floating_point() else v for k, v in data["state"].items()
@@ -181,7 +210,9 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
         path = paths.checkpoints_dir() / f"{path_or_name}.pt"
     data = load_checkpoint(path)
     try:
-        return model_from_checkpoint(data), data
+        return model_from_checkpoint(data, path), data
+    except FormatError:
+        raise
     except (
         RuntimeError,
         KeyError,

@@ -1,0 +1,60 @@
+"""Hostile checkpoints (beatlite.train.checkpoint, beatlite.metrics.extractor): refused with a FormatError
+naming the file and the field, before anything large is allocated and without running code."""
+
+from __future__ import annotations
+
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from beatlite.io import FormatError  # noqa: E402
+from beatlite.models.base import GestureModel  # noqa: E402
+from beatlite.paths import checkpoints_dir  # noqa: E402
+from beatlite.train.checkpoint import load_checkpoint, load_model, save_checkpoint  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def shipped():
+    """The shipped seq2seq checkpoint's dict (small, float16 weights)."""
+    return load_checkpoint(checkpoints_dir() / "seq2seq_tiny.pt")
+
+
+def test_a_config_asking_for_a_huge_model_is_refused_before_the_model_is_built(
+    shipped, tmp_path, monkeypatch
+):
+    """hidden=6000 with the shipped (hidden=64) weights: before, the full model (2.5 GB) was built and
+    initialised and only load_state_dict refused it; now it is compared on the meta device first."""
+    path = save_checkpoint(tmp_path / "huge.pt", {**shipped, "model": {**shipped["model"], "hidden": 6000}})
+    devices = []
+    build = GestureModel.from_config.__func__
+
+    def recording(cls, config):
+        devices.append(torch.empty(0).device.type)  # where factory functions put tensors during this build
+        return build(cls, config)
+
+    monkeypatch.setattr(GestureModel, "from_config", classmethod(recording))
+    with pytest.raises(FormatError) as refused:
+        load_model(path)
+    err = refused.value
+    assert err.path == path and err.field == "state"
+    # the first weights hidden sizes: the GRU encoder's input weights, 3 gates x hidden rows of word_dim (64)
+    assert "encoder.weight_ih_l0" in shipped["state"]
+    assert "'encoder.weight_ih_l0'" in err.reason, err.reason
+    assert "(192, 64)" in err.reason and "(18000, 64)" in err.reason, err.reason
+    assert set(devices) == {"meta"}, f"a model was built for real: {devices}"
+
+
+def test_weights_of_other_names_are_refused_naming_the_first_key(shipped, tmp_path):
+    first = next(iter(shipped["state"]))
+    missing = {k: v for k, v in shipped["state"].items() if k != first}
+    path = save_checkpoint(tmp_path / "missing.pt", {**shipped, "state": missing})
+    with pytest.raises(FormatError, match=repr(first).replace(".", r"\.")) as refused:
+        load_model(path)
+    assert refused.value.field == "state"
+    extra = {**shipped["state"], "no_such.weight": torch.zeros(2)}
+    path = save_checkpoint(tmp_path / "extra.pt", {**shipped, "state": extra})
+    with pytest.raises(FormatError, match="'no_such.weight'") as refused:
+        load_model(path)
+    assert refused.value.field == "state"
+    model, _ = load_model(checkpoints_dir() / "seq2seq_tiny.pt")  # the shipped file still loads
+    assert not model.training
