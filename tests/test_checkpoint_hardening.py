@@ -58,3 +58,41 @@ def test_weights_of_other_names_are_refused_naming_the_first_key(shipped, tmp_pa
     assert refused.value.field == "state"
     model, _ = load_model(checkpoints_dir() / "seq2seq_tiny.pt")  # the shipped file still loads
     assert not model.training
+
+
+def _bomb(src, dst, inflated: int) -> str:
+    """A copy of the torch file ``src`` whose last tensor record is ``inflated`` zero bytes, DEFLATEd (torch.save
+    stores members uncompressed, and torch.load inflates a record in full); returns the record's name."""
+    import zipfile
+
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        records = [n for n in zin.namelist() if "/data/" in n and n.rsplit("/", 1)[1].isdigit()]
+        last = max(records, key=lambda n: int(n.rsplit("/", 1)[1]))
+        for info in zin.infolist():
+            if info.filename != last:
+                zout.writestr(info, zin.read(info))
+        info = zipfile.ZipInfo(last)
+        info.compress_type = zipfile.ZIP_DEFLATED
+        with zout.open(info, "w", force_zip64=True) as f:
+            for _ in range(inflated // 2**20):
+                f.write(bytes(2**20))
+    return last
+
+
+def test_a_decompression_bomb_in_a_checkpoint_is_refused_before_torch_reads_it(tmp_path, monkeypatch):
+    """Before, torch.load inflated the member in full (3 GiB: 3.3 GB RSS, 11 s) before anything refused it."""
+    from beatlite.metrics.extractor import load_extractor
+
+    inflated = 80 * 2**20  # > 64 MiB (ZIP_SMALL_MEMBER_BYTES) at ~1000x: beyond GZIP_MAX_RATIO (100)
+    for name, load in (
+        ("seq2seq_tiny.pt", load_model),
+        ("fgd_dirvec.pt", lambda p: load_extractor("dirvec", p)),
+    ):
+        path = tmp_path / f"bomb_{name}"
+        record = _bomb(checkpoints_dir() / name, path, inflated)
+        assert path.stat().st_size < inflated / 100
+        with monkeypatch.context() as m:
+            m.setattr(torch, "load", lambda *a, **k: pytest.fail("torch.load read the bomb"))
+            with pytest.raises(FormatError, match="decompression bomb") as refused:
+                load(path)
+        assert refused.value.path == path and refused.value.field == record, refused.value

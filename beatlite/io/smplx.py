@@ -44,7 +44,7 @@ import numpy as np
 
 from beatlite.io.bvh import FRAME_TIME_RANGE
 from beatlite.io.errors import FormatError
-from beatlite.io.textfile import GZIP_MAX_RATIO, describe_bytes
+from beatlite.io.textfile import describe_bytes, zip_members
 
 __all__ = ["BEAT2_SPLITS", "SMPLXMotion", "read_beat2_split", "read_smplx", "write_smplx"]
 
@@ -133,20 +133,7 @@ def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
         head = f.read(64)
     if not head.startswith(b"PK\x03\x04"):
         raise FormatError(path, f"not an .npz file (a ZIP archive of .npy arrays): {describe_bytes(head)}")
-    try:
-        with zipfile.ZipFile(path) as z:
-            infos = {i.filename.removesuffix(".npy"): i for i in z.infolist()}
-    except (zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise FormatError(path, f"a damaged ZIP archive ({exc})") from None
-    for key, info in infos.items():
-        ratio = info.file_size / max(info.compress_size, 1)
-        if info.file_size > _MAX_MEMBER_BYTES or (info.file_size > 64 * 2**20 and ratio > GZIP_MAX_RATIO):
-            raise FormatError(
-                path,
-                f"{info.file_size} bytes uncompressed ({ratio:.0f} x the stored size): refused",
-                field=key,
-            )
-    return infos
+    return zip_members(path, _MAX_MEMBER_BYTES, suffix=".npy")
 
 
 def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:

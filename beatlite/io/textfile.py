@@ -11,6 +11,7 @@ from __future__ import annotations
 import gzip
 import io
 import os
+import zipfile
 import zlib
 from pathlib import Path
 from typing import IO
@@ -46,6 +47,66 @@ GZIP_ERRORS = (gzip.BadGzipFile, EOFError, zlib.error)
 #: corpus files inflate 7-19x (BVH with 3 decimals, facial JSON); a gzip "bomb" (e.g. 1.7 MB inflating to
 #: 700 MB) is refused while it is read, so memory and time stay bounded by the file on disk.
 GZIP_MAX_RATIO = 100
+
+
+#: A ZIP member may inflate beyond :data:`GZIP_MAX_RATIO` times its stored size only up to this many bytes (so that
+#: small arrays of zeros, which compress 1000-fold, stay readable); past it the ratio bound applies.
+ZIP_SMALL_MEMBER_BYTES = 64 * 2**20
+
+
+def zip_members(
+    path: Path, max_member_bytes: int | None = None, suffix: str = ""
+) -> dict[str, zipfile.ZipInfo]:
+    """The members of the ZIP archive at ``path`` by name (less ``suffix``, e.g. ``".npy"``), checked from its directory before anything is inflated.
+
+    Refused, a :class:`FormatError` naming the member as the field: a member larger than ``max_member_bytes``
+    uncompressed (None: no such bound), one stored in more bytes than the file has, or one (or all together)
+    inflating to more than :data:`ZIP_SMALL_MEMBER_BYTES` and more than :data:`GZIP_MAX_RATIO` times its stored
+    size (the file's size for all together): a decompression bomb. Used by the ``.npz`` reader
+    (:func:`beatlite.io.smplx.read_smplx`) and the checkpoint loaders (``torch.save`` stores members uncompressed).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> path = Path(tmp.name) / "bomb.zip"
+    >>> with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+    ...     z.writestr("zeros", bytes(65 * 2**20))  # 65 MiB of zeros in 64 KB
+    >>> zip_members(path)
+    Traceback (most recent call last):
+    ...
+    beatlite.io.errors.FormatError: ..., field 'zeros': 68157440 bytes uncompressed (1... x the stored size): refused as a likely decompression bomb
+    >>> tmp.cleanup()
+    """
+    try:
+        with zipfile.ZipFile(path) as z:
+            infos = {i.filename.removesuffix(suffix): i for i in z.infolist()}
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise FormatError(path, f"a damaged ZIP archive ({exc})") from None
+    size = path.stat().st_size
+    total = sum(i.file_size for i in infos.values())
+    for name, info in infos.items():
+        ratio = info.file_size / max(info.compress_size, 1)
+        if info.compress_size > size:
+            raise FormatError(
+                path, f"{info.compress_size} bytes stored in a {size}-byte file: damaged", field=name
+            )
+        if (max_member_bytes is not None and info.file_size > max_member_bytes) or (
+            info.file_size > ZIP_SMALL_MEMBER_BYTES and ratio > GZIP_MAX_RATIO
+        ):
+            raise FormatError(
+                path,
+                f"{info.file_size} bytes uncompressed ({ratio:.0f} x the stored size): refused as a likely "
+                "decompression bomb",
+                field=name,
+            )
+    if total > ZIP_SMALL_MEMBER_BYTES and total > GZIP_MAX_RATIO * size:
+        raise FormatError(
+            path,
+            f"its members inflate to {total} bytes, {total / size:.0f} x the file's size: refused as a likely "
+            "decompression bomb",
+        )
+    return infos
 
 
 class _CheckedGzip(gzip.GzipFile):

@@ -496,7 +496,9 @@ def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> Fea
             f"FGD extractor checkpoint {p} not found; train it with "
             f"`python -m beatlite.metrics.extractor train --space {space}`"
         )
-    data = torch.load(p, map_location="cpu", weights_only=True)
+    from beatlite.train.checkpoint import read_plain
+
+    data = read_plain(p)  # no code run, a decompression bomb refused before it inflates
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise ValueError(f"{p}: not a beatlite FGD extractor checkpoint (format {data.get('format')!r})")
     model = MotionAutoencoder(ExtractorConfig(**data["config"]))

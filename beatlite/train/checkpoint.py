@@ -27,6 +27,7 @@ Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkp
 
 from __future__ import annotations
 
+import zipfile
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ import torch
 from beatlite import paths
 from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError
+from beatlite.io.textfile import zip_members
 from beatlite.models.base import GestureModel
 
 FORMAT = "beatlite-checkpoint/1"
@@ -95,24 +97,23 @@ def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
     return path
 
 
-def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Read a checkpoint dict on the CPU, running no code from the file (``weights_only=True``).
+def read_plain(path: Path) -> Any:
+    """``torch.load(path, weights_only=True)`` on the CPU: tensors, plain values and :data:`NUMPY_ARRAY_GLOBALS` only.
 
-    The metadata's arrays come back as float64 numpy arrays (saved as tensors, or as numpy arrays by
-    older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`).
+    A ZIP file (what ``torch.save`` writes, members stored uncompressed) is first checked from its directory
+    (:func:`beatlite.io.textfile.zip_members`), so a decompression bomb is refused before anything is inflated.
+    Shared by :func:`load_checkpoint` and :func:`beatlite.metrics.extractor.load_extractor`.
 
     Raises
     ------
-    FileNotFoundError
-        No file at ``path``.
+    PermissionError
+        The file cannot be read.
     beatlite.io.FormatError
-        The file is truncated or corrupted, is not a beatlite checkpoint, or holds anything but tensors and
-        plain values (a pickled object that would run code when loaded is refused, never executed).
+        Truncated or damaged, a decompression bomb, or a pickle of anything but tensors and plain values
+        (refused, never executed).
     """
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"checkpoint not found: {path}")
+    if zipfile.is_zipfile(path):
+        zip_members(path)
     try:
         with torch.serialization.safe_globals(NUMPY_ARRAY_GLOBALS):
             data = torch.load(path, map_location="cpu", weights_only=True)
@@ -136,6 +137,28 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
             f"not a plain torch checkpoint (tensors and plain values only): {reason}; if you trust where the "
             "file comes from, beatlite.train.checkpoint.convert_legacy(path, new_path, trust=True) rewrites it",
         ) from None
+    return data
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    """Read a checkpoint dict on the CPU, running no code from the file (``weights_only=True``).
+
+    The metadata's arrays come back as float64 numpy arrays (saved as tensors, or as numpy arrays by
+    older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`).
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at ``path``.
+    beatlite.io.FormatError
+        The file is truncated or corrupted, is not a beatlite checkpoint, or holds anything but tensors and
+        plain values (a pickled object that would run code when loaded is refused, never executed).
+    """
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"checkpoint not found: {path}")
+    data = read_plain(path)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise FormatError(path, f"not a beatlite checkpoint (missing format {FORMAT!r})", field="format")
     for key in ("model", "state"):
