@@ -907,6 +907,8 @@ def _extractor(path: str | Path | None) -> Any:
         extractor = load_extractor("dirvec", path)
     except FileNotFoundError:
         raise ScoreInputError([f"{path}: no such FGD extractor checkpoint"]) from None
+    except ValueError as exc:  # a FormatError names the file and the field
+        raise ScoreInputError([str(exc)]) from None
     except Exception as exc:  # torch.load(weights_only=True) raises several types on a foreign file
         raise ScoreInputError(
             [f"{path}: not a beatlite FGD extractor checkpoint ({type(exc).__name__})"]

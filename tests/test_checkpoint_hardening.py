@@ -96,3 +96,60 @@ def test_a_decompression_bomb_in_a_checkpoint_is_refused_before_torch_reads_it(t
             with pytest.raises(FormatError, match="decompression bomb") as refused:
                 load(path)
         assert refused.value.path == path and refused.value.field == record, refused.value
+
+
+def _extractor_payload():
+    return torch.load(checkpoints_dir() / "fgd_dirvec.pt", weights_only=True)
+
+
+def _hostile_extractors():
+    """(label, payload or raw bytes, the field the refusal must name) of the audit's hostile extractors."""
+    import pickle
+
+    base = _extractor_payload()
+    state = base["state_dict"]
+    first = next(k for k, v in state.items() if v.is_floating_point())
+    return [
+        ("a pickled object", pickle.dumps(_Evil(), protocol=2), None),
+        ("a list", [1, 2], "format"),
+        ("no config", {k: v for k, v in base.items() if k != "config"}, "config"),
+        ("an unknown config field", {**base, "config": {**base["config"], "no_such": 1}}, "config"),
+        ("no weights", {k: v for k, v in base.items() if k != "state_dict"}, "state_dict"),
+        ("weights a list", {**base, "state_dict": [1]}, "state_dict"),
+        (
+            "a missing weight",
+            {**base, "state_dict": {k: v for k, v in state.items() if k != first}},
+            "state_dict",
+        ),
+        (
+            "NaN weights",
+            {**base, "state_dict": {**state, first: torch.full_like(state[first], float("nan"))}},
+            "state_dict",
+        ),
+        ("std all zero", {**base, "input_std": torch.zeros_like(base["input_std"])}, "input_std"),
+        ("NaN mean", {**base, "input_mean": torch.full_like(base["input_mean"], float("nan"))}, "input_mean"),
+        ("a dirvec of 6 channels", {**base, "config": {**base["config"], "input_dim": 6}}, "config"),
+        ("an unknown space", {**base, "space": "nosuch"}, "space"),
+    ]
+
+
+class _Evil:
+    def __reduce__(self):
+        return (pytest.fail, ("unpickling ran code",))
+
+
+@pytest.mark.parametrize("label", [h[0] for h in _hostile_extractors()])
+def test_a_hostile_extractor_is_one_format_error_naming_the_field(label, tmp_path):
+    """Before: UnpicklingError, AttributeError, KeyError, TypeError or RuntimeError; NaN weights, a zero std and a
+    6-channel dirvec extractor were accepted (and scoring failed later, blaming the predictions)."""
+    from beatlite.metrics.extractor import load_extractor
+
+    _, payload, field = next(h for h in _hostile_extractors() if h[0] == label)
+    path = tmp_path / "ex.pt"
+    if isinstance(payload, bytes):
+        path.write_bytes(payload)
+    else:
+        torch.save(payload, path)
+    with pytest.raises(FormatError) as refused:
+        load_extractor("dirvec", path)
+    assert refused.value.path == path and refused.value.field == field, refused.value

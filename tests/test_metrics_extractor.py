@@ -61,8 +61,8 @@ def test_training_is_deterministic_and_reduces_the_loss():
 
 
 def test_checkpoint_round_trip(tmp_path):
-    w = smooth_windows()
-    cfg = ExtractorConfig(input_dim=6, latent_dim=8, channels=8, epochs=1, batch_size=32)
+    w = smooth_windows(d=126)  # a dirvec extractor's windows: 126 channels
+    cfg = ExtractorConfig(input_dim=126, latent_dim=8, channels=8, epochs=1, batch_size=32)
     model, info = train_autoencoder(w, cfg, log=False)
     path = save_extractor(tmp_path / "x.pt", model, info, space="dirvec", meta={"data_fingerprint": "abc"})
     ex = load_extractor(path=path)
@@ -71,8 +71,8 @@ def test_checkpoint_round_trip(tmp_path):
     np.testing.assert_allclose(ex(w), direct, rtol=1e-5, atol=1e-6)
     assert ex.meta["data_fingerprint"] == "abc" and ex.latent_dim == 8
     assert fgd(w, w, extractor=ex) == pytest.approx(0.0, abs=1e-6)
-    with pytest.raises(ValueError, match=r"windows must be \(N, 34, 6\)"):
-        ex(np.zeros((2, 30, 6)))
+    with pytest.raises(ValueError, match=r"windows must be \(N, 34, 126\)"):
+        ex(np.zeros((2, 30, 126)))
     assert not list(tmp_path.glob(".*tmp"))  # atomic write left no temporary file
 
 

@@ -469,8 +469,8 @@ def test_fit_command_trains_the_extractor_again_for_other_data_or_epochs(tmp_pat
 
     def stand_in_train_extractor(data_dir, path, epochs):
         trained.append((data.train.fingerprint, epochs))
-        model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8, epochs=epochs))
-        info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}
+        model = MotionAutoencoder(ExtractorConfig(input_dim=126, latent_dim=4, channels=8, epochs=epochs))
+        info = {"mean": np.zeros(126), "std": np.ones(126), "history": []}
         save_extractor(path, model, info, space="dirvec", meta={"data_fingerprint": data.train.fingerprint})
 
     monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))

@@ -50,6 +50,9 @@ SPACES = {
     "pose": ("pose", "fgd_euler141.pt"),
     "rot6d": ("pose_raw", "fgd_rot6d.pt"),
 }
+#: Channels D of each space's windows: 42 TED-43 bone directions x 3, 47 Euler triplets (``spine_neck_141``), their 47
+#: 6D rotations. :func:`load_extractor` and :func:`save_extractor` refuse an extractor of another input size.
+SPACE_DIMS = {"dirvec": 126, "pose": 141, "rot6d": 282}
 #: Spaces whose windows are computed from their key's values: "rot6d" = the 6D rotation of each of the 47 joints of
 #: the raw Euler degrees (:func:`beatlite.skeleton.rotations.euler_to_6d`, 282-d; EMAGE's FGD space is rot6d).
 SPACE_INPUTS = {"rot6d": "euler_to_6d"}
@@ -424,23 +427,29 @@ def save_extractor(
 ) -> Path:
     """Write the checkpoint atomically: config, weights, input normalisation, fingerprint, history.
 
-    Only tensors and plain Python values are stored, so it loads with ``weights_only=True``.
+    ``space`` is one of :data:`SPACES` and the model's ``input_dim`` its :data:`SPACE_DIMS` (else a ValueError),
+    so that :func:`load_extractor` reads the file back. Only tensors and plain Python values are stored, so it loads with ``weights_only=True``.
 
     Examples
     --------
     >>> import tempfile
-    >>> model = MotionAutoencoder(ExtractorConfig(input_dim=6, latent_dim=4, channels=8)).eval()
-    >>> info = {"mean": np.zeros(6), "std": np.ones(6), "history": []}  # as train_autoencoder returns it
+    >>> model = MotionAutoencoder(ExtractorConfig(input_dim=126, latent_dim=4, channels=8)).eval()
+    >>> info = {"mean": np.zeros(126), "std": np.ones(126), "history": []}  # as train_autoencoder returns it
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     path = save_extractor(f"{tmp}/ae.pt", model, info, space="dirvec", meta={})
     ...     extractor = load_extractor("dirvec", path)
-    >>> windows = np.random.default_rng(0).normal(size=(5, 34, 6)).astype(np.float32)
+    >>> windows = np.random.default_rng(0).normal(size=(5, 34, 126)).astype(np.float32)
     >>> features = extractor(windows)  # (N, L); the same as the saved model's
     >>> features.shape, np.allclose(features, model.encode(torch.from_numpy(windows)).detach().numpy(), atol=1e-6)
     ((5, 4), True)
     """
     from beatlite.io.atomic import atomic_write
 
+    if SPACE_DIMS.get(space) != model.config.input_dim:
+        raise ValueError(
+            f"save_extractor: space must be one of {sorted(SPACES)} with input_dim its SPACE_DIMS, "
+            f"got {space!r} and {model.config.input_dim}"
+        )
     payload = {
         "format": FORMAT,
         "space": space,
@@ -478,7 +487,13 @@ def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> Fea
     FileNotFoundError
         The checkpoint does not exist (train it with ``python -m beatlite.metrics.extractor train``).
     ValueError
-        The file is not a beatlite FGD extractor checkpoint.
+        ``space`` is not one of :data:`SPACES`.
+    beatlite.io.FormatError
+        (a ValueError) The file is not a beatlite FGD extractor checkpoint, naming the field: a pickle of
+        anything but tensors and plain values (never executed), a decompression bomb, a config of other or
+        missing fields or whose ``input_dim`` is not its space's (:data:`SPACE_DIMS`), weights of other
+        names or shapes than that config's model or not finite, an ``input_mean``/``input_std`` that is not
+        a finite (D,) tensor with std > 0.
 
     Examples
     --------
@@ -499,12 +514,58 @@ def load_extractor(space: str = "dirvec", path: str | Path | None = None) -> Fea
     from beatlite.train.checkpoint import read_plain
 
     data = read_plain(p)  # no code run, a decompression bomb refused before it inflates
+    return _extractor_from(data, p)
+
+
+def _extractor_from(data: Any, p: Path) -> FeatureExtractor:
+    """The :class:`FeatureExtractor` of a loaded checkpoint dict, every field checked (FormatError naming it)."""
+    from beatlite.io.errors import FormatError
+    from beatlite.train.checkpoint import check_state, state_mismatch
+
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise ValueError(f"{p}: not a beatlite FGD extractor checkpoint (format {data.get('format')!r})")
-    model = MotionAutoencoder(ExtractorConfig(**data["config"]))
+        found = data.get("format") if isinstance(data, dict) else type(data).__name__
+        raise FormatError(p, f"not a beatlite FGD extractor checkpoint (format {found!r})", field="format")
+    space = data.get("space")
+    if not isinstance(space, str) or space not in SPACES:
+        raise FormatError(p, f"space must be one of {sorted(SPACES)}, got {space!r}", field="space")
+    try:
+        config = ExtractorConfig(**data["config"])
+        with torch.device(
+            "meta"
+        ):  # built without memory first: a huge config is refused before it is allocated
+            skeleton = MotionAutoencoder(config)
+    except Exception as exc:  # noqa: BLE001 - missing/unknown fields (KeyError, TypeError), bad values
+        raise FormatError(
+            p, f"not an extractor config ({type(exc).__name__}: {exc})", field="config"
+        ) from None
+    if config.input_dim != SPACE_DIMS[space]:
+        raise FormatError(
+            p,
+            f"input_dim {config.input_dim}, but {space!r} windows have {SPACE_DIMS[space]} channels",
+            field="config",
+        )
+    check_state(data.get("state_dict"), p, field="state_dict")
+    why = state_mismatch(skeleton, data["state_dict"])
+    if why is not None:
+        raise FormatError(p, f"the weights do not fit the model its config builds: {why}", field="state_dict")
+    moments = {}
+    for key in ("input_mean", "input_std"):
+        value = data.get(key)
+        if not torch.is_tensor(value) or tuple(value.shape) != (config.input_dim,) or value.is_complex():
+            got = tuple(value.shape) if torch.is_tensor(value) else type(value).__name__
+            raise FormatError(p, f"expected a ({config.input_dim},) tensor, got {got}", field=key)
+        moments[key] = value.detach().to_dense().float().numpy()
+        if not np.isfinite(moments[key]).all() or (key == "input_std" and not (moments[key] > 0).all()):
+            raise FormatError(
+                p, "non-finite values" + (" or a std <= 0" if key == "input_std" else ""), field=key
+            )
+    for key, kind in (("meta", dict), ("history", list)):
+        if not isinstance(data.get(key, kind()), kind):
+            raise FormatError(p, f"expected a {kind.__name__}, got {type(data[key]).__name__}", field=key)
+    model = MotionAutoencoder(config)
     model.load_state_dict(data["state_dict"])
     meta = {**data.get("meta", {}), "history": data.get("history", []), "path": str(p)}
-    return FeatureExtractor(model, data["input_mean"].numpy(), data["input_std"].numpy(), data["space"], meta)
+    return FeatureExtractor(model, moments["input_mean"], moments["input_std"], space, meta)
 
 
 # ----------------------------------------------------------------------------- command line

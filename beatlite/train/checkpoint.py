@@ -169,7 +169,28 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def _state_mismatch(model: torch.nn.Module, state: Mapping[str, Any]) -> str | None:
+def check_state(state: Any, path: str | Path | None, field: str = "state") -> None:
+    """Refuse weights that are not a mapping of names to dense tensors, floating ones finite.
+
+    Raises
+    ------
+    beatlite.io.FormatError
+        Naming ``path`` and ``field`` (and the first bad key): not a mapping, a value that is not a dense
+        real tensor, or a floating tensor holding NaN or infinity.
+    """
+    if not isinstance(state, Mapping):
+        raise FormatError(
+            path, f"expected a mapping of names to tensors, got {type(state).__name__}", field=field
+        )
+    for key, value in state.items():
+        if not isinstance(key, str) or not torch.is_tensor(value) or value.layout != torch.strided:
+            what = f"a {value.layout} tensor" if torch.is_tensor(value) else type(value).__name__
+            raise FormatError(path, f"{key!r}: expected a dense tensor, got {what}", field=field)
+        if value.is_complex() or (value.is_floating_point() and not bool(torch.isfinite(value).all())):
+            raise FormatError(path, f"{key!r}: non-finite or complex weights", field=field)
+
+
+def state_mismatch(model: torch.nn.Module, state: Mapping[str, Any]) -> str | None:
     """The first difference between ``model``'s state dict and ``state`` (names and shapes), or None."""
     own = model.state_dict()
     for key, value in own.items():
@@ -197,7 +218,7 @@ def model_from_checkpoint(data: Mapping[str, Any], path: str | Path | None = Non
     """
     with torch.device("meta"):
         skeleton = GestureModel.from_config(data["model"])
-    why = _state_mismatch(skeleton, data["state"])
+    why = state_mismatch(skeleton, data["state"])
     if why is not None:
         raise FormatError(path, f"the weights do not fit the model its config builds: {why}", field="state")
     model = GestureModel.from_config(data["model"])
