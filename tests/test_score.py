@@ -426,6 +426,33 @@ def test_cli_mistakes_are_one_error_line(truth_files, tmp_path, capsys):
         assert len(errors) == 1 and text in errors[0] and "Traceback" not in "\n".join(err), (label, err)
 
 
+def test_exporting_a_hostile_checkpoint_is_one_error_line_naming_the_field(tmp_path, capsys):
+    """docs/architecture.md promises one ``error:`` line and exit 2; before, each of these ended in a traceback
+    (AttributeError, write_bvh's ValueError, Normalizer's ValueError, _check_vocab's ValueError)."""
+    import torch
+
+    from beatlite.train.checkpoint import load_checkpoint, save_checkpoint
+
+    base = load_checkpoint(checkpoints_dir() / "camn_tiny.pt")
+    nan = {
+        k: torch.full_like(v, float("nan")) if v.is_floating_point() else v for k, v in base["state"].items()
+    }
+    cases = {
+        "state a list": ({**base, "state": [1, 2]}, "field 'state'"),
+        "NaN weights": ({**base, "state": nan}, "field 'state'"),
+        "bad statistics": ({**base, "meta": {**base["meta"], "pose_std": np.zeros(3)}}, "field 'meta'"),
+        "another vocabulary": ({**base, "meta": {**base["meta"], "vocab": ["a", "b"]}}, "field 'meta.vocab'"),
+    }
+    data = str(REPO / "data_samples")
+    for label, (payload, text) in cases.items():
+        path = save_checkpoint(tmp_path / f"{label.replace(' ', '_')}.pt", payload)
+        assert main([str(tmp_path / "out"), "--export", str(path), "--data", data]) == 2, label
+        err = capsys.readouterr().err.strip().splitlines()
+        errors = [line for line in err if line.startswith("error: ")]
+        assert len(errors) == 1 and str(path) in errors[0] and text in errors[0], (label, err)
+        assert "Traceback" not in "\n".join(err) and not list((tmp_path / "out").glob("*.bvh")), label
+
+
 # ----------------------------------------------------------------------------- the folder
 def test_trimmed_and_extended_predictions_are_scored_on_the_overlap(truth_files, test_set, tmp_path):
     folder = tmp_path / "pred"

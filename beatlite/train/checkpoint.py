@@ -213,9 +213,11 @@ def model_from_checkpoint(data: Mapping[str, Any], path: str | Path | None = Non
     Raises
     ------
     beatlite.io.FormatError
-        ``field="state"``: weights of other names or shapes than the model its config builds (the first
+        ``field="state"``: not a mapping of names to dense tensors with finite floating values
+        (:func:`check_state`), or weights of other names or shapes than the model its config builds (the first
         such key and both shapes named); ``path`` names the file (None: in memory).
     """
+    check_state(data["state"], path)
     with torch.device("meta"):
         skeleton = GestureModel.from_config(data["model"])
     why = state_mismatch(skeleton, data["state"])
@@ -245,8 +247,8 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
     Raises
     ------
     beatlite.io.FormatError
-        Not a plain beatlite checkpoint (:func:`load_checkpoint`), or weights of other shapes or names
-        than the model its config builds, or an unknown config field.
+        Not a plain beatlite checkpoint (:func:`load_checkpoint`); weights that are not finite tensors, or of
+        other shapes or names than the model its config builds (field ``state``); an unknown config field.
     """
 
     path = Path(path_or_name)

@@ -28,6 +28,7 @@ from beatlite.data.normalize import Normalizers
 from beatlite.data.store import build_store
 from beatlite.data.vocab import corpus_vocab
 from beatlite.data.windows import sliding_windows
+from beatlite.io.errors import FormatError
 from beatlite.metrics.beats import audio_beats, mean_angle_change, position_speed
 from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
 from beatlite.metrics.frechet import fgd
@@ -511,13 +512,18 @@ def load_checkpoint_for(source: str, test: EvaluationSet) -> tuple[Any, Normaliz
     """(model, its training normalisers, data fingerprint, stale?) of a checkpoint name or path.
 
     Warns when the checkpoint was trained on other data than ``test``'s train split; a text model whose
-    vocabulary differs from the test set's is a ``ValueError``.
+    vocabulary differs from the test set's, or normalisation statistics in its meta that do not make
+    :class:`~beatlite.data.normalize.Normalizers`, are a :class:`~beatlite.io.FormatError` (field ``meta.vocab``,
+    ``meta``), as are the checkpoint's own problems (:func:`beatlite.train.checkpoint.load_model`).
     """
     from beatlite.train.checkpoint import load_model
 
     model, data = load_model(source)
     meta = data.get("meta") or {}
-    norms = Normalizers.in_meta(meta)
+    try:
+        norms = Normalizers.in_meta(meta)
+    except (ValueError, TypeError, KeyError) as exc:  # statistics of other shapes, non-finite, not arrays
+        raise FormatError(source, f"not usable normalisation statistics: {exc}", field="meta") from None
     _check_vocab(model, data, test, source)
     fingerprint = str(data.get("fingerprint") or "")
     if norms is not None:
@@ -538,10 +544,13 @@ def _check_vocab(model: Any, data: Mapping[str, Any], test: EvaluationSet, sourc
     if "word" not in tuple(getattr(model, "input_keys", ())):
         return
     vocab = (data.get("meta") or {}).get("vocab")
-    if vocab is not None and tuple(vocab) != test.vocab:
-        raise ValueError(
-            f"{source}: the checkpoint was trained with a different vocabulary ({len(vocab)} words) than "
-            f"the test set's ({len(test.vocab)}); retrain it (python -m beatlite.train retrain-all)"
+    if vocab is not None and (not isinstance(vocab, list | tuple) or tuple(vocab) != test.vocab):
+        size = f"{len(vocab)} words" if isinstance(vocab, list | tuple) else f"a {type(vocab).__name__}"
+        raise FormatError(
+            source,
+            f"the checkpoint was trained with a different vocabulary ({size}) than the test set's "
+            f"({len(test.vocab)}); retrain it (python -m beatlite.train retrain-all)",
+            field="meta.vocab",
         )
 
 
