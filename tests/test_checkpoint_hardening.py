@@ -3,6 +3,8 @@ naming the file and the field, before anything large is allocated and without ru
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 
 torch = pytest.importorskip("torch")
@@ -153,3 +155,27 @@ def test_a_hostile_extractor_is_one_format_error_naming_the_field(label, tmp_pat
     with pytest.raises(FormatError) as refused:
         load_extractor("dirvec", path)
     assert refused.value.path == path and refused.value.field == field, refused.value
+
+
+def test_metadata_tensors_of_any_layout_read_back_or_are_a_format_error_naming_the_key(shipped, tmp_path):
+    """bfloat16, requires_grad and sparse tensors in the metadata raised a raw TypeError or RuntimeError."""
+    values = torch.tensor([1.5, 0.0, -2.0])
+    meta = {
+        "bf16": values.to(torch.bfloat16),
+        "grad": values.clone().requires_grad_(True),
+        "sparse": values.to_sparse(),
+        "float8": values.to(torch.float8_e4m3fn),
+    }
+    path = tmp_path / "meta.pt"
+    torch.save({**shipped, "meta": meta}, path)
+    back = load_checkpoint(path)["meta"]
+    for key in meta:
+        assert back[key].tolist() == [1.5, 0.0, -2.0], key  # exact in every dtype here
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # quantized tensors are deprecated: what numpy cannot hold
+        quantized = torch.quantize_per_tensor(values, 0.5, 0, torch.qint8)
+    torch.save({**shipped, "meta": {"q": quantized}}, path)
+    with pytest.raises(FormatError) as refused, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        load_checkpoint(path)
+    assert refused.value.path == path and refused.value.field == "meta.q"

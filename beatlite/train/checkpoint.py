@@ -165,8 +165,23 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         if key not in data:
             raise FormatError(path, f"checkpoint has no {key!r}", field=key)
     if isinstance(data.get("meta"), dict):
-        data["meta"] = {k: v.numpy() if torch.is_tensor(v) else v for k, v in data["meta"].items()}
+        data["meta"] = {
+            k: _meta_array(path, k, v) if torch.is_tensor(v) else v for k, v in data["meta"].items()
+        }
     return data
+
+
+def _meta_array(path: Path, key: Any, value: torch.Tensor) -> np.ndarray:
+    """A metadata tensor as a numpy array of its dtype (floating dtypes numpy lacks, bfloat16, float8, as float64):
+    detached and dense first; a tensor numpy cannot hold (quantized, ...) is a FormatError naming it."""
+    try:
+        dense = value.detach().to_dense()
+        if dense.is_floating_point() and dense.dtype not in (torch.float16, torch.float32, torch.float64):
+            dense = dense.double()
+        return dense.resolve_conj().numpy()
+    except (TypeError, RuntimeError) as exc:
+        reason = (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise FormatError(path, f"a tensor numpy cannot hold ({reason})", field=f"meta.{key}") from None
 
 
 def check_state(state: Any, path: str | Path | None, field: str = "state") -> None:
