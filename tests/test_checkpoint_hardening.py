@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
 import pytest
 
 torch = pytest.importorskip("torch")
@@ -179,3 +180,29 @@ def test_metadata_tensors_of_any_layout_read_back_or_are_a_format_error_naming_t
         warnings.simplefilter("ignore")
         load_checkpoint(path)
     assert refused.value.path == path and refused.value.field == "meta.q"
+
+
+def test_metadata_sharing_its_parts_is_converted_once_per_object(shipped, tmp_path):
+    """40 levels each holding the previous twice (a 10 KB file) were walked path by path: 2**40 conversions,
+    memory exhausted on export. Now each object once, and what was shared stays shared."""
+    from beatlite.train.checkpoint import _tensors_for_numpy, export_checkpoint
+
+    def nested(depth):
+        level = [leaf]
+        for _ in range(depth):
+            level = [level, level]
+        return level
+
+    leaf = np.arange(3.0)
+    cycle = [leaf]
+    cycle.append(cycle)
+    out = _tensors_for_numpy({"nest": nested(12), "cycle": cycle})  # small first: before, 2**12 copies
+    walk = out["nest"]
+    for _ in range(12):
+        assert walk[0] is walk[1]
+        walk = walk[0]
+    assert torch.is_tensor(walk[0]) and walk[0].tolist() == [0.0, 1.0, 2.0]
+    assert out["cycle"][1] is out["cycle"] and out["cycle"][0] is walk[0]
+    src = save_checkpoint(tmp_path / "nest.pt", {**shipped, "meta": {"nest": nested(40)}})
+    back = load_checkpoint(export_checkpoint(src, tmp_path / "small.pt"))["meta"]["nest"]
+    assert back[0] is back[1] and (tmp_path / "small.pt").stat().st_size < 2 * src.stat().st_size

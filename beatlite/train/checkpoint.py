@@ -57,19 +57,35 @@ def _numpy_array_globals() -> list[Any]:
 NUMPY_ARRAY_GLOBALS = _numpy_array_globals()
 
 
-def _tensors_for_numpy(value: Any, other: Any = None) -> Any:
+def _tensors_for_numpy(value: Any, other: Any = None, memo: dict[int, Any] | None = None) -> Any:
     """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones;
     anything else that is not a tensor or a plain value, and dict keys that are not int or str, go through
-    ``other`` (default: kept as they are)."""
+    ``other`` (default: kept as they are).
+
+    Each container or array is converted once (``memo``, by ``id``): what ``value`` shares stays shared, and a
+    container holding itself stays a cycle, so the work and the copy are the size of ``value``'s objects, not of
+    its paths (10 KB of metadata nesting each level twice, 40 deep, is 2**40 paths).
+    """
+    memo = {} if memo is None else memo
+    if id(value) in memo:
+        return memo[id(value)]
     if isinstance(value, np.ndarray):
-        return torch.from_numpy(np.array(value))
+        memo[id(value)] = out = torch.from_numpy(np.array(value))
+        return out
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, Mapping):
         key = (lambda k: k) if other is None else (lambda k: k if isinstance(k, int | str) else other(k))
-        return {key(k): _tensors_for_numpy(v, other) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return type(value)(_tensors_for_numpy(v, other) for v in value)
+        memo[id(value)] = out = {}
+        out.update((key(k), _tensors_for_numpy(v, other, memo)) for k, v in value.items())
+        return out
+    if isinstance(value, list):
+        memo[id(value)] = out = []
+        out.extend(_tensors_for_numpy(v, other, memo) for v in value)
+        return out
+    if isinstance(value, tuple):
+        memo[id(value)] = out = type(value)(_tensors_for_numpy(v, other, memo) for v in value)
+        return out
     if (
         other is None
         or torch.is_tensor(value)
