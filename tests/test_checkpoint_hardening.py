@@ -206,3 +206,29 @@ def test_metadata_sharing_its_parts_is_converted_once_per_object(shipped, tmp_pa
     src = save_checkpoint(tmp_path / "nest.pt", {**shipped, "meta": {"nest": nested(40)}})
     back = load_checkpoint(export_checkpoint(src, tmp_path / "small.pt"))["meta"]["nest"]
     assert back[0] is back[1] and (tmp_path / "small.pt").stat().st_size < 2 * src.stat().st_size
+
+
+def test_convert_legacy_is_advised_only_for_a_blocked_object_and_config_errors_name_the_model(
+    shipped, tmp_path
+):
+    """Before, a text file was told to convert_legacy(trust=True) (running any code it held), and an unknown
+    config field was reported as field 'state'."""
+    import pathlib
+
+    text = tmp_path / "notes.pt"
+    text.write_text("hello world\n")
+    with pytest.raises(FormatError, match="not a torch checkpoint") as refused:
+        load_checkpoint(text)
+    assert "convert_legacy" not in refused.value.reason and refused.value.path == text
+    legacy = tmp_path / "legacy.pt"
+    torch.save({**shipped, "meta": {"source": pathlib.PurePosixPath("/data")}}, legacy)
+    with pytest.raises(FormatError, match=r"GLOBAL pathlib\.PurePosixPath.*convert_legacy"):
+        load_checkpoint(legacy)
+    path = save_checkpoint(tmp_path / "field.pt", {**shipped, "model": {**shipped["model"], "no_such": 1}})
+    with pytest.raises(FormatError, match="no_such") as refused:
+        load_model(path)
+    assert refused.value.field == "model"
+    path = save_checkpoint(tmp_path / "name.pt", {**shipped, "model": {"name": "no_such_model"}})
+    with pytest.raises(FormatError, match="no_such_model") as refused:
+        load_model(path)
+    assert refused.value.field == "model"

@@ -628,10 +628,16 @@ def test_a_checkpoint_whose_weights_do_not_fit_is_a_format_error(windows, tmp_pa
     bad_shape = {**data, "state": {**data["state"], name: data["state"][name][:, :1]}}
     unknown = {**data, "state": {**data["state"], "no_such.weight": torch.zeros(1)}}
     bad_field = {**data, "model": {**data["model"], "no_such_field": 1}}
-    for i, payload in enumerate((bad_shape, unknown, bad_field)):
+    expected = [
+        ("do not fit the model", "state"),
+        ("do not fit the model", "state"),
+        ("no_such_field", "model"),
+    ]
+    for i, (payload, (text, field)) in enumerate(zip((bad_shape, unknown, bad_field), expected, strict=True)):
         save_checkpoint(tmp_path / f"bad{i}.pt", payload)
-        with pytest.raises(FormatError, match="do not fit the model"):
+        with pytest.raises(FormatError, match=text) as refused:
             load_model(tmp_path / f"bad{i}.pt")
+        assert refused.value.field == field
 
 
 def test_a_save_killed_midway_leaves_no_temp_file_after_the_next_save(windows, tmp_path):

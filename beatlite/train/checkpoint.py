@@ -38,7 +38,7 @@ import torch
 from beatlite import paths
 from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError
-from beatlite.io.textfile import zip_members
+from beatlite.io.textfile import describe_bytes, zip_members
 from beatlite.models.base import GestureModel
 
 FORMAT = "beatlite-checkpoint/1"
@@ -142,16 +142,20 @@ def read_plain(path: Path) -> Any:
                 path,
                 f"truncated or corrupted file ({reason}): write it again, e.g. train again or copy it anew",
             ) from None
-        lines = [
-            ln.strip()
-            for ln in str(exc).splitlines()
-            if "GLOBAL" in ln or "got <" in ln or "Unsupported" in ln
-        ]
-        reason = lines[0] if lines else type(exc).__name__
+        globals_ = [ln.strip() for ln in str(exc).splitlines() if "GLOBAL" in ln]
+        if globals_:  # a pickled object the safe loader blocks: what convert_legacy(trust=True) is for
+            raise FormatError(
+                path,
+                f"not a plain torch checkpoint (tensors and plain values only): {globals_[0]}; if you trust where "
+                "the file comes from, beatlite.train.checkpoint.convert_legacy(path, new_path, trust=True) rewrites it",
+            ) from None
+        with open(path, "rb") as fh:
+            head = fh.read(64)
+        first = (str(exc).strip().splitlines() or [""])[0]
         raise FormatError(
             path,
-            f"not a plain torch checkpoint (tensors and plain values only): {reason}; if you trust where the "
-            "file comes from, beatlite.train.checkpoint.convert_legacy(path, new_path, trust=True) rewrites it",
+            f"not a torch checkpoint ({type(exc).__name__}{': ' + first if first else ''}); it starts with "
+            f"{describe_bytes(head)}",
         ) from None
     return data
 
@@ -249,8 +253,18 @@ def model_from_checkpoint(data: Mapping[str, Any], path: str | Path | None = Non
         such key and both shapes named); ``path`` names the file (None: in memory).
     """
     check_state(data["state"], path)
-    with torch.device("meta"):
-        skeleton = GestureModel.from_config(data["model"])
+    try:
+        with torch.device("meta"):
+            skeleton = GestureModel.from_config(data["model"])
+    except (
+        KeyError,
+        TypeError,
+        ValueError,
+        RuntimeError,
+        AttributeError,
+    ) as exc:  # unknown name, field or value
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise FormatError(path, f"the config does not build a model: {first}", field="model") from None
     why = state_mismatch(skeleton, data["state"])
     if why is not None:
         raise FormatError(path, f"the weights do not fit the model its config builds: {why}", field="state")
@@ -290,15 +304,15 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
         return model_from_checkpoint(data, path), data
     except FormatError:
         raise
-    except (
-        RuntimeError,
-        KeyError,
-        TypeError,
-        ValueError,
-    ) as exc:  # wrong shapes, unknown keys or config fields
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    except (RuntimeError, KeyError, TypeError, ValueError) as exc:  # what the checks before did not foresee
+        lines = [ln.strip() for ln in str(exc).strip().splitlines() if ln.strip()]
+        if lines and lines[0].startswith(
+            "Error(s) in loading"
+        ):  # torch's header; the next line names the key
+            lines = lines[1:]
+        reason = (lines or [type(exc).__name__])[0]
         raise FormatError(
-            path, f"the weights or config do not fit the model: {first}", field="state"
+            path, f"the weights or config do not fit the model: {reason}", field="state"
         ) from None
 
 
