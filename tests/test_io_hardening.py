@@ -328,6 +328,34 @@ def test_temp_file_of_a_killed_writer_is_cleaned(tmp_path: Path) -> None:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"] and target.read_text() == "complete\n"
 
 
+def test_a_new_file_follows_the_umask(tmp_path: Path) -> None:
+    """A new file was always 0o644, even under umask 077 (private files readable by everyone)."""
+    old = os.umask(0o077)
+    try:
+        with atomic_write(tmp_path / "private.txt") as f:
+            f.write("secret\n")
+        os.umask(0o022)
+        with atomic_write(tmp_path / "shared.txt") as f:
+            f.write("open\n")
+    finally:
+        os.umask(old)
+    assert (tmp_path / "private.txt").stat().st_mode & 0o777 == 0o600  # 0o666 & ~0o077
+    assert (tmp_path / "shared.txt").stat().st_mode & 0o777 == 0o644  # 0o666 & ~0o022
+
+
+def test_a_sibling_targets_live_temp_file_is_not_taken_for_a_stale_one(tmp_path: Path) -> None:
+    """Writing ``a`` removed ``.a.<digits>.<pid>.<random>.tmp``, the live temp file of a writer of ``a.<digits>``
+    (the digits read as a dead process id)."""
+    dead = 999_999_999  # beyond pid_max: no such process
+    sibling = tmp_path / f".a.{dead}.{os.getpid()}.k3j_x9q2.tmp"  # this live process writing "a.999999999"
+    stale = tmp_path / f".a.{dead}.k3j_x9q2.tmp"  # a killed writer of "a"
+    for p in (sibling, stale):
+        p.write_text("partial")
+    with atomic_write(tmp_path / "a") as f:
+        f.write("whole\n")
+    assert sibling.exists() and not stale.exists()
+
+
 # ----------------------------------------------------------------------------- units and position_mode
 
 

@@ -14,6 +14,7 @@ import contextlib
 import gzip
 import io
 import os
+import re
 import tempfile
 import time
 from collections.abc import Iterator
@@ -142,12 +143,25 @@ def write_json(path: str | os.PathLike[str], data: Any, *, indent: int = 1) -> P
     return path
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it where the system tells it (Linux ``/proc``)."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii", errors="replace") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    mask = os.umask(0o022)  # elsewhere: set and restore (briefly process-wide)
+    os.umask(mask)
+    return mask
+
+
 def _copy_mode(target: Path, tmp: Path) -> None:
-    """Give the temp file the permissions of the file it replaces (``0o644`` for a new file)."""
+    """Give the temp file the permissions of the file it replaces; a new file gets ``0o666 & ~umask`` (what
+    ``open`` would give it: ``0o644`` under the usual umask 022, ``0o600`` under 077)."""
     try:
         mode = target.stat().st_mode & 0o7777
     except FileNotFoundError:
-        mode = 0o644
+        mode = 0o666 & ~_umask()
     with contextlib.suppress(OSError):
         os.chmod(tmp, mode)
 
@@ -183,7 +197,7 @@ def _process_alive(pid: int) -> bool:
 def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
     """Remove the temporary files of ``path`` that a killed writer left behind.
 
-    A temp file ``.{name}.{pid}.*.tmp`` is stale when process ``pid`` no longer exists
+    A temp file ``.{name}.{pid}.{random}.tmp`` (exactly: not a sibling ``{name}.{digits}``'s) is stale when process ``pid`` no longer exists
     (or, where that cannot be checked, when it is older than a day). Temp files of live
     writers are left alone.
 
@@ -205,15 +219,15 @@ def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
     removed = []
-    prefix = f".{target.name}."
+    # exactly what atomic_write names its temp files (mkstemp's random part has no dot): the temp file of a
+    # sibling target named "<name>.<digits>" (".<name>.<digits>.<pid>.<random>.tmp") is not this target's
+    own = re.compile(rf"\.{re.escape(target.name)}\.([0-9]+)\.[A-Za-z0-9_]+\.tmp", re.ASCII)
     with contextlib.suppress(OSError):
         for cand in folder.iterdir():
-            name = cand.name
-            if not (name.startswith(prefix) and name.endswith(".tmp")):
+            match = own.fullmatch(cand.name)
+            if match is None or int(match.group(1)) == os.getpid():
                 continue
-            pid_text = name[len(prefix) :].split(".")[0]
-            if not (pid_text.isascii() and pid_text.isdigit()) or int(pid_text) == os.getpid():
-                continue
+            pid_text = match.group(1)
             try:
                 age = time.time() - cand.stat().st_mtime
             except OSError:
