@@ -174,6 +174,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     args = _parser().parse_args(argv)
     try:
+        if args.fps is not None and _is_bvh(Path(args.dst)):
+            raise ValueError(f"--fps is the rate of a written .npz; {args.dst} keeps its source's rate")
         fps = 30.0 if args.fps is None else args.fps
         report = convert(args.src, args.dst, fps=fps, skeleton=args.skeleton, model=args.model)
     except (

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -90,18 +88,12 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
     """
     if not name or not all(c.isalnum() or c in "_-" for c in name):
         raise ValueError(f"save_table: name must be letters, digits, '_' or '-', got {name!r}")
+    from beatlite.io.atomic import atomic_write
+
     out = tables_dir() / f"{name}.md"
     out.parent.mkdir(parents=True, exist_ok=True)
-    text = (f"### {title}\n\n" if title else "") + markdown.rstrip() + "\n"
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a table is an ordinary readable file
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_write(out) as fh:  # (the project's one atomic writer: the umask's mode, stale temps removed)
+        fh.write((f"### {title}\n\n" if title else "") + markdown.rstrip() + "\n")
     return out
 
 

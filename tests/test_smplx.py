@@ -560,6 +560,14 @@ def test_convert_command_round_trip_and_one_line_errors(tmp_path, capsys):
     assert main([str(SAMPLES / "2_scott_0_1_1.wav"), str(tmp_path / "x.npz")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and "2_scott_0_1_1.wav" in err[0]
+    # --fps is the rate of a written .npz: given for a .bvh it was ignored silently
+    assert main([str(tmp_path / "t.npz"), str(tmp_path / "fps.bvh"), "--fps", "60"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert (
+        len(err) == 1
+        and "--fps is the rate of a written .npz" in err[0]
+        and not (tmp_path / "fps.bvh").exists()
+    )
 
 
 def test_convert_folder_names_each_skipped_take_and_refuses_another_fps(tmp_path, capsys, monkeypatch):

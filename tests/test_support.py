@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 
 import numpy as np
@@ -40,6 +41,11 @@ def test_save_table_is_atomic_and_validated(monkeypatch, tmp_path):
     assert out == tmp_path / "tables" / "02_table1.md"
     assert out.read_text() == "### Table 1\n\n| a |\n|---|\n| 1 |\n"
     assert [p.name for p in out.parent.iterdir()] == ["02_table1.md"]  # no temp file left behind
+    old = os.umask(0o077)  # written by the project's atomic writer: the umask's mode (was a fixed 0o644)
+    try:
+        assert report.save_table("02_private", "x").stat().st_mode & 0o777 == 0o600
+    finally:
+        os.umask(old)
     with pytest.raises(ValueError, match="name"):
         report.save_table("../evil", "x")
 
