@@ -267,3 +267,25 @@ def test_the_readme_batch_scaling_sentences_are_the_record():
         f"{epochs} validated ones, not {record['epochs']})"
         in text
     )
+
+
+def test_counts_and_estimates_of_the_cpu_sentences_follow_their_sources():
+    """The seed trainings' count from the recipes, a CPU epoch of BEAT-4english from 80,000 windows at the 150
+    windows/s the README states, and the notebooks' lecture-mode time from docs/teaching.md's measured table."""
+    from beatlite.train.recipes import RECIPES
+
+    readme, guide = _readme(), (ROOT / "docs" / "teaching.md").read_text()
+    flat = " ".join(readme.split())
+    assert (
+        f"All {len(RECIPES)} shipped recipes with three seeds each (`make seeds`, {3 * len(RECIPES)} trainings)"
+        in flat
+    )
+    minutes = round(EPOCH_WINDOWS / 150 / 60)
+    assert f"150 windows/s on one thread (≈ {minutes} min per epoch for 16 h's 80,000 windows)" in flat
+    assert (
+        f"about {minutes} min per CaMN tiny epoch on one CPU thread (80,000 windows at about 150 windows/s)"
+        in " ".join(guide.split())
+    )
+    row = next(line for line in guide.splitlines() if line.startswith("| wall time (s) |"))
+    seconds = [float(x) for x in row.strip("|").split("|")[1:10]]  # notebooks 00-08
+    assert f"({sum(seconds) / 60:.1f} minutes for 00–08;" in flat

@@ -77,7 +77,8 @@ PRESETS: dict[str, dict[str, Any]] = {
     # at every step t: 0.76 at hidden 64, 0.26 at hidden 192, near the rank deficit 30 / 126 of a 96-wide head)
     # x0-prediction on 3 x the directions: with the paper's eps-prediction on the directions as they are, 40 epochs
     # on data_samples sampled far from the data (test FGD 2174 with DDIM 50); these two changes gave 7.2 at 40 epochs
-    # and 4.4 at 60 (DDIM 25 steps, seed 2021; recipes.DIFFGESTURE_EPOCHS)
+    # and 4.4 at 60 when chosen (DDIM 25 steps, seed 2021; recipes.DIFFGESTURE_EPOCHS; today's seeds:
+    # checkpoints/results_seeds.md)
     "tiny": {"hidden": 256, "depth": 1, "decoder_depth": 1, "heads": 4, "mlp_ratio": 2.0, "sampler": "ddim",
              "sample_steps": 25, "prediction": "x0", "x_scale": 3.0},
     # config/pose_diffusion_expressive.yml and pose_diffusion.py: hidden 512, block_depth 8 (4 + 4), 8 heads,

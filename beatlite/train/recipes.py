@@ -154,8 +154,9 @@ HA2G_LR = 2e-3
 6.6 at epoch 24, 3.71 at 29; test FGD 5.45); at 2e-3 the same seed reached 2.57 (test 3.52)."""
 DIFFGESTURE_EPOCHS = 60
 """Epochs of the DiffGesture checkpoint (about 21 steps of 32 windows each on ``data_samples/``). Seed 2021, one
-thread on a shared 2-core machine: 268 s. Test FGD 4.4 with the tiny preset's DDIM 25 steps (4.6 with 10, 5.3 with
-100, 10.2 with DDPM's 500; 7.2 after 40 epochs). The paper's epsilon-prediction on unscaled directions sampled far
+thread on a shared 2-core machine: 268 s. When the preset was chosen, test FGD 4.4 with the tiny preset's DDIM 25
+steps (4.6 with 10, 5.3 with 100, 10.2 with DDPM's 500; 7.2 after 40 epochs); today's three seeds are in
+``checkpoints/results_seeds.md`` ("DiffGesture-style"). The paper's epsilon-prediction on unscaled directions sampled far
 from the data with this budget (test FGD 2174 after 40 epochs): see :mod:`beatlite.models.diffgesture`."""
 DIFFGESTURE_LR = 1e-3
 """DiffGesture's learning rate. ``select_best`` is off: scoring an epoch by validation FGD samples every
