@@ -104,8 +104,9 @@ def convert(
             raise ValueError(
                 f"convert: a folder is written at BEAT2's {BEAT2_FPS} fps; fps={fps!r} is for a file"
             )
-        skipped = {r.stem: list(r.problems) for r in index_folder(src) if not r.usable}
-        return {"takes": write_beat2_folder(src, dst, rest=_rest(model)), "skipped": skipped}
+        index = index_folder(src)
+        skipped = {r.stem: list(r.problems) for r in index if not r.usable}
+        return {"takes": write_beat2_folder(src, dst, rest=_rest(model), index=index), "skipped": skipped}
     if _is_bvh(src) and dst.suffix == ".npz":
         return _bvh_to_npz(src, dst, fps, _rest(model))
     if src.suffix == ".npz" and _is_bvh(dst):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import shutil
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +25,7 @@ BEAT2_FPS = 30
 
 
 def write_beat2_folder(
-    src: str | os.PathLike[str], dst: str | os.PathLike[str], *, rest: object | None = None
+    src: str | os.PathLike[str], dst: str | os.PathLike[str], *, rest: object | None = None, index: Any = None
 ) -> list[str]:
     """Write the usable takes of BEAT folder ``src`` into BEAT2's layout under ``dst``.
 
@@ -38,6 +39,8 @@ def write_beat2_folder(
         rows; the takes written here replace theirs or are added.
     rest : SMPLXRest, optional
         The SMPL-X body (default :func:`beatlite.skeleton.smplx.approximate_rest`).
+    index : TakeIndex, optional
+        ``src`` already indexed (default :func:`beatlite.data.index_folder` ``(src)``).
 
     Returns
     -------
@@ -70,7 +73,7 @@ def write_beat2_folder(
     for folder in ("smplxflame_30", "wave16k", "textgrid"):
         (out / folder).mkdir(parents=True, exist_ok=True)
     stems = []
-    for record in index_folder(src):
+    for record in index_folder(src) if index is None else index:
         if not record.usable:
             continue
         take = load_take(record.path("motion"), fps=BEAT2_FPS, bvh_fps=record.bvh_fps)
