@@ -164,6 +164,39 @@ def test_figures_are_saved_one_way(path):
     assert not found, f"{path.name}: save figures with bl.viz.save_figure: {found}"
 
 
+_TEMP_MAKERS = ("TemporaryDirectory", "example_corpus", "example_beat2_corpus")
+
+
+def _temporary_dirs_left(path: Path) -> list[str]:
+    """Names bound to a temporary directory outside a ``with`` that no later code cell ``.cleanup()``s."""
+    nb = json.loads(path.read_text())
+    made, cleaned = {}, set()
+    for i, cell in enumerate(nb["cells"]):
+        if cell["cell_type"] != "code":
+            continue
+        src = "\n".join(
+            ln for ln in "".join(cell["source"]).splitlines() if not ln.lstrip().startswith(("%", "!"))
+        )
+        for node in ast.walk(ast.parse(src)):
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
+                if ast.unparse(node.value.func).split(".")[-1] in _TEMP_MAKERS:
+                    made.update({ast.unparse(t): i for t in node.targets})
+            elif isinstance(node, ast.Call) and ast.unparse(node.func).endswith(".cleanup"):
+                cleaned.add(ast.unparse(node.func)[: -len(".cleanup")])
+    return [f"cell {i}: {name}" for name, i in made.items() if name not in cleaned]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_removes_its_temporary_directories(path):
+    """A temporary directory a notebook keeps across cells is ``.cleanup()``-ed by the notebook itself.
+
+    nbval stops its kernels with SIGKILL (``shutdown_kernel(now=True)``), so no finaliser runs: each ``make test`` left
+    a copy in the system's temporary folder.
+    """
+    left = _temporary_dirs_left(path)
+    assert not left, f"{path.name}: call .cleanup() once these are read, or use `with`: {left}"
+
+
 def _notebook_imports(path: Path) -> set[str]:
     nb = json.loads(path.read_text())
     names: set[str] = set()
