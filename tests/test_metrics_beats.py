@@ -195,6 +195,42 @@ def test_reference_columns_are_the_ring_finger_triplet_of_the_30_39_slice():
     assert beat_align(AUDIO, SR, arm_only, FPS, variant=whole_take) == 0.0
 
 
+def _beat_reference_formula(y, euler, t_start=10, t_end=500, sigma=0.3, order=2, fps=15):
+    """BEAT's BeatAlign as utils/metric.py (class ``alignment``) computes it, written out with librosa and scipy only:
+    onset strength of the 16 kHz audio of [t_start, t_end) s, ``onset_detect`` and ``frames_to_time`` at librosa's
+    default rate, onsets backtracked to RMS minima; the L2 speed (forward differences) of columns 30:39 of the pose,
+    third triplet; ``argrelextrema`` minima of order 2 in frames [t_start fps, t_end fps); the mean over audio beats
+    of exp(-d^2 / (2 sigma^2)) to the nearest motion beat."""
+    import librosa
+    from scipy.signal import argrelextrema
+
+    short = y[t_start * SR : t_end * SR]
+    envelope = librosa.onset.onset_strength(y=short, sr=SR)
+    raw = librosa.onset.onset_detect(onset_envelope=envelope, backtrack=False)
+    rms = librosa.feature.rms(S=np.abs(librosa.stft(y=short)))
+    audio_times = librosa.frames_to_time(librosa.onset.onset_backtrack(raw, rms[0]))
+    slice_ = np.asarray(euler, dtype=np.float64)[:, 30:39]
+    velocity = slice_[1:] - slice_[:-1]
+    speed = np.linalg.norm(velocity[:, 6:9], axis=1)
+    motion_times = argrelextrema(speed[t_start * fps : t_end * fps], np.less, order=order)[0] / fps
+    nearest = [min(abs(m - a) for m in motion_times) for a in audio_times]
+    return sum(math.exp(-(d**2) / (2 * sigma**2)) for d in nearest) / len(audio_times)
+
+
+def test_reference_beat_align_equals_beats_code_written_out():
+    """BeatAlign (reference) on 30 s of irregular clicks in noise and a random-walk Euler pose whose columns 36:39
+    swing: the value of BEAT's code written out independently (above), to rounding."""
+    rng = np.random.default_rng(0)
+    clicks = np.cumsum(rng.uniform(0.35, 1.1, 60))
+    audio = click_track(clicks[clicks < 29.5], 30.0) + 0.003 * rng.standard_normal(30 * SR).astype(np.float32)
+    t = np.arange(30 * int(FPS)) / FPS
+    euler = 0.2 * rng.normal(0.0, 5.0, (len(t), 141)).cumsum(axis=0)
+    euler[:, 36:39] += np.outer(20 * np.sin(2 * np.pi * t / 1.3), [1.0, 0.5, 0.2])
+    want = _beat_reference_formula(audio, euler)
+    assert beat_align(audio, SR, euler, FPS, variant="reference") == pytest.approx(want, rel=1e-12)
+    assert 0.5 < want < 1.0
+
+
 def test_window_makes_times_relative_to_its_start():
     full = motion_beat_times(swinging_joint(), FPS)[0]
     cut = motion_beat_times(swinging_joint(), FPS, variant=BeatAlignVariant(window=(1.6, 8.0)))[0]
@@ -348,45 +384,87 @@ def test_angle_change_curve_with_ha2g_constants_hand_computed():
     )
 
 
-def _ha2g_bc_formula(audio, dirs, change_angle, sigma=0.1, length=34, stride=10):
-    """HA2G's BC written out (HA2G supplementary / code protocol): 34-frame clips, librosa onsets."""
+# HA2G's 41 angle pairs over its 44 vectors (``angle_pair`` in HA2G's scripts/train_expressive.py), written out here
+# rather than taken from beatlite.skeleton.ted, so that the oracle below shares no code with beatlite.
+HA2G_ANGLE_PAIRS = (
+    (0, 1), (0, 2), (1, 3), (3, 4), (5, 6), (6, 7), (8, 9), (9, 10), (11, 12), (12, 13), (14, 15), (15, 16),
+    (17, 18), (18, 19), (17, 5), (5, 8), (8, 14), (14, 11), (2, 20), (20, 21), (22, 23), (23, 24), (25, 26),
+    (26, 27), (28, 29), (29, 30), (31, 32), (32, 33), (34, 35), (35, 36), (34, 22), (22, 25), (25, 31), (31, 28),
+    (0, 37), (37, 38), (37, 39), (38, 40), (39, 41), (4, 42), (21, 43),
+)  # fmt: skip
+
+
+def _ha2g_bc_formula(audio, dirs, change_angle, sigma=0.1, thres=0.03, length=34, stride=10):
+    """HA2G's BC as its evaluator computes it (scripts/train_expressive.py, ``evaluate_testset``), written out with
+    NumPy and librosa only: per 34-frame clip (stride 10) the palm normals cross(v11, v17) and cross(v28, v34) of
+    the bones, every one of the 44 vectors normalised, the 41 angles / pi, their summed |change| / MAAC / 41 (frame 0:
+    0), beats at strict minima of frames 2..32 that drop >= ``thres`` to a neighbour, ``onset_detect(y, sr=16000,
+    units="time")`` of the clip's audio as HA2G's loader cuts it (``floor(start / T * N)``, 36266 samples,
+    symmetric-padded to 36267), clips weighted by their audio beats.
+
+    Returns the score and the angle-change curve of every scored or skipped clip, (clips, 34)."""
     import librosa
 
-    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
-
-    v = prepare_directions(dirs)
+    v = np.asarray(dirs, dtype=np.float64).reshape(len(dirs), 42, 3)
+    palms = np.cross(v[:, [11, 28]], v[:, [17, 34]])
+    vec = np.concatenate([v, palms], axis=1)
+    vec = vec / np.linalg.norm(vec, axis=-1, keepdims=True)
     total = weight = 0.0
+    curves = []
     for start in range(0, len(v) - length + 1, stride):
-        a0 = int(round(start / FPS * SR))
-        clip = audio[a0 : a0 + int(round(length / FPS * SR))]
-        onsets = librosa.onset.onset_detect(y=clip, sr=SR, units="time")
+        a0 = math.floor(start / len(v) * len(audio))
+        clip = audio[a0 : a0 + int(length / FPS * SR)]
+        clip = np.pad(clip, (0, int(round(length / FPS * SR)) - len(clip)), mode="symmetric")
+        w = vec[start : start + length]
         c = np.zeros(length)
-        for t in range(1, length):
-            for p, (i, j) in enumerate(default_angle_pairs()):
-                angle = [
-                    np.arccos(np.clip(v[start + s, i] @ v[start + s, j], -1, 1)) / np.pi for s in (t - 1, t)
-                ]
-                c[t] += abs(angle[1] - angle[0]) / change_angle[p] / 41
+        for p, (i, j) in enumerate(HA2G_ANGLE_PAIRS):
+            angle = np.arccos(np.clip(np.einsum("ij,ij->i", w[:, i], w[:, j]), -1, 1)) / math.pi
+            c[1:] += np.abs(angle[1:] - angle[:-1]) / change_angle[p] / len(change_angle)
+        curves.append(c)
         beats = [
-            t / FPS
-            for t in range(2, length - 1)
-            if c[t] < c[t - 1] and c[t] < c[t + 1] and max(c[t - 1] - c[t], c[t + 1] - c[t]) >= 0.03
+            t / 15.0
+            for t in range(2, 33)
+            if c[t] < c[t - 1] and c[t] < c[t + 1] and (c[t - 1] - c[t] >= thres or c[t + 1] - c[t] >= thres)
         ]
-        if not beats or not len(onsets):
+        if not beats:
             continue
-        score = np.mean([np.exp(-min((a - m) ** 2 for m in beats) / (2 * sigma**2)) for a in onsets])
-        total += score * len(onsets)
+        onsets = librosa.onset.onset_detect(y=clip, sr=16000, units="time")
+        total += sum(math.exp(-min((a - m) ** 2 for m in beats) / (2 * sigma * sigma)) for a in onsets)
         weight += len(onsets)
-    return total / weight
+    return total / weight, np.array(curves)
+
+
+def every_bone_swinging(duration: float = 5.0, seed: int = 0) -> np.ndarray:
+    """(T, 42, 3) unit bones, each turning about its own random axis by an angle of period 2 P, amplitude and phase
+    of its own: every one of the 41 angle pairs (palm normals included) changes from frame to frame."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(duration * FPS)) / FPS
+    base, axis = rng.normal(size=(2, 42, 3))
+    amplitude, phase = rng.uniform(0.2, 0.6, 42), rng.uniform(0.0, 0.1, 42)
+    angle = amplitude * np.cos(np.pi * (t[:, None] - phase) / PERIOD)
+    axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+    bones = [Rotation.from_rotvec(axis[k] * angle[:, k : k + 1]).apply(base[k]) for k in range(42)]
+    d = np.stack(bones, axis=1)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
 def test_bc_legacy_with_ha2g_constants_equals_ha2g_formula():
-    t = np.arange(int(5.0 * FPS)) / FPS
-    theta = 0.3 + 0.1 * np.cos(np.pi * (t + 0.5 / FPS) / PERIOD)
-    dirs = ear_swinging_skeleton(theta)
+    """BC (ha2g) against HA2G's evaluator written out independently (pairs, palm normals, normalisation, beats,
+    onsets, weighting, audio cut): the same angle-change curve of every clip and the same score, to rounding."""
+    from beatlite.metrics.consistency import default_angle_pairs, prepare_directions
+
+    dirs = every_bone_swinging()
     audio = AUDIO[: int(5.0 * SR)]
+    want, curves = _ha2g_bc_formula(audio, dirs, HA2G_CHANGE_ANGLE)
+    vec = prepare_directions(dirs)
+    for k, start in enumerate(range(0, len(dirs) - 34 + 1, 10)):
+        got_curve = angle_change_curve(vec[start : start + 34], default_angle_pairs(), HA2G_CHANGE_ANGLE)
+        np.testing.assert_allclose(got_curve, curves[k], rtol=1e-12, atol=1e-12)
+    assert np.all(curves[:, 1:] > 0)  # every frame changes: a wrong pair or palm normal changes the curve
     got = beat_consistency(audio, SR, dirs, FPS, change_angle=HA2G_CHANGE_ANGLE, variant="ha2g")
-    assert got == pytest.approx(_ha2g_bc_formula(audio, dirs, HA2G_CHANGE_ANGLE), rel=1e-12)
+    assert got == pytest.approx(want, rel=1e-12)
     assert 0.5 < got <= 1.0
 
 

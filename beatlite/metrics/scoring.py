@@ -534,8 +534,9 @@ def _bc(variant: str) -> Callable[[Takes, GroundTruth, int], float]:
 
 
 def _bc_published(g: Takes, t: GroundTruth, seed: int) -> float:
-    """HA2G's clip BC as published before the 2023 fix of its README: the train mean direction is not added
-    back, so angles are measured between the mean-subtracted vectors (renormalised) the model outputs."""
+    """HA2G's clip BC as the paper's values were computed (the authors' README note of January 2023; the code they
+    released adds the mean back): the train mean direction is not added back, so angles are measured between the
+    mean-subtracted vectors (renormalised) the model outputs."""
     mean = np.asarray(t.mean_direction, np.float64).reshape(-1, 3)
     residuals = dataclasses.replace(
         g, directions=[np.asarray(d).reshape(len(d), -1, 3) - mean for d in g.directions]
@@ -673,12 +674,12 @@ def _metrics() -> dict[str, Metric]:
                     source="HA2G (Liu et al., CVPR 2022) §4.3 eq. 10-11 on whole takes (docs/reference_code.md#beat-consistency); differs from HA2G's code in scoring whole takes and dropping rigid angle pairs"),
         "BC (ha2g)": Metric("BC", "ha2g", True, ("directions", "audio", "change_angle"), _bc("ha2g"),
                             "HA2G's code: 34-frame clips (stride 10) with their own onsets, σ = 0.1 s",
-                    source="HA2G's code scripts/train_expressive.py (docs/reference_code.md#beat-consistency): 34-frame clips with their own onsets, weighted by audio beats, mean direction added back (the 2023 README fix)"),
+                    source="HA2G's code scripts/train_expressive.py (docs/reference_code.md#beat-consistency): 34-frame clips with their own onsets, weighted by audio beats, mean direction added back (as the released code does)"),
         "BC (ha2g published)": Metric("BC", "ha2g_published", True, ("directions", "audio", "change_angle", "mean_direction"),
                                       _bc_published,
-                                      "HA2G's code as published (before its 2023 README fix): BC (ha2g) on the "
-                                      "mean-subtracted directions, the train mean direction not added back",
-                    source="HA2G's code as released with the paper, before the 2023 README fix (docs/reference_code.md#beat-consistency): the clip protocol on mean-subtracted vectors"),
+                                      "HA2G's BC as its paper's values were computed (the authors' 2023 README note): "
+                                      "BC (ha2g) on the mean-subtracted directions, the train mean direction not added back",
+                    source="HA2G's paper values, per the authors' README note of January 2023 (docs/reference_code.md#beat-consistency): HA2G's code's clip protocol on mean-subtracted vectors (the released code adds the mean back)"),
         "Diversity": Metric("Diversity", "ha2g", True, ("features",), _diversity,
                             "mean L1 distance of extractor features of 500 random window pairs",
                     source="HA2G (Liu et al., CVPR 2022) §4.3 / Trimodal's evaluator: mean L1 distance of features of random clip pairs (docs/reference_code.md#ha2g-diversity); beatlite's extractor"),

@@ -1,9 +1,9 @@
 """DiffGesture-style diffusion model on TED direction vectors (dirvec126): :class:`DiffGesture`.
 
-Zhu, Liu, Lin, Liu and Lu, "Taming Diffusion Models for Audio-Driven Co-Speech Gesture Generation",
+Zhu, Liu, Liu, Qian, Liu and Yu, "Taming Diffusion Models for Audio-Driven Co-Speech Gesture Generation",
 CVPR 2023 (DiffGesture); code: https://github.com/Advocate99/DiffGesture (``scripts/model/pose_diffusion.py``,
-``diffusion_net.py``, ``diffusion_util.py``, ``config/pose_diffusion_expressive.yml``). Read for the design,
-written anew here.
+``diffusion_net.py``, ``diffusion_util.py``, ``config/pose_diffusion_expressive.yml``; what it does, its evaluation
+included: docs/reference_code.md#diffgesture). Read for the design, written anew here.
 
 What it keeps from the paper and its code
 -----------------------------------------
@@ -34,6 +34,8 @@ What differs
   1e-4..0.02, so the network sees an almost constant input. Here it is a sinusoidal code of ``t`` (``time_dim``
   channels, Vaswani et al. 2017), concatenated the same way.
 - The head's LeakyReLU: the reference passes ``True`` as its slope (a slope of 1, i.e. a linear head); here 0.2.
+- Initialisation: PyTorch's defaults and a position embedding drawn from N(0, 0.02^2); the reference initialises
+  every linear layer Xavier-uniform with zero biases and its position embedding from N(0, 1).
 - Condition dropping: with a batch of B >= 2 windows exactly ``clamp(round(p B), 1, B - 1)`` windows lose their
   condition (chosen at random), so the null embedding and the condition path both get a gradient in every step
   (the :class:`~beatlite.models.base.GestureModel` contract; DistributedDataParallel needs it); at B = 128 that is
@@ -48,8 +50,8 @@ What differs
   epsilon-prediction on unscaled directions.
 
 Outputs of :meth:`DiffGesture.forward` (the training pass: one noise level per window): ``"pose"`` the clean
-window predicted from the noise estimate (B, T, 126), ``"eps"`` the estimate, ``"noise"`` the noise added,
-``"t"`` the steps (B,) int64. :meth:`DiffGesture.generate` samples (the whole reverse process).
+window predicted (B, T, 126), ``"eps"`` the noise estimate, ``"noise"`` the noise added, ``"t"`` the steps (B,)
+int64, ``"x0"`` the clean window in diffused units (``x_scale`` times ``batch["dirvec"]``). :meth:`DiffGesture.generate` samples (the whole reverse process).
 
 Taught in ``notebooks/10_diffusion.ipynb``.
 """
@@ -473,7 +475,7 @@ class DiffGesture(GestureModel):
 
     # ------------------------------------------------------------------ contract
     def forward(self, batch: Batch) -> dict[str, torch.Tensor]:
-        """The training pass: ``{"pose": x0 estimate, "eps", "noise", "t"}`` (see the module docstring).
+        """The training pass: ``{"pose": x0 estimate, "eps", "noise", "t", "x0"}`` (see the module docstring).
 
         Training mode draws ``t``, the noise and the dropped windows from torch's global generator; eval mode
         from one seeded with ``config.seed`` (validation losses are the same at every epoch's end).
