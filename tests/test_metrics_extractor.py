@@ -109,3 +109,17 @@ def test_shipped_checkpoint(space, dim):
     assert ex.space == space and len(ex.meta["data_fingerprint"]) == 16
     feats = ex(np.zeros((3, 34, dim), np.float32))
     assert feats.shape == (3, ex.latent_dim) and np.all(np.isfinite(feats))
+
+
+def test_reference_page_states_the_velocity_weights():
+    """docs/reference_code.md#fgd-autoencoder names each extractor's velocity weight; they are ``VELOCITY_WEIGHT``."""
+    from pathlib import Path
+
+    from beatlite.metrics.extractor import VELOCITY_WEIGHT
+
+    page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "reference_code.md").read_text().split())
+    assert VELOCITY_WEIGHT == {"pose": 0.1, "dirvec": 10.0, "rot6d": 10.0}
+    assert (
+        "the Euler-pose one with BEAT's 0.1, the direction-vector and rot6d ones with a velocity weight of 10"
+        in page
+    )
