@@ -104,6 +104,18 @@ def test_planted_correlation_is_significant_and_independent_is_not() -> None:
     assert abs(independent.null_mean) < 0.05
 
 
+def test_correlation_undefined_or_non_finite_is_not_significant() -> None:
+    # a constant signal has no rho; it used to get the smallest permutation p (1 / 51) beside rho = NaN
+    r = correlation_test(np.arange(20.0), np.ones(20), groups=np.repeat([0, 1], 10), n_permutations=50)
+    assert np.isnan(r.rho) and np.isnan(r.p_value) and np.isnan(r.p_permutation) and r.n == 20
+    y = np.arange(20.0)
+    y[3] = np.nan
+    with pytest.raises(ValueError, match="y has 1 non-finite"):
+        correlation_test(np.arange(20.0), y, n_permutations=50)
+    with pytest.raises(ValueError, match="values has 1 non-finite"):
+        group_effect_test(np.array([1.0, 2, 3, np.nan, 5, 6]), np.array([0, 0, 0, 1, 1, 1]))
+
+
 def test_group_effect_hand_computed() -> None:
     # groups a = [1, 2, 3], b = [4, 5, 6]: grand mean 3.5, SS_between = 3*1.5^2*2 = 13.5,
     # SS_total = 17.5 -> eta^2 = 0.7714; F = 13.5 / (4 / 4) = 13.5.

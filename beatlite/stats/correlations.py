@@ -112,7 +112,9 @@ def correlation_test(
     Parameters
     ----------
     x, y : (N,) float
-        Paired values (e.g. window means), in time order within each group.
+        Paired values (e.g. window means), in time order within each group; all finite
+        (``ValueError`` otherwise). When ``x`` or ``y`` is constant, rho is undefined: ``rho``,
+        ``p_value`` and ``p_permutation`` are NaN.
     groups : (N,) int, optional
         Group (take) of each value; ``y`` is rolled by a random offset inside each group.
         Default: one group.
@@ -128,9 +130,17 @@ def correlation_test(
         raise ValueError(
             f"correlation_test: x and y must be equal (N,) with N >= 3, got {x.shape} and {y.shape}"
         )
+    for name, v in (("x", x), ("y", y)):
+        if not np.isfinite(v).all():
+            raise ValueError(f"correlation_test: {name} has {int(np.sum(~np.isfinite(v)))} non-finite values")
     g = np.zeros(len(x), np.int64) if groups is None else np.asarray(groups)
     if g.shape != x.shape:
         raise ValueError(f"correlation_test: groups must be {x.shape}, got {g.shape}")
+    if np.ptp(x) == 0 or np.ptp(y) == 0:  # no rho, so no test (scipy would warn and give NaN)
+        nan = float("nan")
+        return CorrelationResult(
+            rho=nan, p_value=nan, p_permutation=nan, null_mean=nan, null_std=nan, n=len(x)
+        )
     res = spearmanr(x, y)
     rho = float(res.statistic)
     rx, ry = _rank(x), _rank(y)
@@ -175,6 +185,8 @@ def group_effect_test(
         raise ValueError(
             f"group_effect_test: values and labels must be equal (N,), got {v.shape} and {lab.shape}"
         )
+    if not np.isfinite(v).all():
+        raise ValueError(f"group_effect_test: values has {int(np.sum(~np.isfinite(v)))} non-finite values")
     classes = np.unique(lab)
     if len(classes) < 2 or len(classes) == len(v):
         raise ValueError(f"group_effect_test: need >= 2 groups and a group with >= 2 takes ({len(v)} takes)")
