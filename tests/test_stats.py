@@ -116,6 +116,40 @@ def test_correlation_undefined_or_non_finite_is_not_significant() -> None:
         group_effect_test(np.array([1.0, 2, 3, np.nan, 5, 6]), np.array([0, 0, 0, 1, 1, 1]))
 
 
+def test_circular_shift_null_in_blocks_matches_np_roll() -> None:
+    """The null over several blocks of shifted copies equals Spearman's rho of np.roll-ed takes, drawn in
+    the same order (one (n_permutations,) draw per group, groups in sorted order), and memory stays far
+    below one (n_permutations, N) int64 array, which the test used to allocate several times over."""
+    import tracemalloc
+
+    from scipy.stats import spearmanr
+
+    rng = np.random.default_rng(2)
+    n, n_perm = 20_000, 120  # 52 copies per block of 2^20 values: 3 blocks
+    groups = rng.permutation(np.repeat(np.arange(40), n // 40))  # groups interleaved, not contiguous
+    x = rng.normal(size=n)
+    y = 0.3 * x + rng.normal(size=n)
+    r = correlation_test(x, y, groups=groups, n_permutations=n_perm, seed=7)
+    draws = np.random.default_rng(7)
+    idx = [np.flatnonzero(groups == gid) for gid in np.unique(groups)]
+    shifts = [draws.integers(1, len(i), size=n_perm) for i in idx]
+    null = []
+    for k in range(n_perm):
+        shifted = y.copy()
+        for i, s in zip(idx, shifts):
+            shifted[i] = np.roll(y[i], -s[k])  # position t gets the value of t + s within its group
+        null.append(spearmanr(x, shifted).statistic)
+    assert r.null_mean == pytest.approx(np.mean(null), abs=1e-12)
+    assert r.null_std == pytest.approx(np.std(null), abs=1e-12)
+    assert r.p_permutation == (1 + np.sum(np.abs(null) >= abs(r.rho) - 1e-12)) / (1 + n_perm)
+    many = 600  # blocks of 2^20 values (a few 8 MB arrays) whatever the number of copies
+    tracemalloc.start()
+    correlation_test(x, y, groups=groups, n_permutations=many, seed=7)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < n * many * 8 / 2  # half of one (n_permutations, N) int64 array (96 MB)
+
+
 def test_group_effect_hand_computed() -> None:
     # groups a = [1, 2, 3], b = [4, 5, 6]: grand mean 3.5, SS_between = 3*1.5^2*2 = 13.5,
     # SS_total = 17.5 -> eta^2 = 0.7714; F = 13.5 / (4 / 4) = 13.5.

@@ -119,7 +119,8 @@ def correlation_test(
         Group (take) of each value; ``y`` is rolled by a random offset inside each group.
         Default: one group.
     n_permutations : int
-        Number of shifted copies.
+        Number of shifted copies, made in blocks of about 2^20 values (memory does not grow as
+        ``N * n_permutations``: 999 copies of BEAT's 76 h in 2-s windows would be 1 GB per array).
     seed : int
     """
     from scipy.stats import spearmanr
@@ -145,13 +146,19 @@ def correlation_test(
     rho = float(res.statistic)
     rx, ry = _rank(x), _rank(y)
     rng = np.random.default_rng(seed)
-    perm = np.empty((n_permutations, len(x)), dtype=np.int64)
-    for gid in np.unique(g):
-        idx = np.flatnonzero(g == gid)
-        m = len(idx)
-        shifts = rng.integers(1, m, size=n_permutations) if m > 1 else np.zeros(n_permutations, np.int64)
-        perm[:, idx] = idx[(np.arange(m)[None, :] + shifts[:, None]) % m]
-    null = _pearson(rx, ry[perm])
+    order = np.argsort(g, kind="stable")  # positions group by group, in time order within each
+    _, first, member, size = np.unique(g[order], return_index=True, return_inverse=True, return_counts=True)
+    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
+    for k, m in enumerate(size):  # group by group, as the draws have always been made
+        if m > 1:
+            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    start, m, r = first[member], size[member], np.arange(len(x)) - first[member]
+    block = max(1, (1 << 20) // len(x))  # shifted copies at once: about 8 MB per (block, N) array
+    null = np.empty(n_permutations)
+    for b in range(0, n_permutations, block):
+        perm = np.empty((min(block, n_permutations - b), len(x)), dtype=np.int64)
+        perm[:, order] = order[start + (r + shifts[b : b + block, member]) % m]
+        null[b : b + len(perm)] = _pearson(rx, ry[perm])
     p_perm = (1 + int(np.sum(np.abs(null) >= abs(rho) - 1e-12))) / (1 + n_permutations)
     return CorrelationResult(
         rho=rho,
