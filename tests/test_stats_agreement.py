@@ -78,6 +78,18 @@ def test_bad_win_matrices_are_refused():
         bradley_terry(np.array([[0, -1], [1, 0]]))
 
 
+def test_systems_in_groups_never_compared_are_refused():
+    # {0, 1} and {2, 3} were each compared only inside their pair: p0 / p2 has no maximum-likelihood value
+    # (the fit used to return [0.375, 0.125, 0.125, 0.375], an arbitrary even split of the two pairs)
+    wins = np.array([[0, 3, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 3, 0]])
+    with pytest.raises(ValueError, match=r"2 groups .*\[\[0, 1\], \[2, 3\]\]"):
+        bradley_terry(wins)
+    with pytest.raises(ValueError, match="2 groups"):
+        vote_agreement([1.0, 2.0, 3.0, 4.0], wins, n_boot=0)
+    wins[1, 2] = 1  # one vote links the groups: identified
+    assert np.isclose(bradley_terry(wins).sum(), 1.0)
+
+
 def test_kendall_tau_equals_scipy_and_the_pair_count():
     rng = np.random.default_rng(0)
     for n in (5, 8, 12):
