@@ -116,6 +116,15 @@ def test_kendall_tau_bootstrap_interval_contains_tau_and_is_seeded():
     assert np.isnan(kendall_tau(a, b).low)
 
 
+def test_kendall_tau_interval_is_nan_without_a_usable_resample():
+    # a constant side has no tau in any resample; nor do the 2-item resamples that draw one item twice
+    # (seed 0 draws only such with n_boot=1): the interval used to raise IndexError from np.percentile([])
+    r = kendall_tau([1.0, 1.0, 1.0], [1.0, 2.0, 3.0], n_boot=50)
+    assert np.isnan(r.tau) and np.isnan(r.low) and np.isnan(r.high) and r.method == "items"
+    r = kendall_tau([1.0, 2.0], [1.0, 2.0], n_boot=1, seed=0)
+    assert r.tau == 1.0 and np.isnan(r.low) and np.isnan(r.high)
+
+
 def test_kendall_tau_drops_nan_pairs():
     r = kendall_tau([1.0, np.nan, 3.0, 2.0], [1.0, 5.0, 3.0, 2.0])
     assert r.n == 3 and np.isclose(r.tau, 1.0)

@@ -260,8 +260,9 @@ def kendall_tau(
             idx = rng.integers(len(x), size=len(x))
             if np.ptp(x[idx]) > 0 and np.ptp(y[idx]) > 0:
                 draws.append(_tau(x[idx], y[idx]))
-        q = 50 * (1 - level)
-        low, high = (float(v) for v in np.percentile(draws, [q, 100 - q]))
+        if draws:
+            q = 50 * (1 - level)
+            low, high = (float(v) for v in np.percentile(draws, [q, 100 - q]))
     return TauResult(
         float(res.statistic), float(res.pvalue), low, high, len(x), level, "items" if n_boot else ""
     )
