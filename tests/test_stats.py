@@ -193,6 +193,18 @@ def test_gesture_correlations_detects_planted_effects() -> None:
     assert res["speaker"].p_permutation > 0.01  # speakers were balanced across emotions
 
 
+def test_gesture_correlations_emotion_effect_counts_self_talk_takes_only() -> None:
+    import dataclasses
+
+    takes = [make_take(30, emotion=e, speed=np.full(30, v + k), stem=f"s{e}{k}") for e, v in ((0, 5.0), (2, 9.0))
+             for k in range(3)]  # fmt: skip
+    # a conversation is neutral by name but changes emotion turn by turn: not a neutral take of the emotion test
+    talk = dataclasses.replace(make_take(30, emotion=0, speed=np.full(30, 40.0), stem="c"), conversation=True)
+    res = gesture_correlations([*takes, talk], n_permutations=20)
+    assert res["emotion"].n_takes == 6  # was 7, the conversation counted as neutral
+    assert res["emotion"].group_means == {0: pytest.approx(6.0), 2: pytest.approx(10.0)}  # v + 0, 1, 2
+
+
 # ------------------------------------------------------------------ emotion windows
 def test_window_features_hand_computed() -> None:
     x = np.array([[[0.0], [2.0], [4.0]]])  # one window, 3 frames, 1 channel

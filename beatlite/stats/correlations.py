@@ -263,9 +263,10 @@ def gesture_correlations(
     dict
         ``"audio"``, ``"face"``: :class:`CorrelationResult` over windows (face only when every
         take has a JSON); ``"emotion"``, ``"speaker"``: :class:`GroupEffectResult` over takes
-        (speaker only with >= 2 speakers; emotion over self-talk takes).
+        (speaker only with >= 2 speakers; emotion over self-talk takes only, with >= 2 emotions:
+        a conversation take is neutral by its name but changes emotion turn by turn).
     """
-    per_take: list[tuple[float, int, int | None]] = []  # mean speed, emotion, speaker: one pass over takes
+    per_take: list[tuple[float, int, int | None, bool]] = []  # speed, emotion, speaker, conversation
     wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
     out: dict[str, CorrelationResult | GroupEffectResult] = {
         "audio": correlation_test(
@@ -276,20 +277,23 @@ def gesture_correlations(
         out["face"] = correlation_test(
             wm["speed"], wm["face"], groups=wm["take"], n_permutations=n_permutations, seed=seed
         )
-    take_speed = np.array([speed for speed, _, _ in per_take])
-    emotions = np.array([emotion for _, emotion, _ in per_take])
-    speakers = np.array([speaker for _, _, speaker in per_take])
-    if len(np.unique(emotions)) >= 2:
-        out["emotion"] = group_effect_test(take_speed, emotions, n_permutations=n_permutations, seed=seed)
+    take_speed = np.array([speed for speed, _, _, _ in per_take])
+    emotions = np.array([emotion for _, emotion, _, _ in per_take])
+    speakers = np.array([speaker for _, _, speaker, _ in per_take])
+    speech = ~np.array([conversation for _, _, _, conversation in per_take], dtype=bool)
+    if len(np.unique(emotions[speech])) >= 2:
+        out["emotion"] = group_effect_test(
+            take_speed[speech], emotions[speech], n_permutations=n_permutations, seed=seed
+        )
     if len(np.unique(speakers)) >= 2:
         out["speaker"] = group_effect_test(take_speed, speakers, n_permutations=n_permutations, seed=seed)
     return out
 
 
 def _noting_takes(takes: Iterable[CorpusTake], notes: list) -> Iterator[CorpusTake]:
-    """``takes`` unchanged, appending (mean speed, emotion, speaker id) of each to ``notes`` as it passes."""
+    """``takes`` unchanged, appending (mean speed, emotion, speaker id, conversation) of each to ``notes``."""
     for t in takes:
-        notes.append((float(np.mean(t.speed)), t.emotion, t.speaker_id))
+        notes.append((float(np.mean(t.speed)), t.emotion, t.speaker_id, t.conversation))
         yield t
 
 
