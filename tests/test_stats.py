@@ -354,6 +354,8 @@ def test_paper_table1_beat_row() -> None:
 
 # ------------------------------------------------------------------ figures
 def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
+    import dataclasses
+
     import matplotlib.pyplot as plt
 
     plot_figure2(hand_index(), out=tmp_path / "fig2")
@@ -374,6 +376,11 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
     assert sep.n == 18 and sep.n_classes == 3
     fig4 = plot_figure4(takes, out=tmp_path / "fig4")
     assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)", "(c)"]  # the paper's panel order
+    no_words = [
+        dataclasses.replace(t, words=(), word_starts=np.zeros(0), word_ends=np.zeros(0)) for t in takes
+    ]
+    fig4 = plot_figure4(no_words, out=tmp_path / "fig4_no_words")  # no TextGrid: was an empty panel (c)
+    assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)"]
     corr = plot_correlations(takes, out=tmp_path / "corr")  # saved through the figure check: no empty panel
     assert [ax.get_title() for ax in corr.axes] == ["gesture vs audio energy", "gesture energy per emotion"]
     plot_table6({"neutral": 0.5, "avg": 0.5}, out=tmp_path / "table6")
