@@ -104,6 +104,52 @@ def test_planted_correlation_is_significant_and_independent_is_not() -> None:
     assert abs(independent.null_mean) < 0.05
 
 
+def test_correlation_undefined_or_non_finite_is_not_significant() -> None:
+    # a constant signal has no rho; it used to get the smallest permutation p (1 / 51) beside rho = NaN
+    r = correlation_test(np.arange(20.0), np.ones(20), groups=np.repeat([0, 1], 10), n_permutations=50)
+    assert np.isnan(r.rho) and np.isnan(r.p_value) and np.isnan(r.p_permutation) and r.n == 20
+    y = np.arange(20.0)
+    y[3] = np.nan
+    with pytest.raises(ValueError, match="y has 1 non-finite"):
+        correlation_test(np.arange(20.0), y, n_permutations=50)
+    with pytest.raises(ValueError, match="values has 1 non-finite"):
+        group_effect_test(np.array([1.0, 2, 3, np.nan, 5, 6]), np.array([0, 0, 0, 1, 1, 1]))
+
+
+def test_circular_shift_null_in_blocks_matches_np_roll() -> None:
+    """The null over several blocks of shifted copies equals Spearman's rho of np.roll-ed takes, drawn in
+    the same order (one (n_permutations,) draw per group, groups in sorted order), and memory stays far
+    below one (n_permutations, N) int64 array, which the test used to allocate several times over."""
+    import tracemalloc
+
+    from scipy.stats import spearmanr
+
+    rng = np.random.default_rng(2)
+    n, n_perm = 20_000, 120  # 52 copies per block of 2^20 values: 3 blocks
+    groups = rng.permutation(np.repeat(np.arange(40), n // 40))  # groups interleaved, not contiguous
+    x = rng.normal(size=n)
+    y = 0.3 * x + rng.normal(size=n)
+    r = correlation_test(x, y, groups=groups, n_permutations=n_perm, seed=7)
+    draws = np.random.default_rng(7)
+    idx = [np.flatnonzero(groups == gid) for gid in np.unique(groups)]
+    shifts = [draws.integers(1, len(i), size=n_perm) for i in idx]
+    null = []
+    for k in range(n_perm):
+        shifted = y.copy()
+        for i, s in zip(idx, shifts):
+            shifted[i] = np.roll(y[i], -s[k])  # position t gets the value of t + s within its group
+        null.append(spearmanr(x, shifted).statistic)
+    assert r.null_mean == pytest.approx(np.mean(null), abs=1e-12)
+    assert r.null_std == pytest.approx(np.std(null), abs=1e-12)
+    assert r.p_permutation == (1 + np.sum(np.abs(null) >= abs(r.rho) - 1e-12)) / (1 + n_perm)
+    many = 600  # blocks of 2^20 values (a few 8 MB arrays) whatever the number of copies
+    tracemalloc.start()
+    correlation_test(x, y, groups=groups, n_permutations=many, seed=7)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < n * many * 8 / 2  # half of one (n_permutations, N) int64 array (96 MB)
+
+
 def test_group_effect_hand_computed() -> None:
     # groups a = [1, 2, 3], b = [4, 5, 6]: grand mean 3.5, SS_between = 3*1.5^2*2 = 13.5,
     # SS_total = 17.5 -> eta^2 = 0.7714; F = 13.5 / (4 / 4) = 13.5.
@@ -145,6 +191,18 @@ def test_gesture_correlations_detects_planted_effects() -> None:
     assert res["face"].p_permutation > 0.01
     assert res["emotion"].eta2 > 0.9 and res["emotion"].p_permutation < 0.01
     assert res["speaker"].p_permutation > 0.01  # speakers were balanced across emotions
+
+
+def test_gesture_correlations_emotion_effect_counts_self_talk_takes_only() -> None:
+    import dataclasses
+
+    takes = [make_take(30, emotion=e, speed=np.full(30, v + k), stem=f"s{e}{k}") for e, v in ((0, 5.0), (2, 9.0))
+             for k in range(3)]  # fmt: skip
+    # a conversation is neutral by name but changes emotion turn by turn: not a neutral take of the emotion test
+    talk = dataclasses.replace(make_take(30, emotion=0, speed=np.full(30, 40.0), stem="c"), conversation=True)
+    res = gesture_correlations([*takes, talk], n_permutations=20)
+    assert res["emotion"].n_takes == 6  # was 7, the conversation counted as neutral
+    assert res["emotion"].group_means == {0: pytest.approx(6.0), 2: pytest.approx(10.0)}  # v + 0, 1, 2
 
 
 # ------------------------------------------------------------------ emotion windows
@@ -296,6 +354,8 @@ def test_paper_table1_beat_row() -> None:
 
 # ------------------------------------------------------------------ figures
 def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
+    import dataclasses
+
     import matplotlib.pyplot as plt
 
     plot_figure2(hand_index(), out=tmp_path / "fig2")
@@ -316,6 +376,11 @@ def test_figures_are_saved_as_png_and_svg(tmp_path: Path) -> None:
     assert sep.n == 18 and sep.n_classes == 3
     fig4 = plot_figure4(takes, out=tmp_path / "fig4")
     assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)", "(c)"]  # the paper's panel order
+    no_words = [
+        dataclasses.replace(t, words=(), word_starts=np.zeros(0), word_ends=np.zeros(0)) for t in takes
+    ]
+    fig4 = plot_figure4(no_words, out=tmp_path / "fig4_no_words")  # no TextGrid: was an empty panel (c)
+    assert [ax.get_title()[:3] for ax in fig4.axes] == ["(a)", "(b)"]
     corr = plot_correlations(takes, out=tmp_path / "corr")  # saved through the figure check: no empty panel
     assert [ax.get_title() for ax in corr.axes] == ["gesture vs audio energy", "gesture energy per emotion"]
     plot_table6({"neutral": 0.5, "avg": 0.5}, out=tmp_path / "table6")

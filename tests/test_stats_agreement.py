@@ -78,6 +78,18 @@ def test_bad_win_matrices_are_refused():
         bradley_terry(np.array([[0, -1], [1, 0]]))
 
 
+def test_systems_in_groups_never_compared_are_refused():
+    # {0, 1} and {2, 3} were each compared only inside their pair: p0 / p2 has no maximum-likelihood value
+    # (the fit used to return [0.375, 0.125, 0.125, 0.375], an arbitrary even split of the two pairs)
+    wins = np.array([[0, 3, 0, 0], [1, 0, 0, 0], [0, 0, 0, 1], [0, 0, 3, 0]])
+    with pytest.raises(ValueError, match=r"2 groups .*\[\[0, 1\], \[2, 3\]\]"):
+        bradley_terry(wins)
+    with pytest.raises(ValueError, match="2 groups"):
+        vote_agreement([1.0, 2.0, 3.0, 4.0], wins, n_boot=0)
+    wins[1, 2] = 1  # one vote links the groups: identified
+    assert np.isclose(bradley_terry(wins).sum(), 1.0)
+
+
 def test_kendall_tau_equals_scipy_and_the_pair_count():
     rng = np.random.default_rng(0)
     for n in (5, 8, 12):
@@ -102,6 +114,15 @@ def test_kendall_tau_bootstrap_interval_contains_tau_and_is_seeded():
     assert r.low <= r.tau <= r.high and r.method == "items" and r.n == 6
     assert kendall_tau(a, b, n_boot=300, seed=4) == r
     assert np.isnan(kendall_tau(a, b).low)
+
+
+def test_kendall_tau_interval_is_nan_without_a_usable_resample():
+    # a constant side has no tau in any resample; nor do the 2-item resamples that draw one item twice
+    # (seed 0 draws only such with n_boot=1): the interval used to raise IndexError from np.percentile([])
+    r = kendall_tau([1.0, 1.0, 1.0], [1.0, 2.0, 3.0], n_boot=50)
+    assert np.isnan(r.tau) and np.isnan(r.low) and np.isnan(r.high) and r.method == "items"
+    r = kendall_tau([1.0, 2.0], [1.0, 2.0], n_boot=1, seed=0)
+    assert r.tau == 1.0 and np.isnan(r.low) and np.isnan(r.high)
 
 
 def test_kendall_tau_drops_nan_pairs():

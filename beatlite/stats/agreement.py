@@ -95,7 +95,9 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
     ----------
     wins : (K, K) float or int
         ``wins[i, j]``: votes preferring ``i`` to ``j``; the diagonal is ignored. Every system must have been
-        compared at least once. A system that never wins gets strength 0 (the maximum-likelihood estimate is on
+        compared at least once, and the comparisons must link all systems (no two groups of systems that were
+        never compared with each other: the model cannot say how strong one group is against the other, and
+        the fit would return an arbitrary split). A system that never wins gets strength 0 (the maximum-likelihood estimate is on
         the boundary), and the iteration converges slowly then.
     max_iter : int
         Most MM steps.
@@ -110,7 +112,7 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
     Raises
     ------
     ValueError
-        Not a square matrix of counts, or a system never compared.
+        Not a square matrix of counts, a system never compared, or systems in groups never compared.
 
     Examples
     --------
@@ -119,7 +121,16 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
     >>> bradley_terry(np.array([[0, 3], [1, 0]])).tolist()
     [0.75, 0.25]
     """
+    from scipy.sparse.csgraph import connected_components
+
     w = _check_wins(wins)
+    n_parts, part = connected_components(w + w.T > 0, directed=False)
+    if n_parts > 1:
+        groups = [np.flatnonzero(part == k).tolist() for k in range(n_parts)]
+        raise ValueError(
+            f"the comparisons fall into {n_parts} groups of systems never compared with each other: {groups}; "
+            "their relative strengths are not identified"
+        )
     p = np.full(len(w), 1.0 / len(w))
     for _ in range(max_iter):
         new = bradley_terry_step(p, w)
@@ -249,8 +260,9 @@ def kendall_tau(
             idx = rng.integers(len(x), size=len(x))
             if np.ptp(x[idx]) > 0 and np.ptp(y[idx]) > 0:
                 draws.append(_tau(x[idx], y[idx]))
-        q = 50 * (1 - level)
-        low, high = (float(v) for v in np.percentile(draws, [q, 100 - q]))
+        if draws:
+            q = 50 * (1 - level)
+            low, high = (float(v) for v in np.percentile(draws, [q, 100 - q]))
     return TauResult(
         float(res.statistic), float(res.pvalue), low, high, len(x), level, "items" if n_boot else ""
     )

@@ -61,6 +61,9 @@ class CorpusTake:
     semantic_scores : (S,) float32
         Score of every annotated semantic segment.
     word_starts, word_ends : (W,) float64 seconds; words : tuple of str
+    conversation : bool
+        A conversation take (its take-level ``emotion`` is 0 from the name; the turns' emotions are in
+        ``emotion_frames``).
     """
 
     stem: str
@@ -79,6 +82,7 @@ class CorpusTake:
     word_starts: np.ndarray
     word_ends: np.ndarray
     words: tuple[str, ...]
+    conversation: bool = False
 
     @property
     def n_frames(self) -> int:
@@ -158,6 +162,7 @@ def corpus_take(record: TakeRecord, *, fps: float = FPS, sr: int = SR) -> Corpus
         word_starts=np.zeros(0) if words is None else np.asarray(words.starts, dtype=np.float64),
         word_ends=np.zeros(0) if words is None else np.asarray(words.ends, dtype=np.float64),
         words=() if words is None else tuple(words.words),
+        conversation=bool(record.conversation),
     )
 
 

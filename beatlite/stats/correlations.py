@@ -112,12 +112,15 @@ def correlation_test(
     Parameters
     ----------
     x, y : (N,) float
-        Paired values (e.g. window means), in time order within each group.
+        Paired values (e.g. window means), in time order within each group; all finite
+        (``ValueError`` otherwise). When ``x`` or ``y`` is constant, rho is undefined: ``rho``,
+        ``p_value`` and ``p_permutation`` are NaN.
     groups : (N,) int, optional
         Group (take) of each value; ``y`` is rolled by a random offset inside each group.
         Default: one group.
     n_permutations : int
-        Number of shifted copies.
+        Number of shifted copies, made in blocks of about 2^20 values (memory does not grow as
+        ``N * n_permutations``: 999 copies of BEAT's 76 h in 2-s windows would be 1 GB per array).
     seed : int
     """
     from scipy.stats import spearmanr
@@ -128,20 +131,34 @@ def correlation_test(
         raise ValueError(
             f"correlation_test: x and y must be equal (N,) with N >= 3, got {x.shape} and {y.shape}"
         )
+    for name, v in (("x", x), ("y", y)):
+        if not np.isfinite(v).all():
+            raise ValueError(f"correlation_test: {name} has {int(np.sum(~np.isfinite(v)))} non-finite values")
     g = np.zeros(len(x), np.int64) if groups is None else np.asarray(groups)
     if g.shape != x.shape:
         raise ValueError(f"correlation_test: groups must be {x.shape}, got {g.shape}")
+    if np.ptp(x) == 0 or np.ptp(y) == 0:  # no rho, so no test (scipy would warn and give NaN)
+        nan = float("nan")
+        return CorrelationResult(
+            rho=nan, p_value=nan, p_permutation=nan, null_mean=nan, null_std=nan, n=len(x)
+        )
     res = spearmanr(x, y)
     rho = float(res.statistic)
     rx, ry = _rank(x), _rank(y)
     rng = np.random.default_rng(seed)
-    perm = np.empty((n_permutations, len(x)), dtype=np.int64)
-    for gid in np.unique(g):
-        idx = np.flatnonzero(g == gid)
-        m = len(idx)
-        shifts = rng.integers(1, m, size=n_permutations) if m > 1 else np.zeros(n_permutations, np.int64)
-        perm[:, idx] = idx[(np.arange(m)[None, :] + shifts[:, None]) % m]
-    null = _pearson(rx, ry[perm])
+    order = np.argsort(g, kind="stable")  # positions group by group, in time order within each
+    _, first, member, size = np.unique(g[order], return_index=True, return_inverse=True, return_counts=True)
+    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
+    for k, m in enumerate(size):  # group by group, as the draws have always been made
+        if m > 1:
+            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    start, m, r = first[member], size[member], np.arange(len(x)) - first[member]
+    block = max(1, (1 << 20) // len(x))  # shifted copies at once: about 8 MB per (block, N) array
+    null = np.empty(n_permutations)
+    for b in range(0, n_permutations, block):
+        perm = np.empty((min(block, n_permutations - b), len(x)), dtype=np.int64)
+        perm[:, order] = order[start + (r + shifts[b : b + block, member]) % m]
+        null[b : b + len(perm)] = _pearson(rx, ry[perm])
     p_perm = (1 + int(np.sum(np.abs(null) >= abs(rho) - 1e-12))) / (1 + n_permutations)
     return CorrelationResult(
         rho=rho,
@@ -175,6 +192,8 @@ def group_effect_test(
         raise ValueError(
             f"group_effect_test: values and labels must be equal (N,), got {v.shape} and {lab.shape}"
         )
+    if not np.isfinite(v).all():
+        raise ValueError(f"group_effect_test: values has {int(np.sum(~np.isfinite(v)))} non-finite values")
     classes = np.unique(lab)
     if len(classes) < 2 or len(classes) == len(v):
         raise ValueError(f"group_effect_test: need >= 2 groups and a group with >= 2 takes ({len(v)} takes)")
@@ -244,9 +263,10 @@ def gesture_correlations(
     dict
         ``"audio"``, ``"face"``: :class:`CorrelationResult` over windows (face only when every
         take has a JSON); ``"emotion"``, ``"speaker"``: :class:`GroupEffectResult` over takes
-        (speaker only with >= 2 speakers; emotion over self-talk takes).
+        (speaker only with >= 2 speakers; emotion over self-talk takes only, with >= 2 emotions:
+        a conversation take is neutral by its name but changes emotion turn by turn).
     """
-    per_take: list[tuple[float, int, int | None]] = []  # mean speed, emotion, speaker: one pass over takes
+    per_take: list[tuple[float, int, int | None, bool]] = []  # speed, emotion, speaker, conversation
     wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
     out: dict[str, CorrelationResult | GroupEffectResult] = {
         "audio": correlation_test(
@@ -257,20 +277,23 @@ def gesture_correlations(
         out["face"] = correlation_test(
             wm["speed"], wm["face"], groups=wm["take"], n_permutations=n_permutations, seed=seed
         )
-    take_speed = np.array([speed for speed, _, _ in per_take])
-    emotions = np.array([emotion for _, emotion, _ in per_take])
-    speakers = np.array([speaker for _, _, speaker in per_take])
-    if len(np.unique(emotions)) >= 2:
-        out["emotion"] = group_effect_test(take_speed, emotions, n_permutations=n_permutations, seed=seed)
+    take_speed = np.array([speed for speed, _, _, _ in per_take])
+    emotions = np.array([emotion for _, emotion, _, _ in per_take])
+    speakers = np.array([speaker for _, _, speaker, _ in per_take])
+    speech = ~np.array([conversation for _, _, _, conversation in per_take], dtype=bool)
+    if len(np.unique(emotions[speech])) >= 2:
+        out["emotion"] = group_effect_test(
+            take_speed[speech], emotions[speech], n_permutations=n_permutations, seed=seed
+        )
     if len(np.unique(speakers)) >= 2:
         out["speaker"] = group_effect_test(take_speed, speakers, n_permutations=n_permutations, seed=seed)
     return out
 
 
 def _noting_takes(takes: Iterable[CorpusTake], notes: list) -> Iterator[CorpusTake]:
-    """``takes`` unchanged, appending (mean speed, emotion, speaker id) of each to ``notes`` as it passes."""
+    """``takes`` unchanged, appending (mean speed, emotion, speaker id, conversation) of each to ``notes``."""
     for t in takes:
-        notes.append((float(np.mean(t.speed)), t.emotion, t.speaker_id))
+        notes.append((float(np.mean(t.speed)), t.emotion, t.speaker_id, t.conversation))
         yield t
 
 

@@ -153,7 +153,8 @@ def plot_figure4(
     """BEAT Fig. 4 analog in the paper's order: (a) mean score per speaker, (b) score histogram, (c) words.
 
     The histogram marks the paper's low-score threshold (0.2) and states the
-    share of gestures at or below it; every axis has its unit.
+    share of gestures at or below it; every axis has its unit. Takes without word
+    timings (no TextGrid) get no panel (c) (two panels, none empty).
 
     Returns
     -------
@@ -167,7 +168,8 @@ def plot_figure4(
     words = word_scores(takes, top=top)
     spk = speaker_scores(takes)
     with figure_style():
-        fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), layout="constrained")
+        n = 3 if words else 2  # no word timings (no TextGrid): no empty panel for them
+        fig, axes = plt.subplots(1, n, figsize=(13 * n / 3, 4.2), layout="constrained")
         axes[0].bar([str(s) for s in spk], [v["mean"] for v in spk.values()], color=SYSTEM_COLOURS[0])
         axes[0].set_xlabel("speaker id")
         axes[0].set_ylabel("mean semantic score (0-1)")
@@ -189,11 +191,12 @@ def plot_figure4(
         axes[1].set_title(
             f"(b) {hist.share_low * 100:.0f}% <= {LOW_SCORE} (paper {PAPER_LOW_SCORE_SHARE * 100:.0f}%)"
         )
-        axes[2].bar([w for w, _, _ in words], [s for _, _, s in words], color=SYSTEM_COLOURS[0])
-        axes[2].set_xlabel("word")
-        axes[2].set_ylabel("mean semantic score (0-1)")
-        axes[2].set_title(f"(c) {len(words)} most frequent words")
-        axes[2].tick_params(axis="x", rotation=45)
+        if words:
+            axes[2].bar([w for w, _, _ in words], [s for _, _, s in words], color=SYSTEM_COLOURS[0])
+            axes[2].set_xlabel("word")
+            axes[2].set_ylabel("mean semantic score (0-1)")
+            axes[2].set_title(f"(c) {len(words)} most frequent words")
+            axes[2].tick_params(axis="x", rotation=45)
         if out is not None:
             save_figure(fig, out, formats)
     return fig
