@@ -26,7 +26,13 @@ from beatlite.stats.distributions import (
     speaker_durations,
 )
 from beatlite.stats.emotion_classifier import PAPER_TABLE6, EmotionClassifier, plot_table6, table6_markdown
-from beatlite.stats.emotion_clusters import plot_emotion_tsne, rotation_windows, separability, window_features
+from beatlite.stats.emotion_clusters import (
+    emotion_features,
+    plot_emotion_tsne,
+    rotation_windows,
+    separability,
+    window_features,
+)
 from beatlite.stats.semantic import plot_figure4, score_histogram, speaker_scores, word_scores
 
 
@@ -206,6 +212,26 @@ def test_gesture_correlations_emotion_effect_counts_self_talk_takes_only() -> No
 
 
 # ------------------------------------------------------------------ emotion windows
+def test_conversation_windows_and_frames_carry_their_turns_emotions() -> None:
+    """A conversation is neutral by its name; its windows and frames count under the emotion of their turn."""
+    import dataclasses
+
+    turns = np.repeat([0, 3, 5], [30, 30, 30])  # three 2-s turns: neutral, sadness, surprise
+    talk = dataclasses.replace(
+        make_take(90, emotion=0, speed=np.repeat([1.0, 2.0, 4.0], 30), stem="c"),
+        conversation=True,
+        emotion_frames=turns,
+    )
+    speech = make_take(45, emotion=2, speed=np.full(45, 8.0))
+    rw = rotation_windows(
+        [talk, speech], seconds=2.0
+    )  # 30 frames: 3 + 1 windows, middle frames 15, 45, 75, 15
+    assert rw.emotion.tolist() == [0, 3, 5, 2]
+    assert emotion_features([talk, speech], per_speaker=False).emotion.tolist() == [0, 3, 5, 2]
+    speeds = speed_by_emotion([talk, speech])
+    assert speeds == {"neutral": 1.0, "anger": 8.0, "sadness": 2.0, "surprise": 4.0}  # was neutral (1+2+4)/3
+
+
 def test_window_features_hand_computed() -> None:
     x = np.array([[[0.0], [2.0], [4.0]]])  # one window, 3 frames, 1 channel
     # mean 2, std sqrt(((-2)^2 + 0 + 2^2) / 3) = sqrt(8/3), mean |diff| = 2

@@ -39,7 +39,8 @@ class RotationWindows:
     ----------
     windows : (N, L, 141) float32, degrees
     emotion : (N,) int64
-        Take-level emotion id.
+        Emotion id of each window's middle frame (the take's per-frame ``emotion_frames``: a speech take's
+        emotion from its name, a conversation's turn by turn).
     speaker : (N,) int64
         Speaker id (1..30).
     take : (N,) int64
@@ -85,9 +86,9 @@ def rotation_windows(
         Hop between windows (default: ``seconds``, non-overlapping).
     """
     parts, emo, spk, tk = [], [], [], []
-    for i, t, w in _windows_by_take(takes, seconds, stride_seconds, "rotation_windows"):
+    for i, t, w, e in _windows_by_take(takes, seconds, stride_seconds, "rotation_windows"):
         parts.append(w)
-        emo.append(np.full(len(w), t.emotion))
+        emo.append(e)
         spk.append(np.full(len(w), t.speaker_id))
         tk.append(np.full(len(w), i))
     return RotationWindows(
@@ -100,8 +101,10 @@ def rotation_windows(
 
 def _windows_by_take(
     takes: Iterable[CorpusTake], seconds: float, stride_seconds: float | None, who: str
-) -> Iterator[tuple[int, CorpusTake, np.ndarray]]:
-    """``(take number, take, its (W, L, 141) windows)`` for every take with a window, in one pass over ``takes``.
+) -> Iterator[tuple[int, CorpusTake, np.ndarray, np.ndarray]]:
+    """``(take number, take, its (W, L, 141) windows, their (W,) int64 emotions)`` for every take with a window,
+    in one pass over ``takes``. A window's emotion is that of its middle frame (``emotion_frames``), as Table 6's
+    windows are labelled (:func:`beatlite.stats.emotion_classifier.table6_windows`).
 
     Raises ``ValueError`` (naming ``who``) when there is no take, or no take has a whole window.
     """
@@ -114,7 +117,7 @@ def _windows_by_take(
         w = _take_windows(t, length, stride)
         if len(w):
             found += 1
-            yield i, t, w
+            yield i, t, w, np.asarray(t.emotion_frames, np.int64)[np.arange(len(w)) * stride + length // 2]
     if n_takes == 0:
         raise ValueError(f"{who}: no takes")
     if not found:
@@ -362,7 +365,8 @@ class EmotionFeatures:
     ----------
     features : (N, F) float64
     emotion, speaker, take : (N,) int64
-        Take-level emotion id, speaker id (1..30), index of the take in the input order.
+        Emotion id of each window's middle frame (see :class:`RotationWindows`), speaker id (1..30), index of
+        the take in the input order.
     """
 
     features: np.ndarray
@@ -400,9 +404,9 @@ def emotion_features(
     """
     dims = subset_dims(joints)
     feats, emo, spk, tk = [], [], [], []
-    for i, t, w in _windows_by_take(takes, seconds, None, "emotion_features"):
+    for i, t, w, e in _windows_by_take(takes, seconds, None, "emotion_features"):
         feats.append(window_features(w[:, :, dims].astype(np.float32), kind=kind))
-        emo.append(np.full(len(w), t.emotion, np.int64))
+        emo.append(e)
         spk.append(np.full(len(w), t.speaker_id, np.int64))
         tk.append(np.full(len(w), i, np.int64))
     out = EmotionFeatures(np.concatenate(feats), np.concatenate(emo), np.concatenate(spk), np.concatenate(tk))
