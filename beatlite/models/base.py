@@ -23,16 +23,19 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
 - class attributes ``name`` (registry name), ``representation`` (``"euler141"`` or
   ``"dirvec126"``), ``config_class`` (a dataclass with a ``preset`` field);
 - ``forward(batch) -> dict`` with at least ``"pose"``: (B, T, D) in the normalised
-  representation (for dirvec126 models too: the key is always ``"pose"``);
-- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` with a scalar ``"total"`` whose backward reaches
-  every generator parameter in every step (``torchrun`` training reduces gradients with
+  representation (for dirvec126 models too: the key is always ``"pose"``), in the batch's float dtype
+  (float32; a float64 buffer made from numpy would promote it); ``forward`` and ``losses`` leave the batch
+  unchanged (no in-place change, no key assigned: the losses and the harness read it after);
+- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` (tensors, not floats) with a scalar ``"total"``
+  whose backward reaches every generator parameter in every step (``torchrun`` training reduces gradients with
   DistributedDataParallel, which needs that; losses may call modules that ``forward`` does not);
 - the discriminator's parameters live in the ``discriminator`` child alone, the others in child modules;
 - ``discriminator``: an ``nn.Module`` or ``None``; when present,
   ``discriminator_losses(batch, out) -> dict`` with ``"total"`` and the harness runs a
   discriminator step whenever :meth:`GestureModel.adversarial_active` says so;
 - ``generate(batch) -> (B, T, D)``: inference seeded only by the first ``n_pre`` frames
-  of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
+  of ``batch[target_key]`` (the later frames are zeroed before the forward pass), the same pose for the same
+  batch (randomness of eval mode drawn from a generator seeded from the config, restarted by ``reset()``);
 - ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
 - optional ``prepare(train_windows, normalizers=None)``: called once by ``fit`` before training with the
   training window set (a numpy window dict or a :class:`~beatlite.data.store.StoreWindows`; read it
