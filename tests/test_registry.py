@@ -161,3 +161,54 @@ def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_
         scoring.register_metric("Gap2", scoring.Metric("Gap", "test", False, ("euler",), gap, "mean gap"))
     with pytest.raises(ValueError, match="does not name its inputs"):
         scoring.Metric("Gap", "test", False, None, lambda g, t, seed: 0.0, "no names")
+
+
+def test_a_model_class_mistake_is_named_where_it_is_made(tmp_path, monkeypatch):
+    """A class without presets, with an unknown representation or registered under another name than its own:
+    one error naming the class (they were AttributeError "module ... has no attribute 'PRESETS'", a KeyError
+    'euler' deep in the harness, and a checkpoint that did not load); a subclass of a shipped model in a module
+    of its own gets its base's presets."""
+    from beatlite import models
+    from beatlite.models.base import GestureModel
+    from beatlite.models.camn import PRESETS as CAMN_PRESETS
+
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    (tmp_path / "newcomer_models.py").write_text(
+        textwrap.dedent(
+            """
+            from beatlite.models.base import GestureModel
+            from beatlite.models.camn import CaMN
+
+            class NoPresets(GestureModel):
+                name = "no_presets"
+
+            class MyCaMN(CaMN):
+                name = "my_camn"
+            """
+        )
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import newcomer_models
+
+    with pytest.raises(
+        TypeError, match=r"NoPresets: no presets: set its class attribute presets .*newcomer_models"
+    ):
+        models.presets(newcomer_models.NoPresets)
+    assert models.presets(newcomer_models.MyCaMN) == {k: dict(v) for k, v in CAMN_PRESETS.items()}
+
+    with pytest.raises(
+        TypeError, match=r"Typo: representation must be one of \['dirvec126', 'euler141'\], got 'euler'"
+    ):
+
+        class Typo(GestureModel):
+            representation = "euler"
+
+    models.register_model("mine", "newcomer_models:MyCaMN")
+    with pytest.raises(
+        ValueError, match=r"'mine' is registered as newcomer_models:MyCaMN, whose name is 'my_camn'"
+    ):
+        models.build_model("mine")
+    with pytest.raises(
+        ValueError, match=r"CaMNConfig: preset must be one of \['paper', 'tiny'\], got 'smal'"
+    ):
+        models.build_model("camn", preset="smal")

@@ -149,7 +149,7 @@ def config_from_preset(
         An override that is not a field of ``config_class``.
     """
     if preset not in presets:
-        raise ValueError(f"preset must be one of {sorted(presets)}, got {preset!r}")
+        raise ValueError(f"{config_class.__name__}: preset must be one of {sorted(presets)}, got {preset!r}")
     fields = {f.name for f in dataclasses.fields(config_class)}
     unknown = sorted(set(overrides) - fields)
     if unknown:
@@ -311,6 +311,15 @@ class GestureModel(nn.Module):
     """Why ``torch.compile``'s inductor cannot compile this model's training pass (``None``: it can);
     :func:`beatlite.train.fit` then refuses ``TrainConfig.compile`` modes that use it, naming this."""
     n_pre: int = N_PRE
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Refuse an unknown ``representation`` where the class is defined (it failed later as a bare
+        ``KeyError`` deep in the harness)."""
+        super().__init_subclass__(**kwargs)
+        if cls.representation not in REPRESENTATIONS:
+            raise TypeError(
+                f"{cls.__name__}: representation must be one of {sorted(REPRESENTATIONS)}, got {cls.representation!r}"
+            )
 
     def __init__(self, config: ModelConfig) -> None:
         super().__init__()
