@@ -139,6 +139,30 @@ def test_registration_refuses_conflicts(monkeypatch):
         recipes.register_recipe("camn_tiny", recipes.Recipe("s2g", "Other"))
 
 
+def test_a_recipe_mistake_is_refused_when_it_is_registered(monkeypatch):
+    """A typo'd override or training setting, or another recipe's label, is refused by register_recipe naming the
+    recipe (the first two failed only when retrain ran, after the data work; a shared label merged two rows'
+    seeds into one list of the seed table); every shipped recipe passes the same checks."""
+    from beatlite import models
+    from beatlite.train import recipes
+
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    monkeypatch.setattr(recipes, "RECIPES", dict(recipes.RECIPES))
+    for name, recipe in list(recipes.RECIPES.items()):
+        recipes.register_recipe(name, recipe)  # the same entry again: checked, and a no-op
+    with pytest.raises(ValueError, match=r"'s2g_wide': S2GConfig: unknown option\(s\) \['hiden'\]"):
+        recipes.register_recipe("s2g_wide", recipes.Recipe("s2g", "S2G wide", overrides={"hiden": 8}))
+    with pytest.raises(
+        ValueError, match=r"'s2g_cos': TrainConfig: lr_schedule must be one of .* got 'cosin'"
+    ):
+        recipes.register_recipe("s2g_cos", recipes.Recipe("s2g", "S2G cos", lr_schedule="cosin"))
+    with pytest.raises(ValueError, match=r"'s2g_copy': label 'CaMN' is already the row of camn_tiny"):
+        recipes.register_recipe("s2g_copy", recipes.Recipe("s2g", "CaMN"))
+    with pytest.raises(ValueError, match=r"label 'Ground truth' is already the row of the ground truth"):
+        recipes.register_recipe("s2g_gt", recipes.Recipe("s2g", "Ground truth"))
+    assert not {"s2g_wide", "s2g_cos", "s2g_copy", "s2g_gt"} & set(recipes.RECIPES)
+
+
 def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_restored):
     import numpy as np
 
