@@ -187,6 +187,37 @@ def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_
         scoring.Metric("Gap", "test", False, None, lambda g, t, seed: 0.0, "no names")
 
 
+def test_a_metric_that_does_not_return_one_number_is_named(metrics_restored):
+    """A per-take array, a missing return (None), a complex or a string result: a TypeError naming the metric
+    (they were numpy's / float()'s message without the key, or, for a complex value and a string, a number kept
+    silently: the real part, float('1.0')); a 0-d torch tensor or numpy scalar is read as its number."""
+    import numpy as np
+
+    scoring = metrics_restored
+    torch_value = torch.tensor(2.0)
+    results = {
+        "per take": np.array([1.0, 2.0]),
+        "no return": None,
+        "complex": np.complex128(1j),
+        "string": "1.0",
+        "tensor": torch_value,
+        "scalar": np.float32(2.0),
+    }
+    for name, result in results.items():
+        scoring.register_metric(
+            name, scoring.Metric(name, "test", None, ("positions",), lambda g, t, s, r=result: r, "d")
+        )
+    gen = scoring.Takes([np.zeros((3, 2, 3))])
+    truth = scoring.GroundTruth(gen, fps=10)
+    for name in ("per take", "no return", "complex", "string"):
+        with pytest.raises(TypeError, match=rf"^metric '{name}': compute returned .*, not one real number$"):
+            scoring.evaluate(gen, truth, metrics=[name])
+    assert scoring.evaluate(gen, truth, metrics=["tensor", "scalar"]).values() == {
+        "tensor": 2.0,
+        "scalar": 2.0,
+    }
+
+
 def test_a_model_class_mistake_is_named_where_it_is_made(tmp_path, monkeypatch):
     """A class without presets, with an unknown representation or registered under another name than its own:
     one error naming the class (they were AttributeError "module ... has no attribute 'PRESETS'", a KeyError
