@@ -267,3 +267,36 @@ def test_a_model_class_mistake_is_named_where_it_is_made(tmp_path, monkeypatch):
         ValueError, match=r"CaMNConfig: preset must be one of \['paper', 'tiny'\], got 'smal'"
     ):
         models.build_model("camn", preset="smal")
+
+
+def test_a_notebook_cell_run_twice_registers_again(monkeypatch, metrics_restored):
+    """A cell that defines a model class and a metric function and registers them, run twice: the second run
+    replaces the entries (it raised "already registered" / "already a metric"); another class or function under
+    a taken name is still refused."""
+    from beatlite import models
+
+    scoring = metrics_restored
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    cell = textwrap.dedent(MODULE).replace('name = "seed_mean"', 'name = "cell_model"') + textwrap.dedent(
+        """
+        def cell_speed(positions):
+            return 1.0
+
+        register_model("cell_model", SeedMean)
+        register_metric("Cell speed", Metric("Cell speed", "test", None, None, cell_speed, "d"))
+        """
+    )
+    runs = []
+    for _ in range(2):
+        namespace = {"__name__": "__main__", "register_model": models.register_model}
+        namespace.update(register_metric=scoring.register_metric, Metric=scoring.Metric)
+        exec(compile(cell, "<cell>", "exec"), namespace)
+        runs.append(namespace)
+    assert models.model_class("cell_model") is runs[1]["SeedMean"] is not runs[0]["SeedMean"]
+    assert scoring.METRICS["Cell speed"].compute is runs[1]["cell_speed"]
+    with pytest.raises(ValueError, match="already registered"):
+        models.register_model("cell_model", "throwaway_model:SeedMean")
+    with pytest.raises(ValueError, match="already a metric"):
+        scoring.register_metric(
+            "Cell speed", scoring.Metric("Cell speed", "test", None, ("positions",), len, "d")
+        )

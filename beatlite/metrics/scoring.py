@@ -418,7 +418,8 @@ def register_metric(key: str, metric: Metric) -> None:
     Raises
     ------
     ValueError
-        ``key`` is already a metric, or ``metric.compute`` reads an input its ``needs`` does not list.
+        ``key`` is already another metric (the same one again, or its function defined again in a notebook cell
+        run twice, replaces it), or ``metric.compute`` reads an input its ``needs`` does not list.
 
     Examples
     --------
@@ -430,13 +431,24 @@ def register_metric(key: str, metric: Metric) -> None:
     {'Height (demo)': 1.0}
     >>> del METRICS["Height (demo)"]  # keep the registry as shipped
     """
-    if key in METRICS:
+    if key in METRICS and not _same_metric(METRICS[key], metric):
         raise ValueError(f"{key!r} is already a metric ({METRICS[key].describe})")
     if bind_inputs(metric.compute) is not metric.compute:
         unlisted = sorted(set(needs_of(metric.compute)) - set(metric.needs))
         if unlisted:
             raise ValueError(f"{key!r}: compute reads {unlisted}, which needs={metric.needs} does not list")
     METRICS[key] = metric
+
+
+def _same_metric(old: Metric, new: Metric) -> bool:
+    """``new`` equals ``old`` up to its ``compute`` being the same function defined again (same module and
+    qualified name: a notebook cell run twice)."""
+    a, b = old.compute, new.compute
+    same = a is b or (
+        (getattr(a, "__module__", None), getattr(a, "__qualname__", None))
+        == (getattr(b, "__module__", None), getattr(b, "__qualname__", 0))
+    )
+    return same and dataclasses.replace(old, compute=b) == new
 
 
 def _one_number(key: str, value: Any) -> float:
