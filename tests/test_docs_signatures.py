@@ -171,3 +171,23 @@ def test_resolution_is_by_section_then_unique(index):
     assert missing_parameters(srgr, ["gen", "gt"]) == ["gen", "gt"]  # the old text's names
     assert resolve("load_take", "beatlite.io", index) is importlib.import_module("beatlite.io.take").load_take
     assert resolve("no_such_function", "beatlite", index) is None
+
+
+def test_the_store_training_example_runs_as_written(data_samples):
+    """The statements of "Training on the store (for the trainer)" in docs/architecture.md run as written on
+    data_samples/ (the loop body ``...`` replaced by keeping one batch)."""
+    pytest.importorskip("torch")
+    from beatlite.data.index import index_folder
+    from beatlite.data.store import build_store
+    from beatlite.data.torch_dataset import window_loader
+
+    text = DOC.read_text()
+    start = text.index("Training on the store (for the trainer):")
+    spans = [" ".join(s.split()) for s in SPAN.findall(text[start : text.index("\n- ", start)])]
+    assert len(spans) == 4 and spans[-1].endswith(": ..."), spans
+    names = {"build_store": build_store, "window_loader": window_loader, "index": index_folder(data_samples)}
+    names.update(model_keys=("pose", "audio"), epoch_seed=0, cuda=False, seen=[])
+    for statement in spans:
+        exec(statement.replace(": ...", ": seen.append(batch); break"), names)
+    assert len(names["seen"]) == 1 and set(names["seen"][0]) >= {"pose", "audio"}
+    assert len(names["val"]) > 0 and names["val"].normalizers.matches(names["train"].normalizers)

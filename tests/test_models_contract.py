@@ -69,6 +69,7 @@ def test_check_model_runs_every_check_and_returns_their_names(
 
 def _broken_models() -> dict[str, tuple[type, str]]:
     """S2G variants that each break one rule: class -> (rule's check, words of its message)."""
+    import numpy as np
     import torch
 
     from beatlite.models.baselines import S2G
@@ -103,7 +104,76 @@ def _broken_models() -> dict[str, tuple[type, str]]:
             out = super().forward(batch)
             return {"pose": out["pose"] * torch.ones(out["pose"].shape[-1]).to(out["pose"].device)}
 
+    class ReadsAnUnlistedKey(S2G):  # input_keys does not list face
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            return {"pose": super().forward(batch)["pose"] + 0 * batch["face"].mean()}
+
+    class LossesReadAnUnlistedKey(S2G):  # losses read semantic, batch_keys not overridden (CaMN overrides it)
+        def losses(self, batch, out, *, epoch):  # noqa: ANN001, ANN202
+            return {"total": ((out["pose"] - batch["pose"]).abs().mean(-1) * batch["semantic"]).mean()}
+
+    class ZeroesTheTargetInPlace(
+        S2G
+    ):  # the losses then compare with zeros: trained silently on a wrong target
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            batch["pose"][:, self.n_pre :] = 0.0
+            return super().forward(batch)
+
+    class Float64Buffer(S2G):  # a statistics buffer made from numpy promotes the output to float64
+        def __init__(self, config) -> None:  # noqa: ANN001
+            super().__init__(config)
+            self.register_buffer("offset", torch.from_numpy(np.linspace(0.0, 1.0, 141)))
+
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            return {"pose": super().forward(batch)["pose"] + self.offset}
+
+    class NoisyGenerate(S2G):  # unseeded noise in eval mode too: another pose at every call
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            pose = super().forward(batch)["pose"]
+            return {"pose": pose + 0.1 * torch.randn_like(pose)}
+
+    class ReturnsTheTensor(S2G):
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            return super().forward(batch)["pose"]
+
+    class NoTotal(S2G):
+        def losses(self, batch, out, *, epoch):  # noqa: ANN001, ANN202
+            return {"rec": (out["pose"] - batch["pose"]).abs().mean()}
+
+    class FloatLoss(S2G):
+        def losses(self, batch, out, *, epoch):  # noqa: ANN001, ANN202
+            rec = (out["pose"] - batch["pose"]).abs().mean()
+            return {"rec": rec.item(), "total": rec}
+
     return {
+        "reads an unlisted key": (
+            ReadsAnUnlistedKey,
+            "shapes",
+            "forward reads batch['face'], which batch_keys(config) = (",
+        ),
+        "losses read an unlisted key": (
+            LossesReadAnUnlistedKey,
+            "gradients",
+            "losses reads batch['semantic'], which batch_keys(config)",
+        ),
+        "zeroes the target in place": (
+            ZeroesTheTargetInPlace,
+            "shapes",
+            "forward changed the batch's ['pose']",
+        ),
+        "float64 buffer": (
+            Float64Buffer,
+            "shapes",
+            "forward pose is torch.float64, the batch's 'pose' torch.float32 (float64",
+        ),
+        "noisy generate": (NoisyGenerate, "shapes", "generate gives another pose for the same batch"),
+        "returns the tensor": (
+            ReturnsTheTensor,
+            "shapes",
+            "forward must return a dict with 'pose', got Tensor",
+        ),
+        "no total": (NoTotal, "gradients", "losses must return a dict with 'total', got ['rec']"),
+        "a float loss": (FloatLoss, "gradients", "losses ['rec'] are not tensors"),
         "dead parameter": (DeadParameter, "gradients", "no gradient: ['unused.weight', 'unused.bias']"),
         "checks on the host": (
             ChecksOnTheHost,
@@ -118,8 +188,10 @@ def _broken_models() -> dict[str, tuple[type, str]]:
 
 @pytest.mark.parametrize(
     "broken",
-    ["dead parameter", "reads the future", "forgets a key", "checks on the host", "copies to the device"],
-)
+    ["dead parameter", "reads the future", "forgets a key", "checks on the host", "copies to the device",
+     "reads an unlisted key", "losses read an unlisted key", "zeroes the target in place", "float64 buffer",
+     "noisy generate", "returns the tensor", "no total", "a float loss"],
+)  # fmt: skip
 def test_the_contract_names_the_rule_a_model_breaks(broken: str, tmp_path: Path) -> None:
     cls, check, message = _broken_models()[broken]
     with pytest.raises(AssertionError, match=re.escape(message)):

@@ -139,6 +139,30 @@ def test_registration_refuses_conflicts(monkeypatch):
         recipes.register_recipe("camn_tiny", recipes.Recipe("s2g", "Other"))
 
 
+def test_a_recipe_mistake_is_refused_when_it_is_registered(monkeypatch):
+    """A typo'd override or training setting, or another recipe's label, is refused by register_recipe naming the
+    recipe (the first two failed only when retrain ran, after the data work; a shared label merged two rows'
+    seeds into one list of the seed table); every shipped recipe passes the same checks."""
+    from beatlite import models
+    from beatlite.train import recipes
+
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    monkeypatch.setattr(recipes, "RECIPES", dict(recipes.RECIPES))
+    for name, recipe in list(recipes.RECIPES.items()):
+        recipes.register_recipe(name, recipe)  # the same entry again: checked, and a no-op
+    with pytest.raises(ValueError, match=r"'s2g_wide': S2GConfig: unknown option\(s\) \['hiden'\]"):
+        recipes.register_recipe("s2g_wide", recipes.Recipe("s2g", "S2G wide", overrides={"hiden": 8}))
+    with pytest.raises(
+        ValueError, match=r"'s2g_cos': TrainConfig: lr_schedule must be one of .* got 'cosin'"
+    ):
+        recipes.register_recipe("s2g_cos", recipes.Recipe("s2g", "S2G cos", lr_schedule="cosin"))
+    with pytest.raises(ValueError, match=r"'s2g_copy': label 'CaMN' is already the row of camn_tiny"):
+        recipes.register_recipe("s2g_copy", recipes.Recipe("s2g", "CaMN"))
+    with pytest.raises(ValueError, match=r"label 'Ground truth' is already the row of the ground truth"):
+        recipes.register_recipe("s2g_gt", recipes.Recipe("s2g", "Ground truth"))
+    assert not {"s2g_wide", "s2g_cos", "s2g_copy", "s2g_gt"} & set(recipes.RECIPES)
+
+
 def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_restored):
     import numpy as np
 
@@ -161,3 +185,118 @@ def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_
         scoring.register_metric("Gap2", scoring.Metric("Gap", "test", False, ("euler",), gap, "mean gap"))
     with pytest.raises(ValueError, match="does not name its inputs"):
         scoring.Metric("Gap", "test", False, None, lambda g, t, seed: 0.0, "no names")
+
+
+def test_a_metric_that_does_not_return_one_number_is_named(metrics_restored):
+    """A per-take array, a missing return (None), a complex or a string result: a TypeError naming the metric
+    (they were numpy's / float()'s message without the key, or, for a complex value and a string, a number kept
+    silently: the real part, float('1.0')); a 0-d torch tensor or numpy scalar is read as its number."""
+    import numpy as np
+
+    scoring = metrics_restored
+    torch_value = torch.tensor(2.0)
+    results = {
+        "per take": np.array([1.0, 2.0]),
+        "no return": None,
+        "complex": np.complex128(1j),
+        "string": "1.0",
+        "tensor": torch_value,
+        "scalar": np.float32(2.0),
+    }
+    for name, result in results.items():
+        scoring.register_metric(
+            name, scoring.Metric(name, "test", None, ("positions",), lambda g, t, s, r=result: r, "d")
+        )
+    gen = scoring.Takes([np.zeros((3, 2, 3))])
+    truth = scoring.GroundTruth(gen, fps=10)
+    for name in ("per take", "no return", "complex", "string"):
+        with pytest.raises(TypeError, match=rf"^metric '{name}': compute returned .*, not one real number$"):
+            scoring.evaluate(gen, truth, metrics=[name])
+    assert scoring.evaluate(gen, truth, metrics=["tensor", "scalar"]).values() == {
+        "tensor": 2.0,
+        "scalar": 2.0,
+    }
+
+
+def test_a_model_class_mistake_is_named_where_it_is_made(tmp_path, monkeypatch):
+    """A class without presets, with an unknown representation or registered under another name than its own:
+    one error naming the class (they were AttributeError "module ... has no attribute 'PRESETS'", a KeyError
+    'euler' deep in the harness, and a checkpoint that did not load); a subclass of a shipped model in a module
+    of its own gets its base's presets."""
+    from beatlite import models
+    from beatlite.models.base import GestureModel
+    from beatlite.models.camn import PRESETS as CAMN_PRESETS
+
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    (tmp_path / "newcomer_models.py").write_text(
+        textwrap.dedent(
+            """
+            from beatlite.models.base import GestureModel
+            from beatlite.models.camn import CaMN
+
+            class NoPresets(GestureModel):
+                name = "no_presets"
+
+            class MyCaMN(CaMN):
+                name = "my_camn"
+            """
+        )
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import newcomer_models
+
+    with pytest.raises(
+        TypeError, match=r"NoPresets: no presets: set its class attribute presets .*newcomer_models"
+    ):
+        models.presets(newcomer_models.NoPresets)
+    assert models.presets(newcomer_models.MyCaMN) == {k: dict(v) for k, v in CAMN_PRESETS.items()}
+
+    with pytest.raises(
+        TypeError, match=r"Typo: representation must be one of \['dirvec126', 'euler141'\], got 'euler'"
+    ):
+
+        class Typo(GestureModel):
+            representation = "euler"
+
+    models.register_model("mine", "newcomer_models:MyCaMN")
+    with pytest.raises(
+        ValueError, match=r"'mine' is registered as newcomer_models:MyCaMN, whose name is 'my_camn'"
+    ):
+        models.build_model("mine")
+    with pytest.raises(
+        ValueError, match=r"CaMNConfig: preset must be one of \['paper', 'tiny'\], got 'smal'"
+    ):
+        models.build_model("camn", preset="smal")
+
+
+def test_a_notebook_cell_run_twice_registers_again(monkeypatch, metrics_restored):
+    """A cell that defines a model class and a metric function and registers them, run twice: the second run
+    replaces the entries (it raised "already registered" / "already a metric"); another class or function under
+    a taken name is still refused."""
+    from beatlite import models
+
+    scoring = metrics_restored
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    cell = textwrap.dedent(MODULE).replace('name = "seed_mean"', 'name = "cell_model"') + textwrap.dedent(
+        """
+        def cell_speed(positions):
+            return 1.0
+
+        register_model("cell_model", SeedMean)
+        register_metric("Cell speed", Metric("Cell speed", "test", None, None, cell_speed, "d"))
+        """
+    )
+    runs = []
+    for _ in range(2):
+        namespace = {"__name__": "__main__", "register_model": models.register_model}
+        namespace.update(register_metric=scoring.register_metric, Metric=scoring.Metric)
+        exec(compile(cell, "<cell>", "exec"), namespace)
+        runs.append(namespace)
+    assert models.model_class("cell_model") is runs[1]["SeedMean"] is not runs[0]["SeedMean"]
+    assert scoring.METRICS["Cell speed"].compute is runs[1]["cell_speed"]
+    with pytest.raises(ValueError, match="already registered"):
+        models.register_model("cell_model", "throwaway_model:SeedMean")
+    with pytest.raises(ValueError, match="already a metric"):
+        scoring.register_metric(
+            "Cell speed", scoring.Metric("Cell speed", "test", None, ("positions",), len, "d")
+        )

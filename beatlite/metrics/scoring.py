@@ -292,7 +292,7 @@ def evaluate(
             skipped[key] = f"needs {', '.join(missing)}"
             continue
         try:
-            value = float(bind_inputs(m.compute)(generated, truth, seed))
+            value = _one_number(key, bind_inputs(m.compute)(generated, truth, seed))
         except TooFewWindows as e:  # a defined metric that this test set is too small for: skipped, said why
             skipped[key] = str(e)
             continue
@@ -418,7 +418,8 @@ def register_metric(key: str, metric: Metric) -> None:
     Raises
     ------
     ValueError
-        ``key`` is already a metric, or ``metric.compute`` reads an input its ``needs`` does not list.
+        ``key`` is already another metric (the same one again, or its function defined again in a notebook cell
+        run twice, replaces it), or ``metric.compute`` reads an input its ``needs`` does not list.
 
     Examples
     --------
@@ -430,13 +431,56 @@ def register_metric(key: str, metric: Metric) -> None:
     {'Height (demo)': 1.0}
     >>> del METRICS["Height (demo)"]  # keep the registry as shipped
     """
-    if key in METRICS:
+    if key in METRICS and not _same_metric(METRICS[key], metric):
         raise ValueError(f"{key!r} is already a metric ({METRICS[key].describe})")
     if bind_inputs(metric.compute) is not metric.compute:
         unlisted = sorted(set(needs_of(metric.compute)) - set(metric.needs))
         if unlisted:
             raise ValueError(f"{key!r}: compute reads {unlisted}, which needs={metric.needs} does not list")
     METRICS[key] = metric
+
+
+def _same_metric(old: Metric, new: Metric) -> bool:
+    """``new`` equals ``old`` up to its ``compute`` being the same function defined again (same module and
+    qualified name: a notebook cell run twice)."""
+    a, b = old.compute, new.compute
+    same = a is b or (
+        (getattr(a, "__module__", None), getattr(a, "__qualname__", None))
+        == (getattr(b, "__module__", None), getattr(b, "__qualname__", 0))
+    )
+    return same and dataclasses.replace(old, compute=b) == new
+
+
+def _one_number(key: str, value: Any) -> float:
+    """``float(value)`` of a metric's result, or a ``TypeError`` naming the metric when it is not one real number
+    (``None`` from a missing ``return``, a per-take array, a complex value, a string).
+
+    Examples
+    --------
+    >>> _one_number("Speed", np.float32(2.5))
+    2.5
+    >>> _one_number("Speed", np.array([1.0, 2.0]))
+    Traceback (most recent call last):
+    ...
+    TypeError: metric 'Speed': compute returned an array of shape (2,), not one real number
+    """
+    shape = getattr(value, "shape", ())
+    if tuple(shape) != ():
+        raise TypeError(
+            f"metric {key!r}: compute returned an array of shape {tuple(shape)}, not one real number"
+        )
+    if (
+        value is None
+        or isinstance(value, (str, bytes, complex, np.complexfloating))
+        or "complex" in str(getattr(value, "dtype", ""))
+    ):
+        raise TypeError(f"metric {key!r}: compute returned {value!r}, not one real number")
+    try:
+        return float(value)
+    except (TypeError, ValueError) as error:
+        raise TypeError(
+            f"metric {key!r}: compute returned {type(value).__name__}, not one real number"
+        ) from error
 
 
 def _has(need: str, gen: Takes, truth: GroundTruth) -> bool:

@@ -61,7 +61,8 @@ def register_model(name: str, model: str | type[GestureModel]) -> None:
     Parameters
     ----------
     name : str
-        The registry name (stored in its checkpoints' config; ``GestureModel.name`` should equal it).
+        The registry name (stored in its checkpoints' config; ``GestureModel.name`` must equal it:
+        :func:`model_class` refuses a class whose ``name`` differs).
     model : str or GestureModel subclass
         ``"package.module:ClassName"`` (imported on first use, so torch stays lazy) or the class.
 
@@ -73,13 +74,23 @@ def register_model(name: str, model: str | type[GestureModel]) -> None:
     Examples
     --------
     >>> register_model("camn", "beatlite.models.camn:CaMN")  # the same entry again: a no-op
+
+    A class defined again under the same module and name (a notebook cell run twice) replaces its entry.
     """
     entry = tuple(model.split(":")) if isinstance(model, str) else model
     if isinstance(entry, tuple) and len(entry) != 2:
         raise ValueError(f"register_model: give 'package.module:ClassName', got {model!r}")
-    if name in MODELS and MODELS[name] != entry:
+    if name in MODELS and MODELS[name] != entry and not _redefined(MODELS[name], entry):
         raise ValueError(f"register_model: {name!r} is already registered as {MODELS[name]!r}")
     MODELS[name] = entry
+
+
+def _redefined(old: Any, new: Any) -> bool:
+    """Whether ``new`` is ``old`` defined again (same module and qualified name: a notebook cell run twice)."""
+    return all(hasattr(x, "__qualname__") for x in (old, new)) and (old.__module__, old.__qualname__) == (
+        new.__module__,
+        new.__qualname__,
+    )
 
 
 def model_class(name: str) -> type[GestureModel]:
@@ -88,24 +99,44 @@ def model_class(name: str) -> type[GestureModel]:
     Raises
     ------
     ValueError
-        Unknown name.
+        Unknown name, or a class whose ``name`` is not ``name``.
     """
     if name not in MODELS:
         raise ValueError(f"model name must be one of {sorted(MODELS)}, got {name!r}")
     entry = MODELS[name]
     if isinstance(entry, tuple):
         module_name, class_name = entry
-        return getattr(importlib.import_module(module_name), class_name)
+        entry = getattr(importlib.import_module(module_name), class_name)
+    if getattr(entry, "name", None) != name:  # its checkpoints store entry.name and load by it
+        raise ValueError(
+            f"model {name!r} is registered as {entry.__module__}:{entry.__qualname__}, whose name is "
+            f"{getattr(entry, 'name', None)!r}: set its class attribute name = {name!r}"
+        )
     return entry
 
 
 def presets(name: str | type[GestureModel]) -> dict[str, dict[str, Any]]:
     """Preset table of model ``name`` (a registry name or a model class; preset -> config field overrides).
 
-    The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module.
+    The class attribute ``presets`` when set, else the ``PRESETS`` dict of the model's module (or of the module of
+    the nearest base class that has one: a subclass of CaMN in a module of its own gets CaMN's).
+
+    Raises
+    ------
+    TypeError
+        No presets found (naming the class).
     """
     cls = model_class(name) if isinstance(name, str) else name
-    table = cls.presets if cls.presets is not None else importlib.import_module(cls.__module__).PRESETS
+    table = cls.presets
+    for klass in cls.__mro__ if table is None else ():  # the module of the class, else of a base it extends
+        table = getattr(importlib.import_module(klass.__module__), "PRESETS", None)
+        if table is not None or klass.__name__ == "GestureModel":
+            break
+    if table is None:
+        raise TypeError(
+            f"{cls.__name__}: no presets: set its class attribute presets (or a PRESETS dict in its module "
+            f"{cls.__module__}), at least {{'tiny': {{...}}}}"
+        )
     return {k: dict(v) for k, v in table.items()}
 
 

@@ -23,16 +23,19 @@ Contract (shared by CaMN, HA2G and the baselines; the harness in
 - class attributes ``name`` (registry name), ``representation`` (``"euler141"`` or
   ``"dirvec126"``), ``config_class`` (a dataclass with a ``preset`` field);
 - ``forward(batch) -> dict`` with at least ``"pose"``: (B, T, D) in the normalised
-  representation (for dirvec126 models too: the key is always ``"pose"``);
-- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` with a scalar ``"total"`` whose backward reaches
-  every generator parameter in every step (``torchrun`` training reduces gradients with
+  representation (for dirvec126 models too: the key is always ``"pose"``), in the batch's float dtype
+  (float32; a float64 buffer made from numpy would promote it); ``forward`` and ``losses`` leave the batch
+  unchanged (no in-place change, no key assigned: the losses and the harness read it after);
+- ``losses(batch, out, *, epoch) -> dict[str, Tensor]`` (tensors, not floats) with a scalar ``"total"``
+  whose backward reaches every generator parameter in every step (``torchrun`` training reduces gradients with
   DistributedDataParallel, which needs that; losses may call modules that ``forward`` does not);
 - the discriminator's parameters live in the ``discriminator`` child alone, the others in child modules;
 - ``discriminator``: an ``nn.Module`` or ``None``; when present,
   ``discriminator_losses(batch, out) -> dict`` with ``"total"`` and the harness runs a
   discriminator step whenever :meth:`GestureModel.adversarial_active` says so;
 - ``generate(batch) -> (B, T, D)``: inference seeded only by the first ``n_pre`` frames
-  of ``batch[target_key]`` (the later frames are zeroed before the forward pass);
+  of ``batch[target_key]`` (the later frames are zeroed before the forward pass), the same pose for the same
+  batch (randomness of eval mode drawn from a generator seeded from the config, restarted by ``reset()``);
 - ``to_config() -> dict`` / ``GestureModel.from_config(dict)`` for checkpoints;
 - optional ``prepare(train_windows, normalizers=None)``: called once by ``fit`` before training with the
   training window set (a numpy window dict or a :class:`~beatlite.data.store.StoreWindows`; read it
@@ -146,7 +149,7 @@ def config_from_preset(
         An override that is not a field of ``config_class``.
     """
     if preset not in presets:
-        raise ValueError(f"preset must be one of {sorted(presets)}, got {preset!r}")
+        raise ValueError(f"{config_class.__name__}: preset must be one of {sorted(presets)}, got {preset!r}")
     fields = {f.name for f in dataclasses.fields(config_class)}
     unknown = sorted(set(overrides) - fields)
     if unknown:
@@ -308,6 +311,15 @@ class GestureModel(nn.Module):
     """Why ``torch.compile``'s inductor cannot compile this model's training pass (``None``: it can);
     :func:`beatlite.train.fit` then refuses ``TrainConfig.compile`` modes that use it, naming this."""
     n_pre: int = N_PRE
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Refuse an unknown ``representation`` where the class is defined (it failed later as a bare
+        ``KeyError`` deep in the harness)."""
+        super().__init_subclass__(**kwargs)
+        if cls.representation not in REPRESENTATIONS:
+            raise TypeError(
+                f"{cls.__name__}: representation must be one of {sorted(REPRESENTATIONS)}, got {cls.representation!r}"
+            )
 
     def __init__(self, config: ModelConfig) -> None:
         super().__init__()

@@ -6,7 +6,8 @@ forward/backward pass can be unit-tested without the data pipeline.
 
 :func:`check_model` runs every rule of the :class:`~beatlite.models.base.GestureModel` contract on a
 model (in the spirit of scikit-learn's ``check_estimator``): shapes and seed-only generation on a batch of
-exactly its ``batch_keys``, finite losses whose backward reaches every parameter, determinism under a
+exactly its ``batch_keys`` (a key read beyond them named), the pose in the batch's dtype, the batch left unchanged,
+the same generation twice, finite losses whose backward reaches every parameter, determinism under a
 seed, the checkpoint round trip, a training pass that never reads the device back to the host, and (given a small window store) two training steps from the store that
 equal the in-memory route bit for bit, and two under bfloat16 autocast with CUDA's dtype rules.
 ``tests/test_models_contract.py`` runs it over the whole registry.
@@ -168,10 +169,74 @@ def _train_losses(model: Any, batch: dict[str, torch.Tensor]) -> dict[str, torch
     return model.losses(batch, model(batch), epoch=LATE_EPOCH)
 
 
+def _checked_losses(case: ModelCase, model: Any, batch: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    """:func:`_train_losses`, checked: a dict of tensors with a ``"total"``, and the batch unchanged."""
+    before = _snapshot(batch)
+    model.train()
+    out = _forward(case, model, batch)
+    losses = _reading(case, "losses", model.losses, batch, out, epoch=LATE_EPOCH)
+    _expect(
+        isinstance(losses, Mapping) and "total" in losses,
+        case,
+        f"losses must return a dict with 'total', got {sorted(losses) if isinstance(losses, Mapping) else losses}",
+    )
+    loose = [k for k, v in losses.items() if not isinstance(v, torch.Tensor)]
+    _expect(not loose, case, f"losses {loose} are not tensors (keep them as tensors: no .item() or float())")
+    _unchanged(case, batch, before, "forward or losses")
+    return losses
+
+
 def _expect(ok: Any, case: ModelCase, message: str) -> None:
     """Raise ``AssertionError`` naming the model when ``ok`` is false (kept under ``python -O``)."""
     if not bool(ok):
         raise AssertionError(f"{case.cls.__name__} ({case.preset}): {message}")
+
+
+def _reading(
+    case: ModelCase, what: str, fn: Any, batch: Mapping[str, torch.Tensor], *args: Any, **kw: Any
+) -> Any:
+    """``fn(batch, *args, **kw)``; a ``KeyError`` for a window key the batch lacks becomes an ``AssertionError``
+    naming the model, the key and the ``batch_keys`` that do not list it (``fit`` gives only those)."""
+    try:
+        return fn(batch, *args, **kw)
+    except KeyError as error:
+        key = error.args[0] if error.args else None
+        if key not in FAKE_SHAPES or key in batch:
+            raise
+        where = "input_keys (or keys_for)" if what == "forward" else "batch_keys (the losses read more)"
+        raise AssertionError(
+            f"{case.cls.__name__} ({case.preset}): {what} reads batch[{key!r}], which batch_keys(config) = "
+            f"{tuple(batch)} does not list: add it to {where}"
+        ) from error
+
+
+def _forward(case: ModelCase, model: Any, batch: Mapping[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    """``model(batch)``, checked to be a dict holding a ``"pose"`` tensor."""
+    out = _reading(case, "forward", model, batch)
+    _expect(
+        isinstance(out, Mapping), case, f"forward must return a dict with 'pose', got {type(out).__name__}"
+    )
+    _expect("pose" in out, case, f"forward returned no 'pose' (keys: {sorted(out)})")
+    _expect(isinstance(out["pose"], torch.Tensor), case, f"out['pose'] is a {type(out['pose']).__name__}")
+    return out
+
+
+def _unchanged(
+    case: ModelCase, batch: Mapping[str, torch.Tensor], before: Mapping[str, torch.Tensor], what: str
+) -> None:
+    """Every key of ``before`` still in ``batch`` with the same values: ``what`` did not change the batch (in place
+    or by assigning a key), which the losses and the harness read after it."""
+    changed = [k for k, v in before.items() if k not in batch or not torch.equal(batch[k], v)]
+    _expect(
+        not changed,
+        case,
+        f"{what} changed the batch's {changed} (in place or by assigning the key): "
+        "the losses and the harness read the batch after it; work on a copy",
+    )
+
+
+def _snapshot(batch: Mapping[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    return {k: v.clone() for k, v in batch.items()}
 
 
 def _finite(values: Mapping[str, Any]) -> list[str]:
@@ -184,20 +249,42 @@ def _finite(values: Mapping[str, Any]) -> list[str]:
 
 
 def check_shapes(case: ModelCase) -> None:
-    """``batch_keys`` covers ``keys_for`` and the target; on a batch of exactly those keys ``forward`` and
-    ``generate`` give a finite (B, T, D) pose, and ``generate`` reads only the ``n_pre`` seed frames (and
-    leaves a model in training mode there)."""
+    """``batch_keys`` covers ``keys_for`` and the target; on a batch of exactly those keys ``forward`` (a dict)
+    and ``generate`` give a finite (B, T, D) pose in the batch's dtype, leave the batch unchanged, ``generate``
+    gives the same pose twice and reads only the ``n_pre`` seed frames (and leaves a model in training mode
+    there)."""
     model = _prepared(case, case.build())
     keys = set(type(model).batch_keys(model.config))
     missing = (set(type(model).keys_for(model.config)) | {model.target_key}) - keys
     _expect(not missing, case, f"batch_keys lacks {sorted(missing)}")
     batch = case.batch(model)
+    before = _snapshot(batch)
     b, t = batch[model.target_key].shape[:2]
-    pose = model(batch)["pose"]
-    _expect(tuple(pose.shape) == (b, t, model.pose_dim), case, f"forward pose has shape {tuple(pose.shape)}")
+    pose = _forward(case, model, batch)["pose"]
+    _unchanged(case, batch, before, "forward")
+    _expect(
+        tuple(pose.shape) == (b, t, model.pose_dim),
+        case,
+        f"forward pose has shape {tuple(pose.shape)}, not (B, T, D) = {(b, t, model.pose_dim)}",
+    )
+    want = batch[model.target_key].dtype
+    wide = [n for n, v in (*model.named_parameters(), *model.named_buffers()) if v.dtype == torch.float64]
+    _expect(
+        pose.dtype == want,
+        case,
+        f"forward pose is {pose.dtype}, the batch's {model.target_key!r} {want}"
+        + (f" (float64 parameters or buffers, from numpy?: {wide[:5]})" if wide else ""),
+    )
     _expect(torch.isfinite(pose).all(), case, "forward pose is not finite")
     seeded = _reset(model).generate(batch)
+    _unchanged(case, batch, before, "generate")
     _expect(tuple(seeded.shape) == (b, t, model.pose_dim), case, f"generate gave shape {tuple(seeded.shape)}")
+    _expect(
+        torch.equal(_reset(model).generate(batch), seeded),
+        case,
+        "generate gives another pose for the same batch: draw any randomness of eval mode from a "
+        "torch.Generator seeded from the config and restarted by reset() (as A2G and DiffGesture do)",
+    )
     later = dict(batch)
     later[model.target_key] = batch[model.target_key].clone()
     later[model.target_key][:, model.n_pre :] += 1.0
@@ -206,11 +293,12 @@ def check_shapes(case: ModelCase) -> None:
 
 
 def check_gradients(case: ModelCase) -> None:
-    """A finite scalar ``"total"`` whose backward gives every generator parameter a finite, non-zero
-    gradient (adversarial terms on), and a discriminator loss that does the same for the discriminator."""
+    """``losses`` returns a dict of tensors (the batch unchanged) with a finite scalar ``"total"`` whose backward
+    gives every generator parameter a finite, non-zero gradient (adversarial terms on), and a discriminator loss
+    that does the same for the discriminator."""
     model = _prepared(case, case.build())
     batch = case.batch(model)
-    losses = _train_losses(model, batch)
+    losses = _checked_losses(case, model, batch)
     _expect(losses["total"].ndim == 0, case, "losses['total'] is not a scalar")
     _expect(not _finite(losses), case, f"non-finite losses {_finite(losses)}")
     names = {id(p): n for n, p in model.named_parameters()}

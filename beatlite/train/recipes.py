@@ -257,16 +257,37 @@ Adding a model: :func:`beatlite.models.register_model`, then :func:`register_rec
 def register_recipe(name: str, recipe: Recipe) -> None:
     """Add checkpoint ``name`` trained by ``recipe`` to :data:`RECIPES` (its row joins the tables).
 
+    Checked here, before any data work: the model's ``tiny`` config with the recipe's ``overrides`` and the
+    training settings (:class:`~beatlite.train.TrainConfig`'s checks) are built once (this imports the model).
+
     Raises
     ------
     ValueError
-        The recipe's model is not registered, or ``name`` is taken by another recipe.
+        The recipe's model is not registered; ``name`` is taken by another recipe; its ``label`` is another
+        recipe's or a ground-truth row's (labels key the results tables and the seed record); an override that
+        is not a field of the model's config; a training setting ``TrainConfig`` refuses.
     """
+    from beatlite.models.base import config_from_preset
+    from beatlite.train.evaluation import GROUND_TRUTH, GROUND_TRUTH_141
 
     if recipe.model not in models.MODELS:
         raise ValueError(f"register_recipe: model {recipe.model!r} is not registered (register_model first)")
     if name in RECIPES and RECIPES[name] != recipe:
         raise ValueError(f"register_recipe: {name!r} is already a recipe ({RECIPES[name]})")
+    owner = next((n for n, r in RECIPES.items() if r.label == recipe.label and n != name), None)
+    if owner is not None or recipe.label in (GROUND_TRUTH, GROUND_TRUTH_141):
+        raise ValueError(
+            f"register_recipe: {name!r}: label {recipe.label!r} is already the row of {owner or 'the ground truth'} "
+            "(a label keys the results tables and the seed record: give another)"
+        )
+    try:
+        cls = model_class(recipe.model)
+        config_from_preset(cls.config_class, presets(recipe.model), "tiny", **dict(recipe.overrides))
+        TrainConfig(
+            epochs=recipe.epochs, batch_size=recipe.batch_size, lr=recipe.lr, lr_schedule=recipe.lr_schedule
+        )
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"register_recipe: {name!r}: {error}") from error
     RECIPES[name] = recipe
 
 
