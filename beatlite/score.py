@@ -637,7 +637,6 @@ def load_split(data: str | Path | None = None, split: str = "test", *, protocol:
     test = load_test_set(index, split=split)
     if protocol == "clips":
         test = clip_test_set(test)
-    test.folder = str(folder.resolve())
     return test
 
 
@@ -676,7 +675,8 @@ def score_folder(
     allow_missing : bool
         Score the takes that have a prediction when some have none (default: an error).
     test : EvaluationSet, optional
-        The loaded split (instead of ``data`` and ``split``; its ``folder`` attribute names the data folder).
+        The loaded split (instead of ``data`` and ``split``; :attr:`~beatlite.train.testset.EvaluationSet.folder`
+        names the data folder).
     progress : bool
         tqdm progress bars on stderr.
 
@@ -879,7 +879,7 @@ def _score(
     intervals = bootstrap_intervals(generated, truth, scored, n=bootstrap, seed=seed, progress=progress)
     info = {
         **info,
-        "data": getattr(test, "folder", ""),
+        "data": test.folder,
         "split": test.split,
         "takes": list(test.takes),
         "frames": int(sum(len(d) for d in test.gt_directions)),

@@ -105,6 +105,19 @@ def test_import_does_not_import_torch():
     subprocess.run([sys.executable, "-c", code], check=True, env={**os.environ, "PYTHONPATH": str(REPO)})
 
 
+def test_a_split_loaded_directly_names_its_data_folder(test_set):
+    """``score_folder(..., test=load_test_set(index))`` names the data folder like ``load_split`` does (its caption
+    said "the `test` split of ``")."""
+    from beatlite.data.index import index_folder
+    from beatlite.train.testset import load_test_set
+
+    direct = load_test_set(index_folder(REPO / "data_samples"))
+    assert direct.folder == test_set.folder == str((REPO / "data_samples").resolve())
+    result = self_check(test=direct, metrics=["PCK"])
+    assert result.info["data"] == direct.folder
+    assert f"split of `{direct.folder}`" in result.to_markdown()
+
+
 # ----------------------------------------------------------------------------- round trip
 @pytest.mark.parametrize("name", REPRESENTATIVE)
 def test_exported_then_scored_equals_the_in_library_evaluation(name, test_set, library, tmp_path):

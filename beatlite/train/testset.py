@@ -78,6 +78,9 @@ class EvaluationSet:
     mean_speed : (43,) float64, cm/s, optional
         Mean speed of each TED-43 joint over the train windows in the common positions space (EMAGE's
         ``avg_vel``, for ``"BC (emage)"``).
+    folder : str
+        The data folder the takes were read from (the index's root, absolute; "" = unknown): the scores'
+        captions name it.
     """
 
     takes: list[str]
@@ -95,6 +98,7 @@ class EvaluationSet:
     fingerprint: str = ""
     train_speakers: tuple[int, ...] = ()
     mean_speed: np.ndarray | None = None
+    folder: str = ""
 
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
@@ -175,6 +179,7 @@ def load_test_set(
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=train.fingerprint,
+        folder="" if getattr(index, "root", None) is None else str(Path(index.root).resolve()),
         train_speakers=tuple(
             sorted({int(store.takes[i].meta["speaker"]) for i in np.unique(train.take_ids)})
         ),
