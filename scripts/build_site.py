@@ -19,8 +19,9 @@ metadata is then taken from ``notebooks/``, so retagging needs no new run); the 
 ``make run`` does. The Colab links need the GitHub repository: ``--colab-repo owner/name`` (``make site
 COLAB_REPO=owner/name``), else the ``origin`` remote when it is on GitHub; without one the index says how to
 add them. ``--set-repo owner/name`` writes the repository into every notebook's Colab cell (commit it once).
-``--tag-slides`` adds the Colab cell where it is missing and gives each cell without slide metadata a slide type
-by the rules of :func:`tag_slides`.
+``--tag-slides`` adds the Colab cell where it is missing, splits a Markdown cell at each section heading inside it
+(:func:`split_headings`: every ``## `` section starts a slide, every ``### `` one a subslide) and gives each cell
+without slide metadata a slide type by the rules of :func:`tag_slides`.
 """
 
 from __future__ import annotations
@@ -133,6 +134,52 @@ def github_repo(setting: str | None = None, cwd: Path = REPO) -> str | None:
 def colab_url(repo: str, notebook: str, branch: str = "main") -> str:
     """The "Open in Colab" address of ``notebooks/<notebook>`` on GitHub."""
     return f"https://colab.research.google.com/github/{repo}/blob/{branch}/notebooks/{notebook}"
+
+
+_HEADING = re.compile(r"^(#{2,3}) ")
+_FENCE = re.compile(r"^ {0,3}(```|~~~)")
+
+
+def split_headings(nb) -> int:
+    """Split every Markdown cell at each ``## `` / ``### `` heading that is not its first line; return how many
+    cells were added.
+
+    A slide starts at a cell, so a section heading in the middle of a cell would land in the middle of the
+    previous section's slide, and reveal.js's right arrow would skip that section (it would sit below the
+    previous one). The new cell starting at a ``## `` heading is a ``slide``, at a ``### `` heading a
+    ``subslide`` (a skipped cell's parts stay skipped); it keeps the cell's tags. Headings inside fenced code
+    stay where they are.
+    """
+    from nbformat.v4 import new_markdown_cell
+
+    added, cells = 0, []
+    for cell in nb.cells:
+        if cell.cell_type != "markdown":
+            cells.append(cell)
+            continue
+        parts, fenced = [[]], False
+        for line in cell.source.splitlines(keepends=True):
+            if _FENCE.match(line):
+                fenced = not fenced
+            if not fenced and _HEADING.match(line) and "".join(parts[-1]).strip():
+                parts.append([])
+            parts[-1].append(line)
+        cells.append(cell)
+        if len(parts) == 1:
+            continue
+        texts = ["".join(p).strip("\n") for p in parts]
+        cell.source = texts[0]
+        for text in texts[1:]:
+            kind = cell.metadata.get("slideshow", {}).get("slide_type")
+            if kind not in ("skip", "notes"):
+                kind = "slide" if text.startswith("## ") else "subslide"
+            metadata = {"slideshow": {"slide_type": kind}}
+            if "tags" in cell.metadata:
+                metadata["tags"] = list(cell.metadata["tags"])
+            cells.append(new_markdown_cell(text, metadata=metadata))
+            added += 1
+    nb.cells = cells
+    return added
 
 
 def tag_slides(nb) -> int:
@@ -447,7 +494,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=int, default=900, help="per-cell timeout when a notebook runs")
     parser.add_argument("--set-repo", metavar="OWNER/NAME", help="write the repository into the Colab cells")
     parser.add_argument(
-        "--tag-slides", action="store_true", help="add the Colab cell, give untagged cells a slide type"
+        "--tag-slides",
+        action="store_true",
+        help="add the Colab cell, split cells at headings, give untagged cells a slide type",
     )
     parser.add_argument("notebooks", nargs="*", type=Path, help="notebooks (default: all, in order)")
     args = parser.parse_args(argv)
@@ -461,7 +510,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.tag_slides:
             for path in paths:
                 nb = nbformat.read(path, as_version=4)
-                if (count := add_colab_cell(nb) + tag_slides(nb)) > 0:
+                if (count := add_colab_cell(nb) + split_headings(nb) + tag_slides(nb)) > 0:
                     nbformat.write(nb, path)
                 print(f"[site] {path.name}: {count} cells tagged")
         return 0

@@ -238,6 +238,66 @@ def test_tag_slides_rules():
     ]
 
 
+def test_split_headings_starts_a_slide_at_every_section_heading():
+    """A heading in the middle of a Markdown cell would sit mid-slide under the previous section (and the right
+    arrow would skip its section): the cell is split there, ``## `` a slide, ``### `` a subslide."""
+    site = _site()
+    nb = new_notebook(
+        cells=[
+            new_markdown_cell("# T\n\n**Goals**\n- g", metadata={"slideshow": {"slide_type": "slide"}}),
+            new_markdown_cell(
+                "End of 1.\n\n## 2. Two\n\nIntro.\n\n### 2.1 Sub\n\nBody.",
+                metadata={"slideshow": {"slide_type": "subslide"}},
+            ),
+            new_code_cell("x = 1"),
+            new_markdown_cell("## Summary\n\n- a\n\n## Exercises\n\nDo them."),
+            new_markdown_cell("Shell:\n\n```\n## not a heading\n```\nafter"),
+            new_markdown_cell(
+                "Answer.\n\n## Hidden", metadata={"tags": ["solution"], "slideshow": {"slide_type": "skip"}}
+            ),
+        ]
+    )
+    assert site.split_headings(nb) == 4
+    got = [
+        (c.source, c.metadata.get("slideshow", {}).get("slide_type"), c.metadata.get("tags"))
+        for c in nb.cells
+    ]
+    assert got == [
+        ("# T\n\n**Goals**\n- g", "slide", None),
+        ("End of 1.", "subslide", None),
+        ("## 2. Two\n\nIntro.", "slide", None),
+        ("### 2.1 Sub\n\nBody.", "subslide", None),
+        ("x = 1", None, None),
+        ("## Summary\n\n- a", None, None),
+        ("## Exercises\n\nDo them.", "slide", None),
+        ("Shell:\n\n```\n## not a heading\n```\nafter", None, None),
+        ("Answer.", "skip", ["solution"]),
+        ("## Hidden", "skip", ["solution"]),
+    ]
+    assert site.split_headings(nb) == 0  # once split, nothing more to do
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_every_section_heading_starts_a_slide(path):
+    """Each ``## `` section of a notebook is a slide of its own (the right arrow reaches it) and each ``### ``
+    subsection a subslide: a heading is always the first line of its Markdown cell (``--tag-slides`` splits)."""
+    nb = nbformat.read(path, as_version=4)
+    kinds = {"## ": "slide", "### ": "subslide"}
+    wrong = []
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "markdown":
+            continue
+        fenced = False
+        for n, line in enumerate(cell.source.lstrip("\n").splitlines()):
+            fenced ^= bool(re.match(r" {0,3}(```|~~~)", line))
+            level = next((k for k in kinds if line.startswith(k)), None)
+            if level and not fenced and n > 0:
+                wrong.append(f"cell {i}: {line[:50]!r} in the middle of the cell")
+            elif level and n == 0 and cell.metadata.get("slideshow", {}).get("slide_type") != kinds[level]:
+                wrong.append(f"cell {i}: {line[:50]!r} is not a {kinds[level]}")
+    assert not wrong, f"run `python scripts/build_site.py --tag-slides`: {wrong}"
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_notebook_slide_metadata_is_valid(path):
     """Every cell has a slide type RISE and nbconvert know; a title slide; setup, checks and answers skipped."""
