@@ -14,9 +14,9 @@ Writes:
 - ``student/NN_name.ipynb`` (the copies without ``solution`` cells), ``guide.html`` (``docs/teaching.md``) and
   ``figures/`` with ``figures.html``.
 
-Executed notebooks are taken from ``BUILD/notebooks/`` when their cells' sources equal the notebook's (the slide
-metadata is then taken from ``notebooks/``, so retagging needs no new run); the others are executed first as
-``make run`` does. The Colab links need the GitHub repository: ``--colab-repo owner/name`` (``make site
+Executed notebooks are taken from ``BUILD/notebooks/`` when their cells' sources equal the notebook's and that run
+was complete (the slide metadata is then taken from ``notebooks/``, so retagging needs no new run); the others are
+executed first as ``make run`` does. The exit status is 1 when a notebook failed (the site is still written). The Colab links need the GitHub repository: ``--colab-repo owner/name`` (``make site
 COLAB_REPO=owner/name``), else the ``origin`` remote when it is on GitHub; without one the index says how to
 add them. ``--set-repo owner/name`` writes the repository into every notebook's Colab cell (commit it once).
 ``--tag-slides`` adds the Colab cell where it is missing, splits a Markdown cell at each section heading inside it
@@ -263,16 +263,32 @@ def header(nb) -> dict:
     }
 
 
+def run_failure(nb) -> str | None:
+    """Why an executed notebook is not a complete run (``None`` if it is): its first code cell that raised (unless
+    tagged ``raises-exception``) or that never ran (the kernel died or a cell timed out before it)."""
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "code" or not cell.source.strip():
+            continue
+        errors = [o for o in cell.get("outputs", []) if o.get("output_type") == "error"]
+        if errors and "raises-exception" not in _tags(cell):
+            return f"cell {i} raised {errors[0].get('ename', 'an error')}"
+        if cell.get("execution_count") is None:
+            return f"cell {i} did not run"
+    return None
+
+
 def executed_notebook(source: Path, build: Path, timeout: int = 900):
-    """The executed copy of ``source``: ``build/notebooks/<name>`` if its cells have the same sources (slide
-    metadata taken from ``source``), else executed now as ``make run`` does. Returns ``(nb, reused)``."""
+    """The executed copy of ``source``: ``build/notebooks/<name>`` if its cells have the same sources and that run
+    was complete (:func:`run_failure`; slide metadata taken from ``source``), else executed now as ``make run``
+    does. Returns ``(nb, reused)``."""
     import nbformat
 
     nb = nbformat.read(source, as_version=4)
     done = build / "notebooks" / source.name
     if done.is_file():
         old = nbformat.read(done, as_version=4)
-        if [(c.cell_type, c.source) for c in old.cells] == [(c.cell_type, c.source) for c in nb.cells]:
+        same = [(c.cell_type, c.source) for c in old.cells] == [(c.cell_type, c.source) for c in nb.cells]
+        if same and run_failure(old) is None:
             for new, cell in zip(nb.cells, old.cells):
                 cell.metadata = new.metadata
             return old, True
@@ -395,7 +411,8 @@ def build_site(
 ) -> dict:
     """Write the site into ``out`` from the notebooks (executed ones from ``build/notebooks/`` when current).
 
-    Returns a summary: ``{"lectures": [names], "executed": [names run now], "colab": bool}``.
+    Returns a summary: ``{"lectures": [names], "executed": [names run now], "failed": [names whose run failed:
+    their pages show the error], "colab": bool}``.
     """
 
     runner = _load("run_notebooks")
@@ -410,11 +427,14 @@ def build_site(
         (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
     (out / "assets" / "site.css").write_text(_STYLE, encoding="utf-8")
 
-    rows, executed, stale_cells = [], [], []
+    rows, executed, failed, stale_cells = [], [], [], []
     for source in notebooks:
         nb, reused = executed_notebook(source, build, timeout)
         if not reused:
             executed.append(source.stem)
+        if why := run_failure(nb):
+            failed.append(source.stem)
+            print(f"[site] {source.name} FAILED ({why}): its page and slides show the error", flush=True)
         if repo and notebook_repo(nb) not in (None, repo):
             stale_cells.append(source.name)
         (out / "lectures" / f"{source.stem}.html").write_text(runner.export_html(nb), encoding="utf-8")
@@ -476,7 +496,12 @@ def build_site(
         f"<th>Colab</th></tr></thead><tbody>{''.join(lines)}</tbody></table>{colab_note}"
     )
     (out / "index.html").write_text(_page("beatlite course", body), encoding="utf-8")
-    return {"lectures": [s.stem for s, _ in rows], "executed": executed, "colab": bool(repo)}
+    return {
+        "lectures": [s.stem for s, _ in rows],
+        "executed": executed,
+        "failed": failed,
+        "colab": bool(repo),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -525,7 +550,12 @@ def main(argv: list[str] | None = None) -> int:
         f"({len(summary['executed'])} executed now), Colab links {'on' if summary['colab'] else 'off'}"
     )
     print(json.dumps(summary["executed"]))
-    return 0
+    if summary["failed"]:
+        print(
+            f"[site] {len(summary['failed'])} notebooks failed: {', '.join(summary['failed'])}",
+            file=sys.stderr,
+        )
+    return 1 if summary["failed"] else 0
 
 
 if __name__ == "__main__":

@@ -93,8 +93,10 @@ def built(tmp_path_factory):
     nbformat.write(second, notebooks / "02_beta.ipynb")
 
     executed = nbformat.from_dict(first)  # as make run leaves it, but written before the slides were tagged
-    for cell in executed.cells:
+    for n, cell in enumerate(executed.cells):
         cell.metadata.pop("slideshow", None)
+        if cell.cell_type == "code":
+            cell.execution_count = n
         if cell.source == "print(x * 2)":
             cell.outputs = [
                 new_output("stream", name="stdout", text="PRINTED-42\n"),
@@ -107,6 +109,40 @@ def built(tmp_path_factory):
     return root / "site", summary, paths, build
 
 
+def test_a_failed_run_is_not_reused_and_fails_the_build(tmp_path, monkeypatch, capsys):
+    """An executed copy left by a failed ``make run`` (an error output) is run again, not put on the site as it is;
+    a notebook that fails now is on the site with its error, and the build exits 1 naming it."""
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "unused"))  # main() sets these two: restored after
+    monkeypatch.setenv("BEATLITE_INTERACTIVE", "off")
+    notebooks, build = tmp_path / "notebooks", tmp_path / "build"
+    notebooks.mkdir()
+    (build / "notebooks").mkdir(parents=True)
+    good, bad = _lecture("01", "Alpha", "g", 10), _lecture("02", "Beta", "g", 10)
+    next(c for c in bad.cells if c.source == "print(x * 2)").source = "print(x * 2)\n1 / 0"
+    nbformat.write(good, notebooks / "01_alpha.ipynb")
+    nbformat.write(bad, notebooks / "02_beta.ipynb")
+    stale = nbformat.from_dict(good)  # what a make run that failed in this cell left behind
+    for cell in stale.cells:
+        if cell.cell_type == "code":
+            cell.execution_count = 1
+        if cell.source == "print(x * 2)":
+            cell.outputs = [
+                new_output("error", ename="OSError", evalue="flaky", traceback=["OSError: flaky"])
+            ]
+    nbformat.write(stale, build / "notebooks" / "01_alpha.ipynb")
+    assert _site().run_failure(stale) == "cell 4 raised OSError"
+
+    paths = [str(notebooks / "01_alpha.ipynb"), str(notebooks / "02_beta.ipynb")]
+    status = _site().main(["--build", str(build), "--out", str(tmp_path / "site"), *paths])
+    out = capsys.readouterr()
+    assert status == 1, out.out + out.err
+    assert "1 notebooks failed: 02_beta" in out.err
+    assert "02_beta.ipynb FAILED (cell 4 raised ZeroDivisionError)" in out.out
+    assert '["01_alpha", "02_beta"]' in out.out  # both executed now: the failed copy of 01 was not reused
+    assert "OSError" not in (tmp_path / "site" / "lectures" / "01_alpha.html").read_text()
+    assert "ZeroDivisionError" in (tmp_path / "site" / "lectures" / "02_beta.html").read_text()
+
+
 def _links(page: Path) -> list[tuple[str, str]]:
     """``(tag, url)`` of every link, image, style sheet and script of a page."""
     text = page.read_text(encoding="utf-8")
@@ -115,7 +151,12 @@ def _links(page: Path) -> list[tuple[str, str]]:
 
 def test_site_reuses_executed_notebooks_and_runs_the_others(built):
     site, summary, _, build = built
-    assert summary == {"lectures": ["01_alpha", "02_beta"], "executed": ["02_beta"], "colab": False}
+    assert summary == {
+        "lectures": ["01_alpha", "02_beta"],
+        "executed": ["02_beta"],
+        "failed": [],
+        "colab": False,
+    }
     assert "PRINTED-42" in (site / "lectures" / "01_alpha.html").read_text()  # the stored output, not a rerun
     assert (build / "notebooks" / "02_beta.ipynb").is_file()
     ran = nbformat.read(build / "notebooks" / "02_beta.ipynb", as_version=4)
