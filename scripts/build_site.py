@@ -411,14 +411,22 @@ def build_site(
 ) -> dict:
     """Write the site into ``out`` from the notebooks (executed ones from ``build/notebooks/`` when current).
 
+    The site's own entries in ``out`` (``index.html``, ``guide.html``, ``figures.html`` and the folders
+    ``lectures``, ``slides``, ``student``, ``figures``, ``assets``) are replaced; anything else there is kept.
+
     Returns a summary: ``{"lectures": [names], "executed": [names run now], "failed": [names whose run failed:
     their pages show the error], "colab": bool}``.
     """
 
     runner = _load("run_notebooks")
-    if out.exists():
-        shutil.rmtree(out)
-    for sub in ("lectures", "slides", "student", "figures", "assets"):
+    subfolders = ("lectures", "slides", "student", "figures", "assets")
+    for name in (*subfolders, "index.html", "guide.html", "figures.html"):  # only what a build writes: `out`
+        old = out / name  # may be build/ itself, whose notebooks, caches and lab/ work stay
+        if old.is_dir() and not old.is_symlink():
+            shutil.rmtree(old)
+        elif old.exists() or old.is_symlink():
+            old.unlink()
+    for sub in subfolders:
         (out / sub).mkdir(parents=True, exist_ok=True)
     reveal = reveal_dir()
     for rel in _REVEAL_FILES:

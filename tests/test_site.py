@@ -143,6 +143,34 @@ def test_a_failed_run_is_not_reused_and_fails_the_build(tmp_path, monkeypatch, c
     assert "ZeroDivisionError" in (tmp_path / "site" / "lectures" / "02_beta.html").read_text()
 
 
+def test_a_site_written_into_the_build_folder_keeps_the_other_files(tmp_path):
+    """``--out build`` (the site beside make run's outputs) replaces only the site's own files: the executed
+    notebooks, caches and a student's work in ``lab/`` stay; a page left by an earlier build goes."""
+    notebooks, build = tmp_path / "notebooks", tmp_path / "build"
+    notebooks.mkdir()
+    (build / "notebooks").mkdir(parents=True)
+    (build / "lab").mkdir()
+    (build / "lab" / "01_alpha.ipynb").write_text("my work")
+    (build / "results.md").write_text("# beatlite results")
+    (build / "lectures").mkdir()
+    (build / "lectures" / "00_renamed.html").write_text("stale")
+    nb = _lecture("01", "Alpha", "g", 10)
+    nbformat.write(nb, notebooks / "01_alpha.ipynb")
+    for n, cell in enumerate(nb.cells):  # executed: reused, nothing runs
+        if cell.cell_type == "code":
+            cell.execution_count = n
+    nbformat.write(nb, build / "notebooks" / "01_alpha.ipynb")
+
+    summary = _site().build_site(
+        build, build, [notebooks / "01_alpha.ipynb"], guide=REPO / "docs" / "teaching.md"
+    )
+    assert summary["executed"] == [] and (build / "index.html").is_file()
+    assert (build / "lab" / "01_alpha.ipynb").read_text() == "my work"
+    assert (build / "results.md").is_file() and (build / "notebooks" / "01_alpha.ipynb").is_file()
+    assert not (build / "lectures" / "00_renamed.html").exists()
+    assert (build / "lectures" / "01_alpha.html").is_file()
+
+
 def _links(page: Path) -> list[tuple[str, str]]:
     """``(tag, url)`` of every link, image, style sheet and script of a page."""
     text = page.read_text(encoding="utf-8")
