@@ -85,6 +85,7 @@ __all__ = [
     "load_split",
     "main",
     "match_predictions",
+    "mean_interval",
     "read_prediction",
     "score_folder",
     "self_check",
@@ -1011,6 +1012,47 @@ def bootstrap_intervals(
             tuple(float(x) for x in np.percentile(scored, [q, 100 - q])) if len(scored) else (math.nan,) * 2
         )
     return out
+
+
+def mean_interval(values: Any, n: int, seed: int = 0, *, level: float = 0.95) -> np.ndarray:
+    """Percentile interval of the mean of one value per take over ``n`` resamples of the takes.
+
+    What :func:`bootstrap_intervals` gives a metric that is a mean over takes, on the values alone (the reference
+    of notebook 09's exercise 3): each resample draws ``K`` of the ``K`` values with replacement by
+    ``rng.integers(K, size=K)`` from ``rng = numpy.random.default_rng(seed)``, in order, and takes their mean.
+
+    Parameters
+    ----------
+    values : (K,) float
+        One value per take.
+    n : int
+        Resamples (at least 1).
+    seed : int
+    level : float
+        Coverage of the central interval (0.95: the 2.5th and 97.5th percentiles).
+
+    Returns
+    -------
+    (2,) float64
+        ``[low, high]``.
+
+    Examples
+    --------
+    >>> mean_interval([2.0, 2.0, 2.0], 50).tolist()  # every resample has the same mean
+    [2.0, 2.0]
+    >>> low, high = mean_interval(np.arange(8.0), 2000)
+    >>> bool(low < 3.5 < high)
+    True
+    """
+    x = np.asarray(values, dtype=np.float64)
+    if x.ndim != 1 or len(x) == 0 or n < 1:
+        raise ValueError(
+            f"mean_interval needs a non-empty 1-D array and n >= 1, got shape {x.shape} and n={n}"
+        )
+    rng = np.random.default_rng(seed)
+    means = [x[rng.integers(len(x), size=len(x))].mean() for _ in range(n)]
+    q = 50 * (1 - level)
+    return np.percentile(means, [q, 100 - q])
 
 
 def _pick(xs: list[Any] | None, idx: np.ndarray) -> list[Any] | None:

@@ -14,13 +14,14 @@ Writes:
 - ``student/NN_name.ipynb`` (the copies without ``solution`` cells), ``guide.html`` (``docs/teaching.md``) and
   ``figures/`` with ``figures.html``.
 
-Executed notebooks are taken from ``BUILD/notebooks/`` when their cells' sources equal the notebook's (the slide
-metadata is then taken from ``notebooks/``, so retagging needs no new run); the others are executed first as
-``make run`` does. The Colab links need the GitHub repository: ``--colab-repo owner/name`` (``make site
+Executed notebooks are taken from ``BUILD/notebooks/`` when their cells' sources equal the notebook's and that run
+was complete (the slide metadata is then taken from ``notebooks/``, so retagging needs no new run); the others are
+executed first as ``make run`` does. The exit status is 1 when a notebook failed (the site is still written). The Colab links need the GitHub repository: ``--colab-repo owner/name`` (``make site
 COLAB_REPO=owner/name``), else the ``origin`` remote when it is on GitHub; without one the index says how to
 add them. ``--set-repo owner/name`` writes the repository into every notebook's Colab cell (commit it once).
-``--tag-slides`` adds the Colab cell where it is missing and gives each cell without slide metadata a slide type
-by the rules of :func:`tag_slides`.
+``--tag-slides`` adds the Colab cell where it is missing, splits a Markdown cell at each section heading inside it
+(:func:`split_headings`: every ``## `` section starts a slide, every ``### `` one a subslide) and gives each cell
+without slide metadata a slide type by the rules of :func:`tag_slides`.
 """
 
 from __future__ import annotations
@@ -135,6 +136,52 @@ def colab_url(repo: str, notebook: str, branch: str = "main") -> str:
     return f"https://colab.research.google.com/github/{repo}/blob/{branch}/notebooks/{notebook}"
 
 
+_HEADING = re.compile(r"^(#{2,3}) ")
+_FENCE = re.compile(r"^ {0,3}(```|~~~)")
+
+
+def split_headings(nb) -> int:
+    """Split every Markdown cell at each ``## `` / ``### `` heading that is not its first line; return how many
+    cells were added.
+
+    A slide starts at a cell, so a section heading in the middle of a cell would land in the middle of the
+    previous section's slide, and reveal.js's right arrow would skip that section (it would sit below the
+    previous one). The new cell starting at a ``## `` heading is a ``slide``, at a ``### `` heading a
+    ``subslide`` (a skipped cell's parts stay skipped); it keeps the cell's tags. Headings inside fenced code
+    stay where they are.
+    """
+    from nbformat.v4 import new_markdown_cell
+
+    added, cells = 0, []
+    for cell in nb.cells:
+        if cell.cell_type != "markdown":
+            cells.append(cell)
+            continue
+        parts, fenced = [[]], False
+        for line in cell.source.splitlines(keepends=True):
+            if _FENCE.match(line):
+                fenced = not fenced
+            if not fenced and _HEADING.match(line) and "".join(parts[-1]).strip():
+                parts.append([])
+            parts[-1].append(line)
+        cells.append(cell)
+        if len(parts) == 1:
+            continue
+        texts = ["".join(p).strip("\n") for p in parts]
+        cell.source = texts[0]
+        for text in texts[1:]:
+            kind = cell.metadata.get("slideshow", {}).get("slide_type")
+            if kind not in ("skip", "notes"):
+                kind = "slide" if text.startswith("## ") else "subslide"
+            metadata = {"slideshow": {"slide_type": kind}}
+            if "tags" in cell.metadata:
+                metadata["tags"] = list(cell.metadata["tags"])
+            cells.append(new_markdown_cell(text, metadata=metadata))
+            added += 1
+    nb.cells = cells
+    return added
+
+
 def tag_slides(nb) -> int:
     """Give every cell without ``metadata.slideshow`` a slide type; return how many were tagged.
 
@@ -216,16 +263,32 @@ def header(nb) -> dict:
     }
 
 
+def run_failure(nb) -> str | None:
+    """Why an executed notebook is not a complete run (``None`` if it is): its first code cell that raised (unless
+    tagged ``raises-exception``) or that never ran (the kernel died or a cell timed out before it)."""
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "code" or not cell.source.strip():
+            continue
+        errors = [o for o in cell.get("outputs", []) if o.get("output_type") == "error"]
+        if errors and "raises-exception" not in _tags(cell):
+            return f"cell {i} raised {errors[0].get('ename', 'an error')}"
+        if cell.get("execution_count") is None:
+            return f"cell {i} did not run"
+    return None
+
+
 def executed_notebook(source: Path, build: Path, timeout: int = 900):
-    """The executed copy of ``source``: ``build/notebooks/<name>`` if its cells have the same sources (slide
-    metadata taken from ``source``), else executed now as ``make run`` does. Returns ``(nb, reused)``."""
+    """The executed copy of ``source``: ``build/notebooks/<name>`` if its cells have the same sources and that run
+    was complete (:func:`run_failure`; slide metadata taken from ``source``), else executed now as ``make run``
+    does. Returns ``(nb, reused)``."""
     import nbformat
 
     nb = nbformat.read(source, as_version=4)
     done = build / "notebooks" / source.name
     if done.is_file():
         old = nbformat.read(done, as_version=4)
-        if [(c.cell_type, c.source) for c in old.cells] == [(c.cell_type, c.source) for c in nb.cells]:
+        same = [(c.cell_type, c.source) for c in old.cells] == [(c.cell_type, c.source) for c in nb.cells]
+        if same and run_failure(old) is None:
             for new, cell in zip(nb.cells, old.cells):
                 cell.metadata = new.metadata
             return old, True
@@ -348,13 +411,22 @@ def build_site(
 ) -> dict:
     """Write the site into ``out`` from the notebooks (executed ones from ``build/notebooks/`` when current).
 
-    Returns a summary: ``{"lectures": [names], "executed": [names run now], "colab": bool}``.
+    The site's own entries in ``out`` (``index.html``, ``guide.html``, ``figures.html`` and the folders
+    ``lectures``, ``slides``, ``student``, ``figures``, ``assets``) are replaced; anything else there is kept.
+
+    Returns a summary: ``{"lectures": [names], "executed": [names run now], "failed": [names whose run failed:
+    their pages show the error], "colab": bool}``.
     """
 
     runner = _load("run_notebooks")
-    if out.exists():
-        shutil.rmtree(out)
-    for sub in ("lectures", "slides", "student", "figures", "assets"):
+    subfolders = ("lectures", "slides", "student", "figures", "assets")
+    for name in (*subfolders, "index.html", "guide.html", "figures.html"):  # only what a build writes: `out`
+        old = out / name  # may be build/ itself, whose notebooks, caches and lab/ work stay
+        if old.is_dir() and not old.is_symlink():
+            shutil.rmtree(old)
+        elif old.exists() or old.is_symlink():
+            old.unlink()
+    for sub in subfolders:
         (out / sub).mkdir(parents=True, exist_ok=True)
     reveal = reveal_dir()
     for rel in _REVEAL_FILES:
@@ -363,11 +435,14 @@ def build_site(
         (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
     (out / "assets" / "site.css").write_text(_STYLE, encoding="utf-8")
 
-    rows, executed, stale_cells = [], [], []
+    rows, executed, failed, stale_cells = [], [], [], []
     for source in notebooks:
         nb, reused = executed_notebook(source, build, timeout)
         if not reused:
             executed.append(source.stem)
+        if why := run_failure(nb):
+            failed.append(source.stem)
+            print(f"[site] {source.name} FAILED ({why}): its page and slides show the error", flush=True)
         if repo and notebook_repo(nb) not in (None, repo):
             stale_cells.append(source.name)
         (out / "lectures" / f"{source.stem}.html").write_text(runner.export_html(nb), encoding="utf-8")
@@ -429,7 +504,12 @@ def build_site(
         f"<th>Colab</th></tr></thead><tbody>{''.join(lines)}</tbody></table>{colab_note}"
     )
     (out / "index.html").write_text(_page("beatlite course", body), encoding="utf-8")
-    return {"lectures": [s.stem for s, _ in rows], "executed": executed, "colab": bool(repo)}
+    return {
+        "lectures": [s.stem for s, _ in rows],
+        "executed": executed,
+        "failed": failed,
+        "colab": bool(repo),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -447,7 +527,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=int, default=900, help="per-cell timeout when a notebook runs")
     parser.add_argument("--set-repo", metavar="OWNER/NAME", help="write the repository into the Colab cells")
     parser.add_argument(
-        "--tag-slides", action="store_true", help="add the Colab cell, give untagged cells a slide type"
+        "--tag-slides",
+        action="store_true",
+        help="add the Colab cell, split cells at headings, give untagged cells a slide type",
     )
     parser.add_argument("notebooks", nargs="*", type=Path, help="notebooks (default: all, in order)")
     args = parser.parse_args(argv)
@@ -461,7 +543,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.tag_slides:
             for path in paths:
                 nb = nbformat.read(path, as_version=4)
-                if (count := add_colab_cell(nb) + tag_slides(nb)) > 0:
+                if (count := add_colab_cell(nb) + split_headings(nb) + tag_slides(nb)) > 0:
                     nbformat.write(nb, path)
                 print(f"[site] {path.name}: {count} cells tagged")
         return 0
@@ -476,7 +558,12 @@ def main(argv: list[str] | None = None) -> int:
         f"({len(summary['executed'])} executed now), Colab links {'on' if summary['colab'] else 'off'}"
     )
     print(json.dumps(summary["executed"]))
-    return 0
+    if summary["failed"]:
+        print(
+            f"[site] {len(summary['failed'])} notebooks failed: {', '.join(summary['failed'])}",
+            file=sys.stderr,
+        )
+    return 1 if summary["failed"] else 0
 
 
 if __name__ == "__main__":

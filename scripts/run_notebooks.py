@@ -175,6 +175,9 @@ def offline_notebook(nb):
     return nb
 
 
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
 def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
     """Execute one notebook in its own folder; save the executed copy and its HTML."""
     import nbformat
@@ -195,6 +198,7 @@ def execute(path: Path, out_dir: Path, timeout: int) -> tuple[bool, float, str]:
         DeadKernelError,
     ) as exc:  # a dead kernel fails this notebook only
         ok, message = False, str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
+        message = _ANSI.sub("", message)  # the traceback's colours: results.md is plain Markdown
     seconds = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, out_dir / path.name)

@@ -286,6 +286,45 @@ def test_no_student_cell_makes_a_choice_key(path):
         assert "answer_key(" not in src and "course_key(" not in src, f"{path.name} cell {i} makes a key"
 
 
+def _library_calls(func: ast.FunctionDef) -> set[str]:
+    """What ``func`` calls outside numpy, the builtins and the names it assigns (a method of a parameter counts,
+    e.g. ``index.where``)."""
+    own = {
+        t.id
+        for n in ast.walk(func)
+        if isinstance(n, ast.Assign)
+        for t in n.targets
+        if isinstance(t, ast.Name)
+    }
+    calls = set()
+    for node in ast.walk(func):
+        if isinstance(node, ast.Call):
+            root = node.func
+            while isinstance(root, ast.Attribute | ast.Subscript | ast.Call):
+                root = root.value if not isinstance(root, ast.Call) else root.func
+            if (
+                isinstance(root, ast.Name)
+                and root.id not in own | {"np", "numpy"}
+                and root.id not in dir(builtins)
+            ):
+                calls.add(ast.unparse(node.func))
+    return calls
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_no_stub_cell_shows_the_answer(path):
+    """The reference beside a stub (the cell the student fills in) calls the library, torch, scipy...: one written
+    out in numpy alone is the answer in plain sight (notebook 09's bootstrap was, line for line)."""
+    for ex in sheet.exercises(path):
+        for _, src in ex.stubs:
+            for node in ast.parse(sheet._python(src)).body:
+                if isinstance(node, ast.FunctionDef) and node.name not in ex.names:
+                    assert _library_calls(node), (
+                        f"{path.name} {ex.title}: {node.name} in the student's cell is written out in numpy; "
+                        "call the library's reference instead"
+                    )
+
+
 def test_instructor_sheet_has_every_answer(tmp_path):
     written = sheet.write_sheets(tmp_path)
     assert written[0] == tmp_path / "answers.md" and len(written) == 1 + len(NOTEBOOKS)

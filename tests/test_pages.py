@@ -340,3 +340,15 @@ def test_a_notebook_whose_kernel_dies_is_reported_and_the_next_one_runs(tmp_path
     assert code == 1
     assert "| [01_dies](notebooks/01_dies.html) | FAILED" in results
     assert "| [02_fine](notebooks/02_fine.html) | ok |" in results and "1/2 ok" in results
+
+
+def test_a_failure_is_reported_in_plain_text(tmp_path, monkeypatch):
+    """The failed row of results.md names the exception without the traceback's terminal colour codes."""
+    for name in ("BEATLITE_BUILD", "BEATLITE_INTERACTIVE"):  # main() sets them: restored after the test
+        monkeypatch.setenv(name, os.environ.get(name, ""))
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("1 / 0")])
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, tmp_path / "01_fails.ipynb")
+    assert _runner().main(["--out", str(tmp_path / "out"), str(tmp_path / "01_fails.ipynb")]) == 1
+    results = (tmp_path / "out" / "results.md").read_text()
+    assert "| FAILED: ZeroDivisionError: division by zero |" in results, results

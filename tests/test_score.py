@@ -28,6 +28,7 @@ from beatlite.score import (  # noqa: E402
     export_ground_truth,
     main,
     match_predictions,
+    mean_interval,
     read_prediction,
     score_folder,
     self_check,
@@ -548,6 +549,25 @@ def test_bootstrap_of_two_takes_spans_their_own_values():
     truth = GroundTruth(Takes(positions=real))
     low, high = bootstrap_intervals(Takes(positions=gen), truth, ["MPJPE"], n=400, seed=3)["MPJPE"]
     assert low == pytest.approx(min(own), rel=1e-12) and high == pytest.approx(max(own), rel=1e-12)
+
+
+def test_mean_interval_is_bootstrap_intervals_on_per_take_values():
+    """``mean_interval`` (the reference of notebook 09's exercise 3) is what ``bootstrap_intervals`` gives a mean
+    over takes: takes of equal length make the frame-weighted MPJPE the mean of the per-take MPJPEs, so the same
+    seed draws the same takes and gives the same interval. Two values: a resample's mean is a, (a + b) / 2 or b,
+    each end 1/4 likely, so the 2.5th and 97.5th percentiles are the values themselves."""
+    rng = np.random.default_rng(1)
+    real = [rng.normal(size=(40, 3, 3)) for _ in range(6)]
+    gen = [t + rng.normal(scale=0.2 * (k + 1), size=t.shape) for k, t in enumerate(real)]
+    per_take = [float(np.linalg.norm(g - t, axis=-1).mean()) for g, t in zip(gen, real, strict=True)]
+    truth = GroundTruth(Takes(positions=real))
+    want = bootstrap_intervals(Takes(positions=gen), truth, ["MPJPE"], n=300, seed=4)["MPJPE"]
+    np.testing.assert_allclose(mean_interval(per_take, 300, 4), want, rtol=1e-12)
+    assert mean_interval([3.0, 7.0], 400, 0).tolist() == [3.0, 7.0]
+    narrow, wide = mean_interval(per_take, 300, 4, level=0.5), mean_interval(per_take, 300, 4)
+    assert wide[0] <= narrow[0] <= narrow[1] <= wide[1]
+    with pytest.raises(ValueError, match="non-empty 1-D"):
+        mean_interval([], 10)
 
 
 def test_bootstrap_resamples_that_cannot_score_a_metric_are_left_out_and_counted():

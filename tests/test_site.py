@@ -93,8 +93,10 @@ def built(tmp_path_factory):
     nbformat.write(second, notebooks / "02_beta.ipynb")
 
     executed = nbformat.from_dict(first)  # as make run leaves it, but written before the slides were tagged
-    for cell in executed.cells:
+    for n, cell in enumerate(executed.cells):
         cell.metadata.pop("slideshow", None)
+        if cell.cell_type == "code":
+            cell.execution_count = n
         if cell.source == "print(x * 2)":
             cell.outputs = [
                 new_output("stream", name="stdout", text="PRINTED-42\n"),
@@ -107,6 +109,68 @@ def built(tmp_path_factory):
     return root / "site", summary, paths, build
 
 
+def test_a_failed_run_is_not_reused_and_fails_the_build(tmp_path, monkeypatch, capsys):
+    """An executed copy left by a failed ``make run`` (an error output) is run again, not put on the site as it is;
+    a notebook that fails now is on the site with its error, and the build exits 1 naming it."""
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "unused"))  # main() sets these two: restored after
+    monkeypatch.setenv("BEATLITE_INTERACTIVE", "off")
+    notebooks, build = tmp_path / "notebooks", tmp_path / "build"
+    notebooks.mkdir()
+    (build / "notebooks").mkdir(parents=True)
+    good, bad = _lecture("01", "Alpha", "g", 10), _lecture("02", "Beta", "g", 10)
+    next(c for c in bad.cells if c.source == "print(x * 2)").source = "print(x * 2)\n1 / 0"
+    nbformat.write(good, notebooks / "01_alpha.ipynb")
+    nbformat.write(bad, notebooks / "02_beta.ipynb")
+    stale = nbformat.from_dict(good)  # what a make run that failed in this cell left behind
+    for cell in stale.cells:
+        if cell.cell_type == "code":
+            cell.execution_count = 1
+        if cell.source == "print(x * 2)":
+            cell.outputs = [
+                new_output("error", ename="OSError", evalue="flaky", traceback=["OSError: flaky"])
+            ]
+    nbformat.write(stale, build / "notebooks" / "01_alpha.ipynb")
+    assert _site().run_failure(stale) == "cell 4 raised OSError"
+
+    paths = [str(notebooks / "01_alpha.ipynb"), str(notebooks / "02_beta.ipynb")]
+    status = _site().main(["--build", str(build), "--out", str(tmp_path / "site"), *paths])
+    out = capsys.readouterr()
+    assert status == 1, out.out + out.err
+    assert "1 notebooks failed: 02_beta" in out.err
+    assert "02_beta.ipynb FAILED (cell 4 raised ZeroDivisionError)" in out.out
+    assert '["01_alpha", "02_beta"]' in out.out  # both executed now: the failed copy of 01 was not reused
+    assert "OSError" not in (tmp_path / "site" / "lectures" / "01_alpha.html").read_text()
+    assert "ZeroDivisionError" in (tmp_path / "site" / "lectures" / "02_beta.html").read_text()
+
+
+def test_a_site_written_into_the_build_folder_keeps_the_other_files(tmp_path):
+    """``--out build`` (the site beside make run's outputs) replaces only the site's own files: the executed
+    notebooks, caches and a student's work in ``lab/`` stay; a page left by an earlier build goes."""
+    notebooks, build = tmp_path / "notebooks", tmp_path / "build"
+    notebooks.mkdir()
+    (build / "notebooks").mkdir(parents=True)
+    (build / "lab").mkdir()
+    (build / "lab" / "01_alpha.ipynb").write_text("my work")
+    (build / "results.md").write_text("# beatlite results")
+    (build / "lectures").mkdir()
+    (build / "lectures" / "00_renamed.html").write_text("stale")
+    nb = _lecture("01", "Alpha", "g", 10)
+    nbformat.write(nb, notebooks / "01_alpha.ipynb")
+    for n, cell in enumerate(nb.cells):  # executed: reused, nothing runs
+        if cell.cell_type == "code":
+            cell.execution_count = n
+    nbformat.write(nb, build / "notebooks" / "01_alpha.ipynb")
+
+    summary = _site().build_site(
+        build, build, [notebooks / "01_alpha.ipynb"], guide=REPO / "docs" / "teaching.md"
+    )
+    assert summary["executed"] == [] and (build / "index.html").is_file()
+    assert (build / "lab" / "01_alpha.ipynb").read_text() == "my work"
+    assert (build / "results.md").is_file() and (build / "notebooks" / "01_alpha.ipynb").is_file()
+    assert not (build / "lectures" / "00_renamed.html").exists()
+    assert (build / "lectures" / "01_alpha.html").is_file()
+
+
 def _links(page: Path) -> list[tuple[str, str]]:
     """``(tag, url)`` of every link, image, style sheet and script of a page."""
     text = page.read_text(encoding="utf-8")
@@ -115,7 +179,12 @@ def _links(page: Path) -> list[tuple[str, str]]:
 
 def test_site_reuses_executed_notebooks_and_runs_the_others(built):
     site, summary, _, build = built
-    assert summary == {"lectures": ["01_alpha", "02_beta"], "executed": ["02_beta"], "colab": False}
+    assert summary == {
+        "lectures": ["01_alpha", "02_beta"],
+        "executed": ["02_beta"],
+        "failed": [],
+        "colab": False,
+    }
     assert "PRINTED-42" in (site / "lectures" / "01_alpha.html").read_text()  # the stored output, not a rerun
     assert (build / "notebooks" / "02_beta.ipynb").is_file()
     ran = nbformat.read(build / "notebooks" / "02_beta.ipynb", as_version=4)
@@ -236,6 +305,66 @@ def test_tag_slides_rules():
         "subslide",
         "-",
     ]
+
+
+def test_split_headings_starts_a_slide_at_every_section_heading():
+    """A heading in the middle of a Markdown cell would sit mid-slide under the previous section (and the right
+    arrow would skip its section): the cell is split there, ``## `` a slide, ``### `` a subslide."""
+    site = _site()
+    nb = new_notebook(
+        cells=[
+            new_markdown_cell("# T\n\n**Goals**\n- g", metadata={"slideshow": {"slide_type": "slide"}}),
+            new_markdown_cell(
+                "End of 1.\n\n## 2. Two\n\nIntro.\n\n### 2.1 Sub\n\nBody.",
+                metadata={"slideshow": {"slide_type": "subslide"}},
+            ),
+            new_code_cell("x = 1"),
+            new_markdown_cell("## Summary\n\n- a\n\n## Exercises\n\nDo them."),
+            new_markdown_cell("Shell:\n\n```\n## not a heading\n```\nafter"),
+            new_markdown_cell(
+                "Answer.\n\n## Hidden", metadata={"tags": ["solution"], "slideshow": {"slide_type": "skip"}}
+            ),
+        ]
+    )
+    assert site.split_headings(nb) == 4
+    got = [
+        (c.source, c.metadata.get("slideshow", {}).get("slide_type"), c.metadata.get("tags"))
+        for c in nb.cells
+    ]
+    assert got == [
+        ("# T\n\n**Goals**\n- g", "slide", None),
+        ("End of 1.", "subslide", None),
+        ("## 2. Two\n\nIntro.", "slide", None),
+        ("### 2.1 Sub\n\nBody.", "subslide", None),
+        ("x = 1", None, None),
+        ("## Summary\n\n- a", None, None),
+        ("## Exercises\n\nDo them.", "slide", None),
+        ("Shell:\n\n```\n## not a heading\n```\nafter", None, None),
+        ("Answer.", "skip", ["solution"]),
+        ("## Hidden", "skip", ["solution"]),
+    ]
+    assert site.split_headings(nb) == 0  # once split, nothing more to do
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_every_section_heading_starts_a_slide(path):
+    """Each ``## `` section of a notebook is a slide of its own (the right arrow reaches it) and each ``### ``
+    subsection a subslide: a heading is always the first line of its Markdown cell (``--tag-slides`` splits)."""
+    nb = nbformat.read(path, as_version=4)
+    kinds = {"## ": "slide", "### ": "subslide"}
+    wrong = []
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "markdown":
+            continue
+        fenced = False
+        for n, line in enumerate(cell.source.lstrip("\n").splitlines()):
+            fenced ^= bool(re.match(r" {0,3}(```|~~~)", line))
+            level = next((k for k in kinds if line.startswith(k)), None)
+            if level and not fenced and n > 0:
+                wrong.append(f"cell {i}: {line[:50]!r} in the middle of the cell")
+            elif level and n == 0 and cell.metadata.get("slideshow", {}).get("slide_type") != kinds[level]:
+                wrong.append(f"cell {i}: {line[:50]!r} is not a {kinds[level]}")
+    assert not wrong, f"run `python scripts/build_site.py --tag-slides`: {wrong}"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
