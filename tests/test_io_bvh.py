@@ -178,6 +178,19 @@ def test_a_joint_with_two_end_sites_is_a_format_error(tmp_path: Path) -> None:
         read_bvh(write(tmp_path, doubled))
 
 
+@pytest.mark.parametrize("frame_time", ["0", "0.0", "-0.033333"])
+def test_the_header_refuses_a_frame_time_of_zero_or_less(tmp_path: Path, frame_time: str) -> None:
+    """read_bvh refused such a file but read_bvh_header returned the value, so bvh_duration gave -0.1 s."""
+    from beatlite.data.index import bvh_duration
+
+    p = write(tmp_path, small_bvh(frame_time=frame_time))
+    for reader in (read_bvh_header, bvh_duration):
+        with pytest.raises(FormatError, match="positive") as info:
+            reader(p)
+        assert info.value.line == FIRST_DATA_LINE - 1
+    assert read_bvh(p, fps=30).n_frames == 3  # an override still reads the rows
+
+
 # ----------------------------------------------------------------------------- real files
 
 

@@ -540,12 +540,12 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
     n_frames_declared : int
         The ``Frames:`` value (the rows are not counted).
     frame_time : float
-        The ``Frame Time:`` value in seconds, as written.
+        The ``Frame Time:`` value in seconds, as written (positive).
 
     Raises
     ------
     FormatError
-        If the header is malformed (naming the line).
+        If the header is malformed (naming the line), a ``Frame Time`` of zero or less included.
 
     Examples
     --------
@@ -569,6 +569,8 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
         raise FormatError(p, f"Frame Time {time_text!r} is not a number", line=time_line) from None
     if not math.isfinite(frame_time):
         raise FormatError(p, f"Frame Time {time_text!r} is not finite", line=time_line)
+    if frame_time <= 0:
+        raise FormatError(p, f"Frame Time {time_text!r} is not a positive number of seconds", line=time_line)
     return skeleton, n_frames, frame_time
 
 
