@@ -603,8 +603,8 @@ def _check_motion(record: TakeRecord, bvh_fps: float | None) -> None:
     if record.format == "beat2":  # the .npz states its rate
         record.bvh_fps = None if bvh_fps is None else motion.fps
         return
-    header_fps = parse_frame_time(repr(read_bvh_header(path)[2]))
-    if bvh_fps is not None or motion.fps != header_fps:
+    # with an override the header's Frame Time is not read (it may be the wrong value the override replaces)
+    if bvh_fps is not None or motion.fps != parse_frame_time(repr(read_bvh_header(path)[2])):
         record.bvh_fps = motion.fps
 
 
