@@ -462,3 +462,20 @@ def test_a_gzip_bomb_without_a_newline_is_refused_within_the_limit(tmp_path: Pat
         finally:
             tracemalloc.stop()
         assert peak < 3 * limit, f"{reader.__name__}: peak {peak} bytes for a limit of {limit}"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("subtype", ["FLOAT", "DOUBLE"])
+def test_a_float_wav_with_a_non_finite_sample_is_refused(tmp_path: Path, bad: float, subtype: str) -> None:
+    """A float WAV may store NaN or inf; read_audio returned them (and resampling spread NaN over the neighbours)."""
+    y = np.full((3000, 2), 0.25)
+    y[1234, 1] = bad
+    path = tmp_path / "take.wav"
+    sf.write(path, y, 48000, subtype=subtype)
+    for sr in (None, 16000):
+        with pytest.raises(FormatError, match="sample 1234 of channel 1") as info:
+            read_audio(path, sr=sr)
+        assert info.value.field == "samples"
+    y[1234, 1] = 0.5  # the same file with a finite sample reads
+    sf.write(path, y, 48000, subtype=subtype)
+    assert read_audio(path, sr=None, mono=False)[0][1234, 1] == 0.5
