@@ -364,3 +364,22 @@ def test_usable_means_the_window_features_build_on_random_broken_takes(tmp_path:
             take_features(record, mel=False)  # raises if "usable" lied
         else:
             assert record.problems, record.stem
+
+
+@pytest.mark.parametrize(("xmax", "line"), [("e", 5), ("1e400", 5), ("-", 5)])
+def test_textgrid_duration_of_an_unreadable_xmax_is_a_format_error(
+    tmp_path: Path, xmax: str, line: int
+) -> None:
+    """'xmax = e' raised a bare ValueError (no file named) and 'xmax = 1e400' returned inf."""
+    from beatlite.data.index import textgrid_duration
+    from beatlite.io import FormatError
+
+    path = tmp_path / "t.TextGrid"
+    path.write_text(f'File type = "ooTextFile"\nObject class = "TextGrid"\n\nxmin = 0\nxmax = {xmax}\n')
+    with pytest.raises(FormatError, match="xmax") as info:
+        textgrid_duration(path)
+    assert info.value.path == path and info.value.line == line and info.value.field == "xmax"
+    path.write_text(
+        'File type = "ooTextFile"\nObject class = "TextGrid"\n\n0\n2.5\n<exists>\n'
+    )  # short format
+    assert textgrid_duration(path) == 2.5
