@@ -199,6 +199,32 @@ def test_read_smplx_refuses_a_decompression_bomb_before_decompressing(tmp_path):
         read_smplx(path)
 
 
+@pytest.mark.parametrize("key", ["poses", "trans", "betas"])
+def test_read_smplx_refuses_a_member_whose_header_claims_more_than_it_holds(tmp_path, key):
+    """numpy allocates the shape an .npy header claims before reading data: a 27 kB file claiming 10**13 frames
+    raised a bare MemoryError (5.86 PiB); now a FormatError naming the key, before anything is allocated."""
+    arrays = _beat2_like()
+    path = tmp_path / "take.npz"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as z:
+        for name, value in arrays.items():
+            buf = io.BytesIO()
+            if name == key:  # the true data under a header claiming 10**13 rows
+                header = {
+                    "descr": value.dtype.str,
+                    "fortran_order": False,
+                    "shape": (10**13, *value.shape[1:]),
+                }
+                np.lib.format.write_array_header_1_0(buf, header)
+                buf.write(value.tobytes())
+            else:
+                np.lib.format.write_array(buf, value)
+            z.writestr(f"{name}.npy", buf.getvalue())
+    with pytest.raises(
+        FormatError, match=rf"field '{key}'.*needs \d+ bytes, the member holds {arrays[key].nbytes}"
+    ):
+        read_smplx(path)
+
+
 def test_read_beat2_split_names_the_bad_line(tmp_path):
     path = tmp_path / "train_test_split.csv"
     path.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_2_2,holdout\n")
