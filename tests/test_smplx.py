@@ -225,6 +225,35 @@ def test_read_smplx_refuses_a_member_whose_header_claims_more_than_it_holds(tmp_
         read_smplx(path)
 
 
+def test_read_smplx_names_the_key_of_damaged_member_bytes(tmp_path):
+    """Corrupt deflate data (savez_compressed) raised a bare zlib.error, and a header numpy's tokenizer cannot read
+    a bare tokenize.TokenError; each is now a FormatError naming the key."""
+    import struct
+
+    path = tmp_path / "deflated.npz"
+    np.savez_compressed(path, **_beat2_like())
+    data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as z:
+        offset = z.getinfo("poses.npy").header_offset
+    name_len, extra_len = struct.unpack("<HH", data[offset + 26 : offset + 30])
+    start = offset + 30 + name_len + extra_len  # the member's deflate stream
+    data[start + 40 : start + 80] = bytes(range(7, 247, 6))
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="field 'poses'.*decompressing"):
+        read_smplx(path)
+    path = tmp_path / "header.npz"
+    with zipfile.ZipFile(path, "w") as z:
+        for key, value in _beat2_like().items():
+            if key != "trans":
+                buf = io.BytesIO()
+                np.lib.format.write_array(buf, value)
+                z.writestr(f"{key}.npy", buf.getvalue())
+        text = b"{'descr': '<f4', 'fortran_order': False, 'shape': (".ljust(117) + b"\n"  # an unclosed tuple
+        z.writestr("trans.npy", b"\x93NUMPY\x01\x00" + len(text).to_bytes(2, "little") + text + bytes(480))
+    with pytest.raises(FormatError, match="field 'trans'.*EOF in multi-line statement"):
+        read_smplx(path)
+
+
 def test_read_beat2_split_names_the_bad_line(tmp_path):
     path = tmp_path / "train_test_split.csv"
     path.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_2_2,holdout\n")

@@ -38,7 +38,9 @@ import csv
 import dataclasses
 import math
 import os
+import tokenize
 import zipfile
+import zlib
 from collections.abc import Callable
 from pathlib import Path
 
@@ -138,6 +140,11 @@ def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
     return zip_members(path, _MAX_MEMBER_BYTES, suffix=".npy")
 
 
+#: What a damaged member raises while numpy reads it: a bad ZIP entry, corrupt deflate data, a header numpy's
+#: tokenizer cannot read.
+_DAMAGED = (OSError, EOFError, zipfile.BadZipFile, zlib.error, tokenize.TokenError)
+
+
 def _check_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, key: str) -> None:
     """The member's ``.npy`` header, read before numpy reads it: numpy allocates the shape the header claims before
     it reads a byte of data, so a shape needing more bytes than the member holds is refused here, as is an object
@@ -151,7 +158,7 @@ def _check_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, key: s
             read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
             shape, _, dtype = read(fh)
             have = info.file_size - fh.tell()
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+    except (*_DAMAGED, ValueError) as exc:
         raise FormatError(path, f"not a readable array ({' '.join(str(exc).split())})", field=key) from None
     if dtype.hasobject:
         raise FormatError(path, "a pickled object array (never loaded: it could run code)", field=key)
@@ -171,7 +178,7 @@ def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:
                 path, "a pickled object array (never loaded: it could run code)", field=key
             ) from None
         raise FormatError(path, f"not a readable array ({exc})", field=key) from None
-    except (OSError, EOFError, zipfile.BadZipFile) as exc:
+    except _DAMAGED as exc:
         raise FormatError(path, f"not a readable array ({exc})", field=key) from None
     return value
 
@@ -268,7 +275,7 @@ def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
             _check_header(zf, info, p, key)
     try:
         z = np.load(p, allow_pickle=False)
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+    except (*_DAMAGED, ValueError) as exc:
         raise FormatError(p, f"not a readable npz ({exc})") from None
     with z:
         raw = {key: _array(z, p, key) for key in infos}
