@@ -232,3 +232,25 @@ def test_convert_legacy_is_advised_only_for_a_blocked_object_and_config_errors_n
     with pytest.raises(FormatError, match="no_such_model") as refused:
         load_model(path)
     assert refused.value.field == "model"
+
+
+def test_a_flipped_byte_in_a_weight_is_refused_by_the_zip_crc(tmp_path):
+    """torch.load does not check the CRC-32 of the members: one flipped bit in a tensor's bytes loaded as a
+    silently different weight (a2g_tiny: motion_encoder.0.net.0.weight off by 4.9e-4). Now a FormatError."""
+    import struct
+    import zipfile
+
+    from beatlite.metrics.extractor import load_extractor
+
+    for name, load in (("a2g_tiny.pt", load_model), ("fgd_dirvec.pt", lambda p: load_extractor("dirvec", p))):
+        src = checkpoints_dir() / name
+        with zipfile.ZipFile(src) as z:
+            big = max(z.infolist(), key=lambda i: i.file_size)  # the largest tensor's storage
+        data = bytearray(src.read_bytes())
+        name_len, extra_len = struct.unpack("<HH", data[big.header_offset + 26 : big.header_offset + 30])
+        data[big.header_offset + 30 + name_len + extra_len + big.file_size // 2] ^= 0x40
+        path = tmp_path / name
+        path.write_bytes(bytes(data))
+        with pytest.raises(FormatError, match=f"member {big.filename} fails its CRC-32 check"):
+            load(path)
+        load(src)  # the file as shipped loads
