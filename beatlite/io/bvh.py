@@ -284,10 +284,22 @@ def _parse_hierarchy(lines: list[tuple[int, str]], path: Path | None) -> Skeleto
         raise FormatError(path, f"expected 'ROOT', found {tok!r}", line=line, column=col)
     stack = [joints.add(_joint_name(tokens, line, "ROOT"), -1, line)]
     tokens.expect("{")
+    declared: dict[
+        tuple[int, str], int
+    ] = {}  # (joint, OFFSET or CHANNELS) -> line: a second one would replace it
     while stack:
         tok, line, col = tokens.next("'}'")
         key = tok.upper()
         j = stack[-1]
+        if key in ("OFFSET", "CHANNELS"):
+            if (j, key) in declared:
+                raise FormatError(
+                    path,
+                    f"joint {joints.names[j]!r} has a second {key} (the first on line {declared[j, key]})",
+                    line=line,
+                    column=col,
+                )
+            declared[j, key] = line
         if key == "OFFSET":
             joints.offsets[j] = tuple(tokens.number(f"OFFSET of {joints.names[j]!r}") for _ in range(3))  # type: ignore[assignment]
         elif key == "CHANNELS":
