@@ -254,3 +254,29 @@ def test_a_flipped_byte_in_a_weight_is_refused_by_the_zip_crc(tmp_path):
         with pytest.raises(FormatError, match=f"member {big.filename} fails its CRC-32 check"):
             load(path)
         load(src)  # the file as shipped loads
+
+
+@pytest.mark.parametrize("damage", ["name", "method", "encrypted"])
+def test_a_member_zipfile_cannot_open_is_a_format_error(tmp_path, damage):
+    """The CRC check opens every member: a damaged name in a local header (UnicodeDecodeError), an unknown
+    compression method (NotImplementedError) or the encryption flag (RuntimeError) must be a FormatError too."""
+    import struct
+
+    data = bytearray((checkpoints_dir() / "a2g_tiny.pt").read_bytes())
+    local = data.index(b"PK\x03\x04")  # the first member's local header
+    if damage == "name":
+        data[local + 30] = 0xFF  # the first byte of its name: not UTF-8
+        data[local + 6 : local + 8] = struct.pack("<H", 0x800)  # flagged as a UTF-8 name
+    else:
+        for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):  # local and central headers alike
+            i = data.find(sig)
+            while i >= 0:
+                if damage == "method":
+                    data[i + at + 2 : i + at + 4] = struct.pack("<H", 99)
+                else:
+                    data[i + at : i + at + 2] = struct.pack("<H", 1)
+                i = data.find(sig, i + 4)
+    path = tmp_path / "damaged.pt"
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="truncated or corrupted"):
+        load_model(path)

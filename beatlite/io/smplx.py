@@ -141,8 +141,16 @@ def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
 
 
 #: What a damaged member raises while numpy reads it: a bad ZIP entry, corrupt deflate data, a header numpy's
-#: tokenizer cannot read.
-_DAMAGED = (OSError, EOFError, zipfile.BadZipFile, zlib.error, tokenize.TokenError)
+#: tokenizer cannot read, an unknown compression method (NotImplementedError), an encrypted member (RuntimeError).
+_DAMAGED = (
+    OSError,
+    EOFError,
+    zipfile.BadZipFile,
+    zlib.error,
+    tokenize.TokenError,
+    NotImplementedError,
+    RuntimeError,
+)
 
 
 def _check_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, key: str) -> None:

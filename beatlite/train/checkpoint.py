@@ -168,13 +168,22 @@ def _check_crcs(path: Path) -> None:
     try:
         with zipfile.ZipFile(path) as z:
             bad = z.testzip()
-    except (zipfile.BadZipFile, OSError, EOFError, zlib.error) as exc:
-        bad = f"? ({exc})"
-    if bad is not None:
+        reason = None if bad is None else f"member {bad} fails its CRC-32 check"
+    except (
+        zipfile.BadZipFile,
+        OSError,
+        EOFError,
+        zlib.error,
+        ValueError,
+        NotImplementedError,
+        RuntimeError,
+    ) as exc:
+        reason = " ".join(
+            str(exc).split()
+        )  # a damaged member name, an unknown compression method, encryption
+    if reason is not None:
         raise FormatError(
-            path,
-            f"truncated or corrupted file (member {bad} fails its CRC-32 check): write it again, e.g. train again "
-            "or copy it anew",
+            path, f"truncated or corrupted file ({reason}): write it again, e.g. train again or copy it anew"
         )
 
 
