@@ -63,6 +63,7 @@ import hashlib
 import math
 import sys
 import tempfile
+import tokenize
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -260,7 +261,7 @@ def _bvh_prediction(path: Path) -> Prediction:
     from beatlite.io import read_bvh
 
     motion = read_bvh(path)
-    return _channels_prediction(beat_channels(motion, path), motion.fps, "bvh")
+    return _channels_prediction(beat_channels(motion, path), motion.fps, "bvh", path)
 
 
 def _smplx_prediction(path: Path) -> Prediction:
@@ -268,11 +269,12 @@ def _smplx_prediction(path: Path) -> Prediction:
     from beatlite.io.smplx import read_smplx
 
     motion = read_smplx(path)
-    return _channels_prediction(motion.to_beat().channels, motion.fps, "npz smplx -> BEAT skeleton,")  # type: ignore[attr-defined]
+    return _channels_prediction(motion.to_beat().channels, motion.fps, "npz smplx -> BEAT skeleton,", path)  # type: ignore[attr-defined]
 
 
-def _channels_prediction(channels: np.ndarray, fps: float, form: str) -> Prediction:
+def _channels_prediction(channels: np.ndarray, fps: float, form: str, path: Path) -> Prediction:
     """BEAT-skeleton rows at ``fps`` -> directions and Euler channels at 15 fps."""
+    from beatlite.io import FormatError
     from beatlite.io.motion import Motion
     from beatlite.io.take import resample_frames, rotation_columns
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
@@ -285,7 +287,15 @@ def _channels_prediction(channels: np.ndarray, fps: float, form: str) -> Predict
         channels = resample_frames(channels, fps, FPS, angle_columns=cols)
         form += f" -> {FPS:g} fps"
     euler = channels[:, subset_columns(beat_skeleton(), "spine_neck_141")]
-    return Prediction(channels_to_directions(channels), euler, form)
+    try:  # zero-length bones when positions (a root at 1e30 cm) are too large to tell a bone's ends apart
+        directions = channels_to_directions(channels)
+    except ValueError as exc:
+        raise FormatError(
+            path,
+            f"{str(exc).split(';')[0]} on BEAT's skeleton: values too large to give directions",
+            field="values",
+        ) from None
+    return Prediction(directions, euler, form)
 
 
 def _npy_prediction(path: Path) -> Prediction:
@@ -299,6 +309,8 @@ def _npy_prediction(path: Path) -> Prediction:
             path, f"dtype {getattr(x, 'dtype', type(x).__name__)} is not a real number type", field="dtype"
         )
     x = np.asarray(x, np.float64)
+    if x.ndim and not len(x):
+        raise FormatError(path, f"no frames: shape {x.shape}", field="shape")
     if x.ndim == 2 and x.shape[1] == 141:
         _check_finite(x, path)
         return Prediction(euler_to_directions(x), x, "npy euler (T, 141)")
@@ -328,7 +340,7 @@ def _load_npy(path: Path) -> np.ndarray:
             fmt = np.lib.format
             read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
             shape, _, dtype = read(fh)
-        except (ValueError, OSError, EOFError) as exc:
+        except (ValueError, OSError, EOFError, tokenize.TokenError) as exc:
             raise FormatError(path, f"not a readable .npy header ({' '.join(str(exc).split())})") from None
         if dtype.hasobject:
             raise FormatError(path, "a pickled object array (never loaded: it could run code)", field="dtype")

@@ -184,6 +184,21 @@ def test_wrong_frame_time_is_reconciled_with_the_audio(tmp_path: Path) -> None:
         index_folder(tmp_path, bvh_fps={"2_scott_0_99_99": 24})
 
 
+def test_an_override_makes_a_take_with_a_zero_frame_time_usable(tmp_path: Path) -> None:
+    """load_take(bvh_fps=15) reads a BVH whose 'Frame Time' is 0; the index with the same override called its
+    motion unreadable (it parsed the header's Frame Time anyway), so the take was dropped from every split."""
+    from beatlite.io import load_take
+
+    write_tiny_bvh(tmp_path / "2_scott_0_9_9.bvh", 30, frame_time=0.0)
+    write_wav(tmp_path / "2_scott_0_9_9.wav", np.zeros(2 * 16000, np.float32))
+    bad = index_folder(tmp_path, cache=False)["2_scott_0_9_9"]
+    assert not bad.usable and any("frame time" in p for p in bad.problems)
+    r = index_folder(tmp_path, cache=False, bvh_fps={"2_scott_0_9_9": 15})["2_scott_0_9_9"]
+    assert r.usable, r.problems
+    assert r.bvh_fps == 15.0 and r.durations["motion"] == pytest.approx(30 / 15)
+    assert load_take(r.path("motion"), bvh_fps=r.bvh_fps).n_frames == 30
+
+
 def test_not_a_folder(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match="is not a folder"):
         index_folder(tmp_path / "missing")
@@ -349,3 +364,22 @@ def test_usable_means_the_window_features_build_on_random_broken_takes(tmp_path:
             take_features(record, mel=False)  # raises if "usable" lied
         else:
             assert record.problems, record.stem
+
+
+@pytest.mark.parametrize(("xmax", "line"), [("e", 5), ("1e400", 5), ("-", 5)])
+def test_textgrid_duration_of_an_unreadable_xmax_is_a_format_error(
+    tmp_path: Path, xmax: str, line: int
+) -> None:
+    """'xmax = e' raised a bare ValueError (no file named) and 'xmax = 1e400' returned inf."""
+    from beatlite.data.index import textgrid_duration
+    from beatlite.io import FormatError
+
+    path = tmp_path / "t.TextGrid"
+    path.write_text(f'File type = "ooTextFile"\nObject class = "TextGrid"\n\nxmin = 0\nxmax = {xmax}\n')
+    with pytest.raises(FormatError, match="xmax") as info:
+        textgrid_duration(path)
+    assert info.value.path == path and info.value.line == line and info.value.field == "xmax"
+    path.write_text(
+        'File type = "ooTextFile"\nObject class = "TextGrid"\n\n0\n2.5\n<exists>\n'
+    )  # short format
+    assert textgrid_duration(path) == 2.5

@@ -178,6 +178,30 @@ def test_a_joint_with_two_end_sites_is_a_format_error(tmp_path: Path) -> None:
         read_bvh(write(tmp_path, doubled))
 
 
+@pytest.mark.parametrize("line", ["OFFSET 0 99 0", "CHANNELS 3 Xrotation Yrotation Zrotation", "CHANNELS 0"])
+def test_a_joint_with_a_second_offset_or_channels_line_is_a_format_error(tmp_path: Path, line: str) -> None:
+    """The second OFFSET or CHANNELS of a joint silently replaced the first (which one the exporter meant is
+    unknowable: the rows were read with the last)."""
+    text = small_bvh()
+    i = text.index("\t\tCHANNELS 3 Zrotation")  # inside mixamorig:Spine, after its OFFSET (line 8)
+    with pytest.raises(FormatError, match="'mixamorig:Spine' has a second") as info:
+        read_bvh(write(tmp_path, text[:i] + "\t\t" + line + "\n" + text[i:]))
+    assert info.value.line == (9 if line.startswith("OFFSET") else 10)  # the second of the two lines
+
+
+@pytest.mark.parametrize("frame_time", ["0", "0.0", "-0.033333"])
+def test_the_header_refuses_a_frame_time_of_zero_or_less(tmp_path: Path, frame_time: str) -> None:
+    """read_bvh refused such a file but read_bvh_header returned the value, so bvh_duration gave -0.1 s."""
+    from beatlite.data.index import bvh_duration
+
+    p = write(tmp_path, small_bvh(frame_time=frame_time))
+    for reader in (read_bvh_header, bvh_duration):
+        with pytest.raises(FormatError, match="positive") as info:
+            reader(p)
+        assert info.value.line == FIRST_DATA_LINE - 1
+    assert read_bvh(p, fps=30).n_frames == 3  # an override still reads the rows
+
+
 # ----------------------------------------------------------------------------- real files
 
 

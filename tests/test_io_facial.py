@@ -168,3 +168,23 @@ def test_an_empty_track_is_an_error_and_a_hole_in_the_time_stamps_warns_with_its
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a regular track: no warning
         read_facial(tmp_path / "even.json")
+
+
+@pytest.mark.parametrize("key", ["names", "frames", "weights", "time"])
+def test_a_key_given_twice_in_one_object_is_a_format_error(tmp_path: Path, key: str) -> None:
+    """json keeps the last of two equal keys: a file with a second, reversed "names" list was read with every
+    column reordered by the wrong names (and a second "time" or "weights" replaced a frame's values)."""
+    path = tmp_path / "face.json"
+    write_facial(path, ARKIT_51, np.arange(3 * 51).reshape(3, 51) / 1000, fps=60)
+    text = path.read_text()
+    twice = {
+        "names": ('{"names":', '{"names":' + json.dumps(list(ARKIT_51[::-1])) + ',"names":'),
+        "frames": ('"frames":', '"frames":[],"frames":'),
+        "weights": ('{"time":0.0,', '{"time":0.0,"weights":[],'),
+        "time": ('{"time":0.0,', '{"time":0.0,"time":0.5,'),
+    }[key]
+    assert text.count(twice[0]) == 1
+    path.write_text(text.replace(*twice))
+    with pytest.raises(FormatError, match=f"key '{key}' appears twice") as info:
+        read_facial(path, names=ARKIT_51)
+    assert info.value.field == key

@@ -435,3 +435,47 @@ def test_gzip_bombs_are_refused_while_they_inflate(tmp_path: Path) -> None:
     # what real files inflate to passes: every gzipped file of data_samples reads whole
     for p in sorted((repo / "data_samples").glob("*.gz"))[:10]:
         assert len(read_bytes(p)) == len(gzip.decompress(p.read_bytes()))
+
+
+def test_a_gzip_bomb_without_a_newline_is_refused_within_the_limit(tmp_path: Path) -> None:
+    """A .bvh.gz of zeros has no newline: reading its first line inflated it all before the ratio was checked
+    (400 KB -> 400 MB took 20 s and 836 MB). Now a line is read no further than the limit."""
+    import gzip
+    import tracemalloc
+
+    from beatlite.data.index import bvh_duration
+    from beatlite.io import read_bvh_header
+    from beatlite.io.textfile import GZIP_MAX_RATIO
+
+    path = tmp_path / "zeros.bvh.gz"
+    with gzip.GzipFile(path, "wb", mtime=0) as f:
+        for _ in range(300):
+            f.write(bytes(2**20))  # 300 MiB of zeros in about 300 KB
+    limit = GZIP_MAX_RATIO * path.stat().st_size + 2**20
+    assert 300 * 2**20 > 4 * limit  # the file does inflate far beyond the limit
+    for reader in (read_bvh, read_bvh_header, bvh_duration):
+        tracemalloc.start()
+        try:
+            with pytest.raises(FormatError, match="decompression bomb"):
+                reader(path)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert peak < 3 * limit, f"{reader.__name__}: peak {peak} bytes for a limit of {limit}"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("subtype", ["FLOAT", "DOUBLE"])
+def test_a_float_wav_with_a_non_finite_sample_is_refused(tmp_path: Path, bad: float, subtype: str) -> None:
+    """A float WAV may store NaN or inf; read_audio returned them (and resampling spread NaN over the neighbours)."""
+    y = np.full((3000, 2), 0.25)
+    y[1234, 1] = bad
+    path = tmp_path / "take.wav"
+    sf.write(path, y, 48000, subtype=subtype)
+    for sr in (None, 16000):
+        with pytest.raises(FormatError, match="sample 1234 of channel 1") as info:
+            read_audio(path, sr=sr)
+        assert info.value.field == "samples"
+    y[1234, 1] = 0.5  # the same file with a finite sample reads
+    sf.write(path, y, 48000, subtype=subtype)
+    assert read_audio(path, sr=None, mono=False)[0][1234, 1] == 0.5

@@ -526,6 +526,46 @@ def test_cli_refuses_a_bad_folder_with_one_line_per_problem(truth_files, test_se
     assert sum(f"{truncated}.bvh" in line and "15 more" in line for line in lines) == 1, r.stderr
 
 
+def test_predictions_that_crashed_the_scorer_are_one_error_line_each(truth_files, test_set, tmp_path):
+    """Each raised a bare exception through `python -m beatlite.score` (a traceback, exit 1): a (0, 42, 3) .npy
+    (ValueError: zero-size array), a .npy header numpy's tokenizer cannot read (tokenize.TokenError), and a .bvh
+    or BEAT2 .npz whose root lies 1e30 cm away (ValueError: zero-length bones). Now one FormatError line each."""
+    from beatlite.io.smplx import SMPLXMotion, write_smplx
+
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    empty, header, far, far_npz = test_set.takes[:4]
+    for stem in (empty, header, far_npz):
+        (folder / f"{stem}.bvh").unlink()
+    np.save(folder / f"{empty}.npy", np.zeros((0, 42, 3)))
+    text = b"{'descr': '<f8', 'fortran_order': False, 'shape': (".ljust(117) + b"\n"  # an unclosed tuple
+    (folder / f"{header}.npy").write_bytes(b"\x93NUMPY\x01\x00" + len(text).to_bytes(2, "little") + text)
+    m = read_bvh(folder / f"{far}.bvh")
+    channels = m.channels.copy()
+    channels[:, :3] = 1e30  # the root position, cm
+    write_bvh(folder / f"{far}.bvh", Motion(m.skeleton, channels, m.fps))
+    write_smplx(folder / f"{far_npz}.npz", SMPLXMotion(np.zeros((40, 165)), np.full((40, 3), 1e28), 30))
+    expected = {
+        f"{empty}.npy": ("shape", "no frames"),
+        f"{header}.npy": (None, "not a readable .npy header"),
+        f"{far}.bvh": ("values", "zero-length bones"),
+        f"{far_npz}.npz": ("values", "zero-length bones"),
+    }
+    for name, (field, text) in expected.items():
+        with pytest.raises(FormatError, match=text) as info:
+            read_prediction(folder / name)
+        assert info.value.field == field and info.value.path == folder / name
+    for shape in ((0, 126), (0, 141)):  # 0 frames of the other forms
+        np.save(folder / "x.npy", np.zeros(shape))
+        with pytest.raises(FormatError, match="no frames"):
+            read_prediction(folder / "x.npy")
+    (folder / "x.npy").unlink()
+    r = _run_cli(str(folder), "--data", str(REPO / "data_samples"))
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    errors = [line for line in r.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 4 and all(any(n in e for e in errors) for n in expected), r.stderr
+
+
 def test_cli_writes_the_table_and_json(truth_files, tmp_path):
     out = tmp_path / "scores.json"
     r = _run_cli(str(truth_files), "--data", str(REPO / "data_samples"), "--metrics", "FGD", "SRGR",

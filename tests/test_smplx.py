@@ -199,6 +199,81 @@ def test_read_smplx_refuses_a_decompression_bomb_before_decompressing(tmp_path):
         read_smplx(path)
 
 
+@pytest.mark.parametrize("key", ["poses", "trans", "betas"])
+def test_read_smplx_refuses_a_member_whose_header_claims_more_than_it_holds(tmp_path, key):
+    """numpy allocates the shape an .npy header claims before reading data: a 27 kB file claiming 10**13 frames
+    raised a bare MemoryError (5.86 PiB); now a FormatError naming the key, before anything is allocated."""
+    arrays = _beat2_like()
+    path = tmp_path / "take.npz"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as z:
+        for name, value in arrays.items():
+            buf = io.BytesIO()
+            if name == key:  # the true data under a header claiming 10**13 rows
+                header = {
+                    "descr": value.dtype.str,
+                    "fortran_order": False,
+                    "shape": (10**13, *value.shape[1:]),
+                }
+                np.lib.format.write_array_header_1_0(buf, header)
+                buf.write(value.tobytes())
+            else:
+                np.lib.format.write_array(buf, value)
+            z.writestr(f"{name}.npy", buf.getvalue())
+    with pytest.raises(
+        FormatError, match=rf"field '{key}'.*needs \d+ bytes, the member holds {arrays[key].nbytes}"
+    ):
+        read_smplx(path)
+
+
+def test_read_smplx_names_the_key_of_damaged_member_bytes(tmp_path):
+    """Corrupt deflate data (savez_compressed) raised a bare zlib.error, and a header numpy's tokenizer cannot read
+    a bare tokenize.TokenError; each is now a FormatError naming the key."""
+    import struct
+
+    path = tmp_path / "deflated.npz"
+    np.savez_compressed(path, **_beat2_like())
+    data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as z:
+        offset = z.getinfo("poses.npy").header_offset
+    name_len, extra_len = struct.unpack("<HH", data[offset + 26 : offset + 30])
+    start = offset + 30 + name_len + extra_len  # the member's deflate stream
+    data[start + 40 : start + 80] = bytes(range(7, 247, 6))
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="field 'poses'.*decompressing"):
+        read_smplx(path)
+    path = tmp_path / "header.npz"
+    with zipfile.ZipFile(path, "w") as z:
+        for key, value in _beat2_like().items():
+            if key != "trans":
+                buf = io.BytesIO()
+                np.lib.format.write_array(buf, value)
+                z.writestr(f"{key}.npy", buf.getvalue())
+        text = b"{'descr': '<f4', 'fortran_order': False, 'shape': (".ljust(117) + b"\n"  # an unclosed tuple
+        z.writestr("trans.npy", b"\x93NUMPY\x01\x00" + len(text).to_bytes(2, "little") + text + bytes(480))
+    with pytest.raises(FormatError, match="field 'trans'.*EOF in multi-line statement"):
+        read_smplx(path)
+
+
+@pytest.mark.parametrize("damage", ["method", "encrypted"])
+def test_read_smplx_names_a_member_zipfile_cannot_open(tmp_path, damage):
+    """An unknown compression method raised a bare NotImplementedError, the encryption flag a bare RuntimeError."""
+    import struct
+
+    path = _save(tmp_path / "take.npz", _beat2_like())
+    data = bytearray(path.read_bytes())
+    for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):  # every local and central header
+        i = data.find(sig)
+        while i >= 0:
+            if damage == "method":
+                data[i + at + 2 : i + at + 4] = struct.pack("<H", 99)
+            else:
+                data[i + at : i + at + 2] = struct.pack("<H", 1)
+            i = data.find(sig, i + 4)
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="field 'betas'.*not a readable array"):
+        read_smplx(path)
+
+
 def test_read_beat2_split_names_the_bad_line(tmp_path):
     path = tmp_path / "train_test_split.csv"
     path.write_text("id,type\n2_scott_0_1_1,test\n2_scott_0_2_2,holdout\n")

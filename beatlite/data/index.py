@@ -36,6 +36,7 @@ Taught in notebooks/00_setup_and_tour.ipynb, sections 2 (what is in the data fol
 from __future__ import annotations
 
 import io
+import math
 import os
 import re
 import warnings
@@ -449,18 +450,32 @@ def textgrid_duration(path: str | Path) -> float:
         head = [line for _, line in zip(range(12), f)]
     if "textgrid" not in "".join(head[:2]).lower():
         raise FormatError(path, "not a TextGrid (no 'Object class = \"TextGrid\"' line)", line=2)
-    for line in head:
+    for lineno, line in enumerate(head, start=1):
         m = _XMAX.match(line)
         if m:
-            return float(m.group(1))
+            return _finite_xmax(path, m.group(1), lineno)
     # short format: File type, Object class, blank, xmin, xmax
     numbers = [
-        line.strip() for line in head[1:] if line.strip() and not line.strip().startswith(("Object", '"'))
+        (lineno, line.strip())
+        for lineno, line in enumerate(head, start=1)
+        if lineno > 1 and line.strip() and not line.strip().startswith(("Object", '"'))
     ]
+    if len(numbers) < 2:
+        raise FormatError(path, "no xmax in the first lines", field="xmax")
+    return _finite_xmax(path, numbers[1][1], numbers[1][0])
+
+
+def _finite_xmax(path: Path, text: str, line: int) -> float:
+    """``float(text)``, or a :class:`FormatError` naming the line for text that is no finite number."""
+    from beatlite.io.errors import FormatError
+
     try:
-        return float(numbers[1])
-    except (IndexError, ValueError):
-        raise FormatError(path, "no xmax in the first lines", field="xmax") from None
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise FormatError(path, f"xmax {text!r} is not a finite number of seconds", line=line, field="xmax")
+    return value
 
 
 def _check_face(path: Path) -> float:
@@ -603,8 +618,8 @@ def _check_motion(record: TakeRecord, bvh_fps: float | None) -> None:
     if record.format == "beat2":  # the .npz states its rate
         record.bvh_fps = None if bvh_fps is None else motion.fps
         return
-    header_fps = parse_frame_time(repr(read_bvh_header(path)[2]))
-    if bvh_fps is not None or motion.fps != header_fps:
+    # with an override the header's Frame Time is not read (it may be the wrong value the override replaces)
+    if bvh_fps is not None or motion.fps != parse_frame_time(repr(read_bvh_header(path)[2])):
         record.bvh_fps = motion.fps
 
 

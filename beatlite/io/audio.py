@@ -250,9 +250,10 @@ def read_audio(
     ------
     FormatError
         If the bytes are not audio (naming what they look like), the header fails
-        the checks of :func:`audio_info` (checked before any sample is decoded), or
-        libsndfile cannot decode them. A truncated WAV (fewer samples than its
-        ``data`` chunk declares) is read with a :class:`FormatWarning`.
+        the checks of :func:`audio_info` (checked before any sample is decoded),
+        libsndfile cannot decode them, or a sample is NaN or infinite (a float WAV;
+        field ``samples``). A truncated WAV (fewer samples than its ``data`` chunk
+        declares) is read with a :class:`FormatWarning`.
 
     Examples
     --------
@@ -283,6 +284,14 @@ def read_audio(
         y, native = sf.read(source, dtype="float32", always_2d=True)
     except (sf.LibsndfileError, RuntimeError, TypeError) as exc:
         raise FormatError(p, f"cannot decode audio ({describe_bytes(head[:64])}): {exc}") from None
+    finite = np.isfinite(y)
+    if not finite.all():  # a float WAV may hold NaN or inf: they would spread through resampling and features
+        frame, channel = (int(i) for i in np.argwhere(~finite)[0])
+        raise FormatError(
+            p,
+            f"sample {frame} of channel {channel} is {y[frame, channel]}, not a finite number",
+            field="samples",
+        )
     if mono:
         y = y.mean(axis=1, dtype=np.float32) if y.shape[1] > 1 else y[:, 0]
     if target is not None and target != native:

@@ -284,10 +284,22 @@ def _parse_hierarchy(lines: list[tuple[int, str]], path: Path | None) -> Skeleto
         raise FormatError(path, f"expected 'ROOT', found {tok!r}", line=line, column=col)
     stack = [joints.add(_joint_name(tokens, line, "ROOT"), -1, line)]
     tokens.expect("{")
+    declared: dict[
+        tuple[int, str], int
+    ] = {}  # (joint, OFFSET or CHANNELS) -> line: a second one would replace it
     while stack:
         tok, line, col = tokens.next("'}'")
         key = tok.upper()
         j = stack[-1]
+        if key in ("OFFSET", "CHANNELS"):
+            if (j, key) in declared:
+                raise FormatError(
+                    path,
+                    f"joint {joints.names[j]!r} has a second {key} (the first on line {declared[j, key]})",
+                    line=line,
+                    column=col,
+                )
+            declared[j, key] = line
         if key == "OFFSET":
             joints.offsets[j] = tuple(tokens.number(f"OFFSET of {joints.names[j]!r}") for _ in range(3))  # type: ignore[assignment]
         elif key == "CHANNELS":
@@ -540,12 +552,12 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
     n_frames_declared : int
         The ``Frames:`` value (the rows are not counted).
     frame_time : float
-        The ``Frame Time:`` value in seconds, as written.
+        The ``Frame Time:`` value in seconds, as written (positive).
 
     Raises
     ------
     FormatError
-        If the header is malformed (naming the line).
+        If the header is malformed (naming the line), a ``Frame Time`` of zero or less included.
 
     Examples
     --------
@@ -569,6 +581,8 @@ def read_bvh_header(path: str | os.PathLike[str]) -> tuple[Skeleton, int, float]
         raise FormatError(p, f"Frame Time {time_text!r} is not a number", line=time_line) from None
     if not math.isfinite(frame_time):
         raise FormatError(p, f"Frame Time {time_text!r} is not finite", line=time_line)
+    if frame_time <= 0:
+        raise FormatError(p, f"Frame Time {time_text!r} is not a positive number of seconds", line=time_line)
     return skeleton, n_frames, frame_time
 
 

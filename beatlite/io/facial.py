@@ -120,13 +120,34 @@ def estimate_fps(times: np.ndarray, default: float = DEFAULT_FPS) -> float:
     return float(n) if n >= 1 and abs(fps - n) <= 0.01 * n else fps
 
 
+class _DuplicateKey(Exception):
+    pass
+
+
+def _unique_keys(pairs: list[tuple[str, object]]) -> dict:
+    """A JSON object as a dict; a key given twice raises (``json`` would keep the last one silently)."""
+    doc = dict(pairs)
+    if len(doc) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise _DuplicateKey(key)
+            seen.add(key)
+    return doc
+
+
 def _parse_json(p: Path) -> dict:
-    """The JSON object of ``p``; numbers become floats (no digit limit, no overflow)."""
+    """The JSON object of ``p``; numbers become floats (no digit limit, no overflow); no key twice in an object."""
     text = read_text(p)
     if not text.strip():
         raise FormatError(p, "empty file: expected facial JSON")
     try:
-        doc = json.loads(text, parse_int=float)
+        doc = json.loads(text, parse_int=float, object_pairs_hook=_unique_keys)
+    except _DuplicateKey as exc:
+        key = str(exc.args[0])
+        raise FormatError(
+            p, f"key {key!r} appears twice in one object (which one is meant is unknown)", field=key
+        ) from None
     except json.JSONDecodeError as exc:
         raise FormatError(p, f"invalid JSON: {exc.msg}", line=exc.lineno, column=exc.colno) from None
     except RecursionError:
@@ -256,8 +277,8 @@ def read_facial(path: str | os.PathLike[str], *, names: Sequence[str] | None = N
     Raises
     ------
     FormatError
-        Invalid or too deeply nested JSON (line/column), a missing key, duplicate
-        names, a frame whose weight count differs from the number of names, a weight
+        Invalid or too deeply nested JSON (line/column), a missing key, a key given
+        twice in one object (e.g. two ``"names"``), duplicate names, a frame whose weight count differs from the number of names, a weight
         or time that is not a finite number (strings and booleans included), or time
         stamps that do not increase (each naming the frame index).
 

@@ -17,7 +17,8 @@ key                    shape, dtype                meaning
 =====================  ==========================  ==================================================
 
 :func:`read_smplx` reads one with ``allow_pickle=False``; every problem (not an npz, a Git-LFS pointer, a
-pickled object array, a missing key, a wrong shape, a non-finite value, an unbounded decompression) is one
+pickled object array, a missing key, a wrong shape, a non-finite value, an unbounded decompression, an array header
+claiming more bytes than its member holds) is one
 :class:`~beatlite.io.errors.FormatError` naming the file and the key. ``poses``, ``trans`` and
 ``mocap_frame_rate`` are required (a prediction file needs no more); ``betas`` and ``expressions`` may be absent.
 :func:`write_smplx` writes the same layout atomically.
@@ -35,8 +36,11 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import math
 import os
+import tokenize
 import zipfile
+import zlib
 from collections.abc import Callable
 from pathlib import Path
 
@@ -136,6 +140,43 @@ def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
     return zip_members(path, _MAX_MEMBER_BYTES, suffix=".npy")
 
 
+#: What a damaged member raises while numpy reads it: a bad ZIP entry, corrupt deflate data, a header numpy's
+#: tokenizer cannot read, an unknown compression method (NotImplementedError), an encrypted member (RuntimeError).
+_DAMAGED = (
+    OSError,
+    EOFError,
+    zipfile.BadZipFile,
+    zlib.error,
+    tokenize.TokenError,
+    NotImplementedError,
+    RuntimeError,
+)
+
+
+def _check_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, key: str) -> None:
+    """The member's ``.npy`` header, read before numpy reads it: numpy allocates the shape the header claims before
+    it reads a byte of data, so a shape needing more bytes than the member holds is refused here, as is an object
+    dtype (a pickle). A member that is no ``.npy`` (numpy gives its bytes) is left to the checks of its key."""
+    fmt = np.lib.format
+    try:
+        with zf.open(info) as fh:
+            if fh.read(len(fmt.MAGIC_PREFIX)) != fmt.MAGIC_PREFIX:
+                return
+            fh.seek(0)
+            read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
+            shape, _, dtype = read(fh)
+            have = info.file_size - fh.tell()
+    except (*_DAMAGED, ValueError) as exc:
+        raise FormatError(path, f"not a readable array ({' '.join(str(exc).split())})", field=key) from None
+    if dtype.hasobject:
+        raise FormatError(path, "a pickled object array (never loaded: it could run code)", field=key)
+    need = math.prod(shape) * dtype.itemsize
+    if need > have:
+        raise FormatError(
+            path, f"the header's shape {shape} {dtype} needs {need} bytes, the member holds {have}", field=key
+        )
+
+
 def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:
     try:
         value = z[key]
@@ -145,7 +186,7 @@ def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:
                 path, "a pickled object array (never loaded: it could run code)", field=key
             ) from None
         raise FormatError(path, f"not a readable array ({exc})", field=key) from None
-    except (OSError, EOFError, zipfile.BadZipFile) as exc:
+    except _DAMAGED as exc:
         raise FormatError(path, f"not a readable array ({exc})", field=key) from None
     return value
 
@@ -237,9 +278,12 @@ def read_smplx(path: str | os.PathLike[str]) -> SMPLXMotion:
     for key in ("poses", "trans", "mocap_frame_rate"):
         if key not in infos:
             raise FormatError(p, f"no {key!r} array (keys: {', '.join(sorted(infos)) or 'none'})", field=key)
+    with zipfile.ZipFile(p) as zf:
+        for key, info in infos.items():
+            _check_header(zf, info, p, key)
     try:
         z = np.load(p, allow_pickle=False)
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+    except (*_DAMAGED, ValueError) as exc:
         raise FormatError(p, f"not a readable npz ({exc})") from None
     with z:
         raw = {key: _array(z, p, key) for key in infos}

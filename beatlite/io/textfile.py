@@ -143,6 +143,8 @@ class _CheckedGzip(gzip.GzipFile):
         return self._checked("read1", size)
 
     def readline(self, size: int = -1) -> bytes:
+        if size is None or size < 0:  # a line with no newline (zeros) inflated unchecked: stop past the limit
+            size = max(self.limit - self.inflated, 0) + 1
         return self._checked("readline", size)
 
     def peek(self, n: int) -> bytes:

@@ -28,6 +28,7 @@ Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkp
 from __future__ import annotations
 
 import zipfile
+import zlib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -125,11 +126,12 @@ def read_plain(path: Path) -> Any:
     PermissionError
         The file cannot be read.
     beatlite.io.FormatError
-        Truncated or damaged, a decompression bomb, or a pickle of anything but tensors and plain values
-        (refused, never executed).
+        Truncated or damaged (a ZIP member failing its CRC-32 included), a decompression bomb, or a pickle of
+        anything but tensors and plain values (refused, never executed).
     """
     if zipfile.is_zipfile(path):
         zip_members(path)
+        _check_crcs(path)
     try:
         with torch.serialization.safe_globals(NUMPY_ARRAY_GLOBALS):
             data = torch.load(path, map_location="cpu", weights_only=True)
@@ -158,6 +160,31 @@ def read_plain(path: Path) -> Any:
             f"{describe_bytes(head)}",
         ) from None
     return data
+
+
+def _check_crcs(path: Path) -> None:
+    """Every member's CRC-32, which ``torch.load`` does not check: a flipped byte in a tensor's data loads as a
+    silently different weight."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            bad = z.testzip()
+        reason = None if bad is None else f"member {bad} fails its CRC-32 check"
+    except (
+        zipfile.BadZipFile,
+        OSError,
+        EOFError,
+        zlib.error,
+        ValueError,
+        NotImplementedError,
+        RuntimeError,
+    ) as exc:
+        reason = " ".join(
+            str(exc).split()
+        )  # a damaged member name, an unknown compression method, encryption
+    if reason is not None:
+        raise FormatError(
+            path, f"truncated or corrupted file ({reason}): write it again, e.g. train again or copy it anew"
+        )
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
