@@ -500,6 +500,8 @@ def build_site(
         f"{_nav()}<h1>beatlite: co-speech gesture synthesis, a course</h1>"
         "<p>Lectures in order: the executed notebook, its slides (arrow keys; <kbd>s</kbd> opens the speaker "
         "view, <kbd>Esc</kbd> the overview), the student copy without solutions.</p>"
+        "<p class='note'>The executed lecture pages show the exercises' solutions (the slides and the student "
+        "copies do not): publish them once the exercises are due.</p>"
         "<table><thead><tr><th>lecture</th><th>goal</th><th>time</th><th>slides</th><th>download</th>"
         f"<th>Colab</th></tr></thead><tbody>{''.join(lines)}</tbody></table>{colab_note}"
     )

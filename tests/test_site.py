@@ -226,6 +226,7 @@ def test_index_is_the_course_map(built):
     ]
     assert "Learn what" in rows[0][2] and "<math" in rows[0][2]  # the goal line, its formula as MathML
     assert "colab.research.google.com" not in index and "make site COLAB_REPO=owner/name" in index
+    assert "The executed lecture pages show the exercises' solutions" in index  # a warning before publishing
 
 
 def test_colab_links_name_the_repository(built, tmp_path):
