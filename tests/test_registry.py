@@ -183,8 +183,12 @@ def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_
         scoring.register_metric("FGD", metric)
     with pytest.raises(ValueError, match="does not list"):
         scoring.register_metric("Gap2", scoring.Metric("Gap", "test", False, ("euler",), gap, "mean gap"))
-    with pytest.raises(ValueError, match="does not name its inputs"):
+    with pytest.raises(ValueError, match=r"does not name its inputs \(g, t not in INPUTS: positions, "):
         scoring.Metric("Gap", "test", False, None, lambda g, t, seed: 0.0, "no names")
+    with pytest.raises(
+        ValueError, match=r"\(position not in INPUTS: .*\bpositions\b"
+    ):  # a typo: the names listed
+        scoring.Metric("Gap", "test", False, None, lambda position, fps: 0.0, "a typo")
 
 
 def test_a_metric_that_does_not_return_one_number_is_named(metrics_restored):

@@ -407,7 +407,14 @@ def needs_of(fn: Callable[..., float]) -> tuple[str, ...]:
     ('positions', 'semantic')
     """
     if bind_inputs(fn) is fn:
-        raise ValueError(f"{getattr(fn, '__name__', fn)!r} does not name its inputs; give needs explicitly")
+        required = [
+            p.name for p in inspect.signature(fn).parameters.values() if p.default is inspect.Parameter.empty
+        ]
+        unknown = [name for name in required if name not in INPUTS]
+        raise ValueError(
+            f"{getattr(fn, '__name__', fn)!r} does not name its inputs ({', '.join(unknown)} not in INPUTS: "
+            f"{', '.join(INPUTS)}); rename them, or give needs explicitly"
+        )
     names = [p for p in inspect.signature(fn).parameters if p in INPUTS and p not in ("fps", "sr", "seed")]
     return tuple(dict.fromkeys(n.removeprefix("truth_") for n in names))
 
