@@ -129,3 +129,20 @@ def test_gpu_record_refuses_a_log_without_its_machine_line(tmp_path, capsys):
     assert gpu_record.main(["add", "next", str(tmp_path), "--record", str(tmp_path / "r.json")]) == 2
     assert capsys.readouterr().err.startswith("gpu_record: the log has no line 'HOST  torch VERSION  GPU'")
     assert not (tmp_path / "r.json").exists()
+
+
+@pytest.mark.slow
+def test_bench_data_without_out_leaves_nothing_in_the_temp_folder(tmp_path):
+    """``make bench`` runs bench/bench_data.py without ``--out``: its figures and window cache (60 MB on
+    data_samples/) went to a ``bench_data_*`` folder of the system's temp folder that was never deleted."""
+    import os
+    import subprocess
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    env = {**os.environ, "TMPDIR": str(temp), "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "bench_data.py")], capture_output=True, text=True,
+                          env=env, cwd=tmp_path, timeout=900)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-6000:]
+    assert "TOTAL cache build" in done.stdout  # (it ran to its last part)
+    assert [p.name for p in temp.iterdir() if p.name.startswith("bench_data_")] == []
