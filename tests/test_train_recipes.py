@@ -437,6 +437,15 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
         assert command.main([*argv, *extra]) == 2, extra
         err = capsys.readouterr().err
         assert err.startswith("error: ") and said in err and err.count("\n") == 1, (extra, err)
+    # under torchrun --nproc_per_node=4 (WORLD_SIZE, as it sets it; no process group is started here), a global
+    # batch of 6 leaves a process 1 window: every step was skipped and the untrained weights were exported
+    monkeypatch.setenv("WORLD_SIZE", "4")
+    assert command.main([*argv, "--batch-size", "6"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("error: fit: batch_size 6 split into 4 micro-batches (4 processes")
+        and err.count("\n") == 1
+    )
     assert not out.exists()
     assert recipe_train_config("random_clip", epochs=0).epochs == 0  # an untrained baseline: nothing to train
 

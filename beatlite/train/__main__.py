@@ -215,7 +215,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     (or resuming from them) while it trains.
     """
 
-    from beatlite.train.training import check_compilable  # (imports torch)
+    from beatlite.train.training import check_batch_split, check_compilable  # (imports torch)
 
     options = {
         "seed": args.seed,
@@ -232,8 +232,10 @@ def _fit_command(args: argparse.Namespace) -> int:
         "lr_scaling": args.lr_scaling,
     }
     try:  # before anything is prepared or written: the flags' values, the device, the compiler
-        recipe_train_config(args.recipe, **options)
+        config = recipe_train_config(args.recipe, **options)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
+        if config.epochs > 0:  # (an untrained baseline takes no step)
+            check_batch_split(config, int(os.environ.get("WORLD_SIZE", "1")))  # (torchrun's process count)
     except ValueError as error:
         return _refused(error)
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()

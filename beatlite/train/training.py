@@ -321,6 +321,8 @@ def fit(
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
 
     check_compilable(type(model), config.compile)  # before any work
+    if model.generator_parameters():  # (an untrained baseline takes no step)
+        check_batch_split(config, distributed_rank()[1])
     data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads, config.deterministic)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
@@ -465,6 +467,29 @@ def check_compilable(model_class: type[GestureModel], mode: str | None) -> None:
             f"fit: {model_class.name} cannot be compiled with inductor (TrainConfig.compile={mode!r}, "
             f"fit --compile {mode}): {model_class.inductor_failure}; train it eagerly (compile=None, no "
             f"--compile) or traced without inductor ('aot_eager')"
+        )
+
+
+def check_batch_split(config: TrainConfig, world: int) -> None:
+    """Raise ``ValueError`` when ``config.batch_size`` split into ``max(micro_batches, world)`` micro-batches (``world``:
+    the processes under ``torchrun``) leaves fewer than 2 windows in one: BatchNorm needs 2, so every step would be
+    skipped and nothing trained. The batch size is the global one, split over the processes.
+
+    Examples
+    --------
+    >>> check_batch_split(TrainConfig(batch_size=8), world=4)  # 4 processes, 2 windows each
+    >>> check_batch_split(TrainConfig(batch_size=4), world=4)
+    Traceback (most recent call last):
+    ...
+    ValueError: fit: batch_size 4 split into 4 micro-batches (4 processes, micro_batches=1) leaves fewer than 2 windows in one (BatchNorm needs 2: no step would train); batch_size must be >= 8 (it is the global batch, split over the processes)
+    """
+    parts = max(config.micro_batches, world)
+    if config.batch_size < 2 * parts:
+        raise ValueError(
+            f"fit: batch_size {config.batch_size} split into {parts} micro-batches ({world} process"
+            f"{'es' if world > 1 else ''}, micro_batches={config.micro_batches}) leaves fewer than 2 windows in "
+            f"one (BatchNorm needs 2: no step would train); batch_size must be >= {2 * parts} (it is the global "
+            "batch, split over the processes)"
         )
 
 
