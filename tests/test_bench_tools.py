@@ -54,6 +54,25 @@ def test_batch_scaling_summarises_each_batch_and_rule_over_the_seeds():
     assert summary(rows[:1]) == {"32 linear": {"FGD": [3.0, None], "SRGR": [3.0, None]}}  # one seed: no sd
 
 
+def test_batch_scaling_records_its_thread_count_host_and_torch(monkeypatch):
+    """The record's command said ``BEATLITE_THREADS=1`` whatever the run's thread count (a training repeats to
+    the bit only for one thread count), and nothing named the machine or torch."""
+    import argparse
+    import platform
+
+    batch_scaling = _load("batch_scaling")
+    monkeypatch.setenv("BEATLITE_THREADS", "2")
+    args = argparse.Namespace(recipe="camn_tiny", batches=[32], rules=["linear"], seeds=[2021], epochs=1,
+                              revision="abc1234")  # fmt: skip
+    record = batch_scaling._record(args, batch_scaling.RECIPES["camn_tiny"], [])
+    assert record["command"].startswith("BEATLITE_THREADS=2 python bench/batch_scaling.py --recipe camn_tiny")
+    assert (record["host"], record["torch"], record["revision"]) == (
+        platform.node(),
+        torch.__version__,
+        "abc1234",
+    )
+
+
 def test_gpu_record_renders_the_readme_table_from_the_shipped_record():
     """bench/gpu_record.py's table of bench/records/bench_train_h200.json is the README's block, to the byte."""
     import json
