@@ -321,8 +321,6 @@ def fit(
         raise TypeError(f"fit: config must be a TrainConfig, got {type(config).__name__}")
 
     check_compilable(type(model), config.compile)  # before any work
-    if model.generator_parameters():  # (an untrained baseline takes no step)
-        check_batch_split(config, distributed_rank()[1])
     data = _Data.of(model, train_windows)
     configure_torch(config.seed, config.threads, config.deterministic)
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
@@ -520,6 +518,8 @@ class _Run:
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
         self.rank, self.world = distributed_rank()
+        if model.generator_parameters():  # before a step (an untrained baseline takes none)
+            check_batch_split(config, self.world)
         # micro-batches per optimiser step, spread over the processes
         self.parts = max(config.micro_batches, self.world)
         self.device = local_device(config.torch_device())
