@@ -22,14 +22,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import platform
 import statistics
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
+import torch
+
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision
+from beatlite.paths import code_revision, n_threads
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
 from beatlite.train.testset import load_test_set
@@ -57,8 +60,11 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "recipe_lr": recipe.lr,
         "epochs": recipe.epochs if args.epochs is None else args.epochs,
         "revision": args.revision,
-        "command": f"BEATLITE_THREADS=1 python bench/batch_scaling.py --recipe {args.recipe} --batches {batches} "
-        f"--rules {rules} --seeds {seeds}" + ("" if args.epochs is None else f" --epochs {args.epochs}"),
+        "command": f"BEATLITE_THREADS={n_threads()} python bench/batch_scaling.py --recipe {args.recipe} "
+        f"--batches {batches} --rules {rules} --seeds {seeds}"
+        + ("" if args.epochs is None else f" --epochs {args.epochs}"),
+        "host": platform.node(),
+        "torch": torch.__version__,
         "rows": rows,
         "summary": summary(rows),
     }

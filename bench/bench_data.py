@@ -7,7 +7,8 @@ Each step is printed with a straightforward alternative measured in the same run
 - per-take log-mel sliced per window vs librosa on every window separately,
 - loading the window cache vs building it.
 
-Usage: ``python bench/bench_data.py [--data FOLDER] [--out FOLDER]``. Timings on a shared machine
+Usage: ``python bench/bench_data.py [--data FOLDER] [--out FOLDER]`` (``--out`` keeps the figures and the
+window cache; without it they go to a temporary folder, deleted at the end). Timings on a shared machine
 are noisy; run it twice and compare.
 """
 
@@ -37,12 +38,31 @@ def main() -> int:
     import matplotlib
 
     matplotlib.use("Agg")
+    from beatlite.paths import data_dir
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", type=Path, default=None, help="BEAT-format folder (default data_dir())")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="folder for figures and caches (default: a temporary one, deleted at the end)",
+    )
+    args = parser.parse_args()
+    root = args.data or data_dir()
+    if args.out is None:  # figures and the window cache (60 MB for data_samples/) deleted at the end
+        with tempfile.TemporaryDirectory(prefix="bench_data_") as tmp:
+            return _run(root, Path(tmp))
+    args.out.mkdir(parents=True, exist_ok=True)
+    return _run(root, args.out)
+
+
+def _run(root: Path, out: Path) -> int:
     import matplotlib.pyplot as plt
 
     from beatlite.data.index import index_folder
     from beatlite.data.windows import MEL_SETTINGS, audio_samples, audio_start, build_windows, log_mel
     from beatlite.io import load_take
-    from beatlite.paths import data_dir
     from beatlite.stats import (
         EmotionClassifier,
         emotion_separability,
@@ -63,15 +83,6 @@ def main() -> int:
         word_scores,
     )
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=None, help="BEAT-format folder (default data_dir())")
-    parser.add_argument(
-        "--out", type=Path, default=None, help="folder for figures and caches (default: temp)"
-    )
-    args = parser.parse_args()
-    root = args.data or data_dir()
-    out = args.out or Path(tempfile.mkdtemp(prefix="bench_data_"))
-    out.mkdir(parents=True, exist_ok=True)
     print(f"data: {root}\noutput: {out}")
 
     # ------------------------------------------------------------------ index + statistics

@@ -5,6 +5,8 @@ Run: ``BEATLITE_THREADS=1 .venv/bin/python bench/bench_train.py --quick [--json 
 core). Without ``--quick`` every trainable registered model's ``tiny`` preset (and on CUDA CaMN's and HA2G's
 ``paper`` preset) runs at batch 16 and 64 on the ``data_samples/`` train split (``--models``, ``--presets``,
 ``--batch-sizes``, ``--devices``, ``--precisions`` choose; a paper preset on one CPU thread takes minutes per row).
+``--json``: the rows and GEMM peaks, rewritten (atomically) after every row, with the command, the code's revision
+(``git rev-parse --short HEAD``, ``+changes`` for a modified checkout) and the machine (host, CPU, torch, threads, GPU).
 
 Per row:
 
@@ -59,9 +61,12 @@ about 150 windows/s). Measured on an H200: ``bench/records/bench_train_h200.json
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import os
+import platform
+import sys
 import tempfile
 import time
 import traceback
@@ -77,7 +82,7 @@ from torch.utils.flop_counter import FlopCounterMode
 from beatlite.io.atomic import write_json
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.models.layers import use_frame_matmul
-from beatlite.paths import data_dir, n_threads
+from beatlite.paths import code_revision, data_dir, n_threads
 from beatlite.train import TrainConfig, fit
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.training import _Run, model_keys
@@ -475,6 +480,8 @@ def main() -> None:
     if args.trace_rnn:
         torch._dynamo.config.allow_rnn = True
     torch.set_num_threads(n_threads())
+    about = {"command": " ".join(["python", *sys.argv]), "machine": machine()}
+    about["revision"] = code_revision() if args.json else None  # (before the record, maybe a tracked file)
     with tempfile.TemporaryDirectory() as tmp:
         train = _store_train(args.quick, Path(tmp) / "store")
         bench = "  cudnn.benchmark" if args.cudnn_benchmark else ""
@@ -510,12 +517,12 @@ def main() -> None:
             print(f"  {name} {preset} {device} {precision} b{batch} {comp} det={det}{matmul_label}: "
                   + (row.note or f"{row.step_wps:,.0f} windows/s{fit_error}"), flush=True)  # fmt: skip
             _write_json(
-                args.json, rows
+                args.json, rows, about
             )  # after every row: a run stopped by a time limit keeps what it measured
     for (device, dtype), flops in sorted(_PEAKS.items(), key=str):
         print(f"peak: {device} {str(dtype).replace('torch.', '')} matrix product {flops / 1e9:,.1f} GFLOP/s")
     print(markdown(rows))
-    _write_json(args.json, rows)
+    _write_json(args.json, rows, about)
 
 
 def _recover(device: str) -> None:
@@ -532,12 +539,25 @@ def _failed(error: BaseException) -> str:
     return f"failed: {type(error).__name__}: {message}"
 
 
-def _write_json(path: Path | None, rows: list[Row]) -> None:
-    """The rows (and the GEMM peaks measured so far) as JSON at ``path`` (nothing without one)."""
+def machine() -> dict[str, Any]:
+    """What ran the rows: host name, CPU model and count, torch version and threads, the CUDA device (or None)."""
+    cpu = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError):
+        names = [line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                 if line.startswith("model name")]  # fmt: skip
+        cpu = names[0] if names else cpu
+    cuda = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
+    return {"host": platform.node(), "cpu": cpu, "cpus": os.cpu_count(), "torch": torch.__version__,
+            "threads": torch.get_num_threads(), "cuda": cuda}  # fmt: skip
+
+
+def _write_json(path: Path | None, rows: list[Row], about: dict[str, Any]) -> None:
+    """The rows (and the GEMM peaks measured so far) as JSON at ``path`` (nothing without one), after ``about``
+    (the command, the code's revision and the :func:`machine`: :func:`main`)."""
     if path is None:
         return
     peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}
-    write_json(path, {"peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]})
+    write_json(path, {**about, "peaks": peaks, "rows": [dataclasses.asdict(r) for r in rows]})
 
 
 if __name__ == "__main__":

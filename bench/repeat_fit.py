@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import platform
 import subprocess
 import sys
 import tempfile
@@ -26,7 +27,7 @@ from pathlib import Path
 import torch
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, data_dir
+from beatlite.paths import code_revision, data_dir, n_threads
 from beatlite.train.checkpoint import load_checkpoint
 from beatlite.train.recipes import RECIPES
 
@@ -77,8 +78,8 @@ def main() -> None:
                              "epochs": args.epochs, "seconds": time.perf_counter() - start, **compare(*runs)})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
                 if args.json is not None:
-                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision,
-                              "torch": torch.__version__, "threads": os.environ.get("BEATLITE_THREADS"), "rows": rows}  # fmt: skip
+                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision, "host": platform.node(),
+                              "torch": torch.__version__, "threads": str(n_threads()), "rows": rows}  # fmt: skip
                     write_json(args.json, record)
 
 

@@ -54,6 +54,25 @@ def test_batch_scaling_summarises_each_batch_and_rule_over_the_seeds():
     assert summary(rows[:1]) == {"32 linear": {"FGD": [3.0, None], "SRGR": [3.0, None]}}  # one seed: no sd
 
 
+def test_batch_scaling_records_its_thread_count_host_and_torch(monkeypatch):
+    """The record's command said ``BEATLITE_THREADS=1`` whatever the run's thread count (a training repeats to
+    the bit only for one thread count), and nothing named the machine or torch."""
+    import argparse
+    import platform
+
+    batch_scaling = _load("batch_scaling")
+    monkeypatch.setenv("BEATLITE_THREADS", "2")
+    args = argparse.Namespace(recipe="camn_tiny", batches=[32], rules=["linear"], seeds=[2021], epochs=1,
+                              revision="abc1234")  # fmt: skip
+    record = batch_scaling._record(args, batch_scaling.RECIPES["camn_tiny"], [])
+    assert record["command"].startswith("BEATLITE_THREADS=2 python bench/batch_scaling.py --recipe camn_tiny")
+    assert (record["host"], record["torch"], record["revision"]) == (
+        platform.node(),
+        torch.__version__,
+        "abc1234",
+    )
+
+
 def test_gpu_record_renders_the_readme_table_from_the_shipped_record():
     """bench/gpu_record.py's table of bench/records/bench_train_h200.json is the README's block, to the byte."""
     import json
@@ -129,3 +148,20 @@ def test_gpu_record_refuses_a_log_without_its_machine_line(tmp_path, capsys):
     assert gpu_record.main(["add", "next", str(tmp_path), "--record", str(tmp_path / "r.json")]) == 2
     assert capsys.readouterr().err.startswith("gpu_record: the log has no line 'HOST  torch VERSION  GPU'")
     assert not (tmp_path / "r.json").exists()
+
+
+@pytest.mark.slow
+def test_bench_data_without_out_leaves_nothing_in_the_temp_folder(tmp_path):
+    """``make bench`` runs bench/bench_data.py without ``--out``: its figures and window cache (60 MB on
+    data_samples/) went to a ``bench_data_*`` folder of the system's temp folder that was never deleted."""
+    import os
+    import subprocess
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    env = {**os.environ, "TMPDIR": str(temp), "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "bench_data.py")], capture_output=True, text=True,
+                          env=env, cwd=tmp_path, timeout=900)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-6000:]
+    assert "TOTAL cache build" in done.stdout  # (it ran to its last part)
+    assert [p.name for p in temp.iterdir() if p.name.startswith("bench_data_")] == []

@@ -110,3 +110,29 @@ def test_a_fit_that_fails_keeps_the_step_columns_of_its_row(monkeypatch, capsys)
     )
     row = next(line for line in out.splitlines() if line.startswith("| camn"))
     assert "| 100 | 160 | - |" in row
+
+
+def test_the_json_record_names_the_revision_and_the_machine(monkeypatch, tmp_path):
+    """``--json`` wrote the rows and peaks alone: nothing said which code or machine measured them."""
+    import json
+    import platform
+
+    from beatlite.paths import code_revision
+
+    bench = _bench()
+    monkeypatch.setattr(
+        bench,
+        "measure_step",
+        lambda name, *a, **k: bench.Row(name, "tiny", "cpu", "fp32", 16, step_wps=100.0, step_ms=160.0),
+    )
+    monkeypatch.setattr(bench, "_store_train", lambda quick, folder: [])
+    argv = ["bench_train.py", "--models", "camn", "--devices", "cpu", "--batch-sizes", "16", "--precisions",
+            "fp32", "--fit-steps", "0", "--json", str(tmp_path / "rows.json")]  # fmt: skip
+    monkeypatch.setattr(sys, "argv", argv)
+    bench.main()
+    record = json.loads((tmp_path / "rows.json").read_text())
+    assert record["revision"] == code_revision() and record["command"] == "python " + " ".join(argv)
+    machine = record["machine"]
+    assert machine["host"] == platform.node() and machine["torch"] == torch.__version__
+    assert machine["threads"] == torch.get_num_threads() and machine["cpu"]
+    assert [r["model"] for r in record["rows"]] == ["camn"]

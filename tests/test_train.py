@@ -180,6 +180,24 @@ def test_fit_checks_keys_and_config(windows):
     assert TrainConfig(batch_size=256).learning_rate == pytest.approx(5e-4)
 
 
+def test_fit_refuses_a_batch_too_small_for_its_micro_batches(windows, monkeypatch):
+    """A batch of 3 split into 2 micro-batches (``micro_batches=2``, or ``torchrun`` with 2 processes) leaves one
+    window in a micro-batch, which BatchNorm cannot take: every step was skipped, the weights never changed and
+    ``fit`` returned as if it had trained (history ``"train": {}``). It refuses before a step; 4 trains."""
+    from beatlite.train import training
+
+    train, _ = windows
+    model = camn()
+    before = {k: v.clone() for k, v in model.named_parameters()}
+    with pytest.raises(ValueError, match=r"batch_size 3 split into 2 micro-batches .* must be >= 4"):
+        fit(model, train, cfg(batch_size=3, micro_batches=2, epochs=1))
+    assert all(torch.equal(before[k], v) for k, v in model.named_parameters())
+    assert fit(camn(), train, cfg(batch_size=4, micro_batches=2, epochs=1)).history[0]["train"]["rec"] > 0
+    monkeypatch.setattr(training, "distributed_rank", lambda: (0, 4))  # as under torchrun --nproc_per_node=4
+    with pytest.raises(ValueError, match=r"batch_size 6 split into 4 micro-batches \(4 processes"):
+        fit(camn(), train, cfg(batch_size=6))
+
+
 def test_export_is_small_and_equivalent(windows, tmp_path):
     train, _ = windows
     model = camn()

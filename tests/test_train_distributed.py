@@ -15,13 +15,18 @@ torch = pytest.importorskip("torch")
 SCRIPT = Path(__file__).with_name("ddp_fit.py")
 
 
-def _env() -> dict[str, str]:
+def _env(tmp_path: Path) -> dict[str, str]:
+    """The children's environment: this checkout first on the path, one thread, and a temp folder of their own
+    inside ``tmp_path`` (torchrun leaves a ``torchelastic_*`` log folder in the temp folder of every run)."""
     root = str(Path(__file__).resolve().parents[1])
     env = {
         k: v for k, v in os.environ.items() if k not in ("WORLD_SIZE", "RANK", "LOCAL_RANK", "MASTER_ADDR")
     }
     env["PYTHONPATH"] = root + os.pathsep + env.get("PYTHONPATH", "")
     env["BEATLITE_THREADS"] = "1"
+    temp = tmp_path / "tmp"
+    temp.mkdir(exist_ok=True)
+    env["TMPDIR"] = str(temp)
     return env
 
 
@@ -37,9 +42,9 @@ def _one_and_two_processes(tmp_path: Path, micro: int, windows: int) -> tuple[di
     torchrun = _torchrun()
     one, two = tmp_path / "one.pt", tmp_path / "two.pt"
     args = [str(micro), str(windows)]
-    run_ok([sys.executable, str(SCRIPT), str(one), *args], env=_env(), timeout=900)
+    run_ok([sys.executable, str(SCRIPT), str(one), *args], env=_env(tmp_path), timeout=900)
     cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(SCRIPT), str(two), *args]
-    run_ok(cmd, env=_env(), timeout=900)
+    run_ok(cmd, env=_env(tmp_path), timeout=900)
     return torch.load(one, weights_only=True), torch.load(two, weights_only=True)
 
 
@@ -69,7 +74,7 @@ def test_two_processes_on_resident_windows_take_the_loaders_steps(tmp_path):
     for mode in ("never", "always"):
         out = tmp_path / f"{mode}.pt"
         run_ok([torchrun, "--standalone", "--nproc_per_node=2", str(SCRIPT), str(out), "2", "48", mode],
-               env=_env(), timeout=900)  # fmt: skip
+               env=_env(tmp_path), timeout=900)  # fmt: skip
         runs[mode] = torch.load(out, weights_only=True)
     a, b = runs["never"], runs["always"]
     assert a["history"] == b["history"]
@@ -103,7 +108,7 @@ def _whole_and_resumed(tmp_path: Path, *options: str) -> tuple[dict, dict]:
     for mode in ("whole", "kill"):
         path = tmp_path / f"{mode}.pt"
         cmd = [torchrun, "--standalone", "--nproc_per_node=2", str(script), str(path), mode, *options]
-        run_ok(cmd, env=_env(), timeout=900)
+        run_ok(cmd, env=_env(tmp_path), timeout=900)
         out[mode] = torch.load(str(path) + ".out", weights_only=True)
     return out["whole"], out["kill"]
 
@@ -168,9 +173,12 @@ def test_the_process_group_is_destroyed_before_the_interpreter_exits(tmp_path):
     script = tmp_path / "exit_check.py"
     script.write_text(EXIT_CHECK)
     cmd = [_torchrun(), "--standalone", "--nproc_per_node=2", str(script)]
-    done = run_ok(cmd, env=_env(), timeout=300)
+    done = run_ok(cmd, env=_env(tmp_path), timeout=300)
     assert done.stdout.count("group alive at exit: False") == 2, done.stdout + done.stderr
     assert "rank 0 of 2" in done.stdout and "rank 1 of 2" in done.stdout
+    # torchrun's log folder (one per run, never removed by torch) went to the children's temp folder in
+    # tmp_path, not to the system's: these tests once left hundreds of torchelastic_* folders in /tmp
+    assert len(list((tmp_path / "tmp").glob("torchelastic_*"))) == 1
 
 
 SUM_ORDER = """
@@ -194,7 +202,7 @@ def test_summed_losses_keep_the_models_order(tmp_path):
     script.write_text(SUM_ORDER)
     run_ok(
         [_torchrun(), "--standalone", "--nproc_per_node=2", str(script), str(tmp_path)],
-        env=_env(),
+        env=_env(tmp_path),
         timeout=300,
     )
     rows = [json.loads((tmp_path / f"{rank}.json").read_text()) for rank in (0, 1)]
@@ -213,7 +221,7 @@ def test_the_fit_command_prepares_new_data_once_under_torchrun(tmp_path):
            "--data", str(corpus), "--out", str(out), "--epochs", "1", "--device", "cpu", "--extractor-epochs", "1",
            "--compile", "aot_eager"]  # fmt: skip
     # (--compile: the DDP-wrapped modules through torch.compile too)
-    env = {k: v for k, v in _env().items() if k != "BEATLITE_BUILD"}
+    env = {k: v for k, v in _env(tmp_path).items() if k != "BEATLITE_BUILD"}
     done = run_ok(cmd, env=env, timeout=900)
     assert done.stdout.count("training the FGD extractor") == 1, done.stdout
     assert (out / "fgd_dirvec.pt").is_file() and (out / "s2g_tiny.pt").is_file()

@@ -437,6 +437,15 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
         assert command.main([*argv, *extra]) == 2, extra
         err = capsys.readouterr().err
         assert err.startswith("error: ") and said in err and err.count("\n") == 1, (extra, err)
+    # under torchrun --nproc_per_node=4 (WORLD_SIZE, as it sets it; no process group is started here), a global
+    # batch of 6 leaves a process 1 window: every step was skipped and the untrained weights were exported
+    monkeypatch.setenv("WORLD_SIZE", "4")
+    assert command.main([*argv, "--batch-size", "6"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("error: fit: batch_size 6 split into 4 micro-batches (4 processes")
+        and err.count("\n") == 1
+    )
     assert not out.exists()
     assert recipe_train_config("random_clip", epochs=0).epochs == 0  # an untrained baseline: nothing to train
 
@@ -454,6 +463,39 @@ def test_fit_command_reports_a_refused_resume_as_one_error_line(tmp_path, monkey
     assert command.main([*argv, "--epochs", "1", "--resume"]) == 2
     err = capsys.readouterr().err
     assert err == "error: fit: cannot resume from x.pt: changed: batch_size 32 -> 64\n"
+
+
+def test_fit_command_refuses_a_second_run_of_the_recipe_into_the_same_out(tmp_path, monkeypatch, capsys):
+    """Two ``fit`` runs of one recipe into one ``--out`` at once both trained and wrote the same checkpoints (the
+    resumable one and the export were whichever run wrote last, and both said they wrote them): a run holds
+    ``<out>/train/.<RECIPE>.lock`` while it trains, and a second one refuses at once with one ``error:`` line,
+    exit 2, before preparing anything; another recipe into the same ``--out`` is not held up."""
+    from beatlite.io.atomic import exclusive_lock
+    from beatlite.train import __main__ as command
+
+    calls = []
+
+    def stand_in_fit(model, train, config, val=None, **kw):
+        calls.append(config.checkpoint)
+        with pytest.raises(BlockingIOError):  # while this run trains, its lock is held
+            with exclusive_lock(tmp_path / "run" / "train" / ".diffgesture_tiny.lock", wait=False):
+                pass
+        raise _Stop(config)
+
+    argv = [*_fit_command_with(stand_in_fit, tmp_path, monkeypatch), "--epochs", "1"]
+    with pytest.raises(_Stop):
+        command.main(argv)
+    assert len(calls) == 1
+    with exclusive_lock(tmp_path / "run" / "train" / ".diffgesture_tiny.lock"):  # another run trains it
+        monkeypatch.setattr(command, "training_data", lambda folder, progress: pytest.fail("data prepared"))
+        assert command.main(argv) == 2
+        err = capsys.readouterr().err
+        assert (
+            err.startswith("error: another fit is training diffgesture_tiny into ") and err.count("\n") == 1
+        )
+        with exclusive_lock(tmp_path / "run" / "train" / ".s2g_tiny.lock", wait=False):  # (another recipe's)
+            pass
+    assert len(calls) == 1
 
 
 def test_fit_command_trains_the_extractor_again_for_other_data_or_epochs(tmp_path, monkeypatch, capsys):

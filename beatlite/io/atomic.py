@@ -240,7 +240,7 @@ def remove_stale_temps(path: str | os.PathLike[str]) -> list[Path]:
 
 
 @contextlib.contextmanager
-def exclusive_lock(path: str | os.PathLike[str]) -> Iterator[None]:
+def exclusive_lock(path: str | os.PathLike[str], *, wait: bool = True) -> Iterator[None]:
     """Hold an exclusive advisory lock (``flock``) on ``path`` (created if needed) for the ``with`` block.
 
     Processes that prepare the same thing (``retrain-all --jobs 2`` and ``torchrun`` start several,
@@ -248,6 +248,9 @@ def exclusive_lock(path: str | os.PathLike[str]) -> Iterator[None]:
     others wait, then find it done. Waiting has no time limit and happens outside any collective of
     ``torch.distributed`` (whose barriers time out after 30 minutes). The lock is released when the
     block ends or the process dies. POSIX only; elsewhere (Windows) the block runs unlocked.
+
+    With ``wait=False`` a lock that another holder has raises ``BlockingIOError`` at once instead (what
+    ``fit`` does when another run trains the same recipe into the same ``--out``).
 
     Examples
     --------
@@ -265,7 +268,7 @@ def exclusive_lock(path: str | os.PathLike[str]) -> Iterator[None]:
         return
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     with open(path, "a+b") as f:
-        fcntl.flock(f.fileno(), fcntl.LOCK_EX)
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
         try:
             yield
         finally:

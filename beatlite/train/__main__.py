@@ -35,6 +35,7 @@ rows (``make seeds ONLY=NAME`` records a new model's rows in the shipped table).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import subprocess
 import sys
@@ -208,9 +209,13 @@ def _fit_command(args: argparse.Namespace) -> int:
     data or ``--extractor-epochs``). Under
     ``torchrun`` each process does it under a file lock (:func:`beatlite.io.atomic.exclusive_lock`):
     the first builds, the others wait (no time limit, no collective) and find it done.
+
+    One run of a recipe trains into one ``--out`` at a time: process 0 holds ``<out>/train/.<RECIPE>.lock``
+    until it ends, and a second run refuses at once (exit 2) instead of overwriting the first's checkpoints
+    (or resuming from them) while it trains.
     """
 
-    from beatlite.train.training import ResumeError, check_compilable  # (imports torch)
+    from beatlite.train.training import check_batch_split, check_compilable  # (imports torch)
 
     options = {
         "seed": args.seed,
@@ -227,8 +232,10 @@ def _fit_command(args: argparse.Namespace) -> int:
         "lr_scaling": args.lr_scaling,
     }
     try:  # before anything is prepared or written: the flags' values, the device, the compiler
-        recipe_train_config(args.recipe, **options)
+        config = recipe_train_config(args.recipe, **options)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
+        if config.epochs > 0:  # (an untrained baseline takes no step)
+            check_batch_split(config, int(os.environ.get("WORLD_SIZE", "1")))  # (torchrun's process count)
     except ValueError as error:
         return _refused(error)
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
@@ -237,6 +244,25 @@ def _fit_command(args: argparse.Namespace) -> int:
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
     rank = int(os.environ.get("RANK", "0"))
+    lock = out / "train" / f".{args.recipe}.lock"
+    with contextlib.ExitStack() as held:
+        if rank == 0:  # one run of a recipe per --out at a time (under torchrun, process 0 holds it for all)
+            try:
+                held.enter_context(exclusive_lock(lock, wait=False))
+            except BlockingIOError:
+                return _refused(
+                    f"another fit is training {args.recipe} into {out} (it holds {lock}); "
+                    "wait for it to end, or give another --out"
+                )
+        return _fit_locked(args, options, data_dir, out, rank)
+
+
+def _fit_locked(
+    args: argparse.Namespace, options: dict[str, object], data_dir: Path, out: Path, rank: int
+) -> int:
+    """``fit`` once its flags are checked and (on process 0) the run's lock is held: prepare, train, export."""
+    from beatlite.train.training import ResumeError
+
     try:
         data = training_data(data_dir, progress=rank == 0)
     except ValueError as error:  # no val takes, no usable take, a file that cannot be read (FormatError)
@@ -259,7 +285,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def _refused(error: Exception) -> int:
+def _refused(error: Exception | str) -> int:
     """Print why ``fit`` refuses to run as one ``error:`` line on stderr; the exit status 2."""
     print(f"error: {error}", file=sys.stderr)
     return 2

@@ -114,7 +114,9 @@ class TrainConfig:
         (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
         batch is split into ``max(micro_batches, K)`` parts spread over the processes, so K processes
         and one process with ``micro_batches=K`` take the same steps (BatchNorm statistics are per
-        micro-batch in both).
+        micro-batch in both). ``batch_size`` must be at least twice the parts (BatchNorm needs 2 windows per
+        micro-batch): :func:`beatlite.train.fit` raises ``ValueError`` otherwise
+        (:func:`beatlite.train.training.check_batch_split`).
     """
 
     epochs: int = 30

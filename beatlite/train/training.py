@@ -468,6 +468,29 @@ def check_compilable(model_class: type[GestureModel], mode: str | None) -> None:
         )
 
 
+def check_batch_split(config: TrainConfig, world: int) -> None:
+    """Raise ``ValueError`` when ``config.batch_size`` split into ``max(micro_batches, world)`` micro-batches (``world``:
+    the processes under ``torchrun``) leaves fewer than 2 windows in one: BatchNorm needs 2, so every step would be
+    skipped and nothing trained. The batch size is the global one, split over the processes.
+
+    Examples
+    --------
+    >>> check_batch_split(TrainConfig(batch_size=8), world=4)  # 4 processes, 2 windows each
+    >>> check_batch_split(TrainConfig(batch_size=4), world=4)
+    Traceback (most recent call last):
+    ...
+    ValueError: fit: batch_size 4 split into 4 micro-batches (4 processes, micro_batches=1) leaves fewer than 2 windows in one (BatchNorm needs 2: no step would train); batch_size must be >= 8 (it is the global batch, split over the processes)
+    """
+    parts = max(config.micro_batches, world)
+    if config.batch_size < 2 * parts:
+        raise ValueError(
+            f"fit: batch_size {config.batch_size} split into {parts} micro-batches ({world} process"
+            f"{'es' if world > 1 else ''}, micro_batches={config.micro_batches}) leaves fewer than 2 windows in "
+            f"one (BatchNorm needs 2: no step would train); batch_size must be >= {2 * parts} (it is the global "
+            "batch, split over the processes)"
+        )
+
+
 def _compiled(fn: Callable[..., Any], mode: str | None, device: torch.device) -> Callable[..., Any]:
     """``fn`` through ``torch.compile`` as :attr:`TrainConfig.compile` says (``fn`` itself for ``None``).
 
@@ -495,6 +518,8 @@ class _Run:
     ) -> None:
         self.model, self.config, self.fingerprint, self.meta = model, config, fingerprint, meta
         self.rank, self.world = distributed_rank()
+        if model.generator_parameters():  # before a step (an untrained baseline takes none)
+            check_batch_split(config, self.world)
         # micro-batches per optimiser step, spread over the processes
         self.parts = max(config.micro_batches, self.world)
         self.device = local_device(config.torch_device())
