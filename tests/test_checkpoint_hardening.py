@@ -10,6 +10,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+from zipdamage import flag_every_member  # noqa: E402
+
 from beatlite.io import FormatError  # noqa: E402
 from beatlite.models.base import GestureModel  # noqa: E402
 from beatlite.paths import checkpoints_dir  # noqa: E402
@@ -268,14 +270,7 @@ def test_a_member_zipfile_cannot_open_is_a_format_error(tmp_path, damage):
         data[local + 30] = 0xFF  # the first byte of its name: not UTF-8
         data[local + 6 : local + 8] = struct.pack("<H", 0x800)  # flagged as a UTF-8 name
     else:
-        for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):  # local and central headers alike
-            i = data.find(sig)
-            while i >= 0:
-                if damage == "method":
-                    data[i + at + 2 : i + at + 4] = struct.pack("<H", 99)
-                else:
-                    data[i + at : i + at + 2] = struct.pack("<H", 1)
-                i = data.find(sig, i + 4)
+        flag_every_member(data, damage)  # local and central headers alike
     path = tmp_path / "damaged.pt"
     path.write_bytes(bytes(data))
     with pytest.raises(FormatError, match="truncated or corrupted"):

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from zipdamage import flag_every_member
 
 from beatlite.io import FormatError, load_take
 from beatlite.io.smplx import SMPLXMotion, read_beat2_split, read_smplx, write_smplx
@@ -257,19 +258,10 @@ def test_read_smplx_names_the_key_of_damaged_member_bytes(tmp_path):
 @pytest.mark.parametrize("damage", ["method", "encrypted"])
 def test_read_smplx_names_a_member_zipfile_cannot_open(tmp_path, damage):
     """An unknown compression method raised a bare NotImplementedError, the encryption flag a bare RuntimeError."""
-    import struct
-
     path = _save(tmp_path / "take.npz", _beat2_like())
-    data = bytearray(path.read_bytes())
-    for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):  # every local and central header
-        i = data.find(sig)
-        while i >= 0:
-            if damage == "method":
-                data[i + at + 2 : i + at + 4] = struct.pack("<H", 99)
-            else:
-                data[i + at : i + at + 2] = struct.pack("<H", 1)
-            i = data.find(sig, i + 4)
-    path.write_bytes(bytes(data))
+    path.write_bytes(
+        bytes(flag_every_member(bytearray(path.read_bytes()), damage))
+    )  # every local and central header
     with pytest.raises(FormatError, match="field 'betas'.*not a readable array"):
         read_smplx(path)
 
