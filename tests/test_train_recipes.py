@@ -785,3 +785,18 @@ def test_scaled_lr_follows_the_batch_linearly_or_by_its_square_root():
         scaled_lr(recipe, 64, "cubic")
     with pytest.raises(ValueError, match="batch_size must be >= 1"):
         scaled_lr(recipe, 0, "sqrt")
+
+
+def test_results_command_names_a_checkpoint_that_is_not_there(monkeypatch, capsys):
+    """``results --only NAME`` of no checkpoint: one ``error:`` line naming it (and those there), exit 2, before any
+    evaluation (it was a FileNotFoundError traceback after loading the test set)."""
+    from beatlite.train import __main__ as command
+
+    def no_evaluation(*args, **kwargs):
+        raise AssertionError("evaluated")
+
+    monkeypatch.setattr(command, "evaluate_models", no_evaluation)
+    assert command.main(["results", "--only", "camn_tiny", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: results: no checkpoint nope in ") and err.count("\n") == 1
+    assert "camn_tiny" in err.split("(there: ")[1] and "fgd_dirvec" not in err

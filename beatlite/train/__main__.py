@@ -161,6 +161,13 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _results_command(args: argparse.Namespace) -> int:
+    folder = paths.checkpoints_dir()
+    missing = [name for name in args.only or () if not (folder / f"{name}.pt").is_file()]
+    if missing:  # before loading the test set; evaluate_models would stop on the first with a traceback
+        there = sorted(p.stem for p in folder.glob("*.pt") if not p.stem.startswith("fgd_"))
+        return _refused(
+            f"results: no checkpoint {', '.join(missing)} in {folder} (there: {', '.join(there)})"
+        )
     results = evaluate_models(args.only or None, progress=True)
     md, js = write_results(results, args.out)
     print(results.to_markdown())
