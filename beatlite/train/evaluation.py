@@ -56,6 +56,7 @@ from beatlite.data.normalize import Normalizers
 from beatlite.metrics.scoring import ARROWS, METRICS, GroundTruth, describe
 from beatlite.report import markdown_table, write_markdown_and_json
 from beatlite.train import recipes
+from beatlite.train.recipes import GROUND_TRUTH, GROUND_TRUTH_141  # the ground truth's rows
 from beatlite.train.testset import (
     EvaluationSet,
     generate_takes,
@@ -82,9 +83,6 @@ RECORD_COLUMNS: tuple[str, ...] = (
 the variants the papers' code computes (FGD in BEAT's Euler space and with scipy's square root, BEAT's
 SRGR and BeatAlign on Euler angles, HA2G's BC on 34-frame clips) for the side-by-side tables of
 notebooks 06-07."""
-
-GROUND_TRUTH = "Ground truth"
-GROUND_TRUTH_141 = "Ground truth (141 Euler channels)"
 
 
 @dataclasses.dataclass

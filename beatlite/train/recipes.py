@@ -254,6 +254,11 @@ Adding a model: :func:`beatlite.models.register_model`, then :func:`register_rec
 (``docs/architecture.md``, "Adding a model")."""
 
 
+#: The labels of the ground truth's rows in the results tables (no recipe may take them).
+GROUND_TRUTH = "Ground truth"
+GROUND_TRUTH_141 = "Ground truth (141 Euler channels)"
+
+
 def register_recipe(name: str, recipe: Recipe) -> None:
     """Add checkpoint ``name`` trained by ``recipe`` to :data:`RECIPES` (its row joins the tables).
 
@@ -268,7 +273,6 @@ def register_recipe(name: str, recipe: Recipe) -> None:
         is not a field of the model's config; a training setting ``TrainConfig`` refuses.
     """
     from beatlite.models.base import config_from_preset
-    from beatlite.train.evaluation import GROUND_TRUTH, GROUND_TRUTH_141
 
     if recipe.model not in models.MODELS:
         raise ValueError(f"register_recipe: model {recipe.model!r} is not registered (register_model first)")
