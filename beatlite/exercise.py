@@ -112,6 +112,10 @@ def _call_text(name: str, args: tuple, kwargs: dict) -> str:
 def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -> str | None:
     """Why ``got`` is not ``want`` in one line, or ``None`` when they match (``numpy.isclose``, NaN == NaN).
 
+    For float32 (or float16) arrays, ``atol`` grows by what rounding alone may change: 16 units in the last place
+    of the largest finite ``|want|`` at that precision (float32: ``16 * 1.19e-7 * max|want|``), so that a solution
+    summing in another order than the reference (numpy's einsum against torch) matches on elements near zero.
+
     Examples
     --------
     >>> difference(None, 4.5)
@@ -133,6 +137,7 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
         return f"shape: got {g.shape}, expected {w.shape}"
     if g.ndim and _KINDS.get(g.dtype.kind) != _KINDS.get(w.dtype.kind):
         return f"dtype: got {_KINDS.get(g.dtype.kind, g.dtype)} ({g.dtype}), expected {_KINDS.get(w.dtype.kind, w.dtype)} ({w.dtype})"
+    atol = atol + _rounding(g, w)
     close = np.isclose(g.astype(float), w.astype(float), rtol=rtol, atol=atol, equal_nan=True)
     if close.all():
         return None
@@ -144,6 +149,16 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
         f"first difference at index {index}: got {describe(g[index].item())}, expected {describe(w[index].item())} "
         f"({int((~close).sum())} of {close.size} elements differ)"
     )
+
+
+def _rounding(got: np.ndarray, want: np.ndarray) -> float:
+    """16 units in the last place of ``max |want|`` at the lower float precision of the two (0 for float64 and
+    integers): how far two orders of the same float32 sums may fall apart."""
+    eps = max((np.finfo(a.dtype).eps for a in (got, want) if a.dtype.kind == "f"), default=0.0)
+    if eps <= np.finfo(np.float64).eps:
+        return 0.0
+    finite = np.abs(want[np.isfinite(want)]) if want.dtype.kind in "fc" else np.abs(want)
+    return float(16 * eps * finite.max()) if finite.size else 0.0
 
 
 def _equal(got: Any, want: Any) -> bool:

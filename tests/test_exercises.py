@@ -245,6 +245,26 @@ def _all_exercises():
 
 
 # ----------------------------------------------------------------------------- static checks (fast)
+def test_float32_results_match_within_their_rounding_and_no_further():
+    """notebook 06's ``blend`` solution (numpy einsum) and its reference (torch) summed float32 products in another
+    order: 2 of 3264 elements near zero differed by 2.2e-8 (-0.000459671 vs -0.000459649, the largest value about
+    0.36), beyond numpy.isclose's atol of 1e-8: the right solution was rejected in one of two fresh-clone runs."""
+    import numpy as np
+
+    from beatlite.exercise import difference
+
+    want = np.array([0.36, -4.59649e-4], np.float32)
+    got = want.copy()
+    got[1] = np.float32(-4.59671e-4)
+    assert difference(got, want) is None  # 2.2e-8 < 16 * 1.19e-7 * 0.36 = 6.9e-7
+    assert (
+        difference(got.astype(np.float64), want.astype(np.float64)) is not None
+    )  # float64: numpy's tolerance
+    got[1] = np.float32(-4.59649e-4 + 2e-6)  # beyond float32 rounding at this scale
+    assert difference(got, want) is not None
+    assert difference(want * np.float32(1.001), want) is not None  # a real (0.1 %) difference still counts
+
+
 def test_every_notebook_has_exercises_with_solutions():
     found = _all_exercises()
     assert {p.name for p, _ in found} == {p.name for p in NOTEBOOKS}
