@@ -63,7 +63,6 @@ import hashlib
 import math
 import sys
 import tempfile
-import tokenize
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -329,28 +328,14 @@ def _load_npy(path: Path) -> np.ndarray:
     """``np.load`` of a ``.npy`` file whose header is checked first: its magic, and a shape whose bytes the file
     holds (a header may claim any size: read as is, it would allocate it)."""
     from beatlite.io import FormatError
-    from beatlite.io.textfile import describe_bytes
+    from beatlite.io.textfile import describe_bytes, npy_header
 
     with open(path, "rb") as fh:
         head = fh.read(64)
         fh.seek(0)
         if not head.startswith(b"\x93NUMPY"):
             raise FormatError(path, f"not a .npy array: {describe_bytes(head)}")
-        try:
-            fmt = np.lib.format
-            read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
-            shape, _, dtype = read(fh)
-        except (ValueError, OSError, EOFError, tokenize.TokenError) as exc:
-            raise FormatError(path, f"not a readable .npy header ({' '.join(str(exc).split())})") from None
-        if dtype.hasobject:
-            raise FormatError(path, "a pickled object array (never loaded: it could run code)", field="dtype")
-        need, have = math.prod(shape) * dtype.itemsize, path.stat().st_size - fh.tell()
-    if need > have:
-        raise FormatError(
-            path,
-            f"the header's shape {shape} {dtype} needs {need} bytes, the file holds {have}",
-            field="shape",
-        )
+        npy_header(fh, path.stat().st_size, path)
     try:
         return np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:

@@ -36,11 +36,9 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import math
 import os
 import tokenize
 import zipfile
-import zlib
 from collections.abc import Callable
 from pathlib import Path
 
@@ -48,7 +46,7 @@ import numpy as np
 
 from beatlite.io.bvh import FRAME_TIME_RANGE
 from beatlite.io.errors import FormatError
-from beatlite.io.textfile import describe_bytes, zip_members
+from beatlite.io.textfile import ZIP_MEMBER_ERRORS, describe_bytes, npy_header, zip_members
 
 __all__ = ["BEAT2_SPLITS", "SMPLXMotion", "read_beat2_split", "read_smplx", "write_smplx"]
 
@@ -140,41 +138,23 @@ def _members(path: Path) -> dict[str, zipfile.ZipInfo]:
     return zip_members(path, _MAX_MEMBER_BYTES, suffix=".npy")
 
 
-#: What a damaged member raises while numpy reads it: a bad ZIP entry, corrupt deflate data, a header numpy's
-#: tokenizer cannot read, an unknown compression method (NotImplementedError), an encrypted member (RuntimeError).
-_DAMAGED = (
-    OSError,
-    EOFError,
-    zipfile.BadZipFile,
-    zlib.error,
-    tokenize.TokenError,
-    NotImplementedError,
-    RuntimeError,
-)
+#: What a damaged member raises while numpy reads it: :data:`~beatlite.io.textfile.ZIP_MEMBER_ERRORS`, and a
+#: header numpy's tokenizer cannot read.
+_DAMAGED = (*ZIP_MEMBER_ERRORS, tokenize.TokenError)
 
 
 def _check_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, key: str) -> None:
-    """The member's ``.npy`` header, read before numpy reads it: numpy allocates the shape the header claims before
-    it reads a byte of data, so a shape needing more bytes than the member holds is refused here, as is an object
-    dtype (a pickle). A member that is no ``.npy`` (numpy gives its bytes) is left to the checks of its key."""
-    fmt = np.lib.format
+    """The member's ``.npy`` header, read before numpy reads it (:func:`~beatlite.io.textfile.npy_header`: a shape
+    needing more bytes than the member holds, an object dtype). A member that is no ``.npy`` (numpy gives its
+    bytes) is left to the checks of its key."""
     try:
         with zf.open(info) as fh:
-            if fh.read(len(fmt.MAGIC_PREFIX)) != fmt.MAGIC_PREFIX:
+            if fh.read(len(np.lib.format.MAGIC_PREFIX)) != np.lib.format.MAGIC_PREFIX:
                 return
             fh.seek(0)
-            read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
-            shape, _, dtype = read(fh)
-            have = info.file_size - fh.tell()
-    except (*_DAMAGED, ValueError) as exc:
+            npy_header(fh, info.file_size, path, field=key, where="member")
+    except _DAMAGED as exc:
         raise FormatError(path, f"not a readable array ({' '.join(str(exc).split())})", field=key) from None
-    if dtype.hasobject:
-        raise FormatError(path, "a pickled object array (never loaded: it could run code)", field=key)
-    need = math.prod(shape) * dtype.itemsize
-    if need > have:
-        raise FormatError(
-            path, f"the header's shape {shape} {dtype} needs {need} bytes, the member holds {have}", field=key
-        )
 
 
 def _array(z: np.lib.npyio.NpzFile, path: Path, key: str) -> np.ndarray:

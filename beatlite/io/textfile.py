@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import gzip
 import io
+import math
 import os
+import tokenize
 import zipfile
 import zlib
 from pathlib import Path
@@ -107,6 +109,63 @@ def zip_members(
             "decompression bomb",
         )
     return infos
+
+
+#: What reading a damaged ZIP member raises: a bad entry, corrupt deflate data, an unknown compression method
+#: (``NotImplementedError``), an encrypted member (``RuntimeError``).
+ZIP_MEMBER_ERRORS = (zipfile.BadZipFile, OSError, EOFError, zlib.error, NotImplementedError, RuntimeError)
+
+
+def npy_header(
+    fh: IO[bytes], size: int, path: Path, *, field: str | None = None, where: str = "file"
+) -> tuple[tuple[int, ...], object]:
+    """``(shape, dtype)`` of the ``.npy`` that ``fh`` (at its start, ``size`` bytes in all) holds, checked before
+    numpy reads it: numpy allocates the shape a header claims before it reads a byte of data, so a shape needing
+    more bytes than the ``where`` holds is refused, as is an object dtype (a pickle).
+
+    Raises
+    ------
+    FormatError
+        An unreadable header, an object dtype, or a shape larger than the bytes present (``field``, else
+        ``"dtype"`` / ``"shape"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> buf = io.BytesIO()
+    >>> np.save(buf, np.zeros((3, 2), np.float32))
+    >>> size = buf.tell()
+    >>> _ = buf.seek(0)
+    >>> npy_header(buf, size, Path("x.npy"))
+    ((3, 2), dtype('float32'))
+    >>> _ = buf.seek(0)
+    >>> npy_header(buf, size - 4, Path("x.npy"))  # one float32 missing
+    Traceback (most recent call last):
+    ...
+    beatlite.io.errors.FormatError: x.npy, field 'shape': the header's shape (3, 2) float32 needs 24 bytes, the file holds 20
+    """
+    import numpy as np
+
+    fmt = np.lib.format
+    try:
+        read = fmt.read_array_header_1_0 if fmt.read_magic(fh) == (1, 0) else fmt.read_array_header_2_0
+        shape, _, dtype = read(fh)
+    except (ValueError, OSError, EOFError, tokenize.TokenError) as exc:
+        raise FormatError(
+            path, f"not a readable .npy header ({' '.join(str(exc).split())})", field=field
+        ) from None
+    if dtype.hasobject:
+        raise FormatError(
+            path, "a pickled object array (never loaded: it could run code)", field=field or "dtype"
+        )
+    need, have = math.prod(shape) * dtype.itemsize, size - fh.tell()
+    if need > have:
+        raise FormatError(
+            path,
+            f"the header's shape {shape} {dtype} needs {need} bytes, the {where} holds {have}",
+            field=field or "shape",
+        )
+    return shape, dtype
 
 
 class _CheckedGzip(gzip.GzipFile):

@@ -28,7 +28,6 @@ Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkp
 from __future__ import annotations
 
 import zipfile
-import zlib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -39,7 +38,7 @@ import torch
 from beatlite import paths
 from beatlite.io.atomic import atomic_write
 from beatlite.io.errors import FormatError
-from beatlite.io.textfile import describe_bytes, zip_members
+from beatlite.io.textfile import ZIP_MEMBER_ERRORS, describe_bytes, zip_members
 from beatlite.models.base import GestureModel
 
 FORMAT = "beatlite-checkpoint/1"
@@ -169,18 +168,8 @@ def _check_crcs(path: Path) -> None:
         with zipfile.ZipFile(path) as z:
             bad = z.testzip()
         reason = None if bad is None else f"member {bad} fails its CRC-32 check"
-    except (
-        zipfile.BadZipFile,
-        OSError,
-        EOFError,
-        zlib.error,
-        ValueError,
-        NotImplementedError,
-        RuntimeError,
-    ) as exc:
-        reason = " ".join(
-            str(exc).split()
-        )  # a damaged member name, an unknown compression method, encryption
+    except (*ZIP_MEMBER_ERRORS, ValueError) as exc:  # a damaged member name, an unknown method, encryption
+        reason = " ".join(str(exc).split())
     if reason is not None:
         raise FormatError(
             path, f"truncated or corrupted file ({reason}): write it again, e.g. train again or copy it anew"
