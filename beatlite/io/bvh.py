@@ -284,9 +284,8 @@ def _parse_hierarchy(lines: list[tuple[int, str]], path: Path | None) -> Skeleto
         raise FormatError(path, f"expected 'ROOT', found {tok!r}", line=line, column=col)
     stack = [joints.add(_joint_name(tokens, line, "ROOT"), -1, line)]
     tokens.expect("{")
-    declared: dict[
-        tuple[int, str], int
-    ] = {}  # (joint, OFFSET or CHANNELS) -> line: a second one would replace it
+    # (joint, OFFSET or CHANNELS) -> its line: a second one would replace the first
+    declared: dict[tuple[int, str], int] = {}
     while stack:
         tok, line, col = tokens.next("'}'")
         key = tok.upper()
