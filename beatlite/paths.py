@@ -98,3 +98,27 @@ def code_revision() -> str:
     except (OSError, subprocess.SubprocessError):
         return "unknown"
     return (head + ("+changes" if changed else "")) if head else "unknown"
+
+
+def machine() -> dict[str, object]:
+    """What ran a benchmark record, in every record's ``machine`` field: host name, CPU model and count,
+    the 1-minute load average when asked (other jobs slow a timing down), torch's version and CPU threads,
+    and the CUDA device's name (``None`` without one).
+
+    >>> sorted(machine())
+    ['cpu', 'cpus', 'cuda', 'host', 'load_average', 'threads', 'torch']
+    """
+    import contextlib
+    import platform
+
+    import torch
+
+    cpu = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError):
+        names = [line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                 if line.startswith("model name")]  # fmt: skip
+        cpu = names[0] if names else cpu
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    cuda = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
+    return {"host": platform.node(), "cpu": cpu, "cpus": os.cpu_count(), "load_average": load,
+            "torch": torch.__version__, "threads": torch.get_num_threads(), "cuda": cuda}  # fmt: skip

@@ -22,6 +22,7 @@ import argparse
 import copy
 import os
 import re
+import resource
 import sys
 import time
 from pathlib import Path
@@ -229,12 +230,29 @@ def _instructor_sheet():
     return sys.modules["instructor_sheet"]
 
 
+def write_record(path: Path, timings: list[dict], total: float) -> None:
+    """The run's timings as JSON (``docs/teaching.md``'s table is checked against the shipped one): each
+    notebook's wall seconds and its kernel's user-CPU seconds, the whole run's wall seconds (exports
+    included), the largest resident memory of one kernel, and the command, revision, machine and settings."""
+    from beatlite.io.atomic import write_json
+    from beatlite.paths import code_revision, machine
+
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024**2  # (kB on Linux) -> GB
+    settings = {k: os.environ.get(k) for k in ("BEATLITE_MODE", "BEATLITE_THREADS", "BEATLITE_DATA")}
+    write_json(path, {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
+                      "date": time.strftime("%Y-%m-%d"), "machine": machine(), "settings": settings,
+                      "total_wall_seconds": total, "largest_kernel_gb": peak, "rows": timings})  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--out", type=Path, default=REPO / "build", help="output folder (default build/)")
     parser.add_argument("--timeout", type=int, default=900, help="per-cell timeout in seconds")
+    parser.add_argument(
+        "--record", type=Path, help="also write each notebook's wall and kernel CPU seconds here (JSON)"
+    )
     parser.add_argument("notebooks", nargs="*", type=Path, help="notebooks to run (default: all, in order)")
     args = parser.parse_args(argv)
 
@@ -249,14 +267,19 @@ def main(argv: list[str] | None = None) -> int:
     for stale in (out / "tables").glob("*.md"):
         stale.unlink()
 
-    rows, failed = [], 0
+    rows, failed, timings = [], 0, []
     total = time.perf_counter()
     for path in paths:
         print(f"[run] {path.name} ...", flush=True)
+        kernels = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime  # (its kernel is reaped on return)
         ok, seconds, message = execute(path.resolve(), out / "notebooks", args.timeout)
+        kernels = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - kernels
         write_student_copy(path, out / "student")
         failed += not ok
         rows.append((path.stem, ok, seconds, message))
+        timings.append(
+            {"notebook": path.stem, "ok": ok, "wall_seconds": seconds, "kernel_user_seconds": kernels}
+        )
         print(f"[run] {path.name}: {'ok' if ok else 'FAILED'} in {seconds:.1f} s {message}", flush=True)
     total = time.perf_counter() - total
     _instructor_sheet().write_sheets(out / "instructor", [p.resolve() for p in paths])
@@ -277,6 +300,8 @@ def main(argv: list[str] | None = None) -> int:
     for table in sorted((out / "tables").glob("*.md")):
         lines += [table.read_text(encoding="utf-8").rstrip(), ""]
     (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
+    if args.record:
+        write_record(args.record, timings, total)
     print(f"[run] wrote {out / 'results.md'} ({len(rows) - failed}/{len(rows)} notebooks ok, {total:.0f} s)")
     return 1 if failed else 0
 
