@@ -23,6 +23,20 @@ from beatlite import __version__, paths
 ENV_INTERACTIVE = "BEATLITE_INTERACTIVE"
 
 
+def defined_again(old: Any, new: Any) -> bool:
+    """Whether ``new`` is ``old`` defined again: the same module and qualified name, as when a notebook cell that
+    defines a class or function runs twice (the registries accept that and refuse a real clash).
+
+    >>> def f(): pass
+    >>> g = f
+    >>> def f(): pass
+    >>> g is f, defined_again(g, f), defined_again(g, print)
+    (False, True, False)
+    """
+    key = [(getattr(x, "__module__", None), getattr(x, "__qualname__", None)) for x in (old, new)]
+    return key[0][1] is not None and key[0] == key[1]
+
+
 def require(version: str) -> None:
     """Raise ``RuntimeError`` when the installed beatlite is older than ``version`` (e.g. ``"0.1"``)."""
 

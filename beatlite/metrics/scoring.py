@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
+from beatlite.notebook import defined_again
 
 
 @dataclass(eq=False)
@@ -448,14 +449,10 @@ def register_metric(key: str, metric: Metric) -> None:
 
 
 def _same_metric(old: Metric, new: Metric) -> bool:
-    """``new`` equals ``old`` up to its ``compute`` being the same function defined again (same module and
-    qualified name: a notebook cell run twice)."""
+    """``new`` equals ``old`` up to its ``compute`` being the same function defined again
+    (:func:`beatlite.notebook.defined_again`)."""
     a, b = old.compute, new.compute
-    same = a is b or (
-        (getattr(a, "__module__", None), getattr(a, "__qualname__", None))
-        == (getattr(b, "__module__", None), getattr(b, "__qualname__", 0))
-    )
-    return same and dataclasses.replace(old, compute=b) == new
+    return (a is b or defined_again(a, b)) and dataclasses.replace(old, compute=b) == new
 
 
 def _one_number(key: str, value: Any) -> float:

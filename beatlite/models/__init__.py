@@ -35,6 +35,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from beatlite.notebook import defined_again
+
 if TYPE_CHECKING:  # pragma: no cover
     from beatlite.models.base import GestureModel
 
@@ -80,17 +82,9 @@ def register_model(name: str, model: str | type[GestureModel]) -> None:
     entry = tuple(model.split(":")) if isinstance(model, str) else model
     if isinstance(entry, tuple) and len(entry) != 2:
         raise ValueError(f"register_model: give 'package.module:ClassName', got {model!r}")
-    if name in MODELS and MODELS[name] != entry and not _redefined(MODELS[name], entry):
+    if name in MODELS and MODELS[name] != entry and not defined_again(MODELS[name], entry):
         raise ValueError(f"register_model: {name!r} is already registered as {MODELS[name]!r}")
     MODELS[name] = entry
-
-
-def _redefined(old: Any, new: Any) -> bool:
-    """Whether ``new`` is ``old`` defined again (same module and qualified name: a notebook cell run twice)."""
-    return all(hasattr(x, "__qualname__") for x in (old, new)) and (old.__module__, old.__qualname__) == (
-        new.__module__,
-        new.__qualname__,
-    )
 
 
 def model_class(name: str) -> type[GestureModel]:
