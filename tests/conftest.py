@@ -9,6 +9,12 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 REAL_SAMPLES = Path(os.environ.get("BEATLITE_REAL_SAMPLES", REPO.parent / "shared" / "real_samples"))
+# torch.compile's kernels (inductor) are cached in this clone's build/, for this process and the ones it starts,
+# not in the machine-wide /tmp/torchinductor_$USER: every run of the tests starts from what a fresh clone on
+# another machine has, and an entry half-written there by a killed process (a 0-byte ``.so``: "file too short"
+# at every later compile of that kernel) or by another checkout's code cannot fail them.
+INDUCTOR_CACHE = REPO / "build" / "torchinductor"
+os.environ.setdefault("TORCHINDUCTOR_CACHE_DIR", str(INDUCTOR_CACHE))
 
 
 @pytest.fixture(scope="session")

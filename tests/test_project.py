@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import json
+import os
 import re
 import subprocess
 import sys
@@ -84,6 +85,15 @@ def test_import_is_lazy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout.strip().splitlines()[-1]) == [], "import beatlite loads heavy modules"
+
+
+def test_compiled_kernels_are_cached_in_this_clone():
+    """``conftest.py`` points inductor's cache at ``build/torchinductor`` (unless the caller chose one), and the
+    torch in use reads it there: what compiles in the tests never depends on the machine-wide cache in /tmp."""
+    pytest.importorskip("torch")
+    from torch._inductor.runtime.cache_dir_utils import cache_dir, default_cache_dir
+
+    assert Path(cache_dir()) == Path(os.environ["TORCHINDUCTOR_CACHE_DIR"]) != Path(default_cache_dir())
 
 
 def test_ci_runs_the_readme_test_command():
