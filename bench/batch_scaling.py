@@ -22,17 +22,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import statistics
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-import torch
-
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, n_threads
+from beatlite.paths import code_revision, machine, n_threads
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
 from beatlite.train.testset import load_test_set
@@ -63,8 +60,7 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "command": f"BEATLITE_THREADS={n_threads()} python bench/batch_scaling.py --recipe {args.recipe} "
         f"--batches {batches} --rules {rules} --seeds {seeds}"
         + ("" if args.epochs is None else f" --epochs {args.epochs}"),
-        "host": platform.node(),
-        "torch": torch.__version__,
+        "machine": machine(),
         "rows": rows,
         "summary": summary(rows),
     }

@@ -61,11 +61,9 @@ about 150 windows/s). Measured on an H200: ``bench/records/bench_train_h200.json
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
 import math
 import os
-import platform
 import sys
 import tempfile
 import time
@@ -82,7 +80,7 @@ from torch.utils.flop_counter import FlopCounterMode
 from beatlite.io.atomic import write_json
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.models.layers import use_frame_matmul
-from beatlite.paths import code_revision, data_dir, n_threads
+from beatlite.paths import code_revision, data_dir, machine, n_threads
 from beatlite.train import TrainConfig, fit
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.training import _Run, model_keys
@@ -539,21 +537,9 @@ def _failed(error: BaseException) -> str:
     return f"failed: {type(error).__name__}: {message}"
 
 
-def machine() -> dict[str, Any]:
-    """What ran the rows: host name, CPU model and count, torch version and threads, the CUDA device (or None)."""
-    cpu = platform.processor() or platform.machine()
-    with contextlib.suppress(OSError):
-        names = [line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                 if line.startswith("model name")]  # fmt: skip
-        cpu = names[0] if names else cpu
-    cuda = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
-    return {"host": platform.node(), "cpu": cpu, "cpus": os.cpu_count(), "torch": torch.__version__,
-            "threads": torch.get_num_threads(), "cuda": cuda}  # fmt: skip
-
-
 def _write_json(path: Path | None, rows: list[Row], about: dict[str, Any]) -> None:
     """The rows (and the GEMM peaks measured so far) as JSON at ``path`` (nothing without one), after ``about``
-    (the command, the code's revision and the :func:`machine`: :func:`main`)."""
+    (the command, the code's revision and :func:`beatlite.paths.machine`: :func:`main`)."""
     if path is None:
         return
     peaks = {f"{d} {t}": f for (d, t), f in _PEAKS.items()}

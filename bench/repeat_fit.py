@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -27,7 +26,7 @@ from pathlib import Path
 import torch
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, data_dir, n_threads
+from beatlite.paths import code_revision, data_dir, machine
 from beatlite.train.checkpoint import load_checkpoint
 from beatlite.train.recipes import RECIPES
 
@@ -78,8 +77,8 @@ def main() -> None:
                              "epochs": args.epochs, "seconds": time.perf_counter() - start, **compare(*runs)})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
                 if args.json is not None:
-                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision, "host": platform.node(),
-                              "torch": torch.__version__, "threads": str(n_threads()), "rows": rows}  # fmt: skip
+                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision, "machine": machine(),
+                              "rows": rows}  # fmt: skip
                     write_json(args.json, record)
 
 

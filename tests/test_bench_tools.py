@@ -66,7 +66,7 @@ def test_batch_scaling_records_its_thread_count_host_and_torch(monkeypatch):
                               revision="abc1234")  # fmt: skip
     record = batch_scaling._record(args, batch_scaling.RECIPES["camn_tiny"], [])
     assert record["command"].startswith("BEATLITE_THREADS=2 python bench/batch_scaling.py --recipe camn_tiny")
-    assert (record["host"], record["torch"], record["revision"]) == (
+    assert (record["machine"]["host"], record["machine"]["torch"], record["revision"]) == (
         platform.node(),
         torch.__version__,
         "abc1234",
