@@ -230,17 +230,41 @@ def _instructor_sheet():
     return sys.modules["instructor_sheet"]
 
 
-def write_record(path: Path, timings: list[dict], total: float) -> None:
+EPOCH_TIME = re.compile(r"([\d.]+) s per epoch")
+
+
+def printed_epoch_seconds(path: Path) -> list[float]:
+    """The seconds per epoch an executed notebook printed (``... 3.3 s per epoch ...``: the cells that train
+    live in ``full`` mode print what they measured), in cell order."""
+    import nbformat
+
+    nb = nbformat.read(path, as_version=4)
+    text = "".join(
+        o.get("text", "") for c in nb.cells for o in c.get("outputs", []) if o.get("output_type") == "stream"
+    )
+    return [float(x) for x in EPOCH_TIME.findall(text)]
+
+
+def _machine() -> dict:
+    """:func:`beatlite.paths.machine` without torch's threads (this process trains nothing; the kernels' threads are
+    ``BEATLITE_THREADS``, in the record's settings)."""
+    from beatlite.paths import machine
+
+    return {**machine(), "threads": None}
+
+
+def write_record(path: Path, timings: list[dict], total: float, about: dict) -> None:
     """The run's timings as JSON (``docs/teaching.md``'s table is checked against the shipped one): each
-    notebook's wall seconds and its kernel's user-CPU seconds, the whole run's wall seconds (exports
-    included), the largest resident memory of one kernel, and the command, revision, machine and settings."""
+    notebook's wall seconds, its kernel's user-CPU seconds and the seconds per epoch it printed, the whole run's wall seconds (exports
+    included), the largest resident memory of one kernel, and the command, revision, settings and ``about``: the
+    machine as :func:`beatlite.paths.machine` described it before the run (the kernels' threads: the settings)."""
     from beatlite.io.atomic import write_json
-    from beatlite.paths import code_revision, machine
+    from beatlite.paths import code_revision
 
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024**2  # (kB on Linux) -> GB
     settings = {k: os.environ.get(k) for k in ("BEATLITE_MODE", "BEATLITE_THREADS", "BEATLITE_DATA")}
     write_json(path, {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
-                      "date": time.strftime("%Y-%m-%d"), "machine": machine(), "settings": settings,
+                      "date": time.strftime("%Y-%m-%d"), "machine": about, "settings": settings,
                       "total_wall_seconds": total, "largest_kernel_gb": peak, "rows": timings})  # fmt: skip
 
 
@@ -268,6 +292,7 @@ def main(argv: list[str] | None = None) -> int:
         stale.unlink()
 
     rows, failed, timings = [], 0, []
+    about = _machine() if args.record else {}
     total = time.perf_counter()
     for path in paths:
         print(f"[run] {path.name} ...", flush=True)
@@ -301,7 +326,7 @@ def main(argv: list[str] | None = None) -> int:
         lines += [table.read_text(encoding="utf-8").rstrip(), ""]
     (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
     if args.record:
-        write_record(args.record, timings, total)
+        write_record(args.record, timings, total, about)
     print(f"[run] wrote {out / 'results.md'} ({len(rows) - failed}/{len(rows)} notebooks ok, {total:.0f} s)")
     return 1 if failed else 0
 

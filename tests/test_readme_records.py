@@ -1,4 +1,5 @@
-"""The README's GPU table and its sentences against the records they come from (``bench/records/``)."""
+"""The README's and docs/teaching.md's measured numbers (GPU table, CPU timings, notebook run times) against the records they
+come from (``bench/records/``)."""
 
 from __future__ import annotations
 
@@ -270,8 +271,8 @@ def test_the_readme_batch_scaling_sentences_are_the_record():
 
 
 def test_counts_and_estimates_of_the_cpu_sentences_follow_their_sources():
-    """The seed trainings' count from the recipes, a CPU epoch of BEAT-4english from 80,000 windows at the 150
-    windows/s the README states, and the notebooks' lecture-mode time from docs/teaching.md's measured table."""
+    """The seed trainings' count from the recipes and a CPU epoch of BEAT-4english from 80,000 windows at the 150
+    windows/s the README states."""
     from beatlite.train.recipes import RECIPES
 
     readme, guide = _readme(), (ROOT / "docs" / "teaching.md").read_text()
@@ -286,6 +287,141 @@ def test_counts_and_estimates_of_the_cpu_sentences_follow_their_sources():
         f"about {minutes} min per CaMN tiny epoch on one CPU thread (80,000 windows at about 150 windows/s)"
         in " ".join(guide.split())
     )
+
+
+def _record(name: str) -> dict:
+    return json.loads((RECORDS / name).read_text())
+
+
+def _guide() -> str:
+    return (ROOT / "docs" / "teaching.md").read_text()
+
+
+def _nice(seconds: float) -> int:
+    """A run-time estimate: ``seconds`` rounded to 5 s, at least 5."""
+    return 5 * max(1, round(seconds / 5))
+
+
+def test_the_readme_recipe_times_are_the_cpu_record():
+    from beatlite.train.recipes import RECIPES
+
+    record = _record("time_recipes_cpu.json")
+    assert record["machine"]["cpus"] == record["machine"]["threads"] == 2  # "on 2 cores", BEATLITE_THREADS=2
+    assert record["machine"]["load_average"] < 1.5  # "idle": not another busy process beside it
+    rows = {r["recipe"]: r for r in record["rows"]}
+    assert all(r["epochs"] == RECIPES[name].epochs and r["seed"] == 2021 for name, r in rows.items())
+    camn, ha2g, trimodal = (rows[n] for n in ("camn_tiny", "ha2g_tiny", "trimodal_tiny"))
+    text = " ".join(_readme().split())
+    minutes = round(max(r["fit_seconds"] for r in rows.values()) / 60)
+    assert f"One tiny model trains in about {minutes} minutes on 2 cores" in text
+    assert (
+        f"recorded {camn['fit_seconds']:.0f} s of `fit` for CaMN ({camn['epochs']} epochs), {ha2g['fit_seconds']:.0f} s "
+        f"for HA2G ({ha2g['epochs']} epochs) and {trimodal['fit_seconds']:.0f} s for Trimodal ({trimodal['epochs']} "
+        "epochs) on an idle 2-core machine (`bench/records/time_recipes_cpu.json`)" in text
+    )
+
+
+def test_the_guide_run_times_and_the_headers_are_the_notebooks_record():
+    """docs/teaching.md's measured table, its totals, each notebook header's estimate (the time rounded to 5 s) and
+    the README's sentence, from ``scripts/run_notebooks.py --record`` of one lecture-mode run."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_teaching_guide import NOTEBOOKS, header_times
+
+    record = _record("notebooks_cpu.json")
+    rows = record["rows"]
+    assert [r["notebook"] for r in rows] == [p.stem for p in NOTEBOOKS] and all(r["ok"] for r in rows)
+    assert record["settings"]["BEATLITE_MODE"] == "lecture" and record["settings"]["BEATLITE_THREADS"] == "1"
+    total, user = record["total_wall_seconds"], sum(r["kernel_user_seconds"] for r in rows)
+    minutes, seconds = divmod(round(total), 60)
+    guide = _guide()
     row = next(line for line in guide.splitlines() if line.startswith("| wall time (s) |"))
-    seconds = [float(x) for x in row.strip("|").split("|")[1:10]]  # notebooks 00-08
-    assert f"({sum(seconds) / 60:.1f} minutes for 00–08;" in flat
+    cells = [c.strip() for c in row.strip().strip("|").split("|")][1:]
+    assert cells == [f"{r['wall_seconds']:.1f}" for r in rows] + [
+        f"{total:.0f} ({minutes} min {seconds} s; {user:.0f} s of the kernels' user CPU, "
+        f"{record['largest_kernel_gb']:.2f} GB resident at most in one kernel)"
+    ]
+    for path, r in zip(NOTEBOOKS, rows):
+        assert header_times(path)["run"] == f"~{_nice(r['wall_seconds'])} s", path.name
+    flat = " ".join(guide.split())
+    assert (
+        f"| **~{total / 60:.1f} min** |" in flat
+        and f"the eleven notebooks run in about {total / 60:.1f} minutes" in flat
+    )
+    assert f"executes the eleven notebooks (~{total / 60:.1f} min)" in flat
+    first9 = sum(r["wall_seconds"] for r in rows[:9])
+    assert (
+        f"`make run` executes the eleven notebooks in about {total / 60:.1f} minutes in lecture mode ({total:.0f} s "
+        f"recorded in `bench/records/notebooks_cpu.json`: {first9 / 60:.1f} minutes for 00–08, "
+        f"{rows[9]['wall_seconds']:.0f} s for 09 and {rows[10]['wall_seconds']:.0f} s for 10"
+        in " ".join(_readme().split())
+    )
+
+
+def test_the_numba_compile_times_are_the_record():
+    record = _record("numba_cpu.json")
+    cold = [r["warm_up_seconds"] for r in record["cold"]]
+    cached = [r["warm_up_seconds"] for r in record["cached"]]
+    assert len(cold) == len(cached) == 3 and max(cached) < min(cold)
+    flat = " ".join(_guide().split())
+    assert (
+        f"librosa's numba compilation ({min(cold):.1f}–{max(cold):.1f} s with an empty `NUMBA_CACHE_DIR`"
+        in flat
+    )
+    assert (
+        f"`warm_up()` took {min(cold):.1f}–{max(cold):.1f} s with an empty cache here and "
+        f"{min(cached):.1f}–{max(cached):.1f} s once compiled, in three fresh processes each" in flat
+    )
+    assert f"a fresh environment adds librosa's numba compile once, about {round(max(cold))} s" in " ".join(
+        _readme().split()
+    )
+
+
+def test_the_readme_cpu_compile_sentence_is_the_record():
+    rows = {r["compile"]: r for r in _record("bench_train_cpu_compile.json")["rows"]}
+    eager, compiled = rows["eager"], rows["default"]
+    assert _record("bench_train_cpu_compile.json")["machine"]["threads"] == 1  # "on one thread"
+    assert all(
+        (r["model"], r["preset"], r["device"], r["batch"]) == ("camn", "tiny", "cpu", 16)
+        for r in (eager, compiled)
+    )
+    assert compiled["step_wps"] <= eager["step_wps"]  # "compiling does not pay"
+    assert (
+        f"On the CPU, compiling does not pay: CaMN tiny at batch 16 on one thread stepped at {compiled['step_wps']:.0f} "
+        f"windows/s compiled (inductor) against {eager['step_wps']:.0f} eager" in " ".join(_readme().split())
+    )
+
+
+def test_the_full_mode_table_is_the_full_mode_record():
+    """docs/teaching.md's "What `full` mode adds" (the headers repeat it: tests/test_teaching_guide.py): the seconds
+    per epoch the cells printed, the extra wall time (full minus lecture, rounded to 5 s) and the full run's time."""
+    lecture = {r["notebook"]: r for r in _record("notebooks_cpu.json")["rows"]}
+    full = _record("notebooks_full_cpu.json")
+    assert full["settings"]["BEATLITE_MODE"] == "full" and full["settings"]["BEATLITE_THREADS"] == "1"
+    table = {}
+    for line in _guide().split("### What `full` mode adds")[1].splitlines():
+        if re.match(r"^\| \d\d ", line):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            table[cells[0][:2]] = (cells[3], cells[4])
+    assert set(table) == {r["notebook"][:2] for r in full["rows"]}
+    for r in full["rows"]:
+        assert r["ok"] and len(r["printed_epoch_seconds"]) == 1, r["notebook"]
+        extra = _nice(r["wall_seconds"] - lecture[r["notebook"]]["wall_seconds"])
+        assert table[r["notebook"][:2]] == (
+            f"{r['printed_epoch_seconds'][0]} s",
+            f"{extra} s ({r['wall_seconds']:.1f} s in all)",
+        ), r["notebook"]
+
+
+def test_the_readme_cpu_route_sentence_and_epoch_rate_are_the_quick_record():
+    rows = [r for r in _record("bench_train_quick_cpu.json")["rows"] if r["device"] == "cpu"]
+    assert {(r["model"], r["precision"]) for r in rows} == {
+        (m, p) for m in ("camn", "ha2g") for p in ("fp32", "bf16")
+    }
+    ratios = [r["fit_resident_wps"] / r["fit_wps"] for r in rows]
+    text = " ".join(_readme().split())
+    assert f"resident/loader {min(ratios):.2f} to {max(ratios):.2f} in one run" in text
+    camn = next(r for r in rows if (r["model"], r["precision"]) == ("camn", "fp32"))
+    assert round(camn["fit_wps"] / 50) * 50 == 150  # "about 150 windows/s on one thread"
+    assert "CaMN tiny epoch on the CPU runs at about 150 windows/s on one thread" in text
