@@ -78,3 +78,43 @@ def test_lab_copies_replace_solution_copies_with_a_backup_and_keep_student_work(
     assert "instructor's copy" in (lab / "backup" / "00_a.T.ipynb").read_text()
     assert "stub" in (lab / "00_a.ipynb").read_text() and "my answer" in (lab / "01_b.ipynb").read_text()
     assert lab_copies.refresh(student, lab, stamp="U") == []  # nothing left to do
+
+
+def test_the_run_record_holds_each_notebook_s_times_and_the_epochs_it_printed(tmp_path, monkeypatch):
+    """``run_notebooks.py --record``: the record docs/teaching.md's tables are checked against (two tiny notebooks
+    run for real: wall and kernel CPU seconds, what a cell printed as ``N s per epoch``, a failed one marked)."""
+    import json
+
+    import nbformat
+
+    folder = tmp_path / "notebooks"
+    folder.mkdir()
+    for name, code in (
+        ("01_a", "print('trained: 2.5 s per CaMN epoch; 0.25 s per epoch')"),
+        ("02_b", "1 / 0"),
+    ):
+        nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+        nbformat.write(nb, folder / f"{name}.ipynb")
+    run = _run_notebooks()
+    monkeypatch.setattr(
+        run, "_instructor_sheet", lambda: type("S", (), {"write_sheets": staticmethod(lambda *a: None)})
+    )
+    record_path = tmp_path / "record.json"
+    code = run.main(
+        [
+            "--out",
+            str(tmp_path / "out"),
+            "--record",
+            str(record_path),
+            *map(str, sorted(folder.glob("*.ipynb"))),
+        ]
+    )
+    record = json.loads(record_path.read_text())
+    assert code == 1  # one notebook failed
+    assert [(r["notebook"], r["ok"], r["printed_epoch_seconds"]) for r in record["rows"]] == [
+        ("01_a", True, [2.5, 0.25]),
+        ("02_b", False, []),
+    ]
+    assert all(r["wall_seconds"] > 0 and r["kernel_user_seconds"] >= 0 for r in record["rows"])
+    assert record["total_wall_seconds"] >= sum(r["wall_seconds"] for r in record["rows"])
+    assert record["largest_kernel_gb"] > 0 and record["machine"]["cpus"] and record["revision"]
