@@ -25,7 +25,7 @@ Growth exponents are least-squares slopes of log(value) against log(hours) (1 = 
 CPU seconds (the step's process plus its finished workers) are printed beside wall time: on a shared
 machine ``CPU s / 2`` is what 2 free cores would take.
 
-Usage: ``python bench/bench_scale.py [--hours 0.25 1] [--workers 2] [--keep DIR]``. Needs about
+Usage: ``python bench/bench_scale.py [--hours 0.25 1] [--workers 2] [--keep DIR] [--json FILE]``. Needs about
 1.8 GB of temporary disk per corpus hour (plain BVH + WAV) plus the store; timings on a shared
 machine are noisy.
 """
@@ -47,6 +47,9 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("BEATLITE_THREADS", "1")
 
 import numpy as np  # noqa: E402
+
+from beatlite.io.atomic import write_json  # noqa: E402
+from beatlite.paths import code_revision, machine  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 SPEECH_S, CONVERSATION_S = 60.0, 600.0
@@ -422,7 +425,12 @@ def main() -> int:
     p.add_argument("--compare-max-hours", type=float, default=1.0, help="run build_windows up to this size")
     p.add_argument("--stats", action="store_true", help="also time emotion_separability over iter_corpus")
     p.add_argument("--keep", type=Path, default=None, help="keep corpora and stores under this folder")
+    p.add_argument(
+        "--json", type=Path, default=None, help="write the rows, command, revision and machine here"
+    )
     args = p.parse_args()
+    about = {"command": " ".join(["python", *sys.argv]), "revision": code_revision(), "date": time.strftime("%Y-%m-%d"),
+             "machine": machine()}  # fmt: skip
     print(f"bench_scale: {os.cpu_count()} CPUs; sizes {args.hours} h")
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)
@@ -431,6 +439,8 @@ def main() -> int:
         base = Path(tempfile.mkdtemp(prefix=f"bench_scale_{hours:g}h_", dir=args.keep))
         try:
             rows.append(run_size(hours, args, base))
+            if args.json is not None:  # after every size: a run stopped later keeps the sizes it measured
+                write_json(args.json, {**about, "rows": rows})
         finally:
             if args.keep is None:
                 shutil.rmtree(base, ignore_errors=True)
