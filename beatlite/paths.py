@@ -83,6 +83,34 @@ def on_data_samples() -> bool:
     return data_dir().resolve() == (repo_root() / "data_samples").resolve()
 
 
+def shareable(path: str | os.PathLike[str]) -> str:
+    """``path`` as the files beatlite writes for others record it (checkpoints, score reports, results tables):
+    never an absolute path of this machine, which would name its home folder, user or host.
+
+    Relative to the repository root when inside it (``"checkpoints/fgd_dirvec.pt"``, ``"data_samples"``,
+    ``"build/seeds/2022/camn_tiny.pt"``), else to :func:`build_dir` as ``"$BEATLITE_BUILD/..."``; a relative
+    path that stays below the working folder as given (``"my_outputs"``); anything else by its last component,
+    the file's or folder's name (``"beat_english_v0.2.1"``).
+
+    >>> shareable(repo_root() / "checkpoints" / "camn_tiny.pt"), shareable("/somewhere/else/beat_v2")
+    ('checkpoints/camn_tiny.pt', 'beat_v2')
+    """
+    given = Path(path).expanduser()
+    if not given.is_absolute() and ".." not in given.parts:
+        return given.as_posix()
+    full = Path(os.path.abspath(given))
+    for root, prefix in ((repo_root(), ""), (build_dir(), "$BEATLITE_BUILD/")):
+        for candidate in (full, full.resolve()):
+            try:
+                rel = candidate.relative_to(Path(os.path.abspath(root)).resolve())
+            except ValueError:
+                continue
+            if prefix:
+                return prefix + rel.as_posix() if rel.parts else prefix.rstrip("/")
+            return rel.as_posix() if rel.parts else "."
+    return full.name or "."
+
+
 def code_revision() -> str:
     """The repository's commit, for the records the benchmarks write: ``git rev-parse --short HEAD``, with
     ``+changes`` when tracked files differ from it, or ``"unknown"`` outside a git checkout."""

@@ -486,7 +486,10 @@ class ScoreResult:
         95 % bootstrap intervals per metric key (empty without ``bootstrap``).
     info : dict
         Data folder and fingerprints, takes, frames, extractor and its sha256, beatlite's version,
-        the files and what was done to them (JSON-friendly).
+        the files and what was done to them (JSON-friendly). The paths, ``pred``, ``data`` and ``extractor``, are
+        as :func:`beatlite.paths.shareable` writes them (relative to the repository or as given, else the
+        folder's or file's name), so a report names no folder of the machine that wrote it; the sha256 values
+        and fingerprints identify the data and the extractor.
     """
 
     evaluation: Any
@@ -687,6 +690,8 @@ def score_folder(
     ScoreInputError
         One line per problem: missing takes, unreadable or unconvertible files, too short predictions.
     """
+    from beatlite.paths import shareable
+
     test = load_split(data, split) if test is None else test
     files, missing, extra = match_predictions(pred, test.takes)
     problems = []
@@ -737,7 +742,7 @@ def score_folder(
         )
     directions = [p.directions[: len(d)] for p, d in zip(chosen, test.gt_directions, strict=True)]
     info = {
-        "pred": str(pred),
+        "pred": shareable(pred),
         "files": {stem: f"{files[stem].name}: {preds[stem].form}" for stem in test.takes},
         "missing": missing,
         "extra": extra,
@@ -856,7 +861,7 @@ def _score(
     import beatlite
     from beatlite.metrics.extractor import load_extractor
     from beatlite.metrics.scoring import METRICS, evaluate
-    from beatlite.paths import n_threads
+    from beatlite.paths import n_threads, shareable
     from beatlite.train.testset import directions_takes
 
     keys = list(METRICS) if metrics is None else list(metrics)
@@ -877,14 +882,14 @@ def _score(
     intervals = bootstrap_intervals(generated, truth, scored, n=bootstrap, seed=seed, progress=progress)
     info = {
         **info,
-        "data": test.folder,
+        "data": shareable(test.folder) if test.folder else "",
         "split": test.split,
         "takes": list(test.takes),
         "frames": int(sum(len(d) for d in test.gt_directions)),
         "fps": FPS,
         "truth_sha256": _truth_sha(test),
         "data_fingerprint": test.fingerprint,
-        "extractor": extractor.meta["path"],
+        "extractor": shareable(extractor.meta["path"]),
         "extractor_sha256": _file_sha(extractor.meta["path"]),
         "euler_extractor_sha256": None if euler_ae is None else _file_sha(euler_ae.meta["path"]),
         "rot6d_extractor_sha256": None if rot6d_ae is None else _file_sha(rot6d_ae.meta["path"]),

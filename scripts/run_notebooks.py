@@ -9,7 +9,8 @@ Writes, for each ``notebooks/NN_name.ipynb``:
 - ``build/student/NN_name.ipynb``: the student copy, without the cells tagged ``solution``;
 - ``build/instructor/``: the answer sheet of the exercises, from the ``solution`` cells
   (``scripts/instructor_sheet.py``);
-- ``build/results.md``: per-notebook status and wall time, then every table.
+- ``build/results.md``: per-notebook status and wall time, then every table (paths as :func:`local_paths` writes
+  them: no folder of this machine).
 
 Exit status is non-zero when any notebook fails (the others still run). The notebooks run with
 ``BEATLITE_INTERACTIVE=off`` (text progress bars, static 3D images: see :func:`beatlite.notebook.interactive`)
@@ -164,7 +165,8 @@ def export_html(nb) -> str:
 
 def offline_notebook(nb):
     """A copy of ``nb`` without web references in its outputs: the animation player's Font Awesome link dropped
-    (the offline style sheet draws its icons) and no widget state."""
+    (the offline style sheet draws its icons) and no widget state; and without this machine's folders
+    (:func:`local_paths`: the page is published on the course site)."""
     nb = copy.deepcopy(nb)
     for cell in nb.cells:
         for output in cell.get("outputs", []):
@@ -172,8 +174,32 @@ def offline_notebook(nb):
             if isinstance(html, str | list):
                 text = "".join(html) if isinstance(html, list) else html
                 output["data"]["text/html"] = _FONT_AWESOME_LINK.sub("", text)
+            for key, value in [("text", output.get("text")), ("evalue", output.get("evalue"))]:
+                if isinstance(value, str | list):
+                    output[key] = local_paths("".join(value) if isinstance(value, list) else value)
+            if isinstance(output.get("traceback"), list):
+                output["traceback"] = [local_paths(line) for line in output["traceback"]]
+            for mime, value in output.get("data", {}).items():
+                if mime.startswith("text/") and isinstance(value, str | list):
+                    output["data"][mime] = local_paths("".join(value) if isinstance(value, list) else value)
     nb.metadata.pop("widgets", None)
     return nb
+
+
+def local_paths(text: str) -> str:
+    """``text`` without this machine's folders: the repository root's path left out of the paths below it
+    (``/home/alice/beatlite/build/tables/x.md`` -> ``build/tables/x.md``, the root itself ``.``) and the home
+    folder written ``~`` (a data folder outside the repository: ``~/beat``), so a published page names no user."""
+    for root, short in ((REPO, ""), (Path.home(), "~")):
+        if str(root) in ("", "/", "."):
+            continue
+        for form in dict.fromkeys((str(root), os.path.abspath(root))):
+            text = re.sub(
+                re.escape(form) + r"(/|(?![\w-]|\.\w))",
+                lambda m, short=short: (short + "/" if short else "") if m.group(1) else (short or "."),
+                text,
+            )
+    return text
 
 
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
@@ -323,7 +349,8 @@ def main(argv: list[str] | None = None) -> int:
     lines += [f"| **total** | {len(rows) - failed}/{len(rows)} ok | {total:.1f} |", ""]
     for table in sorted((out / "tables").glob("*.md")):
         lines += [table.read_text(encoding="utf-8").rstrip(), ""]
-    (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
+    text = local_paths("\n".join(lines))  # shared: no folder of this machine
+    (out / "results.md").write_text(text, encoding="utf-8")
     if args.record:
         write_record(args.record, timings, total, about)
     print(f"[run] wrote {out / 'results.md'} ({len(rows) - failed}/{len(rows)} notebooks ok, {total:.0f} s)")

@@ -271,6 +271,31 @@ def test_page_has_no_remote_reference(small_page):
     assert html.count("<math") == 2 and "\\frac" not in html
 
 
+def test_page_names_no_folder_of_the_machine_that_ran_it(monkeypatch):
+    """Outputs that print paths (the data folder, a saved table, a score caption, a traceback) show them relative
+    to the repository and the home folder as ``~`` (before: ``/home/alice/beatlite/data_samples`` on a published
+    course page, naming the user); a folder that only starts like the repository's is left as it is."""
+    runner = _runner()
+    monkeypatch.setattr(runner, "REPO", Path("/srv/course/beatlite"))
+    monkeypatch.setenv("HOME", "/home/alice")
+    repo, home = "/srv/course/beatlite", "/home/alice"
+    lines = (
+        f"data={repo}/data_samples\nPosixPath('{repo}/build/tables/x.md')\n{home}/beat in {repo}.\n{repo}2/y"
+    )
+    outputs = [
+        new_output("stream", name="stdout", text=lines),
+        new_output("execute_result", data={"text/plain": lines}),
+        new_output("display_data", data={"text/html": f"<p>split of <code>{repo}/data_samples</code></p>"}),
+        new_output(
+            "error", ename="FileNotFoundError", evalue=f"{home}/beat", traceback=[f"{repo}/beatlite/x.py"]
+        ),
+    ]
+    html = runner.export_html(new_notebook(cells=[new_code_cell("print(data)", outputs=outputs)]))
+    assert html.count("data=data_samples") == 2 and html.count("PosixPath('build/tables/x.md')") == 2
+    assert html.count("~/beat in .") == 2 and html.count(f"{repo}2/y") == 2 and "beatlite/x.py" in html
+    assert "split of <code>data_samples</code>" in html and f"{repo}/" not in html and "alice" not in html
+
+
 def test_page_renders_offline_in_chromium(small_page, tmp_path):
     _chromium()
     browser = Browser(tmp_path / "profile")
@@ -352,3 +377,18 @@ def test_a_failure_is_reported_in_plain_text(tmp_path, monkeypatch):
     assert _runner().main(["--out", str(tmp_path / "out"), str(tmp_path / "01_fails.ipynb")]) == 1
     results = (tmp_path / "out" / "results.md").read_text()
     assert "| FAILED: ZeroDivisionError: division by zero |" in results, results
+
+
+def test_results_md_names_no_folder_of_the_machine(tmp_path, monkeypatch):
+    """A failure's message that names a file of the repository is written to build/results.md relative to it
+    (before: the absolute path, e.g. ``/home/alice/beatlite/...``)."""
+    for name in ("BEATLITE_BUILD", "BEATLITE_INTERACTIVE"):  # main() sets them: restored after the test
+        monkeypatch.setenv(name, os.environ.get(name, ""))
+    runner = _runner()
+    missing = runner.REPO / "build" / "no_such_table.md"
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(f"open({str(missing)!r})")])
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, tmp_path / "01_fails.ipynb")
+    assert runner.main(["--out", str(tmp_path / "out"), str(tmp_path / "01_fails.ipynb")]) == 1
+    results = (tmp_path / "out" / "results.md").read_text()
+    assert "'build/no_such_table.md'" in results and str(runner.REPO) not in results, results

@@ -115,8 +115,32 @@ def test_a_split_loaded_directly_names_its_data_folder(test_set):
     direct = load_test_set(index_folder(REPO / "data_samples"))
     assert direct.folder == test_set.folder == str((REPO / "data_samples").resolve())
     result = self_check(test=direct, metrics=["PCK"])
-    assert result.info["data"] == direct.folder
-    assert f"split of `{direct.folder}`" in result.to_markdown()
+    assert result.info["data"] == "data_samples"  # relative to the repository (paths.shareable)
+    assert "split of `data_samples`" in result.to_markdown()
+
+
+def test_a_report_names_no_folder_of_the_machine_that_wrote_it(test_set, truth_files, tmp_path):
+    """The JSON and Markdown reports name the predictions, the data folder and the FGD extractor without the
+    writer's folders (before: absolute paths such as ``/home/alice/outputs``, naming the home folder and user):
+    by their names, or as given when relative; the sha256 values identify them."""
+    import dataclasses
+    import hashlib
+
+    home = tmp_path / "home" / "alice"
+    pred, extractor = home / "outputs", home / "my_fgd.pt"
+    shutil.copytree(truth_files, pred)
+    shutil.copy(checkpoints_dir() / "fgd_dirvec.pt", extractor)
+    elsewhere = dataclasses.replace(test_set, folder=str(home / "beat_english"))  # data in the home folder
+    result = score_folder(pred, test=elsewhere, metrics=["PCK"], extractor=extractor)
+    assert (result.info["pred"], result.info["data"], result.info["extractor"]) == (
+        "outputs",
+        "beat_english",
+        "my_fgd.pt",
+    )
+    for text in (json.dumps(result.to_dict()), result.to_markdown()):
+        assert str(tmp_path) not in text and "alice" not in text, text
+    digest = hashlib.sha256((checkpoints_dir() / "fgd_dirvec.pt").read_bytes()).hexdigest()
+    assert result.info["extractor_sha256"] == digest[:16]  # the extractor stays identified
 
 
 # ----------------------------------------------------------------------------- round trip

@@ -457,3 +457,42 @@ def test_the_per_clip_protocol_seeds_every_clip_with_its_own_ground_truth(test_s
     whole, _ = generate_takes(_SeedEcho(), test_set, None)  # whole takes: the first seed carries on
     np.testing.assert_allclose(whole[0][40], test_set.gt_directions[0][0], atol=1e-6)
     assert np.abs(test_set.gt_directions[0][40] - test_set.gt_directions[0][0]).max() > 1e-3
+
+
+def test_written_tables_name_no_folder_of_the_machine_that_wrote_them(test_set, tmp_path, monkeypatch):
+    """The results tables and the seed table record the FGD extractor, each seed's checkpoints and a row's source
+    without the writer's folders (before: absolute paths such as ``/home/alice/...``, naming the home folder and
+    user): relative to the build folder, else by the file's name."""
+    from beatlite.models.testing import fake_windows
+    from beatlite.train import TrainConfig, fit
+    from beatlite.train import seeds as seeds_module
+
+    home = tmp_path / "home" / "alice"
+    monkeypatch.setenv("BEATLITE_BUILD", str(home / "build"))
+    path = home / "build" / "seeds" / "1" / "mean_pose.pt"
+    config = TrainConfig(epochs=1, checkpoint=path, progress=False)
+    fit(build_model("mean_pose"), fake_windows(4, seed=1), config, meta=test_set.normalizers.to_meta())
+    monkeypatch.setattr(
+        seeds_module,
+        "checkpoint_path",
+        lambda name, seed: home / "build" / "seeds" / str(seed) / f"{name}.pt",
+    )
+
+    class Extractor:  # the stand-in features, loaded from a file of the home folder
+        meta = {"path": str(home / "fgd_dirvec.pt")}
+
+        def __call__(self, windows: np.ndarray) -> np.ndarray:
+            return _features(windows)
+
+    seed_table = seeds_module.evaluate_seeds(["mean_pose"], seeds=[1], test=test_set, extractor=Extractor())
+    table = evaluate_models([str(path)], test=test_set, extractor=Extractor(), ground_truth=False)
+    assert seed_table.info["checkpoints"] == {"mean_pose": ["$BEATLITE_BUILD/seeds/1/mean_pose.pt"]}
+    assert table.info["extractor"] == seed_table.info["extractor"] == "fgd_dirvec.pt"
+    assert table.to_dict()["rows"][0]["source"] == "$BEATLITE_BUILD/seeds/1/mean_pose.pt"
+    written = [
+        *seeds_module.write_seed_results(seed_table, tmp_path / "seeds"),
+        *write_results(table, tmp_path / "r"),
+    ]
+    for file in written:
+        text = file.read_text()
+        assert str(tmp_path) not in text and "alice" not in text, (file.name, text)

@@ -800,3 +800,35 @@ def test_results_command_names_a_checkpoint_that_is_not_there(monkeypatch, capsy
     err = capsys.readouterr().err
     assert err.startswith("error: results: no checkpoint nope in ") and err.count("\n") == 1
     assert "camn_tiny" in err.split("(there: ")[1] and "fgd_dirvec" not in err
+
+
+def test_checkpoints_name_no_folder_of_the_machine_that_wrote_them(tmp_path, monkeypatch):
+    """``retrain``'s resumable and exported checkpoints, made to be shared, record the data folder by its name and the
+    resumable checkpoint by its file name (before: ``meta["data"]`` and ``train_config["checkpoint"]`` were absolute
+    paths, e.g. ``/home/alice/corpus``, naming the writer's home folder and user); ``export_checkpoint`` writes such
+    names for a checkpoint of an older beatlite too. Checked on the files' bytes."""
+    import torch
+
+    from beatlite.train.checkpoint import export_checkpoint, load_checkpoint, save_checkpoint
+    from beatlite.train.recipes import training_data
+
+    home = tmp_path / "home" / "alice"
+    home.mkdir(parents=True)
+    monkeypatch.setenv("BEATLITE_BUILD", str(home / "build"))
+    root = small_corpus(home / "corpus", ["2_scott_0_9_9", "2_scott_0_57_57"])
+    retrain("mean_pose", out_dir=home / "run", data=training_data(root), progress=False)
+    written = [home / "run" / "mean_pose.pt", home / "run" / "train" / "mean_pose.pt"]
+    for path in written:
+        data = load_checkpoint(path)
+        assert data["meta"]["data"] == "corpus" and data["train_config"]["checkpoint"] == "mean_pose.pt", path
+    old = load_checkpoint(written[1])  # as an older beatlite wrote it
+    old["meta"]["data"], old["train_config"]["checkpoint"] = str(root), str(written[1])
+    save_checkpoint(home / "old.pt", old)
+    assert str(root).encode() in (home / "old.pt").read_bytes()  # (the check below sees such paths)
+    export_checkpoint(home / "old.pt", home / "shared.pt")
+    shared = load_checkpoint(home / "shared.pt")
+    assert shared["meta"]["data"] == "corpus" and shared["train_config"]["checkpoint"] == "mean_pose.pt"
+    assert torch.equal(shared["state"]["mean"], old["state"]["mean"].half())
+    for path in [*written, home / "shared.pt"]:
+        raw = path.read_bytes()
+        assert str(tmp_path).encode() not in raw and b"alice" not in raw, path

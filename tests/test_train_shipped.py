@@ -162,3 +162,29 @@ def test_claims_hold_over_the_recorded_seeds(model, reference, metric, verdict):
     seeds = _recorded()
     effect = compare_rows(seeds, reference, [model], metrics=[metric])[0]
     assert effect.verdict == verdict, f"{model} vs {reference} on {metric}: {effect.cell()}"
+
+
+def test_shipped_files_name_no_folder_of_the_machine_that_trained_them():
+    """The shipped checkpoints' ``train_config["checkpoint"]`` and ``meta["data"]`` and the seed table's checkpoint
+    files and extractor are relative to the repository (before: ``/work/main/build/seeds/...``,
+    ``/work/wt/train/data_samples``: the training machine's folders)."""
+    import json
+
+    from beatlite.train.checkpoint import load_checkpoint
+
+    found = sorted(checkpoints_dir().glob("*.pt"))
+    if not found:
+        pytest.skip("no shipped checkpoints")
+    for path in found:
+        data = load_checkpoint(path) if not path.name.startswith("fgd_") else {}
+        for value in (
+            (data.get("train_config") or {}).get("checkpoint"),
+            (data.get("meta") or {}).get("data"),
+        ):
+            assert value is None or not value.startswith(("/", "~")), (path.name, value)
+        assert b"/work/" not in path.read_bytes() and b"/home/" not in path.read_bytes(), path.name
+    table = checkpoints_dir() / "results_seeds.json"
+    info = json.loads(table.read_text())["info"]
+    files = [f for listed in info["checkpoints"].values() for f in listed] + [info["extractor"]]
+    assert files and not [f for f in files if f.startswith(("/", "~"))]
+    assert info["extractor"] == "checkpoints/fgd_dirvec.pt"

@@ -341,11 +341,17 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
     weights are those of the best-scoring epoch, recorded as ``"selected"``:
     ``{"epoch": e, "score": s, "of_epochs": n}`` (and ``"step"``, the global optimiser step, when it was
     validated every ``TrainConfig.val_every`` steps); otherwise the last epoch's.
+
+    The copy is meant to be shared: the paths it records, ``train_config["checkpoint"]`` and ``meta["data"]``,
+    are written as :func:`beatlite.paths.shareable` names them (relative to the repository, else the file's or
+    folder's name), also when ``src`` was written by an older beatlite with absolute ones; the data fingerprint
+    identifies the data.
     """
     data = load_checkpoint(src)
     keep = {
         k: v for k, v in data.items() if k not in ("optimizer", "d_optimizer", "rng", "rng_processes", "best")
     }
+    keep.update(shareable_paths(keep))
     chosen = data.get("best")
     if best and chosen is not None:
         keep["state"] = chosen["state"]
@@ -362,6 +368,24 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
             for k, v in keep["state"].items()
         }
     return save_checkpoint(dst, keep)
+
+
+def shareable_paths(data: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``"train_config"`` and ``"meta"`` entries of checkpoint dict ``data`` with the paths they record,
+    ``train_config["checkpoint"]`` and ``meta["data"]``, as :func:`beatlite.paths.shareable` writes them (no
+    absolute path of the machine that trained it); the entries ``data`` lacks are left out.
+
+    >>> shareable_paths({"train_config": {"checkpoint": "/home/alice/run/train/camn_tiny.pt", "seed": 1},
+    ...                  "meta": {"data": "/home/alice/beat_english_v0.2.1"}})
+    {'train_config': {'checkpoint': 'camn_tiny.pt', 'seed': 1}, 'meta': {'data': 'beat_english_v0.2.1'}}
+    """
+    out: dict[str, Any] = {}
+    for key, field in (("train_config", "checkpoint"), ("meta", "data")):
+        entry = data.get(key)
+        if isinstance(entry, Mapping):
+            value = entry.get(field)
+            out[key] = {**entry, field: paths.shareable(value)} if isinstance(value, str) else dict(entry)
+    return out
 
 
 def convert_legacy(src: str | Path, dst: str | Path, *, trust: bool = False) -> Path:

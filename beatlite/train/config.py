@@ -10,6 +10,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from beatlite.paths import shareable
+
 LR_SCHEDULES = ("constant", "cosine")
 """Values of :attr:`TrainConfig.lr_schedule`."""
 DATA_ON_DEVICE = ("auto", "always", "never")
@@ -207,7 +209,9 @@ class TrainConfig:
         return 0.5 * (1.0 + math.cos(math.pi * min(epoch, self.epochs) / self.epochs))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly dict (paths as strings)."""
+        """JSON-friendly dict, what a checkpoint records as ``"train_config"``: ``checkpoint`` as
+        :func:`beatlite.paths.shareable` writes it (relative to the repository, else the file's name: no
+        absolute path of this machine)."""
         d = dataclasses.asdict(self)
-        d["checkpoint"] = None if self.checkpoint is None else str(self.checkpoint)
+        d["checkpoint"] = None if self.checkpoint is None else shareable(self.checkpoint)
         return d

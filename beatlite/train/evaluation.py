@@ -125,7 +125,8 @@ class ModelResults:
     ----------
     rows : list of ResultRow
     info : dict
-        Split, takes, frames, window counts, extractor path, total seconds.
+        Split, takes, frames, window counts, extractor path (as :func:`beatlite.paths.shareable` writes it:
+        relative to the repository, else the file's name), total seconds.
     """
 
     rows: list[ResultRow]
@@ -187,7 +188,8 @@ class ModelResults:
         return tuple(self.info.get("columns", COLUMNS))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly dict: ``{"columns", "rows": [...], "info"}`` (NaN written as None)."""
+        """JSON-friendly dict: ``{"columns", "rows": [...], "info"}`` (NaN written as None; a row's ``source``
+        path as :func:`beatlite.paths.shareable` writes it)."""
         return {
             "columns": [
                 {"name": key, "higher_is_better": METRICS[key].higher_is_better} for key in self.columns
@@ -195,6 +197,7 @@ class ModelResults:
             "rows": [
                 {
                     **dataclasses.asdict(r),
+                    "source": paths.shareable(r.source),
                     "metrics": {k: (None if not math.isfinite(v) else v) for k, v in r.metrics.items()},
                 }
                 for r in self.rows
@@ -325,7 +328,7 @@ def evaluate_models(
         "frames": test.n_frames,
         "windows": int(len(truth.takes.features)),
         "fps": FPS,
-        "extractor": str(getattr(extractor, "meta", {}).get("path", type(extractor).__name__)),
+        "extractor": paths.shareable(getattr(extractor, "meta", {}).get("path", type(extractor).__name__)),
         "common_space": "TED-43 unit bone directions; positions from BEAT rest-pose bone lengths, root at origin",
         "columns": {key: METRICS[key].describe for key in columns},
         "data_fingerprint": test.fingerprint,

@@ -405,6 +405,10 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     """Index ``data`` (default ``$BEATLITE_DATA``; cached), build or update its window store
     (:func:`beatlite.data.store.build_store`, only changed takes) and open its train/val windows.
 
+    ``meta`` (what :func:`retrain` stores in the checkpoint) holds the train split's normalisation statistics, the
+    vocabulary and ``"data"``, the folder as :func:`beatlite.paths.shareable` names it (``"data_samples"``, or the
+    folder's name: no absolute path of this machine).
+
     ``progress`` shows the store's tqdm bar over the takes it builds. ``ValueError`` when no usable take is in
     the val split (or a reader's ``FormatError``). The vocabulary and the word vectors'
     sentences come from the usable takes only, as the windows do (an unusable take's TextGrid may not read).
@@ -427,7 +431,7 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     meta = {
         **train.normalizers.to_meta(),
         "vocab": list(vocab.itos),
-        "data": str(root),
+        "data": paths.shareable(root),  # the folder's name or repository path; the fingerprint identifies it
     }
     return TrainingData(index, vocab, train, val, take_sentences(usable), meta, store)
 

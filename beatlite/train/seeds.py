@@ -146,8 +146,9 @@ def _existing_checkpoint(name: str, seed: int) -> Path | None:
 
 
 def _seed_files(name: str, seeds: Sequence[int]) -> list[str]:
-    """The checkpoint files of recipe ``name`` for those of ``seeds`` that have one (:func:`checkpoint_path`)."""
-    return [str(path) for s in seeds if (path := _existing_checkpoint(name, s)) is not None]
+    """The checkpoint files of recipe ``name`` for those of ``seeds`` that have one (:func:`checkpoint_path`), as
+    :func:`beatlite.paths.shareable` writes them (``"build/seeds/2022/camn_tiny.pt"``, ``"checkpoints/camn_tiny.pt"``)."""
+    return [paths.shareable(path) for s in seeds if (path := _existing_checkpoint(name, s)) is not None]
 
 
 def _current(name: str, seed: int, verbose: bool) -> bool:
