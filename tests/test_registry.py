@@ -163,6 +163,22 @@ def test_a_recipe_mistake_is_refused_when_it_is_registered(monkeypatch):
     assert not {"s2g_wide", "s2g_cos", "s2g_copy", "s2g_gt"} & set(recipes.RECIPES)
 
 
+def test_a_recipe_of_zero_epochs_is_refused_for_a_model_that_trains(monkeypatch):
+    """epochs=0 marks an untrained baseline's recipe (retrain and fit then skip the epochs >= 1 check): a model
+    with trainable parameters registered so trained nothing, then failed exporting a checkpoint it never wrote.
+    Refused when registered, naming the recipe and the setting; a baseline's 0 epochs are kept."""
+    from beatlite import models
+    from beatlite.train import recipes
+
+    monkeypatch.setattr(models, "MODELS", dict(models.MODELS))
+    monkeypatch.setattr(recipes, "RECIPES", dict(recipes.RECIPES))
+    with pytest.raises(ValueError, match=r"'s2g_zero': epochs=0 for 's2g', a model with trainable"):
+        recipes.register_recipe("s2g_zero", recipes.Recipe("s2g", "S2G zero", epochs=0))
+    assert "s2g_zero" not in recipes.RECIPES
+    recipes.register_recipe("mean_pose_again", recipes.Recipe("mean_pose", "Mean pose again", epochs=0))
+    assert recipes.recipe_train_config("mean_pose_again").epochs == 0
+
+
 def test_metric_registration_binds_inputs_by_name_and_refuses_conflicts(metrics_restored):
     import numpy as np
 

@@ -10,6 +10,7 @@ import scipy.stats
 
 from beatlite.stats.agreement import (
     bradley_terry,
+    bradley_terry_order,
     bradley_terry_step,
     kendall_tau,
     simulate_votes,
@@ -138,3 +139,83 @@ def test_vote_agreement_interval_widens_with_fewer_votes():
     assert many.method == "votes" and many.low <= many.tau <= many.high
     assert (few.high - few.low) > (many.high - many.low)
     assert many.tau == kendall_tau(scores, bradley_terry(simulate_votes(truth, 500, seed=0))).tau
+
+
+def _bounded_mle(wins, bound=25.0):
+    """scipy's maximum of the log-likelihood with every log-strength in [-bound, bound]: where the votes are
+    separated the maximum has no finite location, and the bounded one approaches the limit as the bound grows."""
+    from scipy.optimize import minimize
+
+    wins = np.asarray(wins, dtype=float)
+
+    def nll(t):
+        return -(wins * (t[:, None] - np.logaddexp(t[:, None], t[None, :]))).sum()
+
+    bounds = [(-bound, bound)] * len(wins)
+    theta = minimize(nll, np.zeros(len(wins)), method="L-BFGS-B", bounds=bounds, options={"ftol": 1e-15}).x
+    p = np.exp(theta - theta.max())
+    return p / p.sum()
+
+
+# system 0 won all its 9 votes; 1 and 2 split theirs 3 to 1; 3 lost all its 6 votes
+SEPARATED = np.array([[0, 3, 2, 4], [0, 0, 3, 1], [0, 1, 0, 1], [0, 0, 0, 0]])
+
+
+def test_separated_votes_give_the_likelihoods_limit_at_once(monkeypatch):
+    """When a system wins every vote the maximum-likelihood strengths are on the boundary: bradley_terry used to
+    run all 10,000 MM steps towards it (and vote_agreement that many per resample: ~3 min at its default 1,000).
+    Now the limit is returned: the unbeaten system 0 gets strength 1, the others 0, as scipy's bounded maximum
+    approaches."""
+    from beatlite.stats import agreement
+
+    steps = []
+    step = agreement.bradley_terry_step
+    monkeypatch.setattr(agreement, "bradley_terry_step", lambda p, w: steps.append(1) or step(p, w))
+    p = bradley_terry(SEPARATED)
+    assert p.tolist() == [1.0, 0.0, 0.0, 0.0]
+    # the bounded optimum stops with the beaten systems' strengths near 1e-7, where the likelihood no longer
+    # changes in float64 (at the bounds they would be e^-50); 1e-5 leaves a margin of 100
+    np.testing.assert_allclose(p, _bounded_mle(SEPARATED), atol=1e-5)
+    assert len(steps) < 100, len(steps)  # an MM fit of 2 systems at most, not 10,000 steps
+
+
+def test_the_order_in_the_separated_limit_is_the_bounded_maximums():
+    """bradley_terry_order ranks 0 (unbeaten) above 1 and 2 (their own fit: 3 to 1, so 1 first) above 3
+    (beaten by all), the order of scipy's bounded maximum; within a group the strengths' ratio is the group's
+    own closed form w / l."""
+    order = bradley_terry_order(SEPARATED)
+    assert order.tolist() == [3.0, 2.0, 1.0, 0.0]
+    bounded = _bounded_mle(SEPARATED)
+    assert list(np.argsort(bounded)) == list(np.argsort(order))
+    assert np.isclose(bounded[1] / bounded[2], 3.0, rtol=1e-3)  # the 1-vs-2 votes set it; 0's pull is e^-50
+    # two systems that split their votes and beat the third in every vote: the pair's share, the third 0
+    np.testing.assert_allclose(bradley_terry(np.array([[0, 3, 2], [1, 0, 5], [0, 0, 0]])), [0.75, 0.25, 0.0])
+    # no separation: the order is the strengths themselves
+    wins = simulate_votes([0.4, 0.3, 0.2, 0.1], 30, seed=3)
+    assert np.array_equal(bradley_terry_order(wins), bradley_terry(wins))
+
+
+def test_separated_groups_without_one_order_are_refused():
+    # 0 and 1 each beat 2 in every vote and never met: which is stronger is not identified
+    wins = np.array([[0, 0, 2], [0, 0, 1], [0, 0, 0]])
+    with pytest.raises(ValueError, match=r"groups of systems \[\[0\], \[1\]\] each won every vote"):
+        bradley_terry(wins)
+    with pytest.raises(ValueError, match="not identified"):
+        bradley_terry_order(wins)
+    # 0 beat 1 and 2 in every vote, 1 and 2 never met: 0 is the limit's only strong system, 1 vs 2 has no order
+    wins = np.array([[0, 2, 1], [0, 0, 0], [0, 0, 0]])
+    assert bradley_terry(wins).tolist() == [1.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match="not identified"):
+        bradley_terry_order(wins)
+
+
+def test_vote_agreement_on_separated_votes_takes_few_mm_steps(monkeypatch):
+    """Every resample of a pair voted one way only is separated too: each took 10,000 MM steps."""
+    from beatlite.stats import agreement
+
+    steps = []
+    step = agreement.bradley_terry_step
+    monkeypatch.setattr(agreement, "bradley_terry_step", lambda p, w: steps.append(1) or step(p, w))
+    r = vote_agreement([4.0, 3.0, 2.0, 1.0], SEPARATED, n_boot=50, seed=0)
+    assert r.tau == 1.0 and r.low <= r.tau <= r.high and r.method == "votes"
+    assert len(steps) < 50 * 200, len(steps)  # was 50 * 10,000 and more

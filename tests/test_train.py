@@ -219,6 +219,24 @@ def test_untrained_baselines_fit_saves_and_loads(windows, tmp_path):
     np.testing.assert_allclose(loaded.mean.numpy(), train["pose"].mean(axis=(0, 1)), atol=1e-5)
 
 
+def test_zero_epochs_write_the_checkpoint_of_the_initial_weights(windows, tmp_path):
+    """TrainConfig allows epochs=0: fit returned FitResult.checkpoint without writing it (export_checkpoint then
+    failed, 'checkpoint not found', or exported an older run's file at that path). It writes the untrained
+    weights, as for an untrained baseline; resuming a finished run with epochs=0 leaves its checkpoint alone."""
+    train, _ = windows
+    model = camn()
+    start = {k: v.clone() for k, v in model.state_dict().items()}
+    result = fit(model, train, cfg(epochs=0, checkpoint=tmp_path / "z.pt"))
+    assert result.history == [] and result.checkpoint == tmp_path / "z.pt"
+    export_checkpoint(tmp_path / "z.pt", tmp_path / "z_small.pt")
+    loaded, data = load_model(tmp_path / "z.pt")
+    assert data["epoch"] == 0
+    assert all(torch.equal(v, start[k]) for k, v in loaded.state_dict().items())
+    fit(camn(), train, cfg(epochs=1, checkpoint=tmp_path / "one.pt"))
+    fit(camn(), train, cfg(epochs=0, checkpoint=tmp_path / "one.pt", resume=True))
+    assert load_model(tmp_path / "one.pt")[1]["epoch"] == 1
+
+
 # --------------------------------------------------------------------------- whole-take generation
 @dataclasses.dataclass
 class _StubConfig(ModelConfig):

@@ -20,6 +20,7 @@ from __future__ import annotations
 from beatlite.stats.agreement import (
     TauResult,
     bradley_terry,
+    bradley_terry_order,
     bradley_terry_step,
     kendall_tau,
     simulate_votes,
@@ -50,6 +51,7 @@ __all__ = [
     "CorpusTake",
     "TauResult",
     "bradley_terry",
+    "bradley_terry_order",
     "bradley_terry_step",
     "kendall_tau",
     "simulate_votes",

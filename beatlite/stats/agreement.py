@@ -7,6 +7,7 @@ and :func:`kendall_tau` / :func:`vote_agreement` measure how well a metric order
 
 =========================  ===========================================================================
 ``bradley_terry``          maximum-likelihood strengths, minorisation-maximisation (Hunter 2004)
+``bradley_terry_order``    the systems' order by those strengths, also when one group won every vote
 ``bradley_terry_step``     one MM update (the exercise of notebook 09)
 ``simulate_votes``         votes drawn from known strengths (checks that the fit recovers them)
 ``kendall_tau``            τ-b and its p-value (``scipy.stats.kendalltau``), bootstrap interval over items
@@ -32,6 +33,7 @@ import numpy as np
 __all__ = [
     "TauResult",
     "bradley_terry",
+    "bradley_terry_order",
     "bradley_terry_step",
     "kendall_tau",
     "simulate_votes",
@@ -91,14 +93,22 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
     The model: ``P(i preferred to j) = p_i / (p_i + p_j)``. Fitted by :func:`bradley_terry_step` from equal
     strengths until the largest change is below ``tol`` (Hunter 2004: each step increases the likelihood).
 
+    The maximum-likelihood strengths are all positive exactly when the wins link every system to every other
+    (the directed graph with an edge ``i -> j`` when ``i`` beat ``j`` at least once is strongly connected; Ford
+    1957). Otherwise some group of systems won every vote against the others it met (separation): the
+    likelihood grows as that group's strengths grow without bound relative to the rest, and its supremum is the
+    limit in which every strongly connected group of the wins is infinitely stronger than the groups it beat. That
+    limit is returned, found without iterating towards it: the strongest group (the one no other system ever
+    beat) gets the strengths of a fit to its own votes, every other system 0, so ``P(strongest beats another) =
+    1``. :func:`bradley_terry_order` gives the order of all systems in that limit.
+
     Parameters
     ----------
     wins : (K, K) float or int
         ``wins[i, j]``: votes preferring ``i`` to ``j``; the diagonal is ignored. Every system must have been
         compared at least once, and the comparisons must link all systems (no two groups of systems that were
         never compared with each other: the model cannot say how strong one group is against the other, and
-        the fit would return an arbitrary split). A system that never wins gets strength 0 (the maximum-likelihood estimate is on
-        the boundary), and the iteration converges slowly then.
+        the fit would return an arbitrary split).
     max_iter : int
         Most MM steps.
     tol : float
@@ -107,12 +117,14 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
     Returns
     -------
     (K,) float
-        Strengths summing to 1 (ratios are what the model identifies; ``log p`` are the usual "BT scores").
+        Strengths summing to 1 (ratios are what the model identifies; ``log p`` are the usual "BT scores");
+        0 for the systems outside the strongest group when the votes are separated.
 
     Raises
     ------
     ValueError
-        Not a square matrix of counts, a system never compared, or systems in groups never compared.
+        Not a square matrix of counts, a system never compared, systems in groups never compared, or separated
+        votes with two or more groups that nobody beat (their relative strengths are not identified).
 
     Examples
     --------
@@ -120,7 +132,86 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
 
     >>> bradley_terry(np.array([[0, 3], [1, 0]])).tolist()
     [0.75, 0.25]
+
+    System 0 won every vote: it is infinitely stronger than the others (the limit, not 10,000 slow MM steps).
+
+    >>> bradley_terry(np.array([[0, 2, 3], [0, 0, 1], [0, 2, 0]])).tolist()
+    [1.0, 0.0, 0.0]
     """
+    w = _linked_wins(wins)
+    n_groups, group = _win_groups(w)
+    if n_groups == 1:
+        return _mm(w, max_iter, tol)
+    beaten = _group_wins(w, n_groups, group).any(axis=0)
+    tops = np.flatnonzero(~beaten)
+    if len(tops) > 1:
+        groups = [np.flatnonzero(group == g).tolist() for g in tops]
+        raise ValueError(
+            f"the groups of systems {groups} each won every vote against the systems outside it, and no vote "
+            "decided between them: their relative strengths are not identified"
+        )
+    top = np.flatnonzero(group == tops[0])
+    p = np.zeros(len(w))
+    p[top] = _mm(w[np.ix_(top, top)], max_iter, tol) if len(top) > 1 else 1.0
+    return p
+
+
+def bradley_terry_order(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-12) -> np.ndarray:
+    """The order of the systems by their maximum-likelihood Bradley–Terry strengths, also for separated votes.
+
+    Without separation (see :func:`bradley_terry`) this is :func:`bradley_terry` itself. With it, the
+    strongly connected groups of the wins are ranked by who beat whom (a group above every group it beat) and
+    the systems inside a group by a fit to that group's own votes: the order of the strengths in the limit that
+    maximises the likelihood, which :func:`bradley_terry` collapses to 0 below the strongest group.
+
+    Parameters
+    ----------
+    wins : (K, K) float or int
+        As :func:`bradley_terry` reads them.
+    max_iter, tol : int, float
+        Of the fits (:func:`bradley_terry`).
+
+    Returns
+    -------
+    (K,) float
+        Without separation the strengths; with it the ranks ``0`` (weakest), ``1``, ... (equal strengths share
+        a rank). Only the order is meaningful (e.g. for :func:`kendall_tau`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`bradley_terry`, and for separated votes whose groups have no single order (two groups that
+        no vote decided between, as when both beat a third in every vote and never met).
+
+    Examples
+    --------
+    System 0 won every vote; 1 and 2 split theirs 3 to 1: 0 first, then 1, then 2.
+
+    >>> bradley_terry_order(np.array([[0, 2, 2], [0, 0, 3], [0, 1, 0]])).tolist()
+    [2.0, 1.0, 0.0]
+    """
+    order = _limit_order(_linked_wins(wins), max_iter, tol)
+    if order is None:
+        raise ValueError(
+            "the votes are separated into groups of systems that no vote orders against each other: their order "
+            "is not identified"
+        )
+    return order
+
+
+def _mm(w: np.ndarray, max_iter: int, tol: float) -> np.ndarray:
+    """:func:`bradley_terry_step` from equal strengths until no strength changes by ``tol`` (or ``max_iter``)."""
+    p = np.full(len(w), 1.0 / len(w))
+    for _ in range(max_iter):
+        new = bradley_terry_step(p, w)
+        if np.abs(new - p).max() < tol:
+            return new
+        p = new
+    return p
+
+
+def _linked_wins(wins: np.ndarray) -> np.ndarray:
+    """:func:`_check_wins`, then ``ValueError`` when the comparisons fall into groups never compared."""
     from scipy.sparse.csgraph import connected_components
 
     w = _check_wins(wins)
@@ -131,13 +222,46 @@ def bradley_terry(wins: np.ndarray, *, max_iter: int = 10_000, tol: float = 1e-1
             f"the comparisons fall into {n_parts} groups of systems never compared with each other: {groups}; "
             "their relative strengths are not identified"
         )
-    p = np.full(len(w), 1.0 / len(w))
-    for _ in range(max_iter):
-        new = bradley_terry_step(p, w)
-        if np.abs(new - p).max() < tol:
-            return new
-        p = new
-    return p
+    return w
+
+
+def _win_groups(w: np.ndarray) -> tuple[int, np.ndarray]:
+    """The strongly connected groups of the win graph (``i -> j`` when ``i`` beat ``j``): count, (K,) labels."""
+    from scipy.sparse.csgraph import connected_components
+
+    return connected_components(w > 0, directed=True, connection="strong")
+
+
+def _group_wins(w: np.ndarray, n_groups: int, group: np.ndarray) -> np.ndarray:
+    """``(G, G)`` bool: a system of group ``a`` beat one of group ``b != a`` (the groups' condensed graph)."""
+    beat = np.zeros((n_groups, n_groups), dtype=bool)
+    i, j = np.nonzero(w > 0)
+    beat[group[i], group[j]] = True
+    np.fill_diagonal(beat, False)
+    return beat
+
+
+def _limit_order(w: np.ndarray, max_iter: int, tol: float) -> np.ndarray | None:
+    """:func:`bradley_terry_order` of checked, linked wins; None when separated groups have no single order."""
+    n_groups, group = _win_groups(w)
+    if n_groups == 1:
+        return _mm(w, max_iter, tol)
+    beat = _group_wins(w, n_groups, group)
+    left, tiers = list(range(n_groups)), []
+    while left:  # the groups' order (a unique topological order of the condensed graph, strongest first)
+        free = [a for a in left if not beat[left, a].any()]
+        if len(free) != 1:
+            return None
+        tiers.append(free[0])
+        left.remove(free[0])
+    keys: list[tuple[int, float]] = [(0, 0.0)] * len(w)
+    for tier, g in enumerate(tiers):
+        members = np.flatnonzero(group == g)
+        p = _mm(w[np.ix_(members, members)], max_iter, tol) if len(members) > 1 else np.ones(1)
+        for m, pm in zip(members, p, strict=True):
+            keys[m] = (-tier, float(pm))
+    rank = {key: float(r) for r, key in enumerate(sorted(set(keys)))}
+    return np.array([rank[key] for key in keys])
 
 
 def simulate_votes(strengths: Sequence[float], votes_per_pair: int, *, seed: int = 0) -> np.ndarray:
@@ -276,7 +400,9 @@ def vote_agreement(
     The interval answers "how much would τ move if the same raters voted again?": each resample redraws every
     pair's votes, ``wins*[i, j] ~ Binomial(n_ij, wins[i, j] / n_ij)`` (the pair's own count ``n_ij`` kept), refits
     :func:`bradley_terry` and recomputes τ. It does not cover other systems, other test takes or other raters'
-    tastes.
+    tastes. τ is taken against :func:`bradley_terry_order` (the strengths themselves unless a group of systems won
+    every vote against the rest, which few votes per pair and their resamples often do); a resample whose
+    separated groups have no single order has no τ and is left out.
 
     Parameters
     ----------
@@ -292,7 +418,8 @@ def vote_agreement(
     Returns
     -------
     TauResult
-        ``tau`` and ``p_value`` of ``kendall_tau(scores, bradley_terry(wins))``, the interval over vote resamples.
+        ``tau`` and ``p_value`` of ``kendall_tau(scores, bradley_terry_order(wins))``, the interval over vote
+        resamples.
 
     Examples
     --------
@@ -304,7 +431,7 @@ def vote_agreement(
     s = np.asarray(scores, dtype=np.float64)
     if s.shape != (len(w),):
         raise ValueError(f"scores must have one value per system ({len(w)}), got shape {s.shape}")
-    base = kendall_tau(s, bradley_terry(w))
+    base = kendall_tau(s, bradley_terry_order(w))
     if n_boot <= 0:
         return base
     rng = np.random.default_rng(seed)
@@ -316,7 +443,8 @@ def vote_agreement(
         redrawn = np.zeros_like(w)
         redrawn[i, j] = rng.binomial(n[i, j].astype(np.int64), share)
         redrawn[j, i] = n[i, j] - redrawn[i, j]
-        draws.append(kendall_tau(s, bradley_terry(redrawn)).tau)
+        order = _limit_order(redrawn, 10_000, 1e-12)  # None: separated groups in no single order
+        draws.append(np.nan if order is None else kendall_tau(s, order).tau)
     q = 50 * (1 - level)
     low, high = (float(v) for v in np.nanpercentile(draws, [q, 100 - q]))
     return dataclasses.replace(base, low=low, high=high, level=level, method="votes")

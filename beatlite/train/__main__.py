@@ -222,6 +222,7 @@ def _fit_command(args: argparse.Namespace) -> int:
     (or resuming from them) while it trains.
     """
 
+    from beatlite.train.distributed import process_group
     from beatlite.train.training import check_batch_split, check_compilable  # (imports torch)
 
     options = {
@@ -261,7 +262,10 @@ def _fit_command(args: argparse.Namespace) -> int:
                     f"another fit is training {args.recipe} into {out} (it holds {lock}); "
                     "wait for it to end, or give another --out"
                 )
-        return _fit_locked(args, options, data_dir, out, rank)
+        # under torchrun: the process group the training initialises is destroyed when this block ends (also by
+        # an exception), not left to an exit handler that handlers registered later run before
+        with process_group():
+            return _fit_locked(args, options, data_dir, out, rank)
 
 
 def _fit_locked(

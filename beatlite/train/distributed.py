@@ -26,6 +26,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
+from collections.abc import Iterator
 from typing import Any
 
 import torch
@@ -37,10 +38,13 @@ def distributed_rank() -> tuple[int, int]:
 
     Under ``torchrun`` (``WORLD_SIZE`` >= 2) the default process group is initialised here, with the
     ``nccl`` backend for CUDA tensors when CUDA is available (each process on GPU ``LOCAL_RANK``) and
-    ``gloo`` for CPU tensors. A group initialised here is destroyed at interpreter exit (``atexit``),
-    while Python is still whole: a process that exits with the group alive can abort in gloo's worker
+    ``gloo`` for CPU tensors. A process that exits with the group alive can abort in gloo's worker
     threads during interpreter shutdown (SIGABRT, "terminate called without an active exception"), as
-    it once did in this project's CI.
+    it once did in this project's CI: the program's top level owns the group in a :func:`process_group`
+    block (the ``fit`` command does), which destroys it when the block ends, also by an exception, whatever
+    exit handlers run later. A group initialised outside such a block (a script calling
+    :func:`beatlite.train.fit` or :func:`beatlite.train.recipes.retrain` itself) is destroyed at interpreter
+    exit (``atexit``), while Python is still whole.
     """
     import torch.distributed as dist
 
@@ -58,8 +62,34 @@ def distributed_rank() -> tuple[int, int]:
 def _destroy_process_group() -> None:
     import torch.distributed as dist
 
-    if dist.is_initialized():
+    if dist.is_available() and dist.is_initialized():
         dist.destroy_process_group()
+
+
+@contextlib.contextmanager
+def process_group() -> Iterator[None]:
+    """A block that owns the default process group :func:`distributed_rank` initialises inside it: the group is
+    destroyed when the block ends (normally or by an exception), before the process goes on or exits.
+
+    Nothing is initialised on entry (the ``fit`` command prepares its data before any group exists), and a group
+    that existed before the block is left alone (its owner destroys it). Without ``torchrun`` a no-op. Put it
+    around all of a process's training (a script's whole work): under ``torchrun`` a process cannot initialise a
+    group again after destroying one (the second connects to the first's stale addresses in torchrun's store).
+
+    Examples
+    --------
+    >>> with process_group():  # one process: no group, nothing to destroy
+    ...     distributed_rank()
+    (0, 1)
+    """
+    import torch.distributed as dist
+
+    existed = dist.is_available() and dist.is_initialized()
+    try:
+        yield
+    finally:
+        if not existed:
+            _destroy_process_group()
 
 
 def local_device(device: torch.device) -> torch.device:

@@ -270,7 +270,9 @@ def register_recipe(name: str, recipe: Recipe) -> None:
     ValueError
         The recipe's model is not registered; ``name`` is taken by another recipe; its ``label`` is another
         recipe's or a ground-truth row's (labels key the results tables and the seed record); an override that
-        is not a field of the model's config; a training setting ``TrainConfig`` refuses.
+        is not a field of the model's config; a training setting ``TrainConfig`` refuses; ``epochs=0`` for a
+        model with trainable parameters (only untrained baselines have 0 epochs: :func:`retrain` and the ``fit``
+        command refuse ``epochs < 1`` for a recipe with ``epochs > 0``, and would train nothing for this one).
     """
     from beatlite.models.base import config_from_preset
 
@@ -286,12 +288,17 @@ def register_recipe(name: str, recipe: Recipe) -> None:
         )
     try:
         cls = model_class(recipe.model)
-        config_from_preset(cls.config_class, presets(recipe.model), "tiny", **dict(recipe.overrides))
+        config = config_from_preset(cls.config_class, presets(recipe.model), "tiny", **dict(recipe.overrides))
         TrainConfig(
             epochs=recipe.epochs, batch_size=recipe.batch_size, lr=recipe.lr, lr_schedule=recipe.lr_schedule
         )
     except (TypeError, ValueError) as error:
         raise ValueError(f"register_recipe: {name!r}: {error}") from error
+    if recipe.epochs < 1 and cls(config).trainable:  # (0 epochs: an untrained baseline's recipe)
+        raise ValueError(
+            f"register_recipe: {name!r}: epochs=0 for {recipe.model!r}, a model with trainable parameters: it would "
+            "export untrained weights; give epochs >= 1 (0 is for models without any, as mean_pose and random_clip)"
+        )
     RECIPES[name] = recipe
 
 

@@ -64,7 +64,7 @@ class FitResult:
         ``[{"step": global step, "val": {...}, "val_score": score}, ...]`` (possibly none); ``"val"`` and
         ``"val_score"`` are then the last of them (``{}`` and absent when the epoch had none).
     checkpoint : Path or None
-        The checkpoint written after the last epoch.
+        The checkpoint written after the last epoch (with ``epochs=0``, of the initial weights).
     fingerprint : str
         :func:`data_fingerprint` of the training windows.
     best_epoch : int or None
@@ -327,10 +327,12 @@ def fit(
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
+    resumed = False
     if config.resume:
         wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
         if run.path is not None and run.path.is_file():
             run.resume(data)
+            resumed = True
     run.wrap()
     if run.g_opt is None:  # untrained baseline: nothing to optimise
         run.save(config.epochs)
@@ -347,6 +349,8 @@ def fit(
         run.history.append(entry)
         bar.set_postfix(_shown_losses(entry))
         run.save(epoch + 1)
+    if config.epochs == 0 and not resumed:  # no epoch: the initial weights' checkpoint (as a baseline's)
+        run.save(0)
     return run.result()
 
 
