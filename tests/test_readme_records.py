@@ -249,6 +249,15 @@ def test_the_readme_batch_scaling_sentences_are_the_record():
         f"{seeds['mean']:.2f} ± {seeds['sd']:.2f}",
     ):
         assert sentence in text, sentence
+    b32 = {r["seed"]: r["FGD"] for r in rows if (r["batch"], r["rule"]) == (32, "linear")}
+    table = dict(
+        zip(json.loads((ROOT / "checkpoints" / "results_seeds.json").read_text())["seeds"], seeds["values"])
+    )
+    sentence = (
+        f"FGD {b32[2022]:.3f} for seed 2022 and {b32[2021]:.3f} for 2021 (the batch-32 rows' values), where the "
+        f"table has {table[2022]:.3f} and {table[2021]:.3f}."
+    )  # the seed table's command retrained seeds 2022 and 2021 to these values (README)
+    assert sentence in text, sentence
     from beatlite.train.recipes import training_data  # (the data_samples store the recipes train on)
 
     train = len(training_data(progress=False).train)

@@ -832,3 +832,57 @@ def test_checkpoints_name_no_folder_of_the_machine_that_wrote_them(tmp_path, mon
     for path in [*written, home / "shared.pt"]:
         raw = path.read_bytes()
         assert str(tmp_path).encode() not in raw and b"alice" not in raw, path
+
+
+FIRST_STEPS = {
+    "s2g_tiny": (351.54962158203125, 363.60009765625, 329.1720275878906),
+    "trimodal_tiny": (309.51220703125, 333.9689025878906, 313.64263916015625),
+    "seq2seq_tiny": (221.4296875, 253.5569610595703, 221.08889770507812),
+    "a2g_tiny": (2.1895740032196045, 2.3496880531311035, 2.2336037158966064),
+    "joint_embedding_tiny": (0.6799216866493225, 0.7162935733795166, 0.6759359836578369),
+    "camn_tiny": (406.6547546386719, 421.4700012207031, 404.4474182128906),
+    "ha2g_tiny": (212.46322631835938, 181.69532775878906, 179.2856903076172),
+    "diffgesture_tiny": (0.8908261656761169, 0.672417402267456, 0.6887287497520447),
+}
+"""The total loss of the first three optimiser steps of each model's first recipe (seed 2021, one batch of the
+recipe's size per step, ``data_samples/``), recorded on 2026-11-27 (torch 2.13.0+cpu, one thread). 441ba3b, the
+code of the seed table's CaMN, HA2G, S2G, Trimodal and Seq2Seq rows, gives the same five rows to the bit; A2G's
+recorded seed rows are older than these numbers (README, "Larger batches")."""
+
+
+@pytest.mark.slow
+def test_the_first_training_steps_are_the_recorded_ones():
+    """A change to what a recipe trains (its data, initialisation, random draws, losses, optimiser, frozen
+    parameters) moves these numbers, and then the seed table's rows of that model (checkpoints/results_seeds.json,
+    the shipped checkpoint) no longer describe the code: retrain them (`make seeds ONLY=NAME`) and record the new
+    values here, or say in the commit why the rows stand. Kernels and thread counts move them by at most 9.1e-7
+    (measured here: BEATLITE_THREADS=2, ONEDNN_MAX_CPU_ISA=AVX2 or SSE41, ATEN_CPU_CAPABILITY=avx2 or default); A2G's
+    frozen log-variance heads moved its second step by 2.3e-4: rtol 2e-5 holds on any machine and sees such a change."""
+    pytest.importorskip("torch")
+    from beatlite.train.config import TrainConfig
+    from beatlite.train.recipes import build_recipe_model, training_data
+    from beatlite.train.training import fit
+
+    data = training_data()
+    firsts = {}
+    for name, recipe in RECIPES.items():
+        if recipe.epochs > 0:
+            firsts.setdefault(recipe.model, name)
+    assert sorted(firsts.values()) == sorted(FIRST_STEPS), "a new model: record its first steps here"
+    moved = {}
+    for name in firsts.values():
+        recipe = RECIPES[name]
+        config = TrainConfig(
+            epochs=3,
+            batch_size=recipe.batch_size,
+            lr=recipe.lr,
+            lr_schedule=recipe.lr_schedule,
+            seed=2021,
+            windows_per_epoch=recipe.batch_size,
+            progress=False,
+        )
+        model = build_recipe_model(name, data, seed=2021)
+        got = [epoch["train"]["total"] for epoch in fit(model, data.train, config, meta=data.meta).history]
+        if not np.allclose(got, FIRST_STEPS[name], rtol=2e-5, atol=0):
+            moved[name] = got
+    assert not moved, f"training numbers changed (recorded: FIRST_STEPS): {moved}"
