@@ -539,7 +539,9 @@ def test_keyframes_of_many_systems_fit_a_slide_in_columns():
     assert times == ["t = 0.0 s", "t = 0.1 s", "t = 0.3 s", "t = 0.3 s", "t = 0.5 s", "t = 0.6 s"]
     spans = {tuple(np.round([np.diff(ax.get_xlim())[0], np.diff(ax.get_zlim())[0]], 6)) for ax in fig.axes}
     assert len(spans) == 1  # one scale, as in rows
-    assert check.check_figure(fig) == []
+    assert check.check_figure(fig) == [] == check.check_figure(fig, dpi=100, fit=check.SLIDE_FIGURE_BOX)
+    small = check.check_figure(rows, dpi=100, fit=check.SLIDE_FIGURE_BOX)  # on a slide, at ~40 % of its size
+    assert small and all("shown at" in str(p) for p in small)
     with pytest.raises(ValueError, match="systems_in"):
         plot3d.plot_keyframes(systems, tiny_skeleton(), [0], 15, systems_in="diagonal")
     plt.close("all")
