@@ -547,6 +547,35 @@ def test_keyframes_of_many_systems_fit_a_slide_in_columns():
     plt.close("all")
 
 
+def test_annotation_legend_lists_only_the_gesture_types_it_draws():
+    """A segment's bar is its score high: '00_nogesture' (score 0) drew nothing, yet had a legend swatch of its own
+    (notebook 01's timeline), a colour to look for that is nowhere in the figure."""
+    from beatlite.io.emotion import EmotionSegment
+    from beatlite.io.semantic import SemanticSegment
+    from beatlite.viz import figures
+
+    semantic = [
+        SemanticSegment("00_nogesture", 0.0, 0.7, 0.7, 0.0, ""),
+        SemanticSegment("02_deictic_l", 0.7, 2.3, 1.6, 0.3, "my"),
+        SemanticSegment("00_nogesture", 2.3, 2.5, 0.2, 0.0, ""),
+        SemanticSegment("01_beat_align", 2.5, 4.0, 1.5, 0.1, ""),
+    ]
+    frames = np.repeat([0.0, 0.3, 0.0, 0.1], 15)
+    fig = figures.plot_annotations([EmotionSegment("neutral", 0.0, 4.0, 4.0, 0)], semantic, frames, 15, 4.0)
+    legend = fig.axes[1].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == ["01_beat_align", "02_deictic_l"]
+    bars = {
+        (round(p.get_x(), 3), tuple(p.get_facecolor())) for p in fig.axes[1].patches if p.get_height() > 0
+    }
+    assert {c for _, c in bars} == {
+        tuple(h.get_facecolor()) for h in legend.legend_handles
+    }  # each swatch drawn
+    assert check.check_figure(fig) == []
+    silent = figures.plot_annotations([], semantic[:1], np.zeros(15), 15, 1.0)  # nothing scores: as before
+    assert [t.get_text() for t in silent.axes[1].get_legend().get_texts()] == ["00_nogesture"]
+    plt.close("all")
+
+
 def _slide_animation(**kwargs):
     sr = 1000
     audio = np.sin(2 * np.pi * 5 * np.arange(2 * sr) / sr)
