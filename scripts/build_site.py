@@ -505,9 +505,6 @@ def _continuation(cell, **changes):
 
     new = copy.deepcopy(cell)
     new.metadata["slideshow"] = {"slide_type": "subslide"}
-    if "id" in new:
-        _continuation.count = getattr(_continuation, "count", 0) + 1
-        new["id"] = f"{cell['id']}-{_continuation.count}"[:64]
     for key, value in changes.items():
         new[key] = value
     return new
@@ -621,6 +618,16 @@ def fit_slides(nb, budget: float = _SLIDE_BUDGET) -> int:
     """
     before = sum(_kind(c) in ("slide", "subslide") for c in nb.cells)
     cells = [part for cell in nb.cells for part in _split_cell(cell, budget)]
+    ids = {c["id"] for c in nb.cells if "id" in c}
+    for i, cell in enumerate(
+        cells
+    ):  # the parts of a split cell: its id and their number (unique, as nbformat asks)
+        if "id" in cell and i and cell["id"] == cells[i - 1].get("id", "").split("-part")[0]:
+            n = 1
+            while f"{cell['id']}-part{n}" in ids:
+                n += 1
+            cell["id"] = f"{cell['id']}-part{n}"
+            ids.add(cell["id"])
     filled = 0.0
     for cell in cells:
         height = cell_height(cell)

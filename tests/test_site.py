@@ -457,6 +457,10 @@ def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
     assert len(tables) > 1 and all(t.startswith("| take | FGD | BC |\n|---|---|---|\n") for t in tables)
     assert rows == original.cells[2].outputs[1].data["text/markdown"].splitlines()[2:]
     assert [o for o in outputs if "image/png" in o.get("data", {})] == [original.cells[2].outputs[2]]
+    ids = [c.id for c in nb.cells]
+    assert (
+        len(set(ids)) == len(ids) and ids[2] == f"{original.cells[1].id}-part1"
+    )  # nbformat's unique cell ids
     assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
 
 
