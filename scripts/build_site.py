@@ -9,7 +9,8 @@ Writes:
   MathML, no web script or font);
 - ``slides/NN_name.html``: the same notebook as reveal.js slides. Cells carry Jupyter's slide convention
   (``metadata.slideshow.slide_type``: ``slide``, ``subslide``, ``fragment``, ``skip``, ``notes`` or ``-``), so
-  JupyterLab's RISE presents the same notebooks. reveal.js (MIT) comes from the ``sphinx-revealjs`` package (the
+  JupyterLab's RISE presents the same notebooks; a slide taller than the 1280 x 800 frame continues on slides
+  below it (:func:`fit_slides`). reveal.js (MIT) comes from the ``sphinx-revealjs`` package (the
   ``site`` extra) and is copied into ``assets/reveal/``;
 - ``student/NN_name.ipynb`` (the copies without ``solution`` cells), ``guide.html`` (``docs/teaching.md``) and
   ``figures/`` with ``figures.html``.
@@ -311,23 +312,338 @@ _SLIDES_TEMPLATE = """{%- extends 'index.html.j2' -%}
 <script src="{{ resources.reveal.url_prefix }}/plugin/notes/notes.js"></script>
 <script>
 Reveal.initialize({controls: true, progress: true, hash: true, center: false, transition: "none",
-                   slideNumber: "c/t", width: 1280, height: 800, margin: 0.04, plugins: [RevealNotes]});
+                   slideNumber: "c/t", width: SLIDE_WIDTH, height: SLIDE_HEIGHT, margin: 0.04, plugins: [RevealNotes]});
 </script>
 {%- endblock footer_js -%}
 """
 
-# Slides scroll when a cell is taller than the screen; figures fit its height.
+#: The slides' frame, CSS pixels (reveal.js scales it to the screen): what a slide shows without scrolling.
+SLIDE_WIDTH, SLIDE_HEIGHT = 1280, 800
+_SLIDES_TEMPLATE = _SLIDES_TEMPLATE.replace("SLIDE_WIDTH", f"{SLIDE_WIDTH}").replace(
+    "SLIDE_HEIGHT", f"{SLIDE_HEIGHT}"
+)
+
+# A slide is at most the frame's height (fit_slides splits taller ones; should an estimate fall short, the slide
+# scrolls rather than cut its end); figures at most _IMAGE_MAX_HEIGHT; code in Markdown as large as code cells.
 _SLIDES_CSS = """
 .reveal .slides > section, .reveal .slides > section > section { height: 100%; overflow-y: auto; }
 .reveal .jp-OutputArea-output img { max-height: 600px; width: auto; }
 .reveal .jp-RenderedHTMLCommon table { font-size: 16px; }
 .reveal .jp-InputArea-editor pre, .reveal .jp-OutputArea-output pre { white-space: pre-wrap; font-size: 16px; }
+.reveal .jp-RenderedMarkdown pre { font-size: 16px; line-height: 1.3; }
 .reveal .slide-number { left: 8px; right: auto; }
 """
 
+# fit_slides: heights of rendered cells on a slide, CSS pixels, measured in Chromium on the 1280 x 800 frame with
+# the styles above (paragraphs 20 px text on 26 px lines, list items 32 px lines, code and printed text 16 px
+# monospace on 23 px lines, tables 16 px), and the characters per line of each, a little under what fits.
+# What the cells of one slide may fill: the frame less a margin for the estimate's error.
+_SLIDE_BUDGET = SLIDE_HEIGHT - 60
+_IMAGE_MAX_HEIGHT = 600  # the CSS max-height of a figure above
+_OUTPUT_WIDTH = 1089  # an output's width (the frame less the prompt column)
+_CELL = 12  # a cell's own padding
+_TEXT_LINE, _TEXT_CHARS, _PARAGRAPH = 27, 85, 20
+_ITEM_LINE, _ITEM_CHARS, _LIST = 32, 72, 24
+_TABLE_ROW, _TABLE_LINE, _TABLE_CHARS, _TABLE = 28, 19, 100, 20
+_HEADINGS = {1: (60, 50, 40), 2: (39, 40, 55), 3: (32, 36, 65), 4: (27, 30, 80)}  # line, margins, characters
+_MATH = 70  # a display formula with its margins
+_CODE_LINE, _CODE_CHARS, _CODE = 23, 95, 23  # code cells and fenced code
+_PRINTED_CHARS, _OUTPUT, _FIGURE, _PLAYER, _AUDIO = 85, 16, 56, 180, 80
+_FENCED = re.compile(r"^ {0,3}(```|~~~)")
+_LIST_ITEM = re.compile(r"^\s*(?:[-*+]|\d+\.)\s+")
+
+
+def _lines(text: str, chars: int) -> int:
+    """Screen lines of ``text`` wrapped at word boundaries ``chars`` characters wide (at least 1)."""
+    import textwrap
+
+    return max(1, len(textwrap.wrap(text, chars, break_long_words=False)))
+
+
+def _plain(text: str) -> str:
+    """Markdown as it reads: a formula about a third as wide as its TeX, links as their text, no ** or `."""
+    text = re.sub(r"\$([^$]+)\$", lambda m: "x" * max(1, len(m[1]) // 3), text)
+    return re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", text).replace("**", "").replace("`", "")
+
+
+def _markdown_blocks(source: str) -> list[tuple[str, list[str]]]:
+    """The blocks of a Markdown text, in order: ``("heading", [line])``, ``("fence", lines)`` (with its fence
+    lines), ``("math", lines)``, ``("table", lines)``, ``("list", lines)`` or ``("text", lines)``."""
+    blocks: list[tuple[str, list[str]]] = []
+    lines, fenced = [], False
+    for line in [*source.splitlines(), ""]:
+        if fenced or _FENCED.match(line):
+            lines.append(line)
+            if _FENCED.match(line) and (fenced or len(lines) == 1):
+                fenced = not fenced
+                if not fenced:
+                    blocks.append(("fence", lines))
+                    lines = []
+            elif _FENCED.match(line):  # a fence opening after text
+                blocks.append(("text", lines[:-1]))
+                lines, fenced = [line], True
+            continue
+        if lines and _LIST_ITEM.match(line) and not _LIST_ITEM.match(lines[0]):  # a list right below a line
+            blocks.append(("table" if lines[0].strip().startswith("|") else "text", lines))
+            lines = []
+        if line.strip() and not re.match(r"#{1,6} ", line):
+            lines.append(line)
+            continue
+        if lines:
+            first = lines[0].strip()
+            kind = "table" if first.startswith("|") else "math" if first.startswith("$$") else "list"
+            blocks.append((kind if kind != "list" or _LIST_ITEM.match(lines[0]) else "text", lines))
+            lines = []
+        if line.strip():
+            blocks.append(("heading", [line]))
+    return blocks
+
+
+def markdown_height(source: str) -> float:
+    """Estimated height, CSS pixels, of a Markdown cell's text on a slide."""
+    height = 0.0
+    for kind, lines in _markdown_blocks(source):
+        if kind == "heading":
+            level = min(len(lines[0].split()[0]), 4)
+            line, margins, chars = _HEADINGS[level]
+            height += line * _lines(lines[0], chars) + margins
+        elif kind == "fence":
+            height += _CODE_LINE * sum(_lines(x, _CODE_CHARS) for x in lines[1:-1]) + _CODE + _PARAGRAPH
+        elif kind == "math":
+            height += _MATH * max(1, sum(x.count("$$") for x in lines) // 2) + _TEXT_LINE * sum(
+                x.count("\\\\") for x in lines
+            )
+        elif kind == "table":
+            rows = [x for x in lines if not re.fullmatch(r"\s*\|[\s:|-]+\|\s*", x)]
+            height += _TABLE + sum(
+                _TABLE_ROW + _TABLE_LINE * (_lines(_plain("      ".join(r.split("|"))), _TABLE_CHARS) - 1)
+                for r in rows
+            )
+        elif kind == "list":
+            items: list[str] = []
+            for x in lines:
+                if _LIST_ITEM.match(x):
+                    items.append(_LIST_ITEM.sub("", x))
+                else:
+                    items[-1] += " " + x.strip()
+            height += _LIST + _ITEM_LINE * sum(_lines(_plain(x), _ITEM_CHARS) for x in items)
+        else:
+            height += _PARAGRAPH + _TEXT_LINE * _lines(
+                _plain(" ".join(x.strip() for x in lines)), _TEXT_CHARS
+            )
+    return height
+
+
+def _image_size(data: str) -> tuple[int, int] | None:
+    """(width, height) in pixels of a base64 PNG or JPEG, None if unreadable."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    try:
+        with Image.open(io.BytesIO(base64.b64decode(data))) as image:
+            return image.size
+    except (OSError, ValueError):
+        return None
+
+
+def _shown_image_height(size: tuple[int, int] | None, limit: float = _IMAGE_MAX_HEIGHT) -> float:
+    """Height of an image as the slide shows it: at most the output's width and ``limit`` high."""
+    if size is None:
+        return limit
+    width, height = size
+    return min(height * min(1.0, _OUTPUT_WIDTH / max(width, 1)), limit)
+
+
+def output_height(output) -> float:
+    """Estimated height, CSS pixels, of one output of a code cell on a slide."""
+    kind = output.get("output_type")
+    if kind == "stream":
+        text = output.get("text", "")
+    elif kind == "error":
+        text = "\n".join(output.get("traceback", []))
+    else:
+        data = output.get("data", {})
+        if "image/png" in data or "image/jpeg" in data:
+            return _FIGURE + _shown_image_height(_image_size(data.get("image/png") or data["image/jpeg"]))
+        if "text/html" in data:
+            page = "".join(data["text/html"])
+            if "<audio" in page and "<img" not in page:
+                return _AUDIO
+            frame = re.search(r"data:image/(?:png|jpeg);base64,([A-Za-z0-9+/=]+)", page)
+            if frame:  # an animation player: its first frame, then its buttons and slider
+                return _PLAYER + _shown_image_height(_image_size(frame[1]))
+            return _OUTPUT + markdown_height(re.sub(r"<[^>]+>", " ", page))
+        if "text/markdown" in data:
+            return _OUTPUT + markdown_height("".join(data["text/markdown"]))
+        text = "".join(data.get("text/plain", ""))
+    text = re.sub(r"\x1b\[[0-9;]*m", "", "".join(text))
+    return _OUTPUT + _CODE_LINE * sum(_lines(x, _PRINTED_CHARS) for x in text.rstrip("\n").split("\n"))
+
+
+def cell_height(cell) -> float:
+    """Estimated height, CSS pixels, of a cell on a slide (0 for a cell the slides leave out)."""
+    if cell.metadata.get("slideshow", {}).get("slide_type") in ("skip", "notes"):
+        return 0.0
+    if cell.cell_type == "markdown":
+        return _CELL + markdown_height(cell.source)
+    if cell.cell_type != "code":
+        return _CELL + _CODE_LINE * len(cell.source.splitlines())
+    shown = not cell.metadata.get("transient", {}).get("remove_source", False)
+    code = _CODE + _CODE_LINE * sum(_lines(x, _CODE_CHARS) for x in cell.source.splitlines()) if shown else 0
+    return _CELL + code + sum(output_height(o) for o in cell.get("outputs", []))
+
+
+def _kind(cell) -> str:
+    return cell.metadata.get("slideshow", {}).get("slide_type", "-")
+
+
+def _continuation(cell, **changes):
+    """A copy of ``cell`` on a new subslide below (a skipped cell stays skipped), with ``changes`` applied."""
+    import copy
+
+    new = copy.deepcopy(cell)
+    new.metadata["slideshow"] = {"slide_type": "subslide"}
+    for key, value in changes.items():
+        new[key] = value
+    return new
+
+
+def split_markdown(text: str, budget: float) -> list[str]:
+    """``text`` in parts each at most ``budget`` high (:func:`markdown_height`) where it can: between blocks
+    (paragraphs, lists, tables, formulas, fenced code), a long list between items and a long table between rows,
+    its header row above each part. Any other block taller than ``budget`` stays whole."""
+    pieces: list[str] = []
+    for kind, lines in _markdown_blocks(text):
+        if kind not in ("table", "list") or markdown_height("\n".join(lines)) <= budget:
+            pieces.append("\n".join(lines))
+            continue
+        head, rows = (lines[:2], lines[2:]) if kind == "table" else ([], [])
+        for line in lines if kind == "list" else []:  # an item with its continuation lines
+            if _LIST_ITEM.match(line) or not rows:
+                rows.append(line)
+            else:
+                rows[-1] += "\n" + line
+        part: list[str] = []
+        for row in rows:
+            if part and markdown_height("\n".join([*head, *part, row])) > budget:
+                pieces.append("\n".join([*head, *part]))
+                part = []
+            part.append(row)
+        pieces.append("\n".join([*head, *part]))
+    parts, chunk = [], []
+    for piece in pieces:
+        if chunk and markdown_height("\n\n".join([*chunk, piece])) > budget:
+            parts.append("\n\n".join(chunk))
+            chunk = []
+        chunk.append(piece)
+    return ["\n\n".join(chunk)] if not parts else [*parts, "\n\n".join(chunk)]
+
+
+def _split_output(output, budget: float) -> list:
+    """An output taller than ``budget`` as several: printed text between lines, a Markdown output (a table shown
+    with ``display(Markdown(...))``) by :func:`split_markdown`; any other output as it is."""
+    import copy
+
+    from nbformat import from_dict
+
+    data = output.get("data", {})
+    if output_height(output) <= budget or (
+        "text/markdown" not in data and output.get("output_type") != "stream"
+    ):
+        return [output]
+    parts = []
+    if output.get("output_type") == "stream":
+        lines: list[str] = []
+        for line in "".join(output.get("text", "")).splitlines(keepends=True):
+            if lines and output_height({"output_type": "stream", "text": "".join([*lines, line])}) > budget:
+                parts.append(from_dict({**copy.deepcopy(output), "text": "".join(lines)}))
+                lines = []
+            lines.append(line)
+        return [*parts, from_dict({**copy.deepcopy(output), "text": "".join(lines)})]
+    for text in split_markdown("".join(data["text/markdown"]), budget - _OUTPUT):
+        part = copy.deepcopy(output)
+        part["data"] = {"text/markdown": text}
+        parts.append(part)
+    return parts
+
+
+def _split_cell(cell, budget: float) -> list:
+    """``cell`` as cells each at most ``budget`` high where it can: a Markdown cell at its blocks, a code cell's
+    source at its lines and its outputs one cell below (source hidden), itself split between outputs. A single
+    block, code line or output taller than ``budget`` stays whole."""
+    if cell_height(cell) <= budget or cell.cell_type not in ("markdown", "code"):
+        return [cell]
+    parts: list = []
+    if cell.cell_type == "markdown":
+        texts = split_markdown(cell.source, budget - _CELL)
+        first = _continuation(cell, source=texts[0])
+        first.metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
+        return [first, *(_continuation(cell, source=text) for text in texts[1:])]
+    lines, chunk = cell.source.splitlines(), []
+    for line in lines:
+        if (
+            chunk
+            and _CELL + _CODE + _CODE_LINE * sum(_lines(x, _CODE_CHARS) for x in [*chunk, line]) > budget
+        ):
+            parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
+            chunk = []
+        chunk.append(line)
+    parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
+    parts[0].metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
+    groups: list[list] = []
+    for output in (part for o in cell.get("outputs", []) for part in _split_output(o, budget - _CELL)):
+        if not groups or _CELL + sum(output_height(o) for o in [*groups[-1], output]) > budget:
+            groups.append([])
+        groups[-1].append(output)
+    if len(parts) == 1 and groups and cell_height(_continuation(cell, outputs=groups[0])) <= budget:
+        parts[0]["outputs"] = groups.pop(0)  # the source with its first outputs; the others below
+    for group in groups:
+        parts.append(_continuation(cell, outputs=group))
+        parts[-1].metadata["transient"] = {"remove_source": True}
+    return parts
+
+
+def fit_slides(nb, budget: float = _SLIDE_BUDGET) -> int:
+    """Break every slide taller than the frame into slides below it (subslides); return how many were added.
+
+    A slide is the cells from one ``slide`` or ``subslide`` cell to the next; its height is estimated from the
+    sources and outputs (:func:`cell_height`, the styles of the slides at :data:`SLIDE_WIDTH` x
+    :data:`SLIDE_HEIGHT`). A cell that would end below ``budget`` starts a subslide (it continues the idea
+    below, where the down arrow goes); a cell taller than ``budget`` on its own is split first
+    (:func:`_split_cell`): Markdown between paragraphs, lists, tables or formulas, code between lines, a code
+    cell's outputs onto the slide below its source. Changes ``nb`` in place (the slides' copy: the notebooks
+    keep their tags, so RISE shows them as before).
+    """
+    before = sum(_kind(c) in ("slide", "subslide") for c in nb.cells)
+    cells = [part for cell in nb.cells for part in _split_cell(cell, budget)]
+    ids = {c["id"] for c in nb.cells if "id" in c}
+    for i, cell in enumerate(
+        cells
+    ):  # the parts of a split cell: its id and their number (unique, as nbformat asks)
+        if "id" in cell and i and cell["id"] == cells[i - 1].get("id", "").split("-part")[0]:
+            n = 1
+            while f"{cell['id']}-part{n}" in ids:
+                n += 1
+            cell["id"] = f"{cell['id']}-part{n}"
+            ids.add(cell["id"])
+    filled = 0.0
+    for cell in cells:
+        height = cell_height(cell)
+        if _kind(cell) in ("slide", "subslide"):
+            filled = 0.0
+        elif height and filled and filled + height > budget:
+            cell.metadata["slideshow"] = {"slide_type": "subslide"}
+            filled = 0.0
+        filled += height
+    nb.cells = cells
+    return sum(_kind(c) in ("slide", "subslide") for c in nb.cells) - before
+
 
 def export_slides(nb, url_prefix: str = "../assets/reveal") -> str:
-    """The reveal.js slides of an executed notebook, complete offline (formulas as MathML, reveal.js local)."""
+    """The reveal.js slides of an executed notebook, complete offline (formulas as MathML, reveal.js local); a slide
+    taller than the frame continues on slides below it (:func:`fit_slides`)."""
     from jinja2 import DictLoader, pass_context
     from nbconvert import SlidesExporter
 
@@ -349,9 +665,9 @@ def export_slides(nb, url_prefix: str = "../assets/reveal") -> str:
         reveal_url_prefix=url_prefix,
         reveal_theme="white",  # the copied theme; "simple" (the default) imports web fonts
     )
-    body, _ = exporter.from_notebook_node(
-        runner.offline_notebook(nb), resources={"offline_css": runner._offline_css() + _SLIDES_CSS}
-    )
+    nb = runner.offline_notebook(nb)
+    fit_slides(nb)
+    body, _ = exporter.from_notebook_node(nb, resources={"offline_css": runner._offline_css() + _SLIDES_CSS})
     return body
 
 

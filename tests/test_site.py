@@ -12,6 +12,7 @@ import base64
 import html
 import importlib.util
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -345,6 +346,165 @@ def test_split_headings_starts_a_slide_at_every_section_heading():
         ("## Hidden", "skip", ["solution"]),
     ]
     assert site.split_headings(nb) == 0  # once split, nothing more to do
+
+
+def _png_of(width: int, height: int) -> str:
+    """A white ``width`` x ``height`` RGB PNG, base64 (a figure of that size in pixels)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    rows = b"".join(b"\x00" + b"\xff" * (3 * width) for _ in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    png = (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(rows))
+        + chunk(b"IEND", b"")
+    )
+    return base64.b64encode(png).decode()
+
+
+def _tall_lecture() -> nbformat.NotebookNode:
+    """Slides as the course's tallest: a section with a long text, a long cell that prints a lot, shows a long
+    table and a figure (together several frames high), then a short section that fits."""
+    words = "The quick brown fox jumps over the lazy dog while the speaker gestures on every stressed word. "
+    table = "| take | FGD | BC |\n|---|---|---|\n" + "".join(
+        f"| take_{i} | {i}.5 | 0.{i} |\n" for i in range(60)
+    )
+    code = "\n".join(f"value_{i} = {i}  # one line of a long cell" for i in range(40))
+    cells = [
+        new_markdown_cell(
+            "# 01 · Tall\n\n**Goals**\n- Fit every slide.", metadata={"slideshow": {"slide_type": "slide"}}
+        ),
+        new_markdown_cell(
+            "## 1. A long section\n\n"
+            + "\n\n".join(words * 4 for _ in range(8))
+            + "\n\n- "
+            + "\n- ".join(words for _ in range(12)),
+            metadata={"slideshow": {"slide_type": "slide"}},
+        ),
+        new_code_cell(code, metadata={"slideshow": {"slide_type": "-"}}, execution_count=1),
+        new_markdown_cell("## 2. Short\n\nIt fits.", metadata={"slideshow": {"slide_type": "slide"}}),
+        new_code_cell(
+            "print('SHORT-OUTPUT')", metadata={"slideshow": {"slide_type": "-"}}, execution_count=2
+        ),
+    ]
+    cells[2].outputs = [
+        new_output("stream", name="stdout", text="".join(f"printed line {i}\n" for i in range(50))),
+        new_output("display_data", data={"text/markdown": table, "text/plain": "<Markdown>"}),
+        new_output("display_data", data={"image/png": _png_of(1000, 900), "text/plain": "<Figure>"}),
+    ]
+    cells[4].outputs = [new_output("stream", name="stdout", text="SHORT-OUTPUT\n")]
+    nb = new_notebook(cells=cells)
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    return nb
+
+
+def _slides_of(nb) -> list[list]:
+    """The cells of each slide (a ``slide`` or ``subslide`` cell starts one; skipped cells left out)."""
+    slides: list[list] = []
+    for cell in nb.cells:
+        kind = cell.metadata.get("slideshow", {}).get("slide_type", "-")
+        if kind in ("slide", "subslide") or not slides:
+            slides.append([])
+        if kind not in ("skip", "notes"):
+            slides[-1].append(cell)
+    return slides
+
+
+def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
+    """A slide taller than the frame scrolled (119 of the 237 slides of the course decks did): its text, code,
+    printed lines, tables and figures are shared out over slides below it, each within the frame, all in order."""
+    site = _site()
+    nb = _tall_lecture()
+    heights = [sum(map(site.cell_height, s)) for s in _slides_of(nb)]
+    assert (
+        heights[1] > 3 * site.SLIDE_HEIGHT and heights[0] < site.SLIDE_HEIGHT
+    )  # section 1 is several frames
+    original = nbformat.from_dict(nb)
+
+    added = site.fit_slides(nb)
+    slides = _slides_of(nb)
+    assert added == len(slides) - 3 > 3
+    assert [site.cell_height(c) for c in slides[0]] == [
+        site.cell_height(original.cells[0])
+    ]  # it fitted: as it was
+    assert [c.source for c in slides[-1]] == [original.cells[3].source, original.cells[4].source]
+    for cells in slides:
+        assert sum(map(site.cell_height, cells)) <= site._SLIDE_BUDGET < site.SLIDE_HEIGHT, [
+            c.source[:40] for c in cells
+        ]
+    kinds = [site._kind(c) for c in nb.cells]
+    assert kinds.count("slide") == 3  # what continues a section is below it (a subslide), not a new section
+    # nothing lost or repeated: the Markdown, the code, the printed lines, the table rows and the figure
+    middle = [c for s in slides[1:-1] for c in s]
+    text = "\n\n".join(c.source for c in middle if c.cell_type == "markdown")
+    assert text.split() == original.cells[1].source.split()
+    shown = [
+        c
+        for c in middle
+        if c.cell_type == "code" and not c.metadata.get("transient", {}).get("remove_source")
+    ]
+    assert "\n".join(c.source for c in shown) == original.cells[2].source
+    outputs = [o for c in middle if c.cell_type == "code" for o in c.outputs]
+    printed = "".join(o.text for o in outputs if o.output_type == "stream")
+    assert printed == original.cells[2].outputs[0].text
+    tables = [o.data["text/markdown"] for o in outputs if "text/markdown" in o.get("data", {})]
+    rows = [r for t in tables for r in t.splitlines()[2:]]
+    assert len(tables) > 1 and all(t.startswith("| take | FGD | BC |\n|---|---|---|\n") for t in tables)
+    assert rows == original.cells[2].outputs[1].data["text/markdown"].splitlines()[2:]
+    assert [o for o in outputs if "image/png" in o.get("data", {})] == [original.cells[2].outputs[2]]
+    ids = [c.id for c in nb.cells]
+    assert (
+        len(set(ids)) == len(ids) and ids[2] == f"{original.cells[1].id}-part1"
+    )  # nbformat's unique cell ids
+    assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
+
+
+def test_slides_fit_the_frame_in_chromium(tmp_path):
+    """Measured in the browser at the deck's size: no slide of a deck with tall sections scrolls, and reveal.js
+    counts the slides fit_slides made."""
+    _chromium()
+    site = _site()
+    slides = tmp_path / "slides"
+    slides.mkdir()
+    reveal = site.reveal_dir()
+    for rel in site._REVEAL_FILES:
+        src, dst = reveal / rel, tmp_path / "assets" / "reveal" / rel
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
+    nb = _tall_lecture()
+    (slides / "tall.html").write_text(site.export_slides(nb), encoding="utf-8")
+    browser = Browser(tmp_path / "profile")
+    try:
+        browser.page(
+            "Emulation.setDeviceMetricsOverride",
+            width=1280,  # the deck's frame: reveal.js shows it at scale 1
+            height=800,
+            deviceScaleFactor=1,
+            mobile=False,
+        )
+        open_offline(browser, slides / "tall.html")
+        browser.evaluate("new Promise(r => Reveal.isReady() ? r() : Reveal.on('ready', r))")
+        sizes = browser.evaluate(SLIDE_SIZES)
+    finally:
+        browser.close()
+    tall = [s for s in sizes if s["scroll"] > s["client"]]
+    assert not tall, f"slides taller than the 1280 x 800 frame: {tall}"
+    assert {s["client"] for s in sizes} == {800}
+    site.fit_slides(nb)
+    assert len(sizes) == len(_slides_of(nb))
+
+
+# In the browser: each slide shown in turn, its height and the height of what it holds (CSS pixels).
+SLIDE_SIZES = """(async () => { const out = [];
+  for (const s of Reveal.getSlides()) { const i = Reveal.getIndices(s); Reveal.slide(i.h, i.v);
+    await new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+    out.push({h: i.h, v: i.v || 0, client: s.clientHeight, scroll: s.scrollHeight, text: s.innerText.slice(0, 60)}); }
+  return out; })()"""
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)

@@ -12,7 +12,7 @@ import pytest  # noqa: E402
 from PIL import Image  # noqa: E402
 
 from beatlite.skeleton.core import Skeleton  # noqa: E402
-from beatlite.viz import _inputs, animation, face, plot3d, style  # noqa: E402
+from beatlite.viz import _inputs, animation, check, face, plot3d, style  # noqa: E402
 
 ROT = ("Xrotation", "Yrotation", "Zrotation")
 NAMES = [
@@ -507,6 +507,72 @@ def test_keyframes_share_one_scale_and_colour_rows_by_system():
     row_labels = {t.get_text(): t.get_color() for ax in fig.axes for t in ax.texts}
     assert row_labels == {"ground truth": style.SYSTEM_COLOURS[0], "HA2G": style.SYSTEM_COLOURS[2]}
     assert _floor_lines(fig.axes[0]) and not _floor_lines(fig.axes[2])  # floor only under the standing body
+    plt.close("all")
+
+
+def test_keyframes_of_many_systems_fit_a_slide_in_columns():
+    """Eleven systems as rows of six key frames made a figure 1.8 times as tall as wide (notebook 08's every
+    system: 1004 x 1798 px, shown on a 16:10 slide at a third of its size, its labels 5 px high); as columns it is
+    wider than tall, each label above its column and no wider than it."""
+    labels = ["ground truth", "Mean pose", "Joint Embedding-style", "DiffGesture-style", "CaMN", "HA2G"]
+    labels += [f"Baseline {i}-style" for i in range(5)]
+    systems = {label: wave_motion(10) for label in labels}
+    rows = plot3d.plot_keyframes(systems, tiny_skeleton(), [0, 2, 4, 5, 7, 9], 15)
+    assert rows.get_figheight() > 1.5 * rows.get_figwidth()  # what the notebook drew before
+    fig = plot3d.plot_keyframes(
+        systems, tiny_skeleton(), [0, 2, 4, 5, 7, 9], 15, systems_in="columns", panel_size=1.2
+    )
+    width, height = fig.get_size_inches()
+    assert width > 1.6 * height and height * 16 / 10 < width  # fits a 16:10 frame by its width
+    assert len(fig.axes) == 11 * 6
+    tops = fig.axes[::6]  # each system's column, top panel first
+    assert [ax.get_title().replace("\n", " ").replace("- ", "-") for ax in tops] == labels
+    assert [ax.title.get_color() for ax in tops[:6:4]] == [style.SYSTEM_COLOURS[0], style.SYSTEM_COLOURS[1]]
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in tops:
+        title, panel = ax.title.get_window_extent(renderer), ax.get_window_extent(renderer)
+        assert title.width <= panel.width and title.y0 >= panel.y1 - 2  # within its column, above it
+    times = [t.get_text() for t in fig.axes[0].texts] + [
+        t.get_text() for ax in fig.axes[1:6] for t in ax.texts
+    ]
+    assert times == ["t = 0.0 s", "t = 0.1 s", "t = 0.3 s", "t = 0.3 s", "t = 0.5 s", "t = 0.6 s"]
+    spans = {tuple(np.round([np.diff(ax.get_xlim())[0], np.diff(ax.get_zlim())[0]], 6)) for ax in fig.axes}
+    assert len(spans) == 1  # one scale, as in rows
+    assert check.check_figure(fig) == [] == check.check_figure(fig, dpi=100, fit=check.SLIDE_FIGURE_BOX)
+    small = check.check_figure(rows, dpi=100, fit=check.SLIDE_FIGURE_BOX)  # on a slide, at ~40 % of its size
+    assert small and all("shown at" in str(p) for p in small)
+    with pytest.raises(ValueError, match="systems_in"):
+        plot3d.plot_keyframes(systems, tiny_skeleton(), [0], 15, systems_in="diagonal")
+    plt.close("all")
+
+
+def test_annotation_legend_lists_only_the_gesture_types_it_draws():
+    """A segment's bar is its score high: '00_nogesture' (score 0) drew nothing, yet had a legend swatch of its own
+    (notebook 01's timeline), a colour to look for that is nowhere in the figure."""
+    from beatlite.io.emotion import EmotionSegment
+    from beatlite.io.semantic import SemanticSegment
+    from beatlite.viz import figures
+
+    semantic = [
+        SemanticSegment("00_nogesture", 0.0, 0.7, 0.7, 0.0, ""),
+        SemanticSegment("02_deictic_l", 0.7, 2.3, 1.6, 0.3, "my"),
+        SemanticSegment("00_nogesture", 2.3, 2.5, 0.2, 0.0, ""),
+        SemanticSegment("01_beat_align", 2.5, 4.0, 1.5, 0.1, ""),
+    ]
+    frames = np.repeat([0.0, 0.3, 0.0, 0.1], 15)
+    fig = figures.plot_annotations([EmotionSegment("neutral", 0.0, 4.0, 4.0, 0)], semantic, frames, 15, 4.0)
+    legend = fig.axes[1].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == ["01_beat_align", "02_deictic_l"]
+    bars = {
+        (round(p.get_x(), 3), tuple(p.get_facecolor())) for p in fig.axes[1].patches if p.get_height() > 0
+    }
+    assert {c for _, c in bars} == {
+        tuple(h.get_facecolor()) for h in legend.legend_handles
+    }  # each swatch drawn
+    assert check.check_figure(fig) == []
+    silent = figures.plot_annotations([], semantic[:1], np.zeros(15), 15, 1.0)  # nothing scores: as before
+    assert [t.get_text() for t in silent.axes[1].get_legend().get_texts()] == ["00_nogesture"]
     plt.close("all")
 
 

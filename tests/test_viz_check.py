@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import matplotlib
@@ -167,6 +168,31 @@ def test_save_figure_checks_text_at_the_size_a_notebook_shows_it_inline_too(tmp_
         style.save_figure(fig, tmp_path / "coarse", formats=("png",))
     fig.set_dpi(100)  # 12.5 px inline
     style.save_figure(fig, tmp_path / "fine", formats=("png",))
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("size, flagged", [((4, 16), True), ((16, 4), False), ((6, 4), False)])
+def test_text_a_slide_shrinks_under_8_px_is_flagged(tmp_path, monkeypatch, size, flagged):
+    """A slide shows a figure at most SLIDE_FIGURE_BOX (1089 x 600 px): one 16 in high at 100 dpi (its tight box
+    70-100 % of 1600 px: the default margins cropped) is shown at under half its size, so its 10-pt labels
+    (13.9 px inline) come out under 8 px; 16 in wide it is shown at over 68 %, its labels over 9 px."""
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    fig, ax = plt.subplots(figsize=size, dpi=100)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("time (s)", fontsize=10)
+    ax.tick_params(labelsize=10)
+    assert check.check_figure(fig, dpi=100) == []  # at its own size it is fine
+    problems = check.check_figure(fig, dpi=100, fit=check.SLIDE_FIGURE_BOX)
+    assert bool(problems) == flagged, problems
+    if flagged:
+        px = [float(m) for p in problems for m in re.findall(r"is ([0-9.]+) px high", str(p))]
+        low, high = 10 * 100 / 72 * 600 / 1600, 10 * 100 / 72 * 600 / (0.7 * 1600)
+        assert px and all(low <= v <= high for v in px), problems
+        assert "shown at" in str(problems[0]) and "to fit 1089 x 600" in str(problems[0])
+        with pytest.raises(check.FigureError, match="'time \\(s\\)' is [0-9.]+ px high at 100 dpi, shown at"):
+            style.save_figure(fig, tmp_path / "tall", formats=("png",))
+    else:
+        style.save_figure(fig, tmp_path / "wide", formats=("png",))
     plt.close(fig)
 
 

@@ -12,7 +12,9 @@ What counts as a problem:
   off with nothing in it at all is a blank space, not a panel, and passes;
 - **small text**: a visible, non-empty text (titles, labels, tick labels, legend entries,
   annotations) whose font is smaller than :data:`MIN_TEXT_PX` pixels at the saved size
-  (font size in points x dpi / 72);
+  (font size in points x dpi / 72) or, with ``fit``, once the picture is scaled down to fit
+  that box (:data:`SLIDE_FIGURE_BOX`, the most a slide of the course shows: a figure much taller
+  than wide is shown small, its text with it);
 - **shared colour**: two labelled series (lines, bars, scatter points, filled areas with
   different labels, as in a legend) of one axes or of the figure's legends drawn in the same
   colour; the same label in several panels is one series and may keep its colour.
@@ -45,6 +47,11 @@ import numpy as np
 
 #: Smallest readable font size, pixels of the saved (or shown) picture.
 MIN_TEXT_PX = 8.0
+
+#: The largest picture a slide shows at its own size, pixels (width, height): the output column of the
+#: course's 1280 x 800 slides and their figures' height limit (``scripts/build_site.py``); a larger picture is
+#: scaled down to fit, its text with it.
+SLIDE_FIGURE_BOX = (1089, 600)
 
 #: Two colours closer than this in every RGB channel (0-1) count as one colour.
 COLOUR_TOLERANCE = 0.02
@@ -81,7 +88,11 @@ def check_mode() -> str:
 
 
 def check_figure(
-    fig: Any, *, dpi: float | None = None, min_text_px: float = MIN_TEXT_PX
+    fig: Any,
+    *,
+    dpi: float | None = None,
+    min_text_px: float = MIN_TEXT_PX,
+    fit: tuple[float, float] | None = None,
 ) -> list[FigureProblem]:
     """The problems of a figure as it will be saved: empty panels, small text, shared colours.
 
@@ -94,6 +105,10 @@ def check_figure(
         (``"figure"`` means the figure's own dpi). Animations pass the dpi of their frames.
     min_text_px : float
         Smallest font size allowed, pixels at ``dpi``.
+    fit : (float, float), optional
+        A box, pixels (width, height), the picture is shown in, scaled down to fit when larger
+        (e.g. :data:`SLIDE_FIGURE_BOX`): text is measured at that scale. The picture's size is
+        the figure's tight bounding box (``savefig.bbox="tight"``) at ``dpi``.
 
     Returns
     -------
@@ -111,7 +126,7 @@ def check_figure(
     fig.canvas.draw()  # tick labels and layouts are final only after a draw
     axes = [ax for ax in fig.axes if ax.get_visible()]
     problems = [p for i, ax in enumerate(axes) if (p := _empty_panel(ax, i, len(axes)))]
-    problems += _small_texts(fig, float(dpi), float(min_text_px))
+    problems += _small_texts(fig, float(dpi), float(min_text_px), _fit_scale(fig, float(dpi), fit))
     for i, ax in enumerate(axes):
         problems += _shared_colours(_series(ax), f"axes {i + 1} of {len(axes)}")
     for legend in fig.legends:
@@ -166,17 +181,33 @@ def _empty_panel(ax: Any, index: int, n: int) -> FigureProblem | None:
     return FigureProblem("empty panel", f"axes {index + 1} of {n} shows no data{said}")
 
 
-def _small_texts(fig: Any, dpi: float, min_px: float) -> list[FigureProblem]:
+def _fit_scale(fig: Any, dpi: float, fit: tuple[float, float] | None) -> tuple[float, str]:
+    """How much the picture shrinks to fit ``fit`` (1 when it fits or no box is given) and how to say it."""
+    if fit is None:
+        return 1.0, ""
+    box = fig.get_tightbbox(fig.canvas.get_renderer()).padded(0.1)  # savefig's tight box and pad, inches
+    width, height = box.width * dpi, box.height * dpi
+    scale = min(1.0, fit[0] / width, fit[1] / height)
+    if scale >= 1.0:
+        return 1.0, ""
+    return scale, f", shown at {scale:.0%} of {width:.0f} x {height:.0f} px to fit {fit[0]:g} x {fit[1]:g}"
+
+
+def _small_texts(
+    fig: Any, dpi: float, min_px: float, fit: tuple[float, str] = (1.0, "")
+) -> list[FigureProblem]:
     problems = []
     seen: set[tuple[str, float]] = set()
+    scale, shown = fit
     for name, text in _drawn_texts(fig):
-        px = text.get_fontsize() * dpi / 72.0
+        px = text.get_fontsize() * dpi / 72.0 * scale
         if px < min_px and (name, px) not in seen:
             seen.add((name, px))
             verb = "are" if name.startswith("tick labels") else "is"
             problems.append(
                 FigureProblem(
-                    "small text", f"{name} {verb} {px:.1f} px high at {dpi:g} dpi (under {min_px:g} px)"
+                    "small text",
+                    f"{name} {verb} {px:.1f} px high at {dpi:g} dpi{shown} (under {min_px:g} px)",
                 )
             )
     return problems

@@ -139,6 +139,9 @@ def plot_annotations(
 ):
     """Emotion segments, semantic segments (score, coloured by gesture type) and the per-frame score.
 
+    A segment's bar is as high as its score, so a type whose segments all score 0 (``00_nogesture``) draws
+    nothing: it is left out of the legend (its spans are the gaps between bars) unless no segment scores.
+
     Parameters
     ----------
     emotions : sequence of EmotionSegment
@@ -157,8 +160,11 @@ def plot_annotations(
     """
     import matplotlib.pyplot as plt
 
-    types = sorted({s.type for s in semantic})
-    type_colour = {name: plt.cm.tab20(i % 20) for i, name in enumerate(types)}
+    drawn = [seg for seg in semantic if seg.score > 0] or list(semantic)  # the segments that draw a bar
+    types = sorted({seg.type for seg in drawn})
+    type_colour = {
+        name: plt.cm.tab10(i % 10) for i, name in enumerate(types)
+    }  # one hue each (BEAT: 10 types)
     with figure_style():
         fig, axes = plt.subplots(
             3, 1, figsize=(10, 3.8), sharex=True, gridspec_kw={"height_ratios": [1, 2, 1.5]}
@@ -169,7 +175,7 @@ def plot_annotations(
         axes[0].set_yticks([])
         axes[0].grid(False)
         axes[0].set_ylabel("emotion", rotation=0, ha="right", va="center")
-        for seg in semantic:
+        for seg in drawn:
             axes[1].bar(seg.start, seg.score, width=seg.end - seg.start, align="edge",
                         color=type_colour[seg.type], ec="white", lw=0.3)  # fmt: skip
         axes[1].set_ylabel("score\n(segments)")

@@ -492,6 +492,7 @@ def plot_keyframes(
     *,
     view: str | tuple[float, float] = "front",
     panel_size: float = 1.6,
+    systems_in: str = "rows",
 ) -> Any:
     """Key frames of several systems, one row each, on one scale (HA2G Fig. 2, BEAT Fig. 3b).
 
@@ -515,6 +516,10 @@ def plot_keyframes(
         Camera of every panel (``"front"``: the character faces us).
     panel_size : float
         Width and height of a panel, inches (6 columns x 1.6 in = 9.6 in: 1440 px saved at 150 dpi).
+    systems_in : {"rows", "columns"}
+        ``"columns"``: one column per system (its label above it, wrapped to the column's width) and one row
+        per key frame (its time on the left), for many systems: eleven rows of six frames are 1.8 times as
+        tall as wide, shown on a 16:10 slide at a third of their size, eleven columns of six frames fit it.
 
     Returns
     -------
@@ -524,6 +529,8 @@ def plot_keyframes(
     --------
     >>> fig = plot_keyframes({"ground truth": gt, "CaMN": camn}, skeleton, [0, 15, 30], fps=15)  # doctest: +SKIP
     """
+    if systems_in not in ("rows", "columns"):
+        raise ValueError(f"systems_in must be 'rows' or 'columns', got {systems_in!r}")
     labels = list(systems)
     seqs, bones = checked_sequences(list(systems.values()), skeletons, "systems")
     frames = [_check_frame(f, min(len(p) for p in seqs), "frames") for f in frames]
@@ -531,6 +538,8 @@ def plot_keyframes(
         raise ValueError("frames must list at least one frame, got an empty sequence")
     fps = check_fps(fps)
     half = half_extents([p[frames] for p in seqs])
+    if systems_in == "columns":
+        return _keyframe_columns(labels, seqs, bones, frames, fps, view, panel_size, half)
     with figure_style():
         fig = _new_figure((panel_size * len(frames) + 0.4, panel_size * len(seqs) + 0.3), None)
         fig.subplots_adjust(
@@ -544,6 +553,42 @@ def plot_keyframes(
                            color=system_colour(label, row), fontsize=11, fontweight="bold")  # fmt: skip
         for ax, k in zip(fig.axes, frames):
             ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
+        fig.subplots_adjust(wspace=0, hspace=0)
+    return fig
+
+
+def _keyframe_columns(
+    labels: list[str],
+    seqs: list[np.ndarray],
+    bones: list[Bones],
+    frames: list[int],
+    fps: float,
+    view: Any,
+    panel_size: float,
+    half: Any,
+) -> Any:
+    """:func:`plot_keyframes` with one column per system and one row per key frame."""
+    import textwrap
+
+    chars = max(6, int(panel_size * 72 / (11 * 0.62)))  # 11-pt bold characters across a column
+    titles = [
+        "\n".join(textwrap.wrap(label.replace("-", "- "), chars)).replace("- ", "-") for label in labels
+    ]
+    top = 0.2 + 0.2 * max(t.count("\n") + 1 for t in titles)
+    with figure_style():
+        fig = _new_figure((panel_size * len(seqs) + 0.4, panel_size * len(frames) + top), None)
+        fig.subplots_adjust(
+            left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=1 - top / fig.get_figheight()
+        )
+        for col, (label, title, pos, b) in enumerate(zip(labels, titles, seqs, bones)):
+            axes = [fig.add_subplot(len(frames), len(seqs), row * len(seqs) + col + 1, projection="3d")
+                    for row in range(len(frames))]  # fmt: skip
+            _keyframe_row(axes, pos, b, frames, view, half)
+            axes[0].set_title(title, color=system_colour(label, col), fontsize=11, fontweight="bold")
+            if col == 0:
+                for ax, k in zip(axes, frames):
+                    ax.text2D(-0.06, 0.5, f"t = {k / fps:.1f} s", transform=ax.transAxes, rotation=90,
+                              va="center", ha="right", fontsize=10)  # fmt: skip
         fig.subplots_adjust(wspace=0, hspace=0)
     return fig
 

@@ -161,7 +161,8 @@ def save_figure(
         8 px or two series in one colour (nothing is written); the default ``warn``
         gives a :class:`~beatlite.viz.check.FigureWarning` and saves. Text is measured
         at the lower of the saved dpi (150) and the figure's own dpi (100), at which
-        a notebook shows the figure inline.
+        a notebook shows the figure inline, and as a slide shows that picture (scaled
+        down to :data:`beatlite.viz.check.SLIDE_FIGURE_BOX` when larger).
     """
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -176,14 +177,15 @@ def save_figure(
     stem = Path(path_stem)
     if stem.suffix.lstrip(".").lower() in {f.lower().lstrip(".") for f in formats}:
         stem = stem.with_suffix("")
-    from beatlite.viz.check import check_figure, check_mode, report_problems
+    from beatlite.viz.check import SLIDE_FIGURE_BOX, check_figure, check_mode, report_problems
 
     if (mode := check_mode()) != "off":
         dpi = savefig_kwargs.get("dpi", save_params["savefig.dpi"])
         dpi = (
             fig.dpi if dpi == "figure" else min(float(dpi), fig.dpi)
         )  # saved, and shown inline at the figure's dpi
-        report_problems(check_figure(fig, dpi=dpi), f"save_figure({stem.name!r})", mode)
+        problems = check_figure(fig, dpi=dpi, fit=SLIDE_FIGURE_BOX)
+        report_problems(problems, f"save_figure({stem.name!r})", mode)
     stem.parent.mkdir(parents=True, exist_ok=True)
     written = []
     for fmt in formats:
