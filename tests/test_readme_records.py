@@ -434,3 +434,16 @@ def test_the_readme_cpu_route_sentence_and_epoch_rate_are_the_quick_record():
     camn = next(r for r in rows if (r["model"], r["precision"]) == ("camn", "fp32"))
     assert round(camn["fit_wps"] / 50) * 50 == 150  # "about 150 windows/s on one thread"
     assert "CaMN tiny epoch on the CPU runs at about 150 windows/s on one thread" in text
+
+
+def test_the_re_recorded_a2g_row_is_the_seed_record():
+    record = json.loads((ROOT / "checkpoints" / "results_seeds.json").read_text())
+    row = record["rows"]["A2G-style"]
+    fgd, srgr = row["FGD"], row["SRGR"]
+    text = " ".join(_readme().split())
+    assert (
+        f"FGD 5.07 ± 0.29 → {fgd['mean']:.2f} ± {fgd['sd']:.2f}, SRGR 0.108 → {srgr['mean']:.3f}, shipped seed 2021 → "
+        f"{record['info']['shipped']['A2G-style']}." in text
+    )
+    reference = " ".join((ROOT / "docs" / "reference_code.md").read_text().split())
+    assert f"A2G-style FGD {fgd['mean']:.2f} ± {fgd['sd']:.2f} sd (re-recorded on 2026-11-27" in reference

@@ -847,7 +847,7 @@ FIRST_STEPS = {
 """The total loss of the first three optimiser steps of each model's first recipe (seed 2021, one batch of the
 recipe's size per step, ``data_samples/``), recorded on 2026-11-27 (torch 2.13.0+cpu, one thread). 441ba3b, the
 code of the seed table's CaMN, HA2G, S2G, Trimodal and Seq2Seq rows, gives the same five rows to the bit; A2G's
-recorded seed rows are older than these numbers (README, "Larger batches")."""
+seed rows were re-recorded with the code of these numbers (README, "Larger batches")."""
 
 
 @pytest.mark.slow

@@ -171,7 +171,9 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     rate and schedule; float32, deterministic: a checkpoint trained with ``amp`` or
     ``deterministic=False`` is not the recipe's) and its model config with what :data:`~beatlite.train.recipes.RECIPES`
     builds now (same vocabulary size and seed), so a seed table is never filled with checkpoints of
-    an older recipe. Code changes that leave both unchanged are not seen: retrain with ``force``.
+    an older recipe. Code changes that leave both unchanged are not seen here (the test
+    ``test_the_first_training_steps_are_the_recorded_ones`` in ``tests/test_train_recipes.py`` sees them): retrain with
+    ``force`` (``seeds --force``).
     """
 
     recipe = RECIPES[name]
