@@ -449,8 +449,139 @@ def test_system_colour_by_name_then_by_position():
     assert style.system_colour("CaMN") == style.system_colour("camn (tiny)") == style.SYSTEM_COLOURS[1]
     assert style.system_colour("HA2G") == style.SYSTEM_COLOURS[2]
     assert style.system_colour("ground truth", 5) == style.SYSTEM_COLOURS[0]
-    others = {style.system_colour("baseline", i) for i in range(6)}  # never a named system's colour
-    assert len(others) == 6 and not others & set(style.NAMED_SYSTEM_COLOURS.values())
+    # a colour no longer depends on the position: the old index is ignored
+    assert {style.system_colour("baseline", i) for i in range(6)} == {style.system_colour("baseline")}
+
+
+#: The course's systems: the ground truth's rows and every shipped recipe's row (baselines included).
+def _course_labels(main_rows_only: bool = False) -> list[str]:
+    from beatlite.train.recipes import GROUND_TRUTH, GROUND_TRUTH_141, RECIPES
+
+    recipes = [r.label for r in RECIPES.values() if not (main_rows_only and r.overrides)]
+    return [GROUND_TRUTH, GROUND_TRUTH_141, *recipes]
+
+
+#: Labels a user might give their own models (none names a system of the course).
+USER_LABELS = [
+    "My model",
+    "Transformer (ours)",
+    "EMAGE",
+    "TalkSHOW",
+    "baseline v2",
+    "Gesture LM",
+    "x",
+    "DiffStyle",
+]
+
+
+def test_every_system_of_the_course_has_one_fixed_colour_of_its_own():
+    """Before: only ground truth, CaMN and HA2G had colours by name; Random clip was green in notebook 07's bars,
+    brown in 08's key frames and purple in 09's ranks (colours by position in each figure)."""
+    from matplotlib.colors import to_rgb
+
+    named = set(style.NAMED_SYSTEM_COLOURS.values())
+    for label in _course_labels():  # ablations ("CaMN w/o text") share their model's colour
+        assert style.system_colour(label) in named, label
+    main = _course_labels(main_rows_only=True)  # 2 ground-truth rows + 10 recipes' main rows
+    colours = {label: style.system_colour(label) for label in main}
+    assert len(main) == 12 and len(set(colours.values())) == 12, colours
+    # an ablation beside its model, before or after it, takes a lighter shade: the model keeps its colour
+    assert (
+        style.system_colours(["CaMN w/o text", "CaMN"])[1]
+        == style.system_colours(["CaMN", "CaMN w/o text"])[0]
+    )
+    assert style.system_colours(["HA2G w/o text", "HA2G"])[1] == style.system_colour("HA2G")
+    # the three colours the course had before stay
+    assert (colours["Ground truth"], colours["CaMN"], colours["HA2G"]) == ("#333333", "#1f77b4", "#ff7f0e")
+    rgb = [np.array(to_rgb(c)) for c in colours.values()]  # far apart, not only different hex strings
+    assert min(np.abs(a - b).max() for i, a in enumerate(rgb) for b in rgb[i + 1 :]) > 0.1
+
+
+def test_the_same_system_has_the_same_colour_in_every_figure():
+    """Two figures with different systems in different orders (notebook 07's ranked bars and points, key frames
+    in rows and in columns, an animation's titles) give every label one colour, the one of ``system_colour``."""
+    from matplotlib.colors import to_hex
+
+    from beatlite.viz import charts
+
+    seen: dict[str, set[str]] = {}
+
+    def note(label, colour):
+        seen.setdefault(label.replace("\n", "").replace("- ", "-"), set()).add(to_hex(colour))
+
+    bars = charts.plot_scores(BENCHMARK_FGD, "FGD").axes[0]
+    for handle, label in zip(*bars.get_legend_handles_labels(), strict=True):
+        if not label.startswith("_"):
+            note(label, handle.patches[0].get_facecolor())
+    points = charts.plot_score_scatter(BENCHMARK_FGD, {k: 0.5 for k in BENCHMARK_FGD}, "FGD", "BC").axes[0]
+    for handle, label in zip(*points.get_legend_handles_labels(), strict=True):
+        note(label, handle.get_facecolor()[0])
+    first = ["ground truth", "Mean pose", "Random clip", "S2G-style", "DiffGesture-style", "My model"]
+    rows = plot3d.plot_keyframes({k: wave_motion(4) for k in first}, tiny_skeleton(), [0, 2], 15)
+    for t in (t for ax in rows.axes for t in ax.texts if t.get_text() in first):
+        note(t.get_text(), t.get_color())
+    second = ["Trimodal-style", "My model", "Random clip", "CaMN", "A2G-style", "Mean pose", "Other model"]
+    cols = plot3d.plot_keyframes(
+        {k: wave_motion(4) for k in second}, tiny_skeleton(), [0, 2], 15, systems_in="columns"
+    )
+    for ax in cols.axes[::2]:
+        note(ax.get_title(), ax.title.get_color())
+    anim = animation.animate_skeletons({k: wave_motion(4) for k in ["DiffGesture-style", "Random clip"]},
+                                       tiny_skeleton(), 15)  # fmt: skip
+    for ax in anim.figure.axes:
+        if ax.get_title():
+            note(ax.get_title(), ax.title.get_color())
+    assert {"Random clip", "Mean pose", "My model", "DiffGesture-style", "Trimodal-style"} <= set(seen)
+    assert {k: v for k, v in seen.items() if len(v) > 1} == {}  # before: Random clip in 3 colours, ...
+    assert all(
+        v == {style.system_colour(k)} for k, v in seen.items() if k != "Ground truth (141 Euler channels)"
+    )
+    plt.close("all")
+
+
+def test_a_user_label_never_takes_a_course_colour_and_keeps_its_own():
+    named = set(style.NAMED_SYSTEM_COLOURS.values())
+    assert not named & set(style.OTHER_SYSTEM_COLOURS)
+    for label in USER_LABELS:
+        assert style.system_colour(label) in style.OTHER_SYSTEM_COLOURS, label
+    mixed = _course_labels(main_rows_only=True) + USER_LABELS  # 8 user labels: more than the 6 user colours
+    colours = style.system_colours(mixed)
+    assert len(set(colours)) == len(mixed)  # distinct in one figure (lighter shades after six)
+    user = dict(zip(USER_LABELS, colours[-len(USER_LABELS) :], strict=True))
+    assert not set(user.values()) & named
+    # the order of a figure's systems (e.g. ranked by a score) does not change them
+    assert style.system_colours(mixed[::-1]) == colours[::-1]
+    # a user label alone, or beside the course's systems, keeps the colour of system_colour
+    assert style.system_colours(["Ground truth", "CaMN", "My model"])[2] == style.system_colour("My model")
+    assert style.system_colours(["My model"]) == [style.system_colour("My model")]
+
+
+def test_a_user_label_has_the_same_colour_in_every_python_process():
+    """The colour comes from a checksum of the name, not from Python's salted ``hash``."""
+    import os
+    import subprocess
+    import sys
+
+    code = f"from beatlite.viz.style import system_colour as c; print([c(x) for x in {USER_LABELS!r}])"
+    outputs = set()
+    for seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        proc = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+        )
+        assert proc.returncode == 0, proc.stderr
+        outputs.add(proc.stdout)
+    assert outputs == {f"{[style.system_colour(x) for x in USER_LABELS]}\n"}
+
+
+def test_a_legend_of_every_course_system_and_user_models_passes_the_figure_check():
+    fig, ax = plt.subplots()
+    labels = _course_labels(main_rows_only=True) + USER_LABELS[:3]
+    for i, (label, colour) in enumerate(zip(labels, style.system_colours(labels), strict=True)):
+        ax.plot([0, 1], [i, i], color=colour, label=label)
+    style.legend_outside(ax)
+    assert check.check_figure(fig) == []
+    plt.close("all")
 
 
 def test_legend_outside_does_not_cover_the_data():

@@ -257,7 +257,7 @@ def plot_table6(
     ]
     if generated is not None:
         rows.append((f"beatlite, generated ({generated_by})", [100 * generated.get(n, np.nan) for n in names],
-                     system_colour(generated_by, 3)))  # fmt: skip
+                     system_colour(generated_by)))  # fmt: skip
     with figure_style():
         fig, ax = plt.subplots(figsize=(11, 4.2), layout="constrained")
         x = np.arange(len(names))

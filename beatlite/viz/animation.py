@@ -46,7 +46,7 @@ from beatlite.viz._inputs import (
 )
 from beatlite.viz.face import most_active
 from beatlite.viz.plot3d import SkeletonArtist, SkeletonLike, half_extents, setup_axes
-from beatlite.viz.style import SLIDE_WIDTH_PX, STYLE, legend_outside, system_colour
+from beatlite.viz.style import SLIDE_WIDTH_PX, STYLE, legend_outside, system_colours
 
 FACE_PANELS = ("bars", "heatmap")
 
@@ -384,13 +384,14 @@ def _draw_skeletons(fig: Any, layout: _Layout, seqs: list[np.ndarray], bones: li
                     labels: list[str] | None, view: Any) -> list[SkeletonArtist]:  # fmt: skip
     """Step 4: one 3D panel per sequence, one scale for all, titled in the system's colour."""
     half = half_extents(seqs)
+    colours = system_colours(labels) if labels is not None else []
     artists = []
     for i, (rect, seq, b) in enumerate(zip(layout.skeletons, seqs, bones)):
         ax = fig.add_axes(rect, projection="3d")
         setup_axes(ax, seq, view=view, floor=b.has_feet, half=half)
         artists.append(SkeletonArtist(ax, b))
         if labels is not None:
-            ax.set_title(labels[i], color=system_colour(labels[i], i), fontsize=13, fontweight="bold")
+            ax.set_title(labels[i], color=colours[i], fontsize=13, fontweight="bold")
     return artists
 
 
@@ -495,7 +496,7 @@ def animate_skeletons(
         Playback rate; frames are subsampled to it (``None``: every frame).
     labels : sequence of str, optional
         Panel titles (default: mapping keys, or none for one sequence), in the
-        systems' colours (:func:`beatlite.viz.style.system_colour`).
+        systems' colours (:func:`beatlite.viz.style.system_colours`).
     timeline : Timeline, optional
         Waveform, audio beats and motion beats under the skeletons, with a cursor.
     words : (starts, ends, words) or WordIntervals, optional

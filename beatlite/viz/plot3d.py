@@ -28,7 +28,7 @@ from beatlite.viz._inputs import (
     checked_sequences,
     to_plot_coords,
 )
-from beatlite.viz.style import GROUP_COLOURS, figure_style, legend_outside, system_colour
+from beatlite.viz.style import GROUP_COLOURS, figure_style, legend_outside, system_colours
 
 #: Camera angles ``(elev, azim)`` in degrees of the named views (plot axes, see the module docstring).
 VIEWS: Mapping[str, tuple[float, float]] = {"front": (0.0, -90.0), "side": (0.0, 0.0), "top": (90.0, -90.0)}
@@ -499,7 +499,7 @@ def plot_keyframes(
     Every panel has the same box size in centimetres (:func:`half_extents` of
     all rows), so a shorter skeleton (HA2G's TED-43 upper body) looks shorter
     rather than zoomed in; joint groups have the same colours in every row,
-    the row label the system's colour (:func:`beatlite.viz.style.system_colour`),
+    the row label the system's colour (:func:`beatlite.viz.style.system_colours`: by name, the same in every figure),
     and a floor is drawn only under skeletons that have feet.
 
     Parameters
@@ -545,12 +545,13 @@ def plot_keyframes(
         fig.subplots_adjust(
             left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=1 - 0.3 / fig.get_figheight()
         )
+        colours = system_colours(labels)
         for row, (label, pos, b) in enumerate(zip(labels, seqs, bones)):
             axes = [fig.add_subplot(len(seqs), len(frames), row * len(frames) + col + 1, projection="3d")
                     for col in range(len(frames))]  # fmt: skip
             _keyframe_row(axes, pos, b, frames, view, half)
             axes[0].text2D(-0.06, 0.5, label, transform=axes[0].transAxes, rotation=90, va="center", ha="right",
-                           color=system_colour(label, row), fontsize=11, fontweight="bold")  # fmt: skip
+                           color=colours[row], fontsize=11, fontweight="bold")  # fmt: skip
         for ax, k in zip(fig.axes, frames):
             ax.set_title(f"t = {k / fps:.1f} s", fontsize=10)
         fig.subplots_adjust(wspace=0, hspace=0)
@@ -580,11 +581,12 @@ def _keyframe_columns(
         fig.subplots_adjust(
             left=0.4 / fig.get_figwidth(), right=1, bottom=0, top=1 - top / fig.get_figheight()
         )
-        for col, (label, title, pos, b) in enumerate(zip(labels, titles, seqs, bones)):
+        colours = system_colours(labels)
+        for col, (title, colour, pos, b) in enumerate(zip(titles, colours, seqs, bones)):
             axes = [fig.add_subplot(len(frames), len(seqs), row * len(seqs) + col + 1, projection="3d")
                     for row in range(len(frames))]  # fmt: skip
             _keyframe_row(axes, pos, b, frames, view, half)
-            axes[0].set_title(title, color=system_colour(label, col), fontsize=11, fontweight="bold")
+            axes[0].set_title(title, color=colour, fontsize=11, fontweight="bold")
             if col == 0:
                 for ax, k in zip(axes, frames):
                     ax.text2D(-0.06, 0.5, f"t = {k / fps:.1f} s", transform=ax.transAxes, rotation=90,

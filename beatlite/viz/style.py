@@ -15,8 +15,11 @@ The style's rules, which every figure function of :mod:`beatlite.viz` and
   above the axes, never over bars or curves.
 - **Units on every axis**: labels read ``"quantity (unit)"``; a count or a
   score without unit says so (``"score (0-1)"``).
-- **One colour per system** in every figure: :func:`system_colour` (ground truth
-  dark grey, CaMN blue, HA2G orange), and one colour per joint group
+- **One colour per system** in every figure: :func:`system_colour` by name only
+  (ground truth dark grey, CaMN blue, HA2G orange, and a colour of its own for
+  each baseline and shipped recipe of the course, :data:`NAMED_SYSTEM_COLOURS`; a
+  model you add gets one of :data:`OTHER_SYSTEM_COLOURS`, which the course does
+  not use), :func:`system_colours` for the systems of one figure (distinct), and one colour per joint group
   (:data:`GROUP_COLOURS`) on every skeleton.
 
 Usage (the doctests skip the ``with`` block: it writes files under ``build/``):
@@ -35,6 +38,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import zlib
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
@@ -52,22 +56,32 @@ GROUP_COLOURS: Mapping[str, str] = MappingProxyType(
 #: Colours of the compared systems, in the order ground truth, CaMN, HA2G, then extras.
 SYSTEM_COLOURS: tuple[str, ...] = ("#333333", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b")
 
-#: The colour of a system by name (lower case), so that a model keeps its colour in every figure.
+#: The colour of every system the course shows, by name (lower case): the ground truth's two rows, CaMN and
+#: HA2G (their ablations, e.g. "CaMN w/o text", start with the name and share its colour), the baselines and the
+#: other shipped recipes' rows (:data:`beatlite.train.recipes.RECIPES`' labels), so that a system keeps its colour
+#: in every figure. Chosen to stay apart for deuteranopes and protanopes where twelve colours allow (Paul Tol's
+#: muted and vibrant schemes) and readable as text on white (contrast >= 3:1).
 NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
     {
         "ground truth": SYSTEM_COLOURS[0],
         "real": SYSTEM_COLOURS[0],
         "gt": SYSTEM_COLOURS[0],
+        "ground truth (141 euler channels)": "#999999",
         "camn": SYSTEM_COLOURS[1],
         "ha2g": SYSTEM_COLOURS[2],
+        "mean pose": "#999933",
+        "random clip": "#8c564b",
+        "s2g-style": "#ee3377",
+        "trimodal-style": "#117733",
+        "seq2seq-style": "#332288",
+        "a2g-style": "#882255",
+        "joint embedding-style": "#7b4173",
+        "diffgesture-style": "#d62728",
     }
 )
 
-#: Colours of systems without a named colour (baselines, new models): never grey, blue or orange.
-OTHER_SYSTEM_COLOURS: tuple[str, ...] = (
-    "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",  # tab10 without the named systems' colours
-    "#393b79", "#637939", "#843c39", "#7b4173",  # tab20b's darkest: distinct, and readable as text on white
-)  # fmt: skip
+#: Colours of systems without a named colour (a user's own models): none of :data:`NAMED_SYSTEM_COLOURS`'.
+OTHER_SYSTEM_COLOURS: tuple[str, ...] = ("#d55e00", "#009e73", "#e377c2", "#aa4499", "#393b79", "#bcbd22")
 
 #: Smallest width in pixels of a saved figure, an animation or a GIF ("slide size").
 SLIDE_WIDTH_PX = 960
@@ -197,18 +211,44 @@ def save_figure(
     return written
 
 
+def _named_colour(label: str) -> str | None:
+    """The named colour of ``label`` (the longest name it starts with, case-insensitive), or None."""
+    low = str(label).strip().lower()
+    return next((NAMED_SYSTEM_COLOURS[n] for n in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True)
+                 if low.startswith(n)), None)  # fmt: skip
+
+
+def _other_slot(label: str) -> int:
+    """The place of an unnamed ``label`` in :data:`OTHER_SYSTEM_COLOURS`: from its name, the same in every run."""
+    return zlib.crc32(str(label).strip().lower().encode("utf-8")) % len(OTHER_SYSTEM_COLOURS)
+
+
+def _lighter(colour: str, step: int) -> str:
+    """``colour`` mixed with white: half way for ``step`` 1, three quarters for 2, ..."""
+    from matplotlib.colors import to_hex, to_rgb
+
+    mix = 1.0 - 0.5**step
+    return to_hex([c + (1.0 - c) * mix for c in to_rgb(colour)])
+
+
 def system_colour(label: str, index: int = 0) -> str:
-    """The colour of a compared system: by name when known (ground truth, CaMN, HA2G), else by position.
+    """The colour of a compared system, by its name only, so that it is the same in every figure.
+
+    The systems of the course (ground truth, the baselines, every shipped recipe's
+    row) have their own colours (:data:`NAMED_SYSTEM_COLOURS`); any other name (a
+    model you add) gets one of :data:`OTHER_SYSTEM_COLOURS`, which none of the
+    course's systems uses, chosen from the name (a checksum, not Python's salted
+    ``hash``): the same in every figure and every run. Two such names may share a
+    colour here: a figure with several systems uses :func:`system_colours`.
 
     Parameters
     ----------
     label : str
         System name, e.g. ``"CaMN"``, ``"HA2G (ours)"``, ``"ground truth"``; the
-        first word that names a known system decides (case-insensitive).
+        longest known name it starts with decides (case-insensitive).
     index : int
-        Position of the system in the figure, used for other names:
-        ``OTHER_SYSTEM_COLOURS[index % 10]``, so a baseline never takes the colour of
-        ground truth, CaMN or HA2G.
+        Ignored: kept so that calls that passed a system's position still work
+        (a colour no longer depends on the figure).
 
     Returns
     -------
@@ -217,24 +257,25 @@ def system_colour(label: str, index: int = 0) -> str:
 
     Examples
     --------
-    >>> system_colour("CaMN (tiny)"), system_colour("ground truth"), system_colour("mean pose", 1)
-    ('#1f77b4', '#333333', '#9467bd')
+    >>> system_colour("CaMN (tiny)"), system_colour("ground truth"), system_colour("Random clip")
+    ('#1f77b4', '#333333', '#8c564b')
+    >>> system_colour("my model") in OTHER_SYSTEM_COLOURS
+    True
     """
-    low = str(label).lower()
-    for name in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True):
-        if low.startswith(name):
-            return NAMED_SYSTEM_COLOURS[name]
-    return OTHER_SYSTEM_COLOURS[int(index) % len(OTHER_SYSTEM_COLOURS)]
+    named = _named_colour(label)
+    return named if named is not None else OTHER_SYSTEM_COLOURS[_other_slot(label)]
 
 
 def system_colours(labels: Sequence[str]) -> list[str]:
-    """One distinct colour per system of a figure: named systems by name, the others in turn.
+    """One distinct colour per system of a figure: each the colour of :func:`system_colour` where it is free.
 
-    Unlike ``system_colour(label, index)`` with the position in the figure, the
-    systems without a named colour count only among themselves, so up to ten of
-    them never share a colour, whatever the order (e.g. rows ranked by a score).
-    A label whose named colour is already taken by another label of the list (e.g.
-    a second ground-truth row) gets a lighter shade of it.
+    Named systems take their colours; a label whose named colour is already taken
+    by a shorter label of the list (e.g. an ablation beside its full model) gets a
+    lighter shade of it. The other labels take their own colour from
+    :data:`OTHER_SYSTEM_COLOURS` unless another of them has it; then, in
+    alphabetical order, the next free one (lighter shades once all six are used),
+    so that the colours do not depend on the order of ``labels`` (e.g. rows ranked
+    by a score).
 
     Parameters
     ----------
@@ -248,28 +289,41 @@ def system_colours(labels: Sequence[str]) -> list[str]:
 
     Examples
     --------
-    >>> system_colours(["Ground truth", "Ground truth (141 channels)", "CaMN", "Mean pose", "Random clip"])
-    ['#333333', '#999999', '#1f77b4', '#2ca02c', '#9467bd']
+    >>> system_colours(["Ground truth", "Ground truth (141 Euler channels)", "CaMN", "Mean pose", "Random clip"])
+    ['#333333', '#999999', '#1f77b4', '#999933', '#8c564b']
+    >>> system_colours(["CaMN", "CaMN w/o text"])
+    ['#1f77b4', '#8fbbda']
     """
-    from matplotlib.colors import to_hex, to_rgb
-
     colours: dict[str, str] = {}
-    unnamed = 0
-    for label in labels:
-        if label in colours:
+    unnamed = []
+    by_length = sorted(
+        set(labels), key=lambda x: (len(str(x)), str(x).lower(), str(x))
+    )  # "CaMN" before "CaMN w/o"
+    for label in by_length:
+        if label in colours or label in unnamed:
             continue
-        low = str(label).lower()
-        named = next((NAMED_SYSTEM_COLOURS[n] for n in sorted(NAMED_SYSTEM_COLOURS, key=len, reverse=True)
-                      if low.startswith(n)), None)  # fmt: skip
+        named = _named_colour(label)
         if named is None:
-            colours[label] = OTHER_SYSTEM_COLOURS[unnamed % len(OTHER_SYSTEM_COLOURS)]
-            unnamed += 1
+            unnamed.append(label)
             continue
         colour, lighter = named, 0
         while colour in colours.values() and lighter < 3:  # a second row of a named system: a lighter shade
             lighter += 1
-            mix = 1.0 - 0.5**lighter
-            colour = to_hex([c + (1.0 - c) * mix for c in to_rgb(named)])
+            colour = _lighter(named, lighter)
+        colours[label] = colour
+    taken: set[str] = set()
+    n = len(OTHER_SYSTEM_COLOURS)
+    for label in sorted(unnamed, key=lambda x: (str(x).lower(), str(x))):
+        start = _other_slot(label)
+        candidates = (
+            OTHER_SYSTEM_COLOURS[(start + k) % n]
+            if step == 0
+            else _lighter(OTHER_SYSTEM_COLOURS[(start + k) % n], step)
+            for step in range(4)
+            for k in range(n)
+        )
+        colour = next((c for c in candidates if c not in taken), OTHER_SYSTEM_COLOURS[start])
+        taken.add(colour)
         colours[label] = colour
     return [colours[label] for label in labels]
 
