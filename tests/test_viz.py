@@ -556,6 +556,26 @@ def test_a_user_label_never_takes_a_course_colour_and_keeps_its_own():
     assert style.system_colours(["My model"]) == [style.system_colour("My model")]
 
 
+@pytest.mark.parametrize("model", ["camn", "ha2g"])
+def test_the_bars_of_an_ablation_study_have_one_colour_each(model):
+    """BEAT Table 5 (CaMN and its 7 ablations) or HA2G and its 12 ablations as bars: before, a row after the fourth of
+    one system took the third lighter shade again (five CaMN ablations in #e3eef6, nearly white), which
+    ``check_figure`` reports and ``BEATLITE_FIGURE_CHECK=raise`` refuses to save."""
+    from beatlite.train.recipes import RECIPES
+    from beatlite.viz import charts
+
+    labels = [r.label for r in RECIPES.values() if r.model == model]
+    assert len(labels) in (8, 13)
+    ax = charts.plot_scores({label: 1.0 + i for i, label in enumerate(labels)}, "FGD").axes[0]
+    assert check.check_figure(ax.figure) == []
+    colours = style.system_colours(labels)
+    assert len(set(colours)) == len(labels) and colours[0] == style.system_colour(
+        labels[0]
+    )  # the model keeps its own
+    assert style.system_colours(labels[::-1]) == colours[::-1]
+    plt.close("all")
+
+
 def test_a_user_label_has_the_same_colour_in_every_python_process():
     """The colour comes from a checksum of the name, not from Python's salted ``hash``."""
     import os

@@ -231,6 +231,13 @@ def _lighter(colour: str, step: int) -> str:
     return to_hex([c + (1.0 - c) * mix for c in to_rgb(colour)])
 
 
+def _darker(colour: str, factor: float) -> str:
+    """``colour`` with its RGB values times ``factor`` (0-1)."""
+    from matplotlib.colors import to_hex, to_rgb
+
+    return to_hex([c * factor for c in to_rgb(colour)])
+
+
 def system_colour(label: str, index: int = 0) -> str:
     """The colour of a compared system, by its name only, so that it is the same in every figure.
 
@@ -271,11 +278,12 @@ def system_colours(labels: Sequence[str]) -> list[str]:
 
     Named systems take their colours; a label whose named colour is already taken
     by a shorter label of the list (e.g. an ablation beside its full model) gets a
-    lighter shade of it. The other labels take their own colour from
-    :data:`OTHER_SYSTEM_COLOURS` unless another of them has it; then, in
-    alphabetical order, the next free one (lighter shades once all six are used),
-    so that the colours do not depend on the order of ``labels`` (e.g. rows ranked
-    by a score).
+    shade of it (lighter, darker, lighter still), and a fifth row of one system a
+    colour none of the figure's labels has. The other labels take their own colour
+    from :data:`OTHER_SYSTEM_COLOURS` unless another of them has it; then, in
+    alphabetical order, the next free one (lighter shades once all six are used).
+    The colours do not depend on the order of ``labels`` (e.g. rows ranked by a
+    score), and up to 24 labels never share one.
 
     Parameters
     ----------
@@ -295,26 +303,25 @@ def system_colours(labels: Sequence[str]) -> list[str]:
     ['#1f77b4', '#8fbbda']
     """
     colours: dict[str, str] = {}
-    unnamed = []
+    unnamed, overflow = [], []
     by_length = sorted(
         set(labels), key=lambda x: (len(str(x)), str(x).lower(), str(x))
     )  # "CaMN" before "CaMN w/o"
     for label in by_length:
-        if label in colours or label in unnamed:
-            continue
         named = _named_colour(label)
         if named is None:
             unnamed.append(label)
             continue
-        colour, lighter = named, 0
-        while colour in colours.values() and lighter < 3:  # a second row of a named system: a lighter shade
-            lighter += 1
-            colour = _lighter(named, lighter)
-        colours[label] = colour
-    taken: set[str] = set()
+        shades = (named, _lighter(named, 1), _darker(named, 0.6), _lighter(named, 2))  # rows of one system
+        colour = next((c for c in shades if c not in colours.values()), None)
+        if colour is None:
+            overflow.append(label)  # a fifth row of one system: a free colour of the others, below
+        else:
+            colours[label] = colour
     n = len(OTHER_SYSTEM_COLOURS)
-    for label in sorted(unnamed, key=lambda x: (str(x).lower(), str(x))):
-        start = _other_slot(label)
+    taken = set(colours.values())
+    for label in [*sorted(unnamed, key=lambda x: (str(x).lower(), str(x))), *overflow]:
+        start = _other_slot(label) if label in unnamed else 0
         candidates = (
             OTHER_SYSTEM_COLOURS[(start + k) % n]
             if step == 0
