@@ -38,6 +38,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from beatlite.viz.check import SLIDE_FIGURE_BOX
+
 REPO = Path(__file__).resolve().parents[1]
 SLIDE_TYPES = ("slide", "subslide", "fragment", "skip", "notes", "-")
 #: The repository named in the committed notebooks' Colab cell until ``--set-repo`` writes a real one.
@@ -323,24 +325,26 @@ _SLIDES_TEMPLATE = _SLIDES_TEMPLATE.replace("SLIDE_WIDTH", f"{SLIDE_WIDTH}").rep
     "SLIDE_HEIGHT", f"{SLIDE_HEIGHT}"
 )
 
+# A figure on a slide: at most an output's width (the frame less the prompt column, measured in Chromium) and
+# _IMAGE_MAX_HEIGHT high, the box check_figure measures the text of a saved figure in (one home: SLIDE_FIGURE_BOX).
+_OUTPUT_WIDTH, _IMAGE_MAX_HEIGHT = SLIDE_FIGURE_BOX
+
 # A slide is at most the frame's height (fit_slides splits taller ones; should an estimate fall short, the slide
 # scrolls rather than cut its end); figures at most _IMAGE_MAX_HEIGHT; code in Markdown as large as code cells.
 _SLIDES_CSS = """
 .reveal .slides > section, .reveal .slides > section > section { height: 100%; overflow-y: auto; }
-.reveal .jp-OutputArea-output img { max-height: 600px; width: auto; }
+.reveal .jp-OutputArea-output img { max-height: IMAGE_MAX_HEIGHTpx; width: auto; }
 .reveal .jp-RenderedHTMLCommon table { font-size: 16px; }
 .reveal .jp-InputArea-editor pre, .reveal .jp-OutputArea-output pre { white-space: pre-wrap; font-size: 16px; }
 .reveal .jp-RenderedMarkdown pre { font-size: 16px; line-height: 1.3; }
 .reveal .slide-number { left: 8px; right: auto; }
-"""
+""".replace("IMAGE_MAX_HEIGHT", f"{_IMAGE_MAX_HEIGHT}")
 
 # fit_slides: heights of rendered cells on a slide, CSS pixels, measured in Chromium on the 1280 x 800 frame with
 # the styles above (paragraphs 20 px text on 26 px lines, list items 32 px lines, code and printed text 16 px
 # monospace on 23 px lines, tables 16 px), and the characters per line of each, a little under what fits.
 # What the cells of one slide may fill: the frame less a margin for the estimate's error.
 _SLIDE_BUDGET = SLIDE_HEIGHT - 60
-_IMAGE_MAX_HEIGHT = 600  # the CSS max-height of a figure above
-_OUTPUT_WIDTH = 1089  # an output's width (the frame less the prompt column)
 _CELL = 12  # a cell's own padding
 _TEXT_LINE, _TEXT_CHARS, _PARAGRAPH = 27, 85, 20
 _ITEM_LINE, _ITEM_CHARS, _LIST = 32, 72, 24

@@ -464,6 +464,19 @@ def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
     assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
 
 
+def test_the_slides_figure_box_is_the_one_save_figure_measures_text_in(monkeypatch):
+    """check.SLIDE_FIGURE_BOX, the box save_figure measures a figure's text in as a slide shows it, is the slides'
+    own: the CSS max-height of a figure and the output width fit_slides estimates with follow it (before: 1089 and
+    600 written again in build_site.py, so a change to one side left the check measuring another slide)."""
+    from beatlite.viz import check
+
+    monkeypatch.setattr(check, "SLIDE_FIGURE_BOX", (900, 500))
+    site = _site()  # (executed afresh: its constants from the box above)
+    assert (site._OUTPUT_WIDTH, site._IMAGE_MAX_HEIGHT) == (900, 500)
+    assert ".reveal .jp-OutputArea-output img { max-height: 500px; width: auto; }" in site._SLIDES_CSS
+    assert site._shown_image_height((1800, 900)) == 450  # 900 px wide: half its size
+
+
 def test_slides_fit_the_frame_in_chromium(tmp_path):
     """Measured in the browser at the deck's size: no slide of a deck with tall sections scrolls, and reveal.js
     counts the slides fit_slides made."""
