@@ -575,8 +575,9 @@ def _split_output(output, budget: float) -> list:
 
 def _split_cell(cell, budget: float) -> list:
     """``cell`` as cells each at most ``budget`` high where it can: a Markdown cell at its blocks, a code cell's
-    source at its lines and its outputs one cell below (source hidden), itself split between outputs. A single
-    block, code line or output taller than ``budget`` stays whole."""
+    source at its lines and its outputs one cell below (source hidden), itself split between outputs (a cell whose
+    source is hidden only between outputs: no empty part). A single block, code line or output taller than
+    ``budget`` stays whole."""
     if cell_height(cell) <= budget or cell.cell_type not in ("markdown", "code"):
         return [cell]
     parts: list = []
@@ -585,7 +586,8 @@ def _split_cell(cell, budget: float) -> list:
         first = _continuation(cell, source=texts[0])
         first.metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
         return [first, *(_continuation(cell, source=text) for text in texts[1:])]
-    lines, chunk = cell.source.splitlines(), []
+    shown = not cell.metadata.get("transient", {}).get("remove_source", False)  # (hidden: moved outputs)
+    lines, chunk = cell.source.splitlines() if shown else [], []
     for line in lines:
         if (
             chunk
@@ -594,8 +596,8 @@ def _split_cell(cell, budget: float) -> list:
             parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
             chunk = []
         chunk.append(line)
-    parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
-    parts[0].metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
+    if shown:
+        parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
     groups: list[list] = []
     for output in (part for o in cell.get("outputs", []) for part in _split_output(o, budget - _CELL)):
         if not groups or _CELL + sum(output_height(o) for o in [*groups[-1], output]) > budget:
@@ -606,6 +608,7 @@ def _split_cell(cell, budget: float) -> list:
     for group in groups:
         parts.append(_continuation(cell, outputs=group))
         parts[-1].metadata["transient"] = {"remove_source": True}
+    parts[0].metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
     return parts
 
 

@@ -464,6 +464,29 @@ def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
     assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
 
 
+def test_fit_slides_leaves_fitted_slides_as_they_are_with_an_output_taller_than_a_slide():
+    """An animation player (its frame and buttons) taller than the budget goes below its source with the source
+    hidden; fitting again split that cell again, into an empty cell (no source shown, no output: a blank slide)
+    and the player, whose copy had the same id (notebooks 05 and 08's decks: one slide more at every call)."""
+    site = _site()
+    player = f"<div class='animation'><img id='frame' src='data:image/png;base64,{_png_of(1000, 900)}'></div>"
+    cells = [
+        new_markdown_cell("## 1. Motion", metadata={"slideshow": {"slide_type": "slide"}}),
+        new_code_cell("HTML(anim.to_html())", metadata={"slideshow": {"slide_type": "-"}}, execution_count=1),
+    ]
+    cells[1].outputs = [new_output("display_data", data={"text/html": player, "text/plain": "<HTML>"})]
+    nb = new_notebook(cells=cells)
+    assert site.cell_height(cells[1]) - site.cell_height(new_code_cell(cells[1].source)) > site._SLIDE_BUDGET
+    assert site.fit_slides(nb) == 1  # the player on a slide below its source
+    fitted = nbformat.from_dict(nb)
+    assert site.fit_slides(nb) == 0 and nb == fitted  # once fitted, nothing more to do
+    assert [(site._kind(c), bool(c.get("outputs"))) for c in nb.cells] == [
+        ("slide", False),
+        ("-", False),
+        ("subslide", True),
+    ]
+
+
 def test_the_slides_figure_box_is_the_one_save_figure_measures_text_in(monkeypatch):
     """check.SLIDE_FIGURE_BOX, the box save_figure measures a figure's text in as a slide shows it, is the slides'
     own: the CSS max-height of a figure and the output width fit_slides estimates with follow it (before: 1089 and
