@@ -475,9 +475,11 @@ def output_height(output) -> float:
             page = "".join(data["text/html"])
             if "<audio" in page and "<img" not in page:
                 return _AUDIO
-            frame = re.search(r"data:image/(?:png|jpeg);base64,([A-Za-z0-9+/=]+)", page)
-            if frame:  # an animation player: its first frame, then its buttons and slider
-                return _PLAYER + _shown_image_height(_image_size(frame[1]))
+            # an animation player (matplotlib's to_jshtml: base64 lines continued by a backslash): its first frame,
+            # then its buttons and slider
+            frame = re.search(r"data:image/(?:png|jpeg);base64,([A-Za-z0-9+/=\\\s]+)", page)
+            if frame:
+                return _PLAYER + _shown_image_height(_image_size(re.sub(r"[\\\s]", "", frame[1])))
             return _OUTPUT + markdown_height(re.sub(r"<[^>]+>", " ", page))
         if "text/markdown" in data:
             return _OUTPUT + markdown_height("".join(data["text/markdown"]))

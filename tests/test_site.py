@@ -487,6 +487,30 @@ def test_fit_slides_leaves_fitted_slides_as_they_are_with_an_output_taller_than_
     ]
 
 
+def test_a_player_is_estimated_as_high_as_its_first_frame_and_its_controls():
+    """matplotlib's player (``to_jshtml``, as bl.viz's animations write it) embeds each frame as base64 lines that
+    end in a backslash: the estimate stopped at the first line end, read no frame, and took every player to be a
+    600-px figure high (notebook 05's player, 768 x 416 px: its cell counted 792 px high instead of 608)."""
+    import base64
+    import io
+
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    site = _site()
+    fig = Figure(figsize=(4, 2), dpi=80)
+    (line,) = fig.add_subplot().plot([0, 1], [0, 1])
+    page = FuncAnimation(fig, lambda i: (line,), frames=2).to_jshtml()
+    first = page.split("base64,", 1)[1].split('"', 1)[0]
+    assert "\\\n" in first  # (its base64 lines, continued)
+    with Image.open(io.BytesIO(base64.b64decode(first.replace("\\\n", "")))) as image:
+        width, height = image.size
+    assert width <= site._OUTPUT_WIDTH and height < site._IMAGE_MAX_HEIGHT  # shown at its own size
+    output = new_output("display_data", data={"text/html": page, "text/plain": "<Animation>"})
+    assert site.output_height(output) == site._PLAYER + height
+
+
 def test_the_slides_figure_box_is_the_one_save_figure_measures_text_in(monkeypatch):
     """check.SLIDE_FIGURE_BOX, the box save_figure measures a figure's text in as a slide shows it, is the slides'
     own: the CSS max-height of a figure and the output width fit_slides estimates with follow it (before: 1089 and
