@@ -626,17 +626,19 @@ def fit_slides(nb, budget: float = _SLIDE_BUDGET) -> int:
     keep their tags, so RISE shows them as before).
     """
     before = sum(_kind(c) in ("slide", "subslide") for c in nb.cells)
-    cells = [part for cell in nb.cells for part in _split_cell(cell, budget)]
     ids = {c["id"] for c in nb.cells if "id" in c}
-    for i, cell in enumerate(
-        cells
-    ):  # the parts of a split cell: its id and their number (unique, as nbformat asks)
-        if "id" in cell and i and cell["id"] == cells[i - 1].get("id", "").split("-part")[0]:
-            n = 1
-            while f"{cell['id']}-part{n}" in ids:
+    cells = []
+    for cell in nb.cells:
+        parts = _split_cell(cell, budget)
+        n = 0  # the parts of a split cell: its id and their number (unique, as nbformat asks)
+        for part in parts[1:]:
+            if "id" in part:
                 n += 1
-            cell["id"] = f"{cell['id']}-part{n}"
-            ids.add(cell["id"])
+                while f"{cell['id']}-part{n}" in ids:
+                    n += 1
+                part["id"] = f"{cell['id']}-part{n}"
+                ids.add(part["id"])
+        cells += parts
     filled = 0.0
     for cell in cells:
         height = cell_height(cell)

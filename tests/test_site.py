@@ -464,6 +464,23 @@ def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
     assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
 
 
+@pytest.mark.parametrize("cell_id", ["a1b2c3d4", "theory-part-2"])
+def test_the_parts_of_a_split_cell_get_unique_ids_whatever_its_id(cell_id):
+    """A split cell's parts are numbered after its id; an id that itself holds '-part' (a name given by hand) left
+    every part with the same id (before: three cells 'theory-part-2'; nbformat then put random ids in the
+    slides' HTML and warned 'Non-unique cell id')."""
+    site = _site()
+    words = "The quick brown fox jumps over the lazy dog while the speaker gestures on every stressed word. "
+    cell = new_markdown_cell(
+        "## 1. Long\n\n" + "\n\n".join(words * 4 for _ in range(10)),
+        metadata={"slideshow": {"slide_type": "slide"}},
+    )
+    cell.id = cell_id
+    nb = new_notebook(cells=[cell])
+    assert site.fit_slides(nb) == 2
+    assert [c.id for c in nb.cells] == [cell_id, f"{cell_id}-part1", f"{cell_id}-part2"]
+
+
 def test_fit_slides_leaves_fitted_slides_as_they_are_with_an_output_taller_than_a_slide():
     """An animation player (its frame and buttons) taller than the budget goes below its source with the source
     hidden; fitting again split that cell again, into an empty cell (no source shown, no output: a blank slide)
