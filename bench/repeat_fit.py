@@ -26,7 +26,7 @@ from pathlib import Path
 import torch
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, data_dir, machine
+from beatlite.paths import code_revision, data_dir, machine, n_threads
 from beatlite.train.checkpoint import load_checkpoint
 from beatlite.train.recipes import RECIPES
 
@@ -66,6 +66,9 @@ def main() -> None:
     p.add_argument("--deterministic", nargs="+", default=["on", "off"], choices=["on", "off"])
     p.add_argument("--json", type=Path, default=None)
     args = p.parse_args()
+    torch.set_num_threads(
+        n_threads()
+    )  # the fits' threads (the fit command's), which the record's machine states
     rows, revision = [], code_revision()  # (before this run writes its record, a tracked file)
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.recipes:

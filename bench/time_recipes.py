@@ -20,8 +20,10 @@ import tempfile
 import time
 from pathlib import Path
 
+import torch
+
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, machine
+from beatlite.paths import code_revision, machine, n_threads
 from beatlite.train.recipes import RECIPES, SEED, retrain, training_data, warm_up
 
 
@@ -41,6 +43,7 @@ def main(argv: list[str] | None = None) -> None:
                         choices=sorted(RECIPES), metavar="RECIPE")  # fmt: skip
     parser.add_argument("--json", type=Path, help="write the record here")
     args = parser.parse_args(argv)
+    torch.set_num_threads(n_threads())  # as retrain trains: the threads the record's machine states
     warm_up()  # librosa's numba code compiled before the first timing
     data = training_data(progress=False)  # the window store built (or found) before the first timing
     before = machine()

@@ -38,6 +38,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from beatlite.viz.check import SLIDE_FIGURE_BOX
+
 REPO = Path(__file__).resolve().parents[1]
 SLIDE_TYPES = ("slide", "subslide", "fragment", "skip", "notes", "-")
 #: The repository named in the committed notebooks' Colab cell until ``--set-repo`` writes a real one.
@@ -323,24 +325,26 @@ _SLIDES_TEMPLATE = _SLIDES_TEMPLATE.replace("SLIDE_WIDTH", f"{SLIDE_WIDTH}").rep
     "SLIDE_HEIGHT", f"{SLIDE_HEIGHT}"
 )
 
+# A figure on a slide: at most an output's width (the frame less the prompt column, measured in Chromium) and
+# _IMAGE_MAX_HEIGHT high, the box check_figure measures the text of a saved figure in (one home: SLIDE_FIGURE_BOX).
+_OUTPUT_WIDTH, _IMAGE_MAX_HEIGHT = SLIDE_FIGURE_BOX
+
 # A slide is at most the frame's height (fit_slides splits taller ones; should an estimate fall short, the slide
 # scrolls rather than cut its end); figures at most _IMAGE_MAX_HEIGHT; code in Markdown as large as code cells.
 _SLIDES_CSS = """
 .reveal .slides > section, .reveal .slides > section > section { height: 100%; overflow-y: auto; }
-.reveal .jp-OutputArea-output img { max-height: 600px; width: auto; }
+.reveal .jp-OutputArea-output img { max-height: IMAGE_MAX_HEIGHTpx; width: auto; }
 .reveal .jp-RenderedHTMLCommon table { font-size: 16px; }
 .reveal .jp-InputArea-editor pre, .reveal .jp-OutputArea-output pre { white-space: pre-wrap; font-size: 16px; }
 .reveal .jp-RenderedMarkdown pre { font-size: 16px; line-height: 1.3; }
 .reveal .slide-number { left: 8px; right: auto; }
-"""
+""".replace("IMAGE_MAX_HEIGHT", f"{_IMAGE_MAX_HEIGHT}")
 
 # fit_slides: heights of rendered cells on a slide, CSS pixels, measured in Chromium on the 1280 x 800 frame with
 # the styles above (paragraphs 20 px text on 26 px lines, list items 32 px lines, code and printed text 16 px
 # monospace on 23 px lines, tables 16 px), and the characters per line of each, a little under what fits.
 # What the cells of one slide may fill: the frame less a margin for the estimate's error.
 _SLIDE_BUDGET = SLIDE_HEIGHT - 60
-_IMAGE_MAX_HEIGHT = 600  # the CSS max-height of a figure above
-_OUTPUT_WIDTH = 1089  # an output's width (the frame less the prompt column)
 _CELL = 12  # a cell's own padding
 _TEXT_LINE, _TEXT_CHARS, _PARAGRAPH = 27, 85, 20
 _ITEM_LINE, _ITEM_CHARS, _LIST = 32, 72, 24
@@ -471,9 +475,11 @@ def output_height(output) -> float:
             page = "".join(data["text/html"])
             if "<audio" in page and "<img" not in page:
                 return _AUDIO
-            frame = re.search(r"data:image/(?:png|jpeg);base64,([A-Za-z0-9+/=]+)", page)
-            if frame:  # an animation player: its first frame, then its buttons and slider
-                return _PLAYER + _shown_image_height(_image_size(frame[1]))
+            # an animation player (matplotlib's to_jshtml: base64 lines continued by a backslash): its first frame,
+            # then its buttons and slider
+            frame = re.search(r"data:image/(?:png|jpeg);base64,([A-Za-z0-9+/=\\\s]+)", page)
+            if frame:
+                return _PLAYER + _shown_image_height(_image_size(re.sub(r"[\\\s]", "", frame[1])))
             return _OUTPUT + markdown_height(re.sub(r"<[^>]+>", " ", page))
         if "text/markdown" in data:
             return _OUTPUT + markdown_height("".join(data["text/markdown"]))
@@ -571,8 +577,9 @@ def _split_output(output, budget: float) -> list:
 
 def _split_cell(cell, budget: float) -> list:
     """``cell`` as cells each at most ``budget`` high where it can: a Markdown cell at its blocks, a code cell's
-    source at its lines and its outputs one cell below (source hidden), itself split between outputs. A single
-    block, code line or output taller than ``budget`` stays whole."""
+    source at its lines and its outputs one cell below (source hidden), itself split between outputs (a cell whose
+    source is hidden only between outputs: no empty part). A single block, code line or output taller than
+    ``budget`` stays whole."""
     if cell_height(cell) <= budget or cell.cell_type not in ("markdown", "code"):
         return [cell]
     parts: list = []
@@ -581,7 +588,8 @@ def _split_cell(cell, budget: float) -> list:
         first = _continuation(cell, source=texts[0])
         first.metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
         return [first, *(_continuation(cell, source=text) for text in texts[1:])]
-    lines, chunk = cell.source.splitlines(), []
+    shown = not cell.metadata.get("transient", {}).get("remove_source", False)  # (hidden: moved outputs)
+    lines, chunk = cell.source.splitlines() if shown else [], []
     for line in lines:
         if (
             chunk
@@ -590,8 +598,8 @@ def _split_cell(cell, budget: float) -> list:
             parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
             chunk = []
         chunk.append(line)
-    parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
-    parts[0].metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
+    if shown:
+        parts.append(_continuation(cell, source="\n".join(chunk), outputs=[]))
     groups: list[list] = []
     for output in (part for o in cell.get("outputs", []) for part in _split_output(o, budget - _CELL)):
         if not groups or _CELL + sum(output_height(o) for o in [*groups[-1], output]) > budget:
@@ -602,6 +610,7 @@ def _split_cell(cell, budget: float) -> list:
     for group in groups:
         parts.append(_continuation(cell, outputs=group))
         parts[-1].metadata["transient"] = {"remove_source": True}
+    parts[0].metadata["slideshow"] = dict(cell.metadata.get("slideshow", {"slide_type": "-"}))
     return parts
 
 
@@ -617,17 +626,19 @@ def fit_slides(nb, budget: float = _SLIDE_BUDGET) -> int:
     keep their tags, so RISE shows them as before).
     """
     before = sum(_kind(c) in ("slide", "subslide") for c in nb.cells)
-    cells = [part for cell in nb.cells for part in _split_cell(cell, budget)]
     ids = {c["id"] for c in nb.cells if "id" in c}
-    for i, cell in enumerate(
-        cells
-    ):  # the parts of a split cell: its id and their number (unique, as nbformat asks)
-        if "id" in cell and i and cell["id"] == cells[i - 1].get("id", "").split("-part")[0]:
-            n = 1
-            while f"{cell['id']}-part{n}" in ids:
+    cells = []
+    for cell in nb.cells:
+        parts = _split_cell(cell, budget)
+        n = 0  # the parts of a split cell: its id and their number (unique, as nbformat asks)
+        for part in parts[1:]:
+            if "id" in part:
                 n += 1
-            cell["id"] = f"{cell['id']}-part{n}"
-            ids.add(cell["id"])
+                while f"{cell['id']}-part{n}" in ids:
+                    n += 1
+                part["id"] = f"{cell['id']}-part{n}"
+                ids.add(part["id"])
+        cells += parts
     filled = 0.0
     for cell in cells:
         height = cell_height(cell)

@@ -73,6 +73,31 @@ def test_batch_scaling_records_its_thread_count_host_and_torch(monkeypatch):
     )
 
 
+def test_repeat_fit_and_time_recipes_records_state_the_threads_they_train_with(monkeypatch, tmp_path):
+    """Their records' ``machine["threads"]`` is ``BEATLITE_THREADS``, the threads the fits run with (before: the
+    recording process's torch default, one per core whatever ``BEATLITE_THREADS`` said, as neither process had set
+    it when it described the machine). The trainings are stubbed: what is checked is the record."""
+    import json
+
+    before = torch.get_num_threads()
+    want = 1 if before != 1 else 2  # a count the process does not have already
+    monkeypatch.setenv("BEATLITE_THREADS", str(want))
+    repeat_fit, time_recipes = _load("repeat_fit"), _load("time_recipes")
+    monkeypatch.setattr(repeat_fit, "fit_once", lambda *a: {"state": {"w": torch.zeros(1)}, "history": []})
+    for name, stub in (("warm_up", lambda: None), ("training_data", lambda progress: None),
+                       ("retrain", lambda name, **kw: 1.0)):  # fmt: skip
+        monkeypatch.setattr(time_recipes, name, stub)
+    argv = ["repeat_fit.py", "--recipes", "camn_tiny", "--device", "cpu", "--deterministic", "on"]
+    monkeypatch.setattr(sys, "argv", [*argv, "--json", str(tmp_path / "repeat.json")])
+    try:
+        repeat_fit.main()
+        time_recipes.main(["--recipes", "camn_tiny", "--json", str(tmp_path / "times.json")])
+    finally:
+        torch.set_num_threads(before)
+    for record in ("repeat.json", "times.json"):
+        assert json.loads((tmp_path / record).read_text())["machine"]["threads"] == want, record
+
+
 def test_gpu_record_renders_the_readme_table_from_the_shipped_record():
     """bench/gpu_record.py's table of bench/records/bench_train_h200.json is the README's block, to the byte."""
     import json

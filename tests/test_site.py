@@ -464,6 +464,83 @@ def test_fit_slides_breaks_a_slide_taller_than_the_frame_below_it():
     assert site.fit_slides(nb) == 0  # once fitted, nothing more to do
 
 
+@pytest.mark.parametrize("cell_id", ["a1b2c3d4", "theory-part-2"])
+def test_the_parts_of_a_split_cell_get_unique_ids_whatever_its_id(cell_id):
+    """A split cell's parts are numbered after its id; an id that itself holds '-part' (a name given by hand) left
+    every part with the same id (before: three cells 'theory-part-2'; nbformat then put random ids in the
+    slides' HTML and warned 'Non-unique cell id')."""
+    site = _site()
+    words = "The quick brown fox jumps over the lazy dog while the speaker gestures on every stressed word. "
+    cell = new_markdown_cell(
+        "## 1. Long\n\n" + "\n\n".join(words * 4 for _ in range(10)),
+        metadata={"slideshow": {"slide_type": "slide"}},
+    )
+    cell.id = cell_id
+    nb = new_notebook(cells=[cell])
+    assert site.fit_slides(nb) == 2
+    assert [c.id for c in nb.cells] == [cell_id, f"{cell_id}-part1", f"{cell_id}-part2"]
+
+
+def test_fit_slides_leaves_fitted_slides_as_they_are_with_an_output_taller_than_a_slide():
+    """An animation player (its frame and buttons) taller than the budget goes below its source with the source
+    hidden; fitting again split that cell again, into an empty cell (no source shown, no output: a blank slide)
+    and the player, whose copy had the same id (notebooks 05 and 08's decks: one slide more at every call)."""
+    site = _site()
+    player = f"<div class='animation'><img id='frame' src='data:image/png;base64,{_png_of(1000, 900)}'></div>"
+    cells = [
+        new_markdown_cell("## 1. Motion", metadata={"slideshow": {"slide_type": "slide"}}),
+        new_code_cell("HTML(anim.to_html())", metadata={"slideshow": {"slide_type": "-"}}, execution_count=1),
+    ]
+    cells[1].outputs = [new_output("display_data", data={"text/html": player, "text/plain": "<HTML>"})]
+    nb = new_notebook(cells=cells)
+    assert site.cell_height(cells[1]) - site.cell_height(new_code_cell(cells[1].source)) > site._SLIDE_BUDGET
+    assert site.fit_slides(nb) == 1  # the player on a slide below its source
+    fitted = nbformat.from_dict(nb)
+    assert site.fit_slides(nb) == 0 and nb == fitted  # once fitted, nothing more to do
+    assert [(site._kind(c), bool(c.get("outputs"))) for c in nb.cells] == [
+        ("slide", False),
+        ("-", False),
+        ("subslide", True),
+    ]
+
+
+def test_a_player_is_estimated_as_high_as_its_first_frame_and_its_controls():
+    """matplotlib's player (``to_jshtml``, as bl.viz's animations write it) embeds each frame as base64 lines that
+    end in a backslash: the estimate stopped at the first line end, read no frame, and took every player to be a
+    600-px figure high (notebook 05's player, 768 x 416 px: its cell counted 792 px high instead of 608)."""
+    import base64
+    import io
+
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    site = _site()
+    fig = Figure(figsize=(4, 2), dpi=80)
+    (line,) = fig.add_subplot().plot([0, 1], [0, 1])
+    page = FuncAnimation(fig, lambda i: (line,), frames=2).to_jshtml()
+    first = page.split("base64,", 1)[1].split('"', 1)[0]
+    assert "\\\n" in first  # (its base64 lines, continued)
+    with Image.open(io.BytesIO(base64.b64decode(first.replace("\\\n", "")))) as image:
+        width, height = image.size
+    assert width <= site._OUTPUT_WIDTH and height < site._IMAGE_MAX_HEIGHT  # shown at its own size
+    output = new_output("display_data", data={"text/html": page, "text/plain": "<Animation>"})
+    assert site.output_height(output) == site._PLAYER + height
+
+
+def test_the_slides_figure_box_is_the_one_save_figure_measures_text_in(monkeypatch):
+    """check.SLIDE_FIGURE_BOX, the box save_figure measures a figure's text in as a slide shows it, is the slides'
+    own: the CSS max-height of a figure and the output width fit_slides estimates with follow it (before: 1089 and
+    600 written again in build_site.py, so a change to one side left the check measuring another slide)."""
+    from beatlite.viz import check
+
+    monkeypatch.setattr(check, "SLIDE_FIGURE_BOX", (900, 500))
+    site = _site()  # (executed afresh: its constants from the box above)
+    assert (site._OUTPUT_WIDTH, site._IMAGE_MAX_HEIGHT) == (900, 500)
+    assert ".reveal .jp-OutputArea-output img { max-height: 500px; width: auto; }" in site._SLIDES_CSS
+    assert site._shown_image_height((1800, 900)) == 450  # 900 px wide: half its size
+
+
 def test_slides_fit_the_frame_in_chromium(tmp_path):
     """Measured in the browser at the deck's size: no slide of a deck with tall sections scrolls, and reveal.js
     counts the slides fit_slides made."""

@@ -727,6 +727,26 @@ def test_annotation_legend_lists_only_the_gesture_types_it_draws():
     plt.close("all")
 
 
+def test_annotation_legend_gives_every_gesture_type_its_own_colour():
+    """BEAT's ten scoring types and the two its files may also hold (``habit``, ``need_cut``): twelve types drawn,
+    twelve colours in the legend (tab10 alone gave 'habit' the colour of '01_beat_align' and 'need_cut' that of
+    '02_deictic_l')."""
+    from beatlite.io.emotion import EmotionSegment
+    from beatlite.io.semantic import SemanticSegment
+    from beatlite.viz import figures
+
+    types = [f"{i:02d}_type" for i in range(1, 11)] + ["habit", "need_cut"]
+    semantic = [SemanticSegment(t, 2.0 * i, 2.0 * i + 1.5, 1.5, 0.5) for i, t in enumerate(types)]
+    fig = figures.plot_annotations(
+        [EmotionSegment("neutral", 0.0, 24.0, 24.0, 0)], semantic, np.zeros(24 * 15), 15, 24.0
+    )
+    legend = fig.axes[1].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == types
+    colours = [tuple(h.get_facecolor()) for h in legend.legend_handles]
+    assert len(set(colours)) == len(types), colours
+    plt.close("all")
+
+
 def _slide_animation(**kwargs):
     sr = 1000
     audio = np.sin(2 * np.pi * 5 * np.arange(2 * sr) / sr)

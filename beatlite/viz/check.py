@@ -49,8 +49,8 @@ import numpy as np
 MIN_TEXT_PX = 8.0
 
 #: The largest picture a slide shows at its own size, pixels (width, height): the output column of the
-#: course's 1280 x 800 slides and their figures' height limit (``scripts/build_site.py``); a larger picture is
-#: scaled down to fit, its text with it.
+#: course's 1280 x 800 slides and their figures' height limit (``scripts/build_site.py`` reads both from here: its
+#: CSS max-height and its slide-height estimates); a larger picture is scaled down to fit, its text with it.
 SLIDE_FIGURE_BOX = (1089, 600)
 
 #: Two colours closer than this in every RGB channel (0-1) count as one colour.

@@ -141,6 +141,8 @@ def plot_annotations(
 
     A segment's bar is as high as its score, so a type whose segments all score 0 (``00_nogesture``) draws
     nothing: it is left out of the legend (its spans are the gaps between bars) unless no segment scores.
+    Each drawn type has a colour of its own: tab10's hues for up to 10 types (BEAT's scoring ones), tab20's 20
+    colours for more (``habit`` and ``need_cut`` besides them).
 
     Parameters
     ----------
@@ -162,9 +164,9 @@ def plot_annotations(
 
     drawn = [seg for seg in semantic if seg.score > 0] or list(semantic)  # the segments that draw a bar
     types = sorted({seg.type for seg in drawn})
-    type_colour = {
-        name: plt.cm.tab10(i % 10) for i, name in enumerate(types)
-    }  # one hue each (BEAT: 10 types)
+    # one hue each: tab10 for BEAT's 10 scoring types, tab20 when more are drawn (``habit``, ``need_cut``)
+    cmap = plt.cm.tab10 if len(types) <= 10 else plt.cm.tab20
+    type_colour = {name: cmap(i % cmap.N) for i, name in enumerate(types)}
     with figure_style():
         fig, axes = plt.subplots(
             3, 1, figsize=(10, 3.8), sharex=True, gridspec_kw={"height_ratios": [1, 2, 1.5]}
