@@ -2,19 +2,26 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 REAL_SAMPLES = Path(os.environ.get("BEATLITE_REAL_SAMPLES", REPO.parent / "shared" / "real_samples"))
-# torch.compile's kernels (inductor) are cached in this clone's build/, for this process and the ones it starts,
-# not in the machine-wide /tmp/torchinductor_$USER: every run of the tests starts from what a fresh clone on
-# another machine has, and an entry half-written there by a killed process (a 0-byte ``.so``: "file too short"
-# at every later compile of that kernel) or by another checkout's code cannot fail them.
-INDUCTOR_CACHE = REPO / "build" / "torchinductor"
-os.environ.setdefault("TORCHINDUCTOR_CACHE_DIR", str(INDUCTOR_CACHE))
+# torch.compile's kernels (inductor) are cached in a folder of this test session's own, under this clone's build/,
+# for this process and the ones it starts, and removed at its end: not in the machine-wide /tmp/torchinductor_$USER
+# nor in a folder a later run reuses, where an entry half-written by a killed process (a 0-byte ``.so``: "file too
+# short" at every later compile of that kernel) or by another checkout's code would fail every later run. The tests
+# that compile pay for compiling each run, as on a fresh clone of another machine.
+if "TORCHINDUCTOR_CACHE_DIR" not in os.environ:
+    (REPO / "build").mkdir(exist_ok=True)
+    INDUCTOR_CACHE = Path(tempfile.mkdtemp(prefix="torchinductor_", dir=REPO / "build"))
+    atexit.register(shutil.rmtree, INDUCTOR_CACHE, True)
+    os.environ["TORCHINDUCTOR_CACHE_DIR"] = str(INDUCTOR_CACHE)
 
 
 @pytest.fixture(scope="session")

@@ -87,13 +87,19 @@ def test_import_is_lazy():
     assert json.loads(out.stdout.strip().splitlines()[-1]) == [], "import beatlite loads heavy modules"
 
 
-def test_compiled_kernels_are_cached_in_this_clone():
-    """``conftest.py`` points inductor's cache at ``build/torchinductor`` (unless the caller chose one), and the
-    torch in use reads it there: what compiles in the tests never depends on the machine-wide cache in /tmp."""
+def test_compiled_kernels_are_cached_in_this_session_s_own_folder():
+    """``conftest.py`` points inductor's cache at a new folder under ``build/`` for this session (unless the caller
+    chose one) and torch reads it there: nothing compiled by an earlier, perhaps killed, run or another checkout
+    is loaded, and the machine-wide cache in /tmp is not touched."""
     pytest.importorskip("torch")
-    from torch._inductor.runtime.cache_dir_utils import cache_dir, default_cache_dir
+    import conftest
+    from torch._inductor.runtime.cache_dir_utils import cache_dir
 
-    assert Path(cache_dir()) == Path(os.environ["TORCHINDUCTOR_CACHE_DIR"]) != Path(default_cache_dir())
+    chosen = Path(os.environ["TORCHINDUCTOR_CACHE_DIR"])
+    assert Path(cache_dir()) == chosen
+    if hasattr(conftest, "INDUCTOR_CACHE"):  # (not when the caller set TORCHINDUCTOR_CACHE_DIR)
+        assert chosen == conftest.INDUCTOR_CACHE and chosen.parent == REPO / "build"
+        assert chosen.name.startswith("torchinductor_") and chosen.is_dir()
 
 
 def test_ci_runs_the_readme_test_command():
