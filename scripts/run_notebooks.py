@@ -287,11 +287,15 @@ def write_record(path: Path, timings: list[dict], total: float, about: dict) -> 
     from beatlite.io.atomic import write_json
     from beatlite.paths import code_revision
 
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024**2  # (kB on Linux) -> GB
+    peak = (
+        resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+        * (1 if sys.platform == "darwin" else 1024)
+        / 2**30
+    )
     settings = {k: os.environ.get(k) for k in ("BEATLITE_MODE", "BEATLITE_THREADS", "BEATLITE_DATA")}
     write_json(path, {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
                       "date": time.strftime("%Y-%m-%d"), "machine": about, "settings": settings,
-                      "total_wall_seconds": total, "largest_kernel_gb": peak, "rows": timings})  # fmt: skip
+                      "total_wall_seconds": total, "largest_kernel_gib": peak, "rows": timings})  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -349,8 +349,12 @@ def test_the_guide_run_times_and_the_headers_are_the_notebooks_record():
     cells = [c.strip() for c in row.strip().strip("|").split("|")][1:]
     assert cells == [f"{r['wall_seconds']:.1f}" for r in rows] + [
         f"{total:.0f} ({minutes} min {seconds} s; {user:.0f} s of the kernels' user CPU, "
-        f"{record['largest_kernel_gb']:.2f} GB resident at most in one kernel)"
+        f"{record['largest_kernel_gib']:.2f} GiB resident at most in one kernel)"
     ]
+    peak = (
+        f"{record['largest_kernel_gib']:.2f} GiB resident in one kernel (`bench/records/notebooks_cpu.json`)"
+    )
+    assert f"One `make run` here used at most {peak}" in guide  # the troubleshooting table
     for path, r in zip(NOTEBOOKS, rows):
         assert header_times(path)["run"] == f"~{_nice(r['wall_seconds'])} s", path.name
     flat = " ".join(guide.split())

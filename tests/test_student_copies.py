@@ -117,4 +117,4 @@ def test_the_run_record_holds_each_notebook_s_times_and_the_epochs_it_printed(tm
     ]
     assert all(r["wall_seconds"] > 0 and r["kernel_user_seconds"] >= 0 for r in record["rows"])
     assert record["total_wall_seconds"] >= sum(r["wall_seconds"] for r in record["rows"])
-    assert record["largest_kernel_gb"] > 0 and record["machine"]["cpus"] and record["revision"]
+    assert record["largest_kernel_gib"] > 0 and record["machine"]["cpus"] and record["revision"]
