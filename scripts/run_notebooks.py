@@ -186,10 +186,23 @@ def offline_notebook(nb):
     return nb
 
 
+_BASE64 = re.compile(r"data:[\w/+.-]+;base64,(?:[A-Za-z0-9+/=]|\\\r?\n)*")  # (lines may end in "\")
+
+
 def local_paths(text: str) -> str:
     """``text`` without this machine's folders: the repository root's path left out of the paths below it
     (``/home/alice/beatlite/build/tables/x.md`` -> ``build/tables/x.md``, the root itself ``.``) and the home
-    folder written ``~`` (a data folder outside the repository: ``~/beat``), so a published page names no user."""
+    folder written ``~`` (a data folder outside the repository: ``~/beat``), so a published page names no user.
+    Base64 data (``data:image/png;base64,...``: the animation player's frames) is left as it is: its letters
+    and slashes can spell a short home folder such as ``/root/`` by chance."""
+    parts, end = [], 0
+    for match in _BASE64.finditer(text):
+        parts += [_local_paths(text[end : match.start()]), match.group()]
+        end = match.end()
+    return "".join([*parts, _local_paths(text[end:])])
+
+
+def _local_paths(text: str) -> str:
     for root, short in ((REPO, ""), (Path.home(), "~")):
         if str(root) in ("", "/", "."):
             continue

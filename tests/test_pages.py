@@ -296,6 +296,16 @@ def test_page_names_no_folder_of_the_machine_that_ran_it(monkeypatch):
     assert "split of <code>data_samples</code>" in html and f"{repo}/" not in html and "alice" not in html
 
 
+def test_base64_data_is_left_as_it_is_where_its_letters_spell_the_home_folder(monkeypatch):
+    """An animation player's frames are base64, whose letters and slashes can spell ``/root/`` (a short home
+    folder) by chance: rewriting them would break the frame. Paths outside the data are still rewritten."""
+    runner = _runner()
+    monkeypatch.setenv("HOME", "/root")
+    frame = 'data:image/png;base64,iVBO/root/Rw0K\\\nGgo/root=="'
+    text = f'frames[0] = "{frame}; see /root/beat'
+    assert runner.local_paths(text) == f'frames[0] = "{frame}; see ~/beat'
+
+
 def test_page_renders_offline_in_chromium(small_page, tmp_path):
     _chromium()
     browser = Browser(tmp_path / "profile")
