@@ -421,6 +421,13 @@ def vote_agreement(
         ``tau`` and ``p_value`` of ``kendall_tau(scores, bradley_terry_order(wins))``, the interval over vote
         resamples.
 
+    Raises
+    ------
+    ValueError
+        ``wins`` not a square count matrix, a system never compared, ``scores`` not one value per system, or
+        votes whose separated groups have no single order (:func:`bradley_terry_order`: two groups each won
+        every vote against the rest).
+
     Examples
     --------
     >>> wins = simulate_votes([0.5, 0.3, 0.2], 200, seed=1)
