@@ -453,3 +453,30 @@ def test_the_re_recorded_a2g_row_is_the_seed_record():
     )
     reference = " ".join((ROOT / "docs" / "reference_code.md").read_text().split())
     assert f"A2G-style FGD {fgd['mean']:.2f} ± {fgd['sd']:.2f} sd (re-recorded on 2026-11-27" in reference
+
+
+def test_the_readme_store_scale_table_and_its_sums_are_the_record():
+    record = _record("bench_scale_cpu.json")
+    rows = record["rows"]
+    readme = _readme()
+    table = readme.split("`bench/records/bench_scale_cpu.json`):")[1].split("\n\n")[1].splitlines()[2:]
+    assert table == [
+        f"| {r['hours']:.0f} | {r['store_gb']:.2f} GB | {r['store_s']:.0f} ({r['store_cpu_per_h'] * r['hours']:.0f}) | "
+        f"{r['store_rss_main']:.2f} / {r['store_rss_child']:.2f} GiB | {r['epoch_rss_main']:.2f} / "
+        f"{r['epoch_rss_child']:.2f} GiB | {r['epoch_wps']:,.0f} |"
+        for r in rows
+    ]
+    text = " ".join(readme.split())
+    per_hour = [r["store_gb_per_h"] for r in rows]
+    assert (
+        round(16 * max(per_hour)) == 5 and round(76 * max(per_hour)) == 23
+    )  # "about 5 GB" and "about 23 GB"
+    assert all(r["store_rss_main"] + 2 * r["store_rss_child"] < 2 for r in rows)  # "flat at under 2 GiB"
+    cpu = [r["store_cpu_per_h"] for r in rows]
+    c = rows[-1]["store_cpu_per_h"]
+    assert (
+        f"building takes {min(cpu):.0f}–{max(cpu):.0f} CPU-seconds per hour of mocap (≈ {16 * c / 2 / 60:.0f} min for "
+        f"16 h on 2 free cores, ≈ {76 * c / 2 / 60:.0f} min for 76 h" in text
+    )
+    four = next(r for r in rows if round(r["hours"]) == 4)
+    assert f"one torch thread, {four['train_windows']:,} train windows, idle machine" in text
