@@ -23,6 +23,14 @@ def _readme() -> str:
     return (ROOT / "README.md").read_text()
 
 
+def _guide() -> str:
+    return (ROOT / "docs" / "teaching.md").read_text()
+
+
+def _record(name: str) -> dict:
+    return json.loads((RECORDS / name).read_text())
+
+
 def _table_rows() -> list[list[str]]:
     table = _readme().split("<!-- gpu-table: bench/records/bench_train_h200.json -->")[1]
     lines = table.split("<!-- /gpu-table -->")[0].strip().splitlines()[2:]
@@ -30,7 +38,7 @@ def _table_rows() -> list[list[str]]:
 
 
 def _runs() -> dict[str, dict]:
-    return {r["name"]: r for r in json.loads(RECORD.read_text())["runs"]}
+    return {r["name"]: r for r in _record(RECORD.name)["runs"]}
 
 
 def _row(
@@ -126,7 +134,7 @@ def test_the_readme_gpu_sentences_match_the_records_and_the_logs():
     tiny = _row("full", "camn", "tiny", "fp32", 64, "eager", True)
     best_ha2g = _row("tune", "ha2g", "paper", "bf16", 512, "eager", False)
     ha2g_fp32 = _row("full", "ha2g", "paper", "fp32", 64, "eager", True)
-    issue = json.loads((RECORDS / "issue28_h200_9fb39d3.json").read_text())
+    issue = _record("issue28_h200_9fb39d3.json")
     before = {(r["model"], r["preset"], r["precision"], r["batch"]): r for r in issue["step"]["rows"]}
     before_fit = {(r["model"], r["preset"], r["device"], r["batch"]): r["wps"] for r in issue["fit"]["rows"]}
     b64, b1024 = before["camn", "paper", "fp32", 64], before["camn", "paper", "bf16", 1024]
@@ -212,7 +220,7 @@ def test_the_frame_conv1d_docstring_quotes_the_profile():
 
 
 def test_the_readme_repeat_sentence_is_the_cpu_record():
-    record = json.loads((RECORDS / "repeat_fit_cpu.json").read_text())
+    record = _record("repeat_fit_cpu.json")
     rows = record["rows"]
     assert {(r["recipe"], r["deterministic"]) for r in rows} == {
         (name, det) for name in ("camn_tiny", "ha2g_tiny") for det in (True, False)
@@ -227,7 +235,7 @@ def test_the_readme_repeat_sentence_is_the_cpu_record():
 
 
 def test_the_readme_batch_scaling_sentences_are_the_record():
-    record = json.loads((RECORDS / "batch_scaling_camn_tiny.json").read_text())
+    record = _record("batch_scaling_camn_tiny.json")
     assert record["recipe"] == "camn_tiny" and record["epochs"] == 40 and record["recipe_batch"] == 32
     rows = record["rows"]
     assert {r["seed"] for r in rows} == {2021, 2022, 2023}
@@ -263,7 +271,7 @@ def test_the_readme_batch_scaling_sentences_are_the_record():
     train = len(training_data(progress=False).train)
     steps = math.ceil(train / 128)  # (fit keeps a last, shorter batch of 2 windows or more)
     assert f"With its {train} train windows, batch 128 is {steps} steps per epoch" in text
-    equal = json.loads((RECORDS / "batch_scaling_camn_tiny_equal_steps.json").read_text())
+    equal = _record("batch_scaling_camn_tiny_equal_steps.json")
     assert {(r["batch"], r["rule"], r["seed"]) for r in equal["rows"]} == {
         (128, "linear", s) for s in (2021, 2022, 2023)
     }
@@ -284,7 +292,7 @@ def test_counts_and_estimates_of_the_cpu_sentences_follow_their_sources():
     windows/s the README states."""
     from beatlite.train.recipes import RECIPES
 
-    readme, guide = _readme(), (ROOT / "docs" / "teaching.md").read_text()
+    readme, guide = _readme(), _guide()
     flat = " ".join(readme.split())
     assert (
         f"All {len(RECIPES)} shipped recipes with three seeds each (`make seeds`, {3 * len(RECIPES)} trainings)"
@@ -296,14 +304,6 @@ def test_counts_and_estimates_of_the_cpu_sentences_follow_their_sources():
         f"about {minutes} min per CaMN tiny epoch on one CPU thread (80,000 windows at about 150 windows/s)"
         in " ".join(guide.split())
     )
-
-
-def _record(name: str) -> dict:
-    return json.loads((RECORDS / name).read_text())
-
-
-def _guide() -> str:
-    return (ROOT / "docs" / "teaching.md").read_text()
 
 
 def _nice(seconds: float) -> int:
