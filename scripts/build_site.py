@@ -353,7 +353,6 @@ _HEADINGS = {1: (60, 50, 40), 2: (39, 40, 55), 3: (32, 36, 65), 4: (27, 30, 80)}
 _MATH = 70  # a display formula with its margins
 _CODE_LINE, _CODE_CHARS, _CODE = 23, 95, 23  # code cells and fenced code
 _PRINTED_CHARS, _OUTPUT, _FIGURE, _PLAYER, _AUDIO = 85, 16, 56, 180, 80
-_FENCED = re.compile(r"^ {0,3}(```|~~~)")
 _LIST_ITEM = re.compile(r"^\s*(?:[-*+]|\d+\.)\s+")
 
 
@@ -376,14 +375,15 @@ def _markdown_blocks(source: str) -> list[tuple[str, list[str]]]:
     blocks: list[tuple[str, list[str]]] = []
     lines, fenced = [], False
     for line in [*source.splitlines(), ""]:
-        if fenced or _FENCED.match(line):
+        fence = _FENCE.match(line)
+        if fenced or fence:
             lines.append(line)
-            if _FENCED.match(line) and (fenced or len(lines) == 1):
+            if fence and (fenced or len(lines) == 1):
                 fenced = not fenced
                 if not fenced:
                     blocks.append(("fence", lines))
                     lines = []
-            elif _FENCED.match(line):  # a fence opening after text
+            elif fence:  # a fence opening after text
                 blocks.append(("text", lines[:-1]))
                 lines, fenced = [line], True
             continue
