@@ -224,7 +224,7 @@ def _other_slot(label: str) -> int:
 
 
 def _lighter(colour: str, step: int) -> str:
-    """``colour`` mixed with white: half way for ``step`` 1, three quarters for 2, ..."""
+    """``colour`` mixed with white: not at all for ``step`` 0, half way for 1, three quarters for 2, ..."""
     from matplotlib.colors import to_hex, to_rgb
 
     mix = 1.0 - 0.5**step
@@ -323,11 +323,7 @@ def system_colours(labels: Sequence[str]) -> list[str]:
     for label in [*sorted(unnamed, key=lambda x: (str(x).lower(), str(x))), *overflow]:
         start = _other_slot(label) if label in unnamed else 0
         candidates = (
-            OTHER_SYSTEM_COLOURS[(start + k) % n]
-            if step == 0
-            else _lighter(OTHER_SYSTEM_COLOURS[(start + k) % n], step)
-            for step in range(4)
-            for k in range(n)
+            _lighter(OTHER_SYSTEM_COLOURS[(start + k) % n], step) for step in range(4) for k in range(n)
         )
         colour = next((c for c in candidates if c not in taken), OTHER_SYSTEM_COLOURS[start])
         taken.add(colour)
