@@ -345,8 +345,9 @@ def main(argv: list[str] | None = None) -> int:
         write_student_copy(path, out / "student")
         failed += not ok
         rows.append((path.stem, ok, seconds, message))
-        timings.append({"notebook": path.stem, "ok": ok, "wall_seconds": seconds, "kernel_user_seconds": kernels,
-                        "printed_epoch_seconds": printed_epoch_seconds(out / "notebooks" / path.name)})  # fmt: skip
+        if args.record:  # (reads the executed notebook again)
+            timings.append({"notebook": path.stem, "ok": ok, "wall_seconds": seconds, "kernel_user_seconds": kernels,
+                            "printed_epoch_seconds": printed_epoch_seconds(out / "notebooks" / path.name)})  # fmt: skip
         print(f"[run] {path.name}: {'ok' if ok else 'FAILED'} in {seconds:.1f} s {message}", flush=True)
     total = time.perf_counter() - total
     _instructor_sheet().write_sheets(out / "instructor", [p.resolve() for p in paths])
