@@ -190,3 +190,34 @@ def test_bench_data_without_out_leaves_nothing_in_the_temp_folder(tmp_path):
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-6000:]
     assert "TOTAL cache build" in done.stdout  # (it ran to its last part)
     assert [p.name for p in temp.iterdir() if p.name.startswith("bench_data_")] == []
+
+
+@pytest.mark.slow
+def test_bench_fit_command_times_each_phase_of_a_fresh_and_a_repeated_fit(tmp_path):
+    """bench/bench_fit_command.py runs the README's ``fit`` command twice on one ``--out``: the fresh run
+    prepares the store and trains the FGD extractor, the repeated one only trains; the phases come from the
+    command's own lines (the extractor's ``wrote ... in N s``, fit's ``N s of training``)."""
+    import json
+    import os
+
+    from childproc import run_ok
+
+    corpus = tmp_path / "corpus"  # data_samples/ under another name: fit trains an extractor for it
+    for source in (ROOT / "data_samples").rglob("*"):
+        if source.is_file():
+            (corpus / source.relative_to(ROOT / "data_samples")).parent.mkdir(parents=True, exist_ok=True)
+            (corpus / source.relative_to(ROOT / "data_samples")).symlink_to(source)
+    record = tmp_path / "fit.json"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp_path)}
+    run_ok([sys.executable, str(ROOT / "bench" / "bench_fit_command.py"), "--corpus", str(corpus),
+            "--extractor-epochs", "2", "--json", str(record)], env=env, cwd=tmp_path, timeout=900)  # fmt: skip
+    got = json.loads(record.read_text())
+    assert (
+        got["fit_command"].endswith("--epochs 1 --device cpu --extractor-epochs 2") and got["hours"] is None
+    )
+    fresh, again = got["runs"]["fresh"], got["runs"]["again"]
+    assert fresh["extractor_s"] is not None and again["extractor_s"] is None  # kept: not trained again
+    for run in (fresh, again):
+        assert run["train_s"] > 0 and run["prepare_s"] > 0 and run["peak_rss_kib"] > 0
+        assert run["prepare_s"] + (run["extractor_s"] or 0) + run["train_s"] <= run["wall_s"]
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith("bench_fit_command_")] == []

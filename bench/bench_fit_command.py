@@ -1,0 +1,162 @@
+"""The README's ``fit`` command on a BEAT-rate corpus: wall time, peak memory and where the time goes.
+
+It makes (or reuses, ``--corpus``) a corpus of ``--hours`` of BEAT-rate takes with
+:func:`bench_scale.make_corpus`, then runs the command the README gives for real data,
+``python -m beatlite.train fit RECIPE --data CORPUS --out OUT --epochs 1 --device cpu``, twice on the
+same ``OUT``: ``fresh`` (index, window store, FGD extractor and training all from nothing) and
+``again`` (index cached, store current, extractor kept: only training). Each run is started from a
+fresh measuring process, so that its peak RSS (``ru_maxrss`` of the largest process of the command's
+tree: the main process, the store-build workers, the extractor's process) is its own, as ``/usr/bin/time
+-v`` reports it.
+
+Where the time goes is read from the command's own lines, each stamped with the second it arrived:
+``prepare_s`` (index and store: until the extractor's first line, or until training starts),
+``extractor_s`` (the seconds the extractor prints when it writes itself), and ``train_s`` (the seconds
+``fit`` prints for training and its validations).
+
+Usage: ``python bench/bench_fit_command.py [--hours 4] [--recipe camn_tiny] [--corpus DIR] [--keep DIR]
+[--json FILE]``. A 4-hour corpus needs about 8 GB of temporary disk and about 10 minutes on 2 cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("BEATLITE_THREADS", "1")
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_scale import make_corpus  # noqa: E402
+
+from beatlite.io.atomic import write_json  # noqa: E402
+from beatlite.paths import code_revision, machine, n_threads  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+EXTRACTOR_START = "training the FGD extractor"
+EXTRACTOR_WROTE = re.compile(r"^wrote .*fgd_dirvec\.pt .* in (\d+) s")
+TRAINED = re.compile(r"^\S+: ([0-9.]+) s of training; wrote ")
+
+
+def fit_command(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> list[str]:
+    """The README's command for real data, as an argument list (``extractor_epochs``: None for fit's default)."""
+    extra = [] if extractor_epochs is None else ["--extractor-epochs", str(extractor_epochs)]
+    return [sys.executable, "-m", "beatlite.train", "fit", recipe, "--data", str(corpus), "--out", str(out),
+            "--epochs", "1", "--device", "cpu", *extra]  # fmt: skip
+
+
+def phases(lines: list[tuple[float, str]], wall_s: float) -> dict[str, float | None]:
+    """Seconds of each phase from the command's ``(arrival second, line)`` pairs (None: the phase did not run).
+
+    >>> phases([(30.0, "training the FGD extractor on c -> o (100 epochs on the train windows)"),
+    ...         (400.0, "wrote o/fgd_dirvec.pt (1.00 MB) in 369 s; ..."),
+    ...         (460.0, "camn_tiny: 58.0 s of training; wrote o/camn_tiny.pt")], 461.0)
+    {'prepare_s': 30.0, 'extractor_s': 369.0, 'train_s': 58.0}
+    """
+    started = next((t for t, line in lines if line.startswith(EXTRACTOR_START)), None)
+    wrote = next((float(m[1]) for _, line in lines if (m := EXTRACTOR_WROTE.match(line))), None)
+    train = next((float(m[1]) for _, line in lines if (m := TRAINED.match(line))), None)
+    prepare = started if started is not None else (None if train is None else wall_s - train)
+    return {"prepare_s": prepare, "extractor_s": wrote, "train_s": train}
+
+
+def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> dict:
+    """Run the command once (in this fresh process's only child); its wall seconds, peak RSS and phases."""
+    command = fit_command(recipe, corpus, out, extractor_epochs)
+    tic = time.perf_counter()
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             text=True, bufsize=1)  # fmt: skip
+    lines = []
+    for line in child.stdout:  # tqdm's bars end in \r, so a bar's updates arrive with the next \n
+        lines.append((time.perf_counter() - tic, line.rstrip("\n").split("\r")[-1]))
+    if child.wait() != 0:
+        tail = "\n".join(line for _, line in lines[-40:])
+        raise RuntimeError(f"{' '.join(command)} exited {child.returncode}:\n{tail}")
+    wall = time.perf_counter() - tic
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return {
+        "wall_s": wall,
+        "cpu_s": usage.ru_utime + usage.ru_stime,
+        "peak_rss_kib": usage.ru_maxrss,
+        "peak_rss_gib": usage.ru_maxrss / 2**20,
+        **phases(lines, wall),
+        "output_tail": [line for _, line in lines[-6:]],
+    }
+
+
+def _run_step(args: list[str]) -> dict:
+    """Run this file with ``--step ...`` in a fresh interpreter; returns its JSON line."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run(
+        [sys.executable, __file__, *args], capture_output=True, text=True, env=env, check=False
+    )
+    if out.returncode != 0:
+        raise RuntimeError(f"step {args} failed:\n{out.stderr[-3000:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--hours", type=float, default=4.0, help="corpus size to make (default 4)")
+    p.add_argument("--recipe", default="camn_tiny", help="the recipe fit trains (default camn_tiny)")
+    p.add_argument("--corpus", type=Path, default=None, help="use this corpus instead of making one")
+    p.add_argument("--data", type=Path, default=REPO / "data_samples", help="source of the corpus made")
+    p.add_argument("--workers", type=int, default=2, help="processes making the corpus")
+    p.add_argument("--keep", type=Path, default=None, help="keep the corpus and the run under this folder")
+    p.add_argument(
+        "--json", type=Path, default=None, help="write the runs, command, revision and machine here"
+    )
+    p.add_argument("--extractor-epochs", type=int, default=None, help="passed to fit (default: fit's own)")
+    p.add_argument("--step", nargs=3, metavar=("RECIPE", "CORPUS", "OUT"), help=argparse.SUPPRESS)
+    args = p.parse_args()
+    if args.step:
+        print(
+            json.dumps(step_fit(args.step[0], Path(args.step[1]), Path(args.step[2]), args.extractor_epochs))
+        )
+        return 0
+    base = Path(tempfile.mkdtemp(prefix="bench_fit_command_", dir=args.keep))
+    try:
+        corpus = args.corpus
+        if corpus is None:
+            corpus = base / "corpus"
+            print(f"making a {args.hours:g}-hour corpus in {corpus}", flush=True)
+            make_corpus(args.data, corpus, args.hours, args.workers)
+        about = {
+            "command": " ".join(["python", *sys.argv]),
+            "revision": code_revision(),
+            "date": time.strftime("%Y-%m-%d"),
+            "machine": {**machine(), "threads": n_threads()},
+            "fit_command": " ".join(
+                ["python", *fit_command(args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs)[1:]]
+            ),
+            "hours": args.hours if args.corpus is None else None,
+        }  # fmt: skip
+        runs = {}
+        for name in ("fresh", "again"):
+            epochs = (
+                [] if args.extractor_epochs is None else ["--extractor-epochs", str(args.extractor_epochs)]
+            )
+            runs[name] = _run_step(["--step", args.recipe, str(corpus), str(base / "run"), *epochs])
+            print(
+                f"{name}: {json.dumps({k: v for k, v in runs[name].items() if k != 'output_tail'})}",
+                flush=True,
+            )
+            if args.json is not None:  # after every run: a run stopped later keeps what it measured
+                write_json(args.json, {**about, "runs": runs})
+    finally:
+        if args.keep is None:
+            shutil.rmtree(base, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
