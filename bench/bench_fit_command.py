@@ -123,6 +123,8 @@ def main() -> int:
             json.dumps(step_fit(args.step[0], Path(args.step[1]), Path(args.step[2]), args.extractor_epochs))
         )
         return 0
+    if args.keep is not None:
+        args.keep.mkdir(parents=True, exist_ok=True)
     base = Path(tempfile.mkdtemp(prefix="bench_fit_command_", dir=args.keep))
     try:
         corpus = args.corpus
