@@ -100,8 +100,10 @@ results: $(STAMP)
 ## Train every recipe with seeds 2021-2023 (build/seeds/), ship each row's median-FGD seed to checkpoints/
 ## and record the mean ± sd table in checkpoints/results_seeds.md/.json (about 2 h with JOBS=2 on 2 idle cores).
 ## `make seeds ONLY="NAME ..."`: only these recipes' rows, recorded into the table beside the others'.
+## A checkpoint in build/seeds/ that its recipe would train again is reused; `FORCE=1` retrains it (after a code
+## change that leaves the recipe as it was).
 seeds: $(STAMP)
-	$(VPY) -m beatlite.train seeds --jobs $(JOBS) --ship --out checkpoints/results_seeds $(if $(ONLY),--only $(ONLY))
+	$(VPY) -m beatlite.train seeds --jobs $(JOBS) --ship --out checkpoints/results_seeds $(if $(ONLY),--only $(ONLY)) $(if $(FORCE),--force)
 
 ## Speed benchmarks (run on demand; they print ratios against the named alternatives).
 bench: $(STAMP)

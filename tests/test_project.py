@@ -109,6 +109,25 @@ def test_ci_runs_the_readme_test_command():
     assert re.search(r"^make test\s*$", ci, re.M), ".ci/run must call `make test`, the README's command"
 
 
+def test_make_seeds_retrains_existing_checkpoints_only_when_forced():
+    """``make seeds`` reuses a current checkpoint in build/seeds/; the Makefile had no way to pass ``--force``,
+    so after a code change that left the recipe as it was, the table was recorded from the old weights."""
+    import shutil
+    import subprocess
+
+    if shutil.which("make") is None:
+        pytest.skip("no make")
+
+    def seeds_line(*assignments: str) -> str:
+        done = subprocess.run(["make", "-n", "seeds", "ONLY=camn_tiny", *assignments], cwd=REPO, capture_output=True,
+                              text=True, check=False)  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        return next(line for line in done.stdout.splitlines() if "beatlite.train seeds" in line)
+
+    assert seeds_line("FORCE=1").split()[-3:] == ["--only", "camn_tiny", "--force"]
+    assert "--force" not in seeds_line().split()
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_notebook_is_stripped(path):
     nb = json.loads(path.read_text())
