@@ -130,11 +130,13 @@ def code_revision() -> str:
 
 def machine() -> dict[str, object]:
     """What ran a benchmark record, in every record's ``machine`` field: host name, CPU model and count,
-    the 1-minute load average when asked (other jobs slow a timing down), torch's version and CPU threads,
-    and the CUDA device's name (``None`` without one).
+    the vector instructions torch's CPU kernels use (``torch.backends.cpu.get_cpu_capability()``: ``"AVX2"``,
+    ``"AVX512"``, ...; two CPUs that /proc/cpuinfo names alike, e.g. "AMD EPYC", can differ there, and then
+    train at different speeds and round differently), the 1-minute load average when asked (other jobs slow a
+    timing down), torch's version and CPU threads, and the CUDA device's name (``None`` without one).
 
     >>> sorted(machine())
-    ['cpu', 'cpus', 'cuda', 'host', 'load_average', 'threads', 'torch']
+    ['cpu', 'cpu_capability', 'cpus', 'cuda', 'host', 'load_average', 'threads', 'torch']
     """
     import contextlib
     import platform
@@ -148,5 +150,6 @@ def machine() -> dict[str, object]:
         cpu = names[0] if names else cpu
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     cuda = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
-    return {"host": platform.node(), "cpu": cpu, "cpus": os.cpu_count(), "load_average": load,
-            "torch": torch.__version__, "threads": torch.get_num_threads(), "cuda": cuda}  # fmt: skip
+    return {"host": platform.node(), "cpu": cpu, "cpu_capability": torch.backends.cpu.get_cpu_capability(),
+            "cpus": os.cpu_count(), "load_average": load, "torch": torch.__version__,
+            "threads": torch.get_num_threads(), "cuda": cuda}  # fmt: skip

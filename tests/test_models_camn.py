@@ -423,3 +423,33 @@ def test_in_bf16_the_matmul_route_is_as_close_to_fp32_as_the_convolutions(batch,
     conv_error, matmul_error = (gc - g32).norm(), (gm - g32).norm()
     assert 0 < conv_error and matmul_error <= 1.5 * conv_error
     assert abs(lm - l32) <= 2 * abs(lc - l32) + 1e-6 * abs(l32)
+
+
+def test_run_lstm_under_cpu_bf16_autocast_is_the_lstm_on_any_cpu(monkeypatch):
+    """On an x86 CPU without AVX-512 (AMD Zen 3: torch's capability "AVX2") CPU bf16 autocast sends an LSTM to
+    oneDNN, which raised "could not create a primitive descriptor for the LSTM forward propagation primitive":
+    every bf16 training step of CaMN failed there. ``run_lstm`` runs it in float32 with autocast off where that
+    kernel is missing (forced here, so every machine tries that route), and as it is where it exists."""
+    from beatlite.models import layers
+
+    torch.manual_seed(0)
+    lstm = torch.nn.LSTM(5, 6, batch_first=True, bidirectional=True)
+    x = torch.randn(3, 7, 5)
+    fp32 = lstm(x)[0]
+    monkeypatch.setattr(layers, "_cpu_autocast_lstm_works", lambda: False)
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        fallback = layers.run_lstm(lstm, x)
+    assert fallback.dtype == torch.float32 and torch.equal(fallback, fp32)  # the same float32 computation
+    monkeypatch.undo()
+    state = torch.random.get_rng_state()
+    works = layers._cpu_autocast_lstm_works()
+    assert torch.equal(
+        torch.random.get_rng_state(), state
+    )  # the probe draws no random number of the caller's
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        here = layers.run_lstm(lstm, x)
+    # with the kernel, the LSTM in bfloat16: each of the 7 steps reads inputs and weights rounded to 8 significant
+    # bits (relative 2**-8) and its cell state carries the earlier steps' errors, outputs in (-1, 1): within
+    # 7 * 2 * 2**-8 < 2**-4; without it, the fallback's float32 exactly
+    assert torch.allclose(here.float(), fp32, atol=2**-4 if works else 0, rtol=0)
+    assert torch.equal(layers.run_lstm(lstm, x), fp32)  # no autocast: lstm(x)[0] itself

@@ -59,6 +59,7 @@ from beatlite.models.layers import (
     mlp,
     ns_gan_d_loss,
     ns_gan_g_loss,
+    run_lstm,
     sum_directions,
 )
 
@@ -247,8 +248,7 @@ class _Decoder(nn.Module):
         )
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        seq, _ = self.lstm(x)
-        return self.head(sum_directions(seq, self.hidden))
+        return self.head(sum_directions(run_lstm(self.lstm, x), self.hidden))
 
 
 def _context_encoders(

@@ -14,6 +14,7 @@ Taught in notebooks/05_camn.ipynb, sections 2.1 (audio: from 36266 samples to 34
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import torch
@@ -382,7 +383,8 @@ class ConvDiscriminator(nn.Module):
                 f"got shape {tuple(pose.shape)}"
             )
         feat = self.convs(pose.transpose(1, 2)).transpose(1, 2)
-        seq, _ = getattr(self, self.rnn_name)(feat)
+        rnn = getattr(self, self.rnn_name)
+        seq = run_lstm(rnn, feat) if self.rnn_name == "lstm" else rnn(feat)[0]
         return self.out2(self.out(sum_directions(seq, self.hidden)).squeeze(-1))
 
 
@@ -414,6 +416,44 @@ def mlp(sizes: Sequence[int], slope: float = 0.1, *, last_act: bool = True) -> n
         if last_act or i < len(sizes) - 2:
             layers.append(nn.LeakyReLU(slope))
     return nn.Sequential(*layers)
+
+
+def run_lstm(lstm: nn.LSTM, x: torch.Tensor) -> torch.Tensor:
+    """``lstm(x)``'s output sequence, also under CPU bf16 autocast on a CPU without a bf16 LSTM kernel.
+
+    CPU autocast sends an LSTM to oneDNN in bfloat16, and on x86 CPUs without AVX-512 (e.g. AMD Zen 3, where
+    ``torch.backends.cpu.get_cpu_capability()`` is ``"AVX2"``) torch 2.13 then raises "could not create a
+    primitive descriptor for the LSTM forward propagation primitive". There the LSTM runs in float32 with
+    autocast off, as CPU autocast already runs every GRU; everywhere else (CUDA, CPUs with the kernel, no
+    autocast) it is ``lstm(x)[0]`` unchanged. So a bf16 training step on such a CPU computes the LSTM more
+    exactly than on a CPU with the kernel: one of the differences between machines.
+
+    Shapes: x ``(B, T, input_size)`` (``batch_first``) -> ``(B, T, D * hidden_size)``, D = 2 if bidirectional.
+
+    Examples
+    --------
+    >>> lstm = nn.LSTM(3, 4, batch_first=True, bidirectional=True)
+    >>> with torch.autocast("cpu", dtype=torch.bfloat16):
+    ...     y = run_lstm(lstm, torch.zeros(2, 5, 3))
+    >>> tuple(y.shape)
+    (2, 5, 8)
+    """
+    if x.device.type == "cpu" and torch.is_autocast_enabled("cpu") and not _cpu_autocast_lstm_works():
+        with torch.autocast("cpu", enabled=False):
+            return lstm(x.float())[0]
+    return lstm(x)[0]
+
+
+@functools.cache
+def _cpu_autocast_lstm_works() -> bool:
+    """Whether an LSTM runs under CPU bf16 autocast here (tried once on a 1-unit LSTM; the global random
+    state is left as it was)."""
+    with torch.random.fork_rng(devices=[]), torch.no_grad(), torch.autocast("cpu", dtype=torch.bfloat16):
+        try:
+            nn.LSTM(1, 1, batch_first=True)(torch.zeros(1, 1, 1))
+        except RuntimeError:
+            return False
+    return True
 
 
 def sum_directions(seq: torch.Tensor, hidden: int) -> torch.Tensor:
