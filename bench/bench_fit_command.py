@@ -89,7 +89,9 @@ def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None 
         "peak_rss_kib": usage.ru_maxrss,
         "peak_rss_gib": usage.ru_maxrss / 2**20,
         **phases(lines, wall),
-        "output_tail": [line for _, line in lines[-6:]],
+        "output_tail": [
+            line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-6:]
+        ],
     }
 
 
@@ -125,6 +127,16 @@ def main() -> int:
         return 0
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)
+    about = {
+        "command": " ".join(["python", *sys.argv]),
+        "revision": code_revision(),
+        "date": time.strftime("%Y-%m-%d"),
+        "machine": {**machine(), "threads": n_threads()},
+        "fit_command": " ".join(
+            ["python", *fit_command(args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs)[1:]]
+        ),
+        "hours": args.hours if args.corpus is None else None,
+    }  # fmt: skip  (before the corpus is made: the load average is what else ran)
     base = Path(tempfile.mkdtemp(prefix="bench_fit_command_", dir=args.keep))
     try:
         corpus = args.corpus
@@ -132,16 +144,6 @@ def main() -> int:
             corpus = base / "corpus"
             print(f"making a {args.hours:g}-hour corpus in {corpus}", flush=True)
             make_corpus(args.data, corpus, args.hours, args.workers)
-        about = {
-            "command": " ".join(["python", *sys.argv]),
-            "revision": code_revision(),
-            "date": time.strftime("%Y-%m-%d"),
-            "machine": {**machine(), "threads": n_threads()},
-            "fit_command": " ".join(
-                ["python", *fit_command(args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs)[1:]]
-            ),
-            "hours": args.hours if args.corpus is None else None,
-        }  # fmt: skip
         runs = {}
         for name in ("fresh", "again"):
             epochs = (

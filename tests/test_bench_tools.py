@@ -220,4 +220,7 @@ def test_bench_fit_command_times_each_phase_of_a_fresh_and_a_repeated_fit(tmp_pa
     for run in (fresh, again):
         assert run["train_s"] > 0 and run["prepare_s"] > 0 and run["peak_rss_kib"] > 0
         assert run["prepare_s"] + (run["extractor_s"] or 0) + run["train_s"] <= run["wall_s"]
+        assert not any(
+            str(tmp_path) in line for line in run["output_tail"]
+        )  # <run> and <corpus>, not this machine's
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith("bench_fit_command_")] == []

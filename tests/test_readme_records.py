@@ -478,5 +478,56 @@ def test_the_readme_store_scale_table_and_its_sums_are_the_record():
         f"building takes {min(cpu):.0f}–{max(cpu):.0f} CPU-seconds per hour of mocap (≈ {16 * c / 2 / 60:.0f} min for "
         f"16 h on 2 free cores, ≈ {76 * c / 2 / 60:.0f} min for 76 h" in text
     )
-    four = next(r for r in rows if round(r["hours"]) == 4)
-    assert f"one torch thread, {four['train_windows']:,} train windows, idle machine" in text
+
+
+def _minutes(seconds: float) -> str:
+    """``1559.6`` -> ``"26 min 0 s"``."""
+    return f"{int(round(seconds)) // 60} min {int(round(seconds)) % 60} s"
+
+
+def test_the_readme_fit_command_sentences_are_the_record():
+    """The 4-hour ``fit`` command's time, memory, phases and the estimates from them (README, the guide)."""
+    record = _record("fit_command_cpu.json")
+    fresh, again = record["runs"]["fresh"], record["runs"]["again"]
+    assert record["hours"] == 4 and record["machine"]["cpus"] == 2 and record["machine"]["threads"] == 1
+    assert record["machine"]["cpu_capability"] == "AVX2"  # "one without AVX-512"
+    windows = next(r for r in _record("bench_scale_cpu.json")["rows"] if round(r["hours"]) == 4)[
+        "train_windows"
+    ]
+    extractor_wps = windows * 100 / fresh["extractor_s"]  # fit's default: 100 extractor epochs
+    epoch_wps = windows / fresh["train_s"]
+    text = " ".join(_readme().split())
+    assert (
+        f"`python -m beatlite.train fit camn_tiny --data <corpus> --out <run> --epochs 1 --device cpu`, one torch "
+        f"thread, {windows:,} train windows)"
+        in text
+        and record["fit_command"]
+        == "python -m beatlite.train fit camn_tiny --data <corpus> --out <run> --epochs 1 --device cpu"
+    )
+    assert (
+        f"with a fresh `--out` it took {_minutes(fresh['wall_s'])} and peaked at {fresh['peak_rss_gib']:.2f} GiB resident"
+        in text
+    )
+    assert (
+        f"preparing the index and the store {fresh['prepare_s']:.0f} s, the FGD extractor's 100 epochs "
+        f"{fresh['extractor_s']:,.0f} s ({extractor_wps:,.0f} windows/s) and the CaMN tiny epoch with its validation "
+        f"FGD {fresh['train_s']:.0f} s" in text
+    )
+    assert again["extractor_s"] is None and (
+        f"it took {_minutes(again['wall_s'])} and peaked at {again['peak_rss_gib']:.2f} GiB" in text
+    )
+    assert (
+        f"BEAT-4english (about {EPOCH_WINDOWS:,} train windows) about {EPOCH_WINDOWS / epoch_wps / 60:.0f} min per "
+        f"CaMN tiny epoch with its validation and {EPOCH_WINDOWS * 100 / extractor_wps / 3600:.1f} h for the extractor"
+        in text
+    )
+    assert (
+        f"(76 h, about 4.75 times more) about {4.75 * EPOCH_WINDOWS / epoch_wps / 60:.0f} min per epoch"
+        in text
+    )
+    guide = " ".join(_guide().split())
+    assert (
+        f"took {_minutes(fresh['wall_s'])} on a fresh `--out` on a 2-core CPU without AVX-512 "
+        f"({fresh['extractor_s']:,.0f} s of it the FGD extractor, trained once; {_minutes(again['wall_s'])} run again)"
+        in guide
+    )
