@@ -128,6 +128,25 @@ def code_revision() -> str:
     return (head + ("+changes" if changed else "")) if head else "unknown"
 
 
+def record_about(**machine_fields: object) -> dict[str, object]:
+    """The head of every benchmark record: ``command`` (``python`` and this process's arguments), ``revision``
+    (:func:`code_revision`), ``date`` (YYYY-MM-DD) and ``machine`` (:func:`machine`, with ``machine_fields``
+    replacing its fields, e.g. ``threads=None`` for a process that trains nothing itself).
+
+    Call it when the run starts: before the run writes its record (a tracked file, which would make the
+    revision read ``+changes``) and before its own work loads the machine (the load average is what else ran).
+
+    >>> about = record_about(threads=None)
+    >>> sorted(about), about["machine"]["threads"]
+    (['command', 'date', 'machine', 'revision'], None)
+    """
+    import sys
+    import time
+
+    return {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
+            "date": time.strftime("%Y-%m-%d"), "machine": {**machine(), **machine_fields}}  # fmt: skip
+
+
 def machine() -> dict[str, object]:
     """What ran a benchmark record, in every record's ``machine`` field: host name, CPU model and count,
     the vector instructions torch's CPU kernels use (``torch.backends.cpu.get_cpu_capability()``: ``"AVX2"``,

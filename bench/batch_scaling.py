@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, machine, n_threads
+from beatlite.paths import n_threads, record_about
 from beatlite.train.evaluation import evaluate_models
 from beatlite.train.recipes import RECIPES, retrain, scaled_lr, training_data
 from beatlite.train.testset import load_test_set
@@ -56,11 +56,10 @@ def _record(args: argparse.Namespace, recipe: Any, rows: list[dict]) -> dict:
         "recipe_batch": recipe.batch_size,
         "recipe_lr": recipe.lr,
         "epochs": recipe.epochs if args.epochs is None else args.epochs,
-        "revision": args.revision,
+        **args.about,
         "command": f"BEATLITE_THREADS={n_threads()} python bench/batch_scaling.py --recipe {args.recipe} "
         f"--batches {batches} --rules {rules} --seeds {seeds}"
         + ("" if args.epochs is None else f" --epochs {args.epochs}"),
-        "machine": machine(),
         "rows": rows,
         "summary": summary(rows),
     }
@@ -78,7 +77,7 @@ def main() -> None:
     )
     p.add_argument("--json", type=Path, default=None, help="write the record here")
     args = p.parse_args()
-    args.revision = code_revision()  # (before this run writes its record, a tracked file)
+    args.about = record_about()  # (before this run writes its record, a tracked file)
     recipe = RECIPES[args.recipe]
     with tempfile.TemporaryDirectory() as tmp:
         work = args.work or Path(tmp)

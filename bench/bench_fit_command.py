@@ -39,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_scale import make_corpus  # noqa: E402
 
 from beatlite.io.atomic import write_json  # noqa: E402
-from beatlite.paths import code_revision, machine, n_threads  # noqa: E402
+from beatlite.paths import n_threads, record_about  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 EXTRACTOR_START = "training the FGD extractor"
@@ -128,10 +128,7 @@ def main() -> int:
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)
     about = {
-        "command": " ".join(["python", *sys.argv]),
-        "revision": code_revision(),
-        "date": time.strftime("%Y-%m-%d"),
-        "machine": {**machine(), "threads": n_threads()},
+        **record_about(threads=n_threads()),
         "fit_command": " ".join(
             ["python", *fit_command(args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs)[1:]]
         ),

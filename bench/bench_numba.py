@@ -15,11 +15,10 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, machine
+from beatlite.paths import record_about
 
 CODE = (
     "import time; t = time.perf_counter(); from beatlite.metrics.beats import warm_up; i = time.perf_counter(); "
@@ -42,7 +41,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3, help="cold runs (each with a new empty cache)")
     parser.add_argument("--json", type=Path, help="write the record here")
     args = parser.parse_args()
-    about = machine()
+    about = record_about()
     cold, warm = [], []
     for _ in range(args.repeat):
         with tempfile.TemporaryDirectory(prefix="bench_numba_") as cache:
@@ -51,8 +50,7 @@ def main() -> None:
     for name, runs in (("empty cache", cold), ("cached", warm)):
         print(f"{name:12s} import {min(r[0] for r in runs):5.2f} s, warm_up {min(r[1] for r in runs):6.2f} s")
     if args.json:
-        write_json(args.json, {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
-                               "date": time.strftime("%Y-%m-%d"), "machine": about,
+        write_json(args.json, {**about,
                                "cold": [{"import_seconds": i, "warm_up_seconds": w} for i, w in cold],
                                "cached": [{"import_seconds": i, "warm_up_seconds": w} for i, w in warm]})  # fmt: skip
 

@@ -49,7 +49,7 @@ os.environ.setdefault("BEATLITE_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from beatlite.io.atomic import write_json  # noqa: E402
-from beatlite.paths import code_revision, machine, n_threads  # noqa: E402
+from beatlite.paths import n_threads, record_about  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 SPEECH_S, CONVERSATION_S = 60.0, 600.0
@@ -429,12 +429,7 @@ def main() -> int:
         "--json", type=Path, default=None, help="write the rows, command, revision and machine here"
     )
     args = p.parse_args()
-    about = {
-        "command": " ".join(["python", *sys.argv]),
-        "revision": code_revision(),
-        "date": time.strftime("%Y-%m-%d"),
-        "machine": {**machine(), "threads": n_threads()},
-    }  # fmt: skip  (the steps' torch threads)
+    about = record_about(threads=n_threads())  # (the steps' torch threads)
     print(f"bench_scale: {os.cpu_count()} CPUs; sizes {args.hours} h")
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)

@@ -64,7 +64,6 @@ import argparse
 import dataclasses
 import math
 import os
-import sys
 import tempfile
 import time
 import traceback
@@ -80,7 +79,7 @@ from torch.utils.flop_counter import FlopCounterMode
 from beatlite.io.atomic import write_json
 from beatlite.models import MODELS, build_model, model_class
 from beatlite.models.layers import use_frame_matmul
-from beatlite.paths import code_revision, data_dir, machine, n_threads
+from beatlite.paths import data_dir, n_threads, record_about
 from beatlite.train import TrainConfig, fit
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.training import _Run, model_keys
@@ -478,8 +477,7 @@ def main() -> None:
     if args.trace_rnn:
         torch._dynamo.config.allow_rnn = True
     torch.set_num_threads(n_threads())
-    about = {"command": " ".join(["python", *sys.argv]), "machine": machine()}
-    about["revision"] = code_revision() if args.json else None  # (before the record, maybe a tracked file)
+    about = record_about()  # (before the record, maybe a tracked file)
     with tempfile.TemporaryDirectory() as tmp:
         train = _store_train(args.quick, Path(tmp) / "store")
         bench = "  cudnn.benchmark" if args.cudnn_benchmark else ""

@@ -26,7 +26,7 @@ from pathlib import Path
 import torch
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, data_dir, machine, n_threads
+from beatlite.paths import data_dir, n_threads, record_about
 from beatlite.train.checkpoint import load_checkpoint
 from beatlite.train.recipes import RECIPES
 
@@ -69,7 +69,7 @@ def main() -> None:
     torch.set_num_threads(
         n_threads()
     )  # the fits' threads (the fit command's), which the record's machine states
-    rows, revision = [], code_revision()  # (before this run writes its record, a tracked file)
+    rows, about = [], record_about()  # (before this run writes its record, a tracked file)
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.recipes:
             for det in args.deterministic:
@@ -80,9 +80,7 @@ def main() -> None:
                              "epochs": args.epochs, "seconds": time.perf_counter() - start, **compare(*runs)})  # fmt: skip
                 print(json.dumps(rows[-1]), flush=True)
                 if args.json is not None:
-                    record = {"command": " ".join(["python", *sys.argv]), "revision": revision, "machine": machine(),
-                              "rows": rows}  # fmt: skip
-                    write_json(args.json, record)
+                    write_json(args.json, {**about, "rows": rows})
 
 
 if __name__ == "__main__":

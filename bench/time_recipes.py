@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -23,7 +22,7 @@ from pathlib import Path
 import torch
 
 from beatlite.io.atomic import write_json
-from beatlite.paths import code_revision, machine, n_threads
+from beatlite.paths import machine, n_threads, record_about
 from beatlite.train.recipes import RECIPES, SEED, retrain, training_data, warm_up
 
 
@@ -46,7 +45,7 @@ def main(argv: list[str] | None = None) -> None:
     torch.set_num_threads(n_threads())  # as retrain trains: the threads the record's machine states
     warm_up()  # librosa's numba code compiled before the first timing
     data = training_data(progress=False)  # the window store built (or found) before the first timing
-    before = machine()
+    about = record_about()
     rows = []
     with tempfile.TemporaryDirectory(prefix="time_recipes_") as tmp:
         for name in args.recipes:
@@ -55,9 +54,7 @@ def main(argv: list[str] | None = None) -> None:
             print(f"{name}: {r['epochs']} epochs, fit {r['fit_seconds']:.0f} s, wall {r['wall_seconds']:.0f} s, "
                   f"user CPU {r['user_seconds']:.0f} s", flush=True)  # fmt: skip
     after = machine()
-    record = {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
-              "date": time.strftime("%Y-%m-%d"), "machine": before,
-              "load_average_after": after["load_average"], "rows": rows}  # fmt: skip
+    record = {**about, "load_average_after": after["load_average"], "rows": rows}
     if args.json:
         write_json(args.json, record)
 

@@ -284,21 +284,13 @@ def printed_epoch_seconds(path: Path) -> list[float]:
     return [float(x) for x in EPOCH_TIME.findall(text)]
 
 
-def _machine() -> dict:
-    """:func:`beatlite.paths.machine` without torch's threads (this process trains nothing; the kernels' threads are
-    ``BEATLITE_THREADS``, in the record's settings)."""
-    from beatlite.paths import machine
-
-    return {**machine(), "threads": None}
-
-
 def write_record(path: Path, timings: list[dict], total: float, about: dict) -> None:
     """The run's timings as JSON (``docs/teaching.md``'s table is checked against the shipped one): each
     notebook's wall seconds, its kernel's user-CPU seconds and the seconds per epoch it printed, the whole run's wall seconds (exports
-    included), the largest resident memory of one kernel, and the command, revision, settings and ``about``: the
-    machine as :func:`beatlite.paths.machine` described it before the run (the kernels' threads: the settings)."""
+    included), the largest resident memory of one kernel, the settings, and ``about``: the command, revision and
+    machine as :func:`beatlite.paths.record_about` described them before the run (``threads`` None: this process
+    trains nothing; the kernels' threads are ``BEATLITE_THREADS``, in the settings)."""
     from beatlite.io.atomic import write_json
-    from beatlite.paths import code_revision
 
     peak = (
         resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
@@ -306,8 +298,7 @@ def write_record(path: Path, timings: list[dict], total: float, about: dict) -> 
         / 2**30
     )
     settings = {k: os.environ.get(k) for k in ("BEATLITE_MODE", "BEATLITE_THREADS", "BEATLITE_DATA")}
-    write_json(path, {"command": " ".join(["python", *sys.argv]), "revision": code_revision(),
-                      "date": time.strftime("%Y-%m-%d"), "machine": about, "settings": settings,
+    write_json(path, {**about, "settings": settings,
                       "total_wall_seconds": total, "largest_kernel_gib": peak, "rows": timings})  # fmt: skip
 
 
@@ -335,7 +326,9 @@ def main(argv: list[str] | None = None) -> int:
         stale.unlink()
 
     rows, failed, timings = [], 0, []
-    about = _machine() if args.record else {}
+    from beatlite.paths import record_about
+
+    about = record_about(threads=None) if args.record else {}
     total = time.perf_counter()
     for path in paths:
         print(f"[run] {path.name} ...", flush=True)

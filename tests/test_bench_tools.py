@@ -62,8 +62,12 @@ def test_batch_scaling_records_its_thread_count_host_and_torch(monkeypatch):
 
     batch_scaling = _load("batch_scaling")
     monkeypatch.setenv("BEATLITE_THREADS", "2")
+    about = {
+        **batch_scaling.record_about(),
+        "revision": "abc1234",
+    }  # (as main() describes the run when it starts)
     args = argparse.Namespace(recipe="camn_tiny", batches=[32], rules=["linear"], seeds=[2021], epochs=1,
-                              revision="abc1234")  # fmt: skip
+                              about=about)  # fmt: skip
     record = batch_scaling._record(args, batch_scaling.RECIPES["camn_tiny"], [])
     assert record["command"].startswith("BEATLITE_THREADS=2 python bench/batch_scaling.py --recipe camn_tiny")
     assert (record["machine"]["host"], record["machine"]["torch"], record["revision"]) == (
