@@ -4,11 +4,14 @@ docs/reference_code.md that resolves to one beatlite function or class names onl
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import inspect
 import keyword
 import pkgutil
 import re
+import runpy
+import sys
 from pathlib import Path
 
 import pytest
@@ -212,3 +215,219 @@ def test_the_store_training_example_runs_as_written(data_samples):
         exec(statement.replace(": ...", ": seen.append(batch); break"), names)
     assert len(names["seen"]) == 1 and set(names["seen"][0]) >= {"pose", "audio"}
     assert len(names["val"]) > 0 and names["val"].normalizers.matches(names["train"].normalizers)
+
+
+# --- Command lines: every documented command runs a program that has those subcommands, options and choices ---
+
+DOCS = ("README.md", "docs/architecture.md", "docs/teaching.md", "docs/reference_code.md")
+FENCE = re.compile(r"^ *```(\w*)\n(.*?)^ *```", re.S | re.M)
+TRAIN_COMMANDS = (
+    "fit",
+    "retrain-all",
+    "results",
+    "seeds",
+)  # `fit --resume` is short for python -m beatlite.train
+STOP = {"|", "||", "&&", ";", ">", "2>&1"}
+HYPOTHETICAL = {"mymodel_tiny"}  # the text's own example of a recipe not added to RECIPES
+
+
+def documented_commands(text: str) -> list[str]:
+    """The lines of a Markdown text's shell blocks (comments cut) and its backticked spans (one line each)."""
+    found = [
+        line.split(" #")[0].strip()
+        for lang, body in FENCE.findall(text)
+        if lang in ("bash", "sh", "")
+        for line in body.splitlines()
+    ]
+    found += [" ".join(span.split()) for span in SPAN.findall(FENCE.sub("", text))]
+    return [c for c in found if c and not c.startswith("#")]
+
+
+def split_command(command: str) -> tuple[str | None, list[str], bool]:
+    """``(program, arguments, complete)``: a ``beatlite.*`` module run with ``-m``, a script of ``scripts/`` or
+    ``bench/`` (a ``.py`` or ``.sh``), ``make``, or ``beatlite.train`` for a span starting with one of its
+    subcommands; ``complete`` when the text is a whole command line (a program first), not a mention of options.
+    Synopsis brackets are dropped: ``[--seed S]`` is ``--seed S``."""
+    tokens = [t for t in (t.strip("[]") for t in command.split()) if t]
+    cut = next((i for i, t in enumerate(tokens) if t in STOP or t.startswith("#")), len(tokens))
+    tokens = tokens[:cut]
+    complete = bool(tokens) and bool(
+        re.match(r"\S*(python|torchrun|bash|sudo|make)|\S+\.(py|sh)$", tokens[0])
+    )
+    for i, t in enumerate(tokens):
+        if t == "-m" and i + 1 < len(tokens) and tokens[i + 1].startswith("beatlite."):
+            return tokens[i + 1], tokens[i + 2 :], complete
+        if t.endswith((".py", ".sh")):
+            name = t.rsplit("/", 1)[-1]
+            folders = [f for f in ("scripts", "bench") if (REPO / f / name).is_file()]
+            if len(folders) == 1 and (t == name or t.endswith(f"{folders[0]}/{name}")):
+                return f"{folders[0]}/{name}", tokens[i + 1 :], complete
+        if t == "make":
+            return "make", tokens[:i] + tokens[i + 1 :], complete
+    if len(tokens) > 1 and tokens[0] in TRAIN_COMMANDS:
+        return "beatlite.train", tokens, False
+    return None, tokens, False
+
+
+class _Parsed(Exception):
+    def __init__(self, parser: argparse.ArgumentParser):
+        self.parser = parser
+
+
+def program_parser(program: str) -> argparse.ArgumentParser | None:
+    """The ``argparse`` parser of a ``beatlite.*`` module or a script's ``main()``, taken at its first parse (so
+    nothing runs)."""
+
+    def capture(self, args=None, namespace=None):
+        raise _Parsed(self)
+
+    parse, argv = argparse.ArgumentParser.parse_known_args, sys.argv
+    argparse.ArgumentParser.parse_known_args, sys.argv = capture, [program]  # (argv[0]: a script's prog)
+    try:
+        if program.endswith(".py"):
+            main = runpy.run_path(str(REPO / program))["main"]  # (not as __main__: only definitions run)
+        else:
+            module = importlib.import_module(program)
+            if hasattr(module, "__path__"):  # a package: python -m runs its __main__
+                module = importlib.import_module(f"{program}.__main__")
+            main = module.main
+        main()
+    except _Parsed as parsed:
+        return parsed.parser
+    finally:
+        argparse.ArgumentParser.parse_known_args, sys.argv = parse, argv
+    return None
+
+
+def _placeholder(value: str) -> bool:
+    """``NAME``, ``DIR``, ``<corpus>``, ``/path/to/beat``, ``...``: the reader's value, not a literal."""
+    return value in ("...", "…") or any(c.isupper() or c in "<>/" for c in value)
+
+
+def _not_chosen(action: argparse.Action, values: list[str], where: str) -> list[str]:
+    allowed = {str(c) for c in action.choices or ()}
+    return [
+        f"{where}: {piece!r} is not one of its choices"
+        for value in values
+        for piece in value.split("|")  # (a synopsis' alternatives, dirvec|pose|rot6d)
+        if allowed and piece and not _placeholder(piece) and piece not in allowed | HYPOTHETICAL
+    ]
+
+
+def command_problems(parser: argparse.ArgumentParser, args: list[str], complete: bool = True) -> list[str]:
+    """What ``parser`` would refuse in ``args``: an unknown subcommand or option, a choice it lacks and, in a
+    ``complete`` command line, an option without the values it takes."""
+    problems, i = [], 0
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    positionals = [a for a in parser._actions if not a.option_strings and a is not sub]
+    while i < len(args):
+        token, i = args[i], i + 1
+        if token.startswith("--"):
+            flag, _, inline = token.partition("=")
+            action = parser._option_string_actions.get(flag)
+            if action is None:
+                problems.append(f"{parser.prog}: no option {flag}")
+                continue
+            nargs = action.nargs
+            low, high = {None: (1, 1), "?": (0, 1), "*": (0, 99), "+": (1, 99)}.get(nargs, (nargs, nargs))
+            values = [inline] if inline else []
+            while len(values) < high and i < len(args) and not args[i].startswith("-"):
+                values, i = [*values, args[i]], i + 1
+            if complete and len(values) < low:
+                problems.append(f"{parser.prog} {flag}: takes {low} value(s), the text gives {values}")
+            problems += _not_chosen(action, values, f"{parser.prog} {flag}")
+        elif sub is not None:
+            if token in sub.choices:
+                return problems + command_problems(sub.choices[token], args[i:], complete)
+            return problems + ([] if _placeholder(token) else [f"{parser.prog}: no command {token!r}"])
+        elif positionals:
+            problems += _not_chosen(positionals.pop(0), [token], f"{parser.prog} {token}")
+    return problems
+
+
+def make_problems(args: list[str]) -> list[str]:
+    """Targets the Makefile lacks and ``VAR=value`` settings that neither it nor beatlite reads."""
+    makefile = (REPO / "Makefile").read_text()
+    targets = set(re.findall(r"^([\w-]+):", makefile, re.M))
+    variables = set(re.findall(r"^(?:export )?(\w+)\s*[:?]?=", makefile, re.M))
+    variables |= set(re.findall(r"\$\((\w+)\)", makefile))
+    sources = "".join(p.read_text() for p in (REPO / "beatlite").rglob("*.py"))
+    variables |= set(re.findall(r"[\"'](BEATLITE_\w+)[\"']", sources))
+    problems = []
+    for token in args:
+        name, equals, _ = token.partition("=")
+        if equals and re.fullmatch(r"[A-Z_]+", name) and name not in variables:
+            problems.append(f"make: {name} is no variable of the Makefile or beatlite")
+        elif not equals and re.fullmatch(r"[a-z][\w-]*", token) and token not in targets:
+            problems.append(f"make: no target {token!r}")
+    return problems
+
+
+def stage_problems(script: str, args: list[str]) -> list[str]:
+    """A ``bench/gpu_session.sh STAGE`` whose stage its ``case`` does not accept."""
+    stages = re.search(r'case "\$stage" in ([\w |]+)\)', (REPO / script).read_text()).group(1)
+    known = {s.strip() for s in stages.split("|")}
+    return [f"{script}: no stage {args[0]!r}" for _ in [0] if args and args[0] not in known]
+
+
+def test_the_command_checker_finds_unknown_options_missing_values_and_choices():
+    parser = argparse.ArgumentParser(prog="p")
+    sub = parser.add_subparsers()
+    fit = sub.add_parser("fit", prog="p fit")
+    fit.add_argument("recipe", choices=["camn_tiny", "ha2g_tiny"])
+    fit.add_argument("--keep")
+    fit.add_argument("--space", choices=["dirvec", "pose"])
+    fit.add_argument("--resume", action="store_true")
+    fit.add_argument("--hours", nargs="+")
+    assert split_command("python -m beatlite.train fit camn_tiny [--seed S]  # comment") == (
+        "beatlite.train",
+        ["fit", "camn_tiny", "--seed", "S"],
+        True,
+    )
+    assert split_command("fit --keep") == ("beatlite.train", ["fit", "--keep"], False)
+    assert (
+        command_problems(parser, ["fit", "camn_tiny", "--keep", "DIR", "--hours", "1", "4", "--resume"]) == []
+    )
+    assert command_problems(parser, "fit NAME --space dirvec|pose --keep=x".split()) == []
+    assert command_problems(parser, ["fit", "camn_tiny", "--keep"]) == [
+        "p fit --keep: takes 1 value(s), the text gives []"
+    ]
+    assert command_problems(parser, ["fit", "--keep"], complete=False) == []  # a mention of the option
+    assert command_problems(parser, "fit camn_small --space rot6d --seed 1".split()) == [
+        "p fit camn_small: 'camn_small' is not one of its choices",
+        "p fit --space: 'rot6d' is not one of its choices",
+        "p fit: no option --seed",
+    ]
+    assert command_problems(parser, ["train"]) == ["p: no command 'train'"]
+    assert make_problems(["JOBS=2", "seeds", "ONLY=x", "BEATLITE_DATA=/d", "run"]) == []
+    assert make_problems(["tests", "THREADS=2"]) == [
+        "make: no target 'tests'",
+        "make: THREADS is no variable of the Makefile or beatlite",
+    ]
+
+
+def test_documented_commands_have_those_programs_commands_options_and_choices():
+    """Every command line of README.md and docs/*.md (shell blocks and backticked spans) names a program that
+    exists with the subcommands, options, option values and choices it is given; make targets and variables too."""
+    pytest.importorskip("torch")
+    parsers, wrong, checked = {}, [], 0
+    for doc in DOCS:
+        for command in documented_commands((REPO / doc).read_text()):
+            program, args, complete = split_command(command)
+            if program is None:
+                continue
+            checked += 1
+            if program == "make":
+                problems = make_problems(args)
+            elif program.endswith(".sh"):
+                problems = stage_problems(program, args) if program == "bench/gpu_session.sh" else []
+            else:
+                if program not in parsers:
+                    parsers[program] = program_parser(program)
+                if parsers[program] is None:  # (scripts/lab_copies.py reads sys.argv itself)
+                    continue
+                problems = command_problems(parsers[program], args, complete)
+            wrong += [f"{doc}: `{command}`: {p}" for p in problems]
+    print(f"{checked} command lines checked, {len(parsers)} programs' parsers")
+    assert checked > 100 and len(parsers) >= 12, (checked, sorted(parsers))
+    assert not wrong, "documented commands the programs refuse:\n" + "\n".join(wrong)
