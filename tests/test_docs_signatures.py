@@ -431,3 +431,44 @@ def test_documented_commands_have_those_programs_commands_options_and_choices():
     print(f"{checked} command lines checked, {len(parsers)} programs' parsers")
     assert checked > 100 and len(parsers) >= 12, (checked, sorted(parsers))
     assert not wrong, "documented commands the programs refuse:\n" + "\n".join(wrong)
+
+
+# --- Counts and lists the docs state about the registries ---
+
+NUMBER_WORDS = {"ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13}
+
+
+def recipe_listing(text: str) -> list[tuple[str, int]]:
+    """``(system, recipes)`` of architecture's list of the shipped recipes, ``CaMN + 7 ablations`` = 8."""
+    listing = re.search(r"for every shipped checkpoint \(([^:]*):", text).group(1)
+    items = [" ".join(item.split()) for item in listing.split(",")]
+    return [
+        (re.sub(r" \+ \d+ ablations", "", i), 1 + int(m.group(1)) if (m := re.search(r"\+ (\d+)", i)) else 1)
+        for i in items
+    ]
+
+
+def test_the_documented_counts_and_lists_are_the_registries():
+    """The recipe, model, metric and notebook counts of README.md and docs/architecture.md are those of the code."""
+    pytest.importorskip("torch")
+    from beatlite.metrics.scoring import METRICS
+    from beatlite.models import MODELS
+    from beatlite.train.recipes import RECIPES
+
+    readme, architecture = (REPO / "README.md").read_text(), DOC.read_text()
+    readme_flat = " ".join(readme.split())
+    assert int(re.search(r"All (\d+) shipped recipes", readme_flat).group(1)) == len(RECIPES)
+    seeds = next(a for a in program_parser("beatlite.train")._actions if a.dest == "command").choices["seeds"]
+    n_seeds = len(seeds.get_default("seeds"))
+    assert int(re.search(r"`make seeds`, (\d+) trainings", readme_flat).group(1)) == n_seeds * len(RECIPES)
+    assert int(re.search(r"`METRICS` has (\d+) now", readme_flat).group(1)) == len(METRICS)
+    registry = re.search(r"registry `models.MODELS` \(([^)]*)\)", architecture).group(1)
+    assert [m.strip() for m in registry.split(",")] == list(MODELS)
+    listed = recipe_listing(architecture)
+    assert sum(n for _, n in listed) == len(RECIPES), f"{listed}: {len(RECIPES)} recipes"
+    labels = {r.label.split("-style")[0].lower() for r in RECIPES.values()}
+    assert {system.lower() for system, _ in listed} <= labels, listed
+    notebooks = len(list((REPO / "notebooks").glob("[0-9][0-9]_*.ipynb")))
+    for name in DOCS:
+        for word in re.findall(r"\b(\w+) notebooks\b", (REPO / name).read_text(), re.I):
+            assert NUMBER_WORDS.get(word.lower(), notebooks) == notebooks, f"{name}: '{word} notebooks'"
