@@ -178,19 +178,9 @@ def test_guide_calls_name_real_parameters():
     """Every backticked ``name(params)`` of the guide that resolves to one beatlite function names only its
     parameters (the check of ``docs/architecture.md``, with the notebooks' ``bl.`` prefix dropped)."""
     pytest.importorskip("torch")
-    from tests.test_docs_signatures import _index, documented_calls, missing_parameters, resolve
+    from tests.test_docs_signatures import _index, wrong_calls
 
-    index = _index()
-    fenced = re.compile(r"^ *```.*?^ *```", re.S | re.M)  # shell commands and printed output, not calls
-    text = fenced.sub("", GUIDE.read_text())
-    text = text.replace("`bl.", "`").replace(" bl.", " ")
-    checked, wrong = 0, []
-    for package, name, names, _ in documented_calls(text):
-        obj = resolve(name, package, index)
-        if obj is None or not names:
-            continue
-        checked += 1
-        if bad := missing_parameters(obj, names):
-            wrong.append(f"{name}({', '.join(names)}): {obj.__module__}.{obj.__qualname__} has no {bad}")
+    text = GUIDE.read_text().replace("`bl.", "`").replace(" bl.", " ")
+    checked, wrong = wrong_calls(text, _index())
     assert checked >= 4, checked
     assert not wrong, "docs/teaching.md names parameters the code does not have:\n" + "\n".join(wrong)
