@@ -525,6 +525,10 @@ def test_the_readme_fit_command_sentences_are_the_record():
         f"(76 h, about 4.75 times more) about {4.75 * EPOCH_WINDOWS / epoch_wps / 60:.0f} min per epoch"
         in text
     )
+    assert (
+        f"the second `fit` spent {again['prepare_s']:.0f} s before training instead of {fresh['prepare_s']:.0f} s"
+        in text
+    )
     guide = " ".join(_guide().split())
     assert (
         f"took {_minutes(fresh['wall_s'])} on a fresh `--out` on a 2-core CPU without AVX-512 "
