@@ -69,12 +69,14 @@ def phases(lines: list[tuple[float, str]], wall_s: float) -> dict[str, float | N
     return {"prepare_s": prepare, "extractor_s": wrote, "train_s": train}
 
 
-def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> dict:
-    """Run the command once (in this fresh process's only child); its wall seconds, peak RSS and phases."""
-    command = fit_command(recipe, corpus, out, extractor_epochs)
+def measure(command: list[str], **popen: object) -> tuple[dict, list[tuple[float, str]]]:
+    """Run ``command`` as this process's only child (call it once per fresh process, so that the peak is the
+    command's own): its wall and CPU seconds and peak RSS (``ru_maxrss`` of the largest process of its tree,
+    KiB and GiB), and its output lines with the second each arrived. ``RuntimeError`` with the output's end
+    when it fails."""
     tic = time.perf_counter()
-    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                             text=True, bufsize=1)  # fmt: skip
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1,
+                             **popen)  # fmt: skip
     lines = []
     for line in child.stdout:  # tqdm's bars end in \r, so a bar's updates arrive with the next \n
         lines.append((time.perf_counter() - tic, line.rstrip("\n").split("\r")[-1]))
@@ -88,11 +90,14 @@ def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None 
         "cpu_s": usage.ru_utime + usage.ru_stime,
         "peak_rss_kib": usage.ru_maxrss,
         "peak_rss_gib": usage.ru_maxrss / 2**20,
-        **phases(lines, wall),
-        "output_tail": [
-            line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-6:]
-        ],
-    }
+    }, lines
+
+
+def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> dict:
+    """Run the command once (in this fresh process's only child); its wall seconds, peak RSS and phases."""
+    got, lines = measure(fit_command(recipe, corpus, out, extractor_epochs))
+    tail = [line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-6:]]
+    return {**got, **phases(lines, got["wall_s"]), "output_tail": tail}
 
 
 def _run_step(args: list[str]) -> dict:
