@@ -711,3 +711,32 @@ def test_emage_audio_beats_leave_out_two_seconds_at_both_ends():
     nearest = np.abs(beats[:, None] - np.array([1.0, 3.0])[None]).min(axis=1)
     assert len(beats) >= 2 and nearest.max() < 0.05, beats  # librosa may report a click twice, 32 ms apart
     assert np.abs(beats - 1.0).min() < 0.05 and np.abs(beats - 3.0).min() < 0.05, beats
+
+
+def test_bvh_rows_under_another_rate_s_frame_time_are_refused_and_scored_with_pred_fps(
+    truth_files, test_set, tmp_path
+):
+    """BEAT's code writes its 15 fps results under the 120 fps template's ``Frame Time: 0.008333``. Before, a file
+    whose Frame Time says twice its rows' rate was read as half the take and scored against the take's first half
+    (the exact ground truth got FGD 3.7, MPJPE 11.9 cm, with a trimming warning only), and one at 120 fps was
+    refused as shorter than a window. Now both are one error line naming the file and 'Frame Time' and the rate
+    that spans the take; ``pred_fps=15`` scores them as the ground truth they are."""
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    changed = {test_set.takes[0]: "0.008333", test_set.takes[1]: "0.033333"}  # 120 and 30 fps
+    for stem, frame_time in changed.items():
+        path = folder / f"{stem}.bvh"
+        path.write_text(path.read_text().replace("Frame Time: 0.066667", f"Frame Time: {frame_time}"))
+    with pytest.raises(ScoreInputError) as info:
+        score_folder(folder, test=test_set, metrics=["MPJPE"])
+    lines = info.value.lines
+    assert len(lines) == 2, lines
+    for stem, line in zip(changed, lines, strict=True):
+        frames = len(test_set.gt_directions[test_set.takes.index(stem)])
+        assert f"{stem}.bvh" in line and "'Frame Time'" in line and f"{frames} rows" in line, line
+        assert "at 15 fps they would span it" in line and "--pred-fps" in line, line
+    result = score_folder(folder, test=test_set, metrics=["FGD", "PCK", "MPJPE"], pred_fps=15)
+    values = result.evaluation.values()
+    assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4 and values["FGD"] < 1e-6  # the ground truth itself
+    assert result.info["pred_fps"] == 15 and "--pred-fps" in result.to_markdown()
+    assert result.info["trimmed"] == {}
