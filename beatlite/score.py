@@ -1,7 +1,8 @@
 """Score any model's outputs: ``python -m beatlite.score PRED --data DATA``.
 
 ``PRED`` is a folder of generated takes named like the ground-truth takes of the scored split, one file per
-take (matched by stem, everything before the first dot):
+take (matched by stem, everything before the first dot, in any case; ``res_{stem}``, as BEAT's and EMAGE's test
+code name their results, too):
 
 =====================  ===================================================================================
 ``{stem}.bvh[.gz]``    BEAT's skeleton (joint names), any frame rate (resampled to 15 fps by
@@ -107,6 +108,9 @@ EXPORT_PRECISION = 12
 """Decimals of the BVH files :func:`export_checkpoint_takes` writes (5e-13 degrees: the scores equal the in-library ones to rtol 1e-6)."""
 
 _SUFFIXES = (".bvh", ".bvh.gz", ".npy", ".npz")
+_PREFIX = (
+    "res_"  # BEAT's and EMAGE's test code name a take's result res_{take} (and its ground truth gt_{take})
+)
 
 
 class ScoreInputError(ValueError):
@@ -434,8 +438,9 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     (files, missing, extra)
         ``{stem: path}`` for the takes of ``takes`` that have a file, the takes without one, and the names of
         the other files (ignored): predictions whose stem is no take of the split and files of no prediction
-        suffix (suffixes are matched in any case, ``.BVH`` too). Hidden files (``.DS_Store``, macOS' ``._*``)
-        are skipped.
+        suffix. Names match in any case (``2_Scott_0_1_1.BVH``), and ``res_{stem}`` (as BEAT's and EMAGE's test
+        code name their results; their ``gt_{stem}`` files are extra). Hidden files (``.DS_Store``, macOS'
+        ``._*``) are skipped.
 
     Raises
     ------
@@ -445,26 +450,35 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     folder = Path(pred)
     if not folder.is_dir():
         raise ScoreInputError([f"{folder}: not a folder of predictions"])
-    by_stem: dict[str, list[Path]] = {}
+    wanted = {t.lower(): t for t in takes}
+    by_take: dict[str, list[Path]] = {}
     extra = []
     for p in sorted(folder.iterdir()):
         if not p.is_file() or p.name.startswith("."):
             continue
-        if p.name.lower().endswith(_SUFFIXES):
-            by_stem.setdefault(p.name.split(".")[0], []).append(p)
-        else:
+        take = _take_of(p.name.split(".")[0], wanted) if p.name.lower().endswith(_SUFFIXES) else None
+        if take is None:
             extra.append(p.name)
-    wanted = set(takes)
+        else:
+            by_take.setdefault(take, []).append(p)
     twice = [
-        f"{stem}: several predictions ({', '.join(p.name for p in ps)})"
-        for stem, ps in by_stem.items()
-        if len(ps) > 1 and stem in wanted
+        f"{t}: several predictions ({', '.join(p.name for p in ps)})"
+        for t, ps in by_take.items()
+        if len(ps) > 1
     ]
     if twice:
         raise ScoreInputError(twice)
-    files = {t: by_stem[t][0] for t in takes if t in by_stem}
-    extra += [p.name for stem, ps in by_stem.items() if stem not in wanted for p in ps]
-    return files, [t for t in takes if t not in by_stem], sorted(extra)
+    files = {t: by_take[t][0] for t in takes if t in by_take}
+    return files, [t for t in takes if t not in by_take], sorted(extra)
+
+
+def _take_of(stem: str, wanted: dict[str, str]) -> str | None:
+    """The take (of ``{lowercase name: name}``) that a file stem predicts: its name in any case, or with BEAT's and
+    EMAGE's ``res_`` prefix (their test code writes ``res_{take}.bvh`` / ``res_{take}.npz``)."""
+    key = stem.lower()
+    if key not in wanted and key.startswith(_PREFIX):
+        key = key[len(_PREFIX) :]
+    return wanted.get(key)
 
 
 def trim_test_set(test: Any, frames: Sequence[int]) -> Any:
@@ -743,9 +757,12 @@ def score_folder(
         message = (
             f"{pred}: no prediction for {len(missing)} of the {len(test.takes)} takes: {', '.join(missing)}"
         )
-        near = [name for name in extra if name.split(".")[0] in set(missing)]
+        near = [name for name in extra if any(t.lower() in name.lower() for t in missing)]
         if near:
-            message += f" (files of no prediction suffix {', '.join(_SUFFIXES)}: {', '.join(near)})"
+            message += (
+                f" (files named after them, not {{take}}.* or res_{{take}}.* with a suffix of {', '.join(_SUFFIXES)}:"
+                f" {', '.join(near)})"
+            )
         if not allow_missing:
             problems.append(message + " (--allow-missing scores the others)")
         else:

@@ -740,3 +740,44 @@ def test_bvh_rows_under_another_rate_s_frame_time_are_refused_and_scored_with_pr
     assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4 and values["FGD"] < 1e-6  # the ground truth itself
     assert result.info["pred_fps"] == 15 and "--pred-fps" in result.to_markdown()
     assert result.info["trimmed"] == {}
+
+
+def test_predictions_named_in_another_case_or_as_beat_and_emage_write_them_are_matched(tmp_path):
+    """BEAT's test code names a take's result ``res_{take}.bvh``, EMAGE's ``res_{take}.npz`` beside
+    ``gt_{take}.npz``; before, such a folder (and one of ``2_Scott_0_1_1.BVH``) matched no take ('no prediction for
+    8 of the 8 takes')."""
+    takes = ["2_scott_0_1_1", "4_lawrence_0_65_65", "6_carla_0_87_87", "8_catherine_0_103_103"]
+    names = [
+        "res_2_scott_0_1_1.npz",
+        "gt_2_scott_0_1_1.npz",
+        "4_Lawrence_0_65_65.BVH",
+        "RES_6_carla_0_87_87.bvh",
+    ]
+    names += ["8_catherine_0_103_103_generated.bvh"]
+    for name in names:
+        (tmp_path / name).write_bytes(b"")
+    files, missing, extra = match_predictions(tmp_path, takes)
+    assert {t: p.name for t, p in files.items()} == dict(zip(takes[:3], names[:1] + names[2:4], strict=True))
+    assert missing == takes[3:] and extra == ["8_catherine_0_103_103_generated.bvh", "gt_2_scott_0_1_1.npz"]
+    (tmp_path / "2_scott_0_1_1.bvh").write_bytes(b"")
+    with pytest.raises(
+        ScoreInputError, match=r"2_scott_0_1_1: several predictions \(2_scott_0_1_1.bvh, res_"
+    ):
+        match_predictions(tmp_path, takes)
+
+
+def test_a_folder_of_res_files_scores_and_a_misnamed_file_is_named(truth_files, test_set, tmp_path):
+    """A folder of res_{take}.bvh scores as its files; a file that only holds a take's name is named in the error."""
+    folder = tmp_path / "pred"
+    folder.mkdir()
+    for stem in test_set.takes:
+        shutil.copy(truth_files / f"{stem}.bvh", folder / f"res_{stem}.bvh")
+    result = score_folder(folder, test=test_set, metrics=["PCK", "MPJPE"])
+    assert result.evaluation.values()["PCK"] == 1.0 and result.evaluation.values()["MPJPE"] < 1e-4
+    stem = test_set.takes[0]
+    (folder / f"res_{stem}.bvh").rename(folder / f"{stem}_generated.bvh")
+    with (
+        pytest.warns(ScoreWarning, match="ignored"),
+        pytest.raises(ScoreInputError, match=rf"no prediction for 1 of the 8 takes.*{stem}_generated\.bvh"),
+    ):
+        score_folder(folder, test=test_set, metrics=["PCK"])
