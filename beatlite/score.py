@@ -1,7 +1,8 @@
 """Score any model's outputs: ``python -m beatlite.score PRED --data DATA``.
 
 ``PRED`` is a folder of generated takes named like the ground-truth takes of the scored split, one file per
-take (matched by stem, everything before the first dot):
+take (matched by stem, everything before the first dot, in any case; ``res_{stem}``, as BEAT's and EMAGE's test
+code name their results, too):
 
 =====================  ===================================================================================
 ``{stem}.bvh[.gz]``    BEAT's skeleton (joint names), any frame rate (resampled to 15 fps by
@@ -43,9 +44,12 @@ Checks, each one line on stderr: a missing take is an error (``--allow-missing``
 there); an extra file is listed and ignored (hidden files such as macOS' ``._*`` are skipped; suffixes match in
 any case); a prediction longer than its take is cut to it, one shorter is
 scored against the take cut to the same length (one warning each saying by how many frames), and one shorter
-than a window (34 frames) is an error. A file that cannot be converted (another skeleton, NaN, another shape)
-is a :class:`~beatlite.io.FormatError` naming the file and the field. Errors end the command with exit code 2
-and no traceback.
+than a window (34 frames) is an error. One :data:`RATE_FACTOR` (1.5) times longer or shorter than its take is an
+error naming the rate at which its rows would span the take: its rows are at another rate than the file says
+(BEAT's code writes its 15 fps results under the 120 fps ``Frame Time: 0.008333`` of its template);
+``--pred-fps`` (``pred_fps=``) gives the rate of every ``.bvh``'s and ``.npz``'s rows, trusted. A file that
+cannot be converted (another skeleton, NaN, another shape) is a :class:`~beatlite.io.FormatError` naming the
+file and the field. Errors end the command with exit code 2 and no traceback.
 
 ``--bootstrap N`` adds 95 % percentile intervals over takes (:func:`bootstrap_intervals`); ``--self-check``
 scores the split's own motion written as BVH files (:func:`self_check`); ``--export CHECKPOINT`` writes a
@@ -75,6 +79,7 @@ from beatlite.constants import FPS, SR, WINDOW_LENGTH
 __all__ = [
     "EXPORT_PRECISION",
     "MIN_FRAMES",
+    "RATE_FACTOR",
     "Prediction",
     "ScoreInputError",
     "ScoreResult",
@@ -95,10 +100,17 @@ __all__ = [
 MIN_FRAMES = WINDOW_LENGTH
 """A prediction needs at least one FGD window (34 frames at 15 fps)."""
 
+RATE_FACTOR = 1.5
+"""A prediction this many times longer or shorter than its take is refused, not trimmed: its rows are at another
+rate than the file says (BEAT's code writes 15 fps rows under a 120 fps ``Frame Time``); ``pred_fps`` gives it."""
+
 EXPORT_PRECISION = 12
 """Decimals of the BVH files :func:`export_checkpoint_takes` writes (5e-13 degrees: the scores equal the in-library ones to rtol 1e-6)."""
 
 _SUFFIXES = (".bvh", ".bvh.gz", ".npy", ".npz")
+_PREFIX = (
+    "res_"  # BEAT's and EMAGE's test code name a take's result res_{take} (and its ground truth gt_{take})
+)
 
 
 class ScoreInputError(ValueError):
@@ -125,11 +137,18 @@ class Prediction:
         ``spine_neck_141`` Euler degrees (None for direction files).
     form : str
         What the file was, e.g. ``"bvh 30 fps -> 15 fps"`` or ``"npy directions (T, 42, 3)"``.
+    rows : int or None
+        Frames of the file before resampling (None: ``n_frames``, a ``.npy`` read at 15 fps).
+    fps : float
+        The rate those rows were read at (the file's ``Frame Time`` or ``mocap_frame_rate``, or ``fps`` of
+        :func:`read_prediction`).
     """
 
     directions: np.ndarray
     euler: np.ndarray | None
     form: str
+    rows: int | None = None
+    fps: float = FPS
 
     @property
     def n_frames(self) -> int:
@@ -255,19 +274,23 @@ def _check_parents(src: Any, beat: Any, path: str | Path) -> None:
             )
 
 
-def _bvh_prediction(path: Path) -> Prediction:
-    """A BVH file -> directions and Euler channels at 15 fps (see :func:`beat_channels`)."""
+def _bvh_prediction(path: Path, fps: float | None = None) -> Prediction:
+    """A BVH file -> directions and Euler channels at 15 fps (see :func:`beat_channels`); ``fps`` is the rows'
+    rate instead of the file's ``Frame Time``."""
     from beatlite.io import read_bvh
 
-    motion = read_bvh(path)
+    motion = read_bvh(path, fps=fps)
     return _channels_prediction(beat_channels(motion, path), motion.fps, "bvh", path)
 
 
-def _smplx_prediction(path: Path) -> Prediction:
-    """A BEAT2 ``.npz`` -> BEAT's skeleton (:func:`beatlite.skeleton.smplx.smplx_to_beat`) -> as a BVH."""
+def _smplx_prediction(path: Path, fps: float | None = None) -> Prediction:
+    """A BEAT2 ``.npz`` -> BEAT's skeleton (:func:`beatlite.skeleton.smplx.smplx_to_beat`) -> as a BVH; ``fps``
+    is the rows' rate instead of the file's ``mocap_frame_rate``."""
     from beatlite.io.smplx import read_smplx
 
     motion = read_smplx(path)
+    if fps is not None:
+        motion = dataclasses.replace(motion, fps=float(fps))
     return _channels_prediction(motion.to_beat().channels, motion.fps, "npz smplx -> BEAT skeleton,", path)  # type: ignore[attr-defined]
 
 
@@ -279,7 +302,7 @@ def _channels_prediction(channels: np.ndarray, fps: float, form: str, path: Path
     from beatlite.skeleton.beat import beat_skeleton, subset_columns
     from beatlite.skeleton.ted import channels_to_directions
 
-    form = f"{form} {fps:g} fps"
+    form, rows = f"{form} {fps:g} fps", len(channels)
     motion = Motion(beat_skeleton(), channels[:1], fps)
     if fps != FPS:
         cols = rotation_columns(motion)
@@ -294,7 +317,7 @@ def _channels_prediction(channels: np.ndarray, fps: float, form: str, path: Path
             f"{str(exc).split(';')[0]} on BEAT's skeleton: values too large to give directions",
             field="values",
         ) from None
-    return Prediction(directions, euler, form)
+    return Prediction(directions, euler, form, rows=rows, fps=float(fps))
 
 
 def _npy_prediction(path: Path) -> Prediction:
@@ -377,8 +400,16 @@ def _unit_directions(d: np.ndarray, path: Path) -> np.ndarray:
     return d / norms
 
 
-def read_prediction(path: str | Path) -> Prediction:
+def read_prediction(path: str | Path, *, fps: float | None = None) -> Prediction:
     """One prediction file (``.bvh``, ``.bvh.gz``, ``.npy`` or BEAT2's ``.npz``, see the module docstring) at 15 fps.
+
+    Parameters
+    ----------
+    path : str or Path
+    fps : float, optional
+        The rate of a ``.bvh``'s or ``.npz``'s rows instead of the file's own (``Frame Time``,
+        ``mocap_frame_rate``), e.g. 15 for BEAT's code's results, written under a 120 fps header. A ``.npy`` is
+        always read at 15 fps.
 
     Raises
     ------
@@ -390,11 +421,11 @@ def read_prediction(path: str | Path) -> Prediction:
     p = Path(path)
     name = p.name.lower()
     if name.endswith((".bvh", ".bvh.gz")):
-        return _bvh_prediction(p)
+        return _bvh_prediction(p, fps)
     if name.endswith(".npy"):
         return _npy_prediction(p)
     if name.endswith(".npz"):
-        return _smplx_prediction(p)
+        return _smplx_prediction(p, fps)
     raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
 
 
@@ -407,8 +438,9 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     (files, missing, extra)
         ``{stem: path}`` for the takes of ``takes`` that have a file, the takes without one, and the names of
         the other files (ignored): predictions whose stem is no take of the split and files of no prediction
-        suffix (suffixes are matched in any case, ``.BVH`` too). Hidden files (``.DS_Store``, macOS' ``._*``)
-        are skipped.
+        suffix. Names match in any case (``2_Scott_0_1_1.BVH``), and ``res_{stem}`` (as BEAT's and EMAGE's test
+        code name their results; their ``gt_{stem}`` files are extra). Hidden files (``.DS_Store``, macOS'
+        ``._*``) are skipped.
 
     Raises
     ------
@@ -418,26 +450,35 @@ def match_predictions(pred: str | Path, takes: Sequence[str]) -> tuple[dict[str,
     folder = Path(pred)
     if not folder.is_dir():
         raise ScoreInputError([f"{folder}: not a folder of predictions"])
-    by_stem: dict[str, list[Path]] = {}
+    wanted = {t.lower(): t for t in takes}
+    by_take: dict[str, list[Path]] = {}
     extra = []
     for p in sorted(folder.iterdir()):
         if not p.is_file() or p.name.startswith("."):
             continue
-        if p.name.lower().endswith(_SUFFIXES):
-            by_stem.setdefault(p.name.split(".")[0], []).append(p)
-        else:
+        take = _take_of(p.name.split(".")[0], wanted) if p.name.lower().endswith(_SUFFIXES) else None
+        if take is None:
             extra.append(p.name)
-    wanted = set(takes)
+        else:
+            by_take.setdefault(take, []).append(p)
     twice = [
-        f"{stem}: several predictions ({', '.join(p.name for p in ps)})"
-        for stem, ps in by_stem.items()
-        if len(ps) > 1 and stem in wanted
+        f"{t}: several predictions ({', '.join(p.name for p in ps)})"
+        for t, ps in by_take.items()
+        if len(ps) > 1
     ]
     if twice:
         raise ScoreInputError(twice)
-    files = {t: by_stem[t][0] for t in takes if t in by_stem}
-    extra += [p.name for stem, ps in by_stem.items() if stem not in wanted for p in ps]
-    return files, [t for t in takes if t not in by_stem], sorted(extra)
+    files = {t: by_take[t][0] for t in takes if t in by_take}
+    return files, [t for t in takes if t not in by_take], sorted(extra)
+
+
+def _take_of(stem: str, wanted: dict[str, str]) -> str | None:
+    """The take (of ``{lowercase name: name}``) that a file stem predicts: its name in any case, or with BEAT's and
+    EMAGE's ``res_`` prefix (their test code writes ``res_{take}.bvh`` / ``res_{take}.npz``)."""
+    key = stem.lower()
+    if key not in wanted and key.startswith(_PREFIX):
+        key = key[len(_PREFIX) :]
+    return wanted.get(key)
 
 
 def trim_test_set(test: Any, frames: Sequence[int]) -> Any:
@@ -539,6 +580,10 @@ class ScoreResult:
             )
         if i.get("missing"):
             lines.append(f"Missing takes (not scored): {', '.join(i['missing'])}.")
+        if i.get("pred_fps"):
+            lines.append(
+                f"The .bvh and .npz rows read at {i['pred_fps']:g} fps (--pred-fps), not at the files' own rates."
+            )
         if i.get("trimmed"):
             lines.append(
                 "Trimmed: " + ", ".join(f"{s} ({d:+d} frames)" for s, d in i["trimmed"].items()) + "."
@@ -651,6 +696,7 @@ def score_folder(
     seed: int = 0,
     extractor: str | Path | None = None,
     allow_missing: bool = False,
+    pred_fps: float | None = None,
     test: Any = None,
     progress: bool = False,
 ) -> ScoreResult:
@@ -675,6 +721,10 @@ def score_folder(
         FGD extractor checkpoint of the ``dirvec`` space (default the shipped ``checkpoints/fgd_dirvec.pt``).
     allow_missing : bool
         Score the takes that have a prediction when some have none (default: an error).
+    pred_fps : float, optional
+        The rate of every ``.bvh``'s and ``.npz``'s rows instead of the file's own (:func:`read_prediction`),
+        trusted: a prediction :data:`RATE_FACTOR` times longer or shorter than its take is then scored on the
+        overlap, not refused.
     test : EvaluationSet, optional
         The loaded split (instead of ``data`` and ``split``; :attr:`~beatlite.train.testset.EvaluationSet.folder`
         names the data folder).
@@ -692,6 +742,8 @@ def score_folder(
     """
     from beatlite.paths import shareable
 
+    if pred_fps is not None and not (math.isfinite(pred_fps) and pred_fps > 0):
+        raise ScoreInputError([f"pred_fps {pred_fps}: the rows' frame rate must be a positive number"])
     test = load_split(data, split) if test is None else test
     files, missing, extra = match_predictions(pred, test.takes)
     problems = []
@@ -705,17 +757,20 @@ def score_folder(
         message = (
             f"{pred}: no prediction for {len(missing)} of the {len(test.takes)} takes: {', '.join(missing)}"
         )
-        near = [name for name in extra if name.split(".")[0] in set(missing)]
+        near = [name for name in extra if any(t.lower() in name.lower() for t in missing)]
         if near:
-            message += f" (files of no prediction suffix {', '.join(_SUFFIXES)}: {', '.join(near)})"
+            message += (
+                f" (files named after them, not {{take}}.* or res_{{take}}.* with a suffix of {', '.join(_SUFFIXES)}:"
+                f" {', '.join(near)})"
+            )
         if not allow_missing:
             problems.append(message + " (--allow-missing scores the others)")
         else:
             warnings.warn(message + ": scored without them", ScoreWarning, stacklevel=2)
     if not files and allow_missing:
         problems.append(f"{pred}: no prediction for any of the {len(test.takes)} takes")
-    preds = _read_all(files, problems, progress)
-    frames, trimmed = _frames(test, files, preds, problems)
+    preds = _read_all(files, problems, progress, pred_fps)
+    frames, trimmed = _frames(test, files, preds, problems, rate_given=pred_fps is not None)
     if problems:
         raise ScoreInputError(problems)
     if frames != [len(d) for d in test.gt_directions]:
@@ -748,6 +803,7 @@ def score_folder(
         "extra": extra,
         "trimmed": trimmed,
         "euler_rewritten": moved,
+        "pred_fps": pred_fps,
     }
     return _score(directions, euler, test, metrics, bootstrap, seed, extractor, progress, info)
 
@@ -802,8 +858,11 @@ def _truth_euler_branch(
     return out, moved
 
 
-def _read_all(files: dict[str, Path], problems: list[str], progress: bool) -> dict[str, Prediction]:
-    """Read every file; each one that cannot be converted adds its error line to ``problems``."""
+def _read_all(
+    files: dict[str, Path], problems: list[str], progress: bool, fps: float | None = None
+) -> dict[str, Prediction]:
+    """Read every file (``fps``: :func:`read_prediction`'s); each one that cannot be converted adds its error line
+    to ``problems``."""
     from tqdm import tqdm
 
     from beatlite.io import FormatError
@@ -813,21 +872,30 @@ def _read_all(files: dict[str, Path], problems: list[str], progress: bool) -> di
         files.items(), desc="reading", unit="take", file=sys.stderr, disable=None if progress else True
     ):
         try:
-            preds[stem] = read_prediction(path)
+            preds[stem] = read_prediction(path, fps=fps)
         except FormatError as exc:
             problems.append(str(exc))
     return preds
 
 
 def _frames(
-    test: Any, files: dict[str, Path], preds: dict[str, Prediction], problems: list[str]
+    test: Any,
+    files: dict[str, Path],
+    preds: dict[str, Prediction],
+    problems: list[str],
+    rate_given: bool = False,
 ) -> tuple[list[int], dict[str, int]]:
-    """Frames scored per take (0: no prediction) and ``{stem: prediction frames - take frames}`` where they differ."""
+    """Frames scored per take (0: no prediction) and ``{stem: prediction frames - take frames}`` where they differ;
+    a prediction :data:`RATE_FACTOR` times off its take's length (unless ``rate_given``; a file of fewer rows than a
+    window is too short at any rate) or shorter than a window adds its line to ``problems``."""
     frames, trimmed = [], {}
     for stem, truth in zip(test.takes, test.gt_directions, strict=True):
         have = len(truth)
         n = preds[stem].n_frames if stem in preds else 0
-        if stem in preds and n < MIN_FRAMES:
+        rows = (preds[stem].rows or n) if stem in preds else 0
+        if rows >= MIN_FRAMES and not rate_given and max(n, have) >= RATE_FACTOR * min(n, have):
+            problems.append(_rate_problem(files[stem], preds[stem], have))
+        elif stem in preds and n < MIN_FRAMES:
             problems.append(
                 f"{files[stem]}: {n} frames at {FPS:g} fps, fewer than one {MIN_FRAMES}-frame window"
             )
@@ -842,6 +910,24 @@ def _frames(
             )
         frames.append(min(n, have))
     return frames, trimmed
+
+
+def _rate_problem(path: Path, pred: Prediction, have: int) -> str:
+    """The error line of a prediction :data:`RATE_FACTOR` times off its take's length: the rate its rows would need."""
+    from beatlite.io import FormatError
+
+    rows = pred.n_frames if pred.rows is None else pred.rows
+    field = {".npz": "mocap_frame_rate", ".npy": "shape"}.get(path.suffix.lower(), "Frame Time")
+    fix = (
+        "a .npy is read at 15 fps: resample it to 15 fps"
+        if field == "shape"
+        else f"at {rows * FPS / have:.4g} fps they would span it: if that is their rate (BEAT's code writes 15 fps rows "
+        "under a 120 fps Frame Time), give it with --pred-fps"
+    )
+    message = (
+        f"{rows} rows at {pred.fps:g} fps last {rows / pred.fps:.2f} s, the take {have / FPS:.2f} s; {fix}"
+    )
+    return str(FormatError(path, message, field=field))
 
 
 def _score(
@@ -1246,6 +1332,13 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--self-check", action="store_true", help="score the ground truth written as BVH files")
     p.add_argument("--extractor", help="FGD extractor checkpoint (dirvec space; default the shipped one)")
     p.add_argument("--allow-missing", action="store_true", help="score the takes that have a prediction")
+    p.add_argument(
+        "--pred-fps",
+        type=float,
+        metavar="FPS",
+        help="frame rate of the .bvh/.npz rows instead of the files' own (e.g. 15 for BEAT's code's results, "
+        "written under a 120 fps Frame Time); a prediction of another length is then scored on the overlap",
+    )
     p.add_argument("--export", metavar="CHECKPOINT", help="write CHECKPOINT's generations into PRED and stop")
     p.add_argument("--format", choices=("bvh", "npy"), default="bvh", help="--export file format")
     return p
@@ -1273,7 +1366,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.self_check:
         result = self_check(args.data, **common)
     else:
-        result = score_folder(args.pred, args.data, allow_missing=args.allow_missing, **common)
+        result = score_folder(
+            args.pred, args.data, allow_missing=args.allow_missing, pred_fps=args.pred_fps, **common
+        )
     text = result.to_markdown()
     print(text)
     if args.md:

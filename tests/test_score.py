@@ -711,3 +711,73 @@ def test_emage_audio_beats_leave_out_two_seconds_at_both_ends():
     nearest = np.abs(beats[:, None] - np.array([1.0, 3.0])[None]).min(axis=1)
     assert len(beats) >= 2 and nearest.max() < 0.05, beats  # librosa may report a click twice, 32 ms apart
     assert np.abs(beats - 1.0).min() < 0.05 and np.abs(beats - 3.0).min() < 0.05, beats
+
+
+def test_bvh_rows_under_another_rate_s_frame_time_are_refused_and_scored_with_pred_fps(
+    truth_files, test_set, tmp_path
+):
+    """BEAT's code writes its 15 fps results under the 120 fps template's ``Frame Time: 0.008333``. Before, a file
+    whose Frame Time says twice its rows' rate was read as half the take and scored against the take's first half
+    (the exact ground truth got FGD 3.7, MPJPE 11.9 cm, with a trimming warning only), and one at 120 fps was
+    refused as shorter than a window. Now both are one error line naming the file and 'Frame Time' and the rate
+    that spans the take; ``pred_fps=15`` scores them as the ground truth they are."""
+    folder = tmp_path / "pred"
+    shutil.copytree(truth_files, folder)
+    changed = {test_set.takes[0]: "0.008333", test_set.takes[1]: "0.033333"}  # 120 and 30 fps
+    for stem, frame_time in changed.items():
+        path = folder / f"{stem}.bvh"
+        path.write_text(path.read_text().replace("Frame Time: 0.066667", f"Frame Time: {frame_time}"))
+    with pytest.raises(ScoreInputError) as info:
+        score_folder(folder, test=test_set, metrics=["MPJPE"])
+    lines = info.value.lines
+    assert len(lines) == 2, lines
+    for stem, line in zip(changed, lines, strict=True):
+        frames = len(test_set.gt_directions[test_set.takes.index(stem)])
+        assert f"{stem}.bvh" in line and "'Frame Time'" in line and f"{frames} rows" in line, line
+        assert "at 15 fps they would span it" in line and "--pred-fps" in line, line
+    result = score_folder(folder, test=test_set, metrics=["FGD", "PCK", "MPJPE"], pred_fps=15)
+    values = result.evaluation.values()
+    assert values["PCK"] == 1.0 and values["MPJPE"] < 1e-4 and values["FGD"] < 1e-6  # the ground truth itself
+    assert result.info["pred_fps"] == 15 and "--pred-fps" in result.to_markdown()
+    assert result.info["trimmed"] == {}
+
+
+def test_predictions_named_in_another_case_or_as_beat_and_emage_write_them_are_matched(tmp_path):
+    """BEAT's test code names a take's result ``res_{take}.bvh``, EMAGE's ``res_{take}.npz`` beside
+    ``gt_{take}.npz``; before, such a folder (and one of ``2_Scott_0_1_1.BVH``) matched no take ('no prediction for
+    8 of the 8 takes')."""
+    takes = ["2_scott_0_1_1", "4_lawrence_0_65_65", "6_carla_0_87_87", "8_catherine_0_103_103"]
+    names = [
+        "res_2_scott_0_1_1.npz",
+        "gt_2_scott_0_1_1.npz",
+        "4_Lawrence_0_65_65.BVH",
+        "RES_6_carla_0_87_87.bvh",
+    ]
+    names += ["8_catherine_0_103_103_generated.bvh"]
+    for name in names:
+        (tmp_path / name).write_bytes(b"")
+    files, missing, extra = match_predictions(tmp_path, takes)
+    assert {t: p.name for t, p in files.items()} == dict(zip(takes[:3], names[:1] + names[2:4], strict=True))
+    assert missing == takes[3:] and extra == ["8_catherine_0_103_103_generated.bvh", "gt_2_scott_0_1_1.npz"]
+    (tmp_path / "2_scott_0_1_1.bvh").write_bytes(b"")
+    with pytest.raises(
+        ScoreInputError, match=r"2_scott_0_1_1: several predictions \(2_scott_0_1_1.bvh, res_"
+    ):
+        match_predictions(tmp_path, takes)
+
+
+def test_a_folder_of_res_files_scores_and_a_misnamed_file_is_named(truth_files, test_set, tmp_path):
+    """A folder of res_{take}.bvh scores as its files; a file that only holds a take's name is named in the error."""
+    folder = tmp_path / "pred"
+    folder.mkdir()
+    for stem in test_set.takes:
+        shutil.copy(truth_files / f"{stem}.bvh", folder / f"res_{stem}.bvh")
+    result = score_folder(folder, test=test_set, metrics=["PCK", "MPJPE"])
+    assert result.evaluation.values()["PCK"] == 1.0 and result.evaluation.values()["MPJPE"] < 1e-4
+    stem = test_set.takes[0]
+    (folder / f"res_{stem}.bvh").rename(folder / f"{stem}_generated.bvh")
+    with (
+        pytest.warns(ScoreWarning, match="ignored"),
+        pytest.raises(ScoreInputError, match=rf"no prediction for 1 of the 8 takes.*{stem}_generated\.bvh"),
+    ):
+        score_folder(folder, test=test_set, metrics=["PCK"])
