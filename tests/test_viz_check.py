@@ -172,11 +172,10 @@ def test_save_figure_checks_text_at_the_size_a_notebook_shows_it_inline_too(tmp_
 
 
 @pytest.mark.parametrize("size, flagged", [((4, 16), True), ((16, 4), False), ((6, 4), False)])
-def test_text_a_slide_shrinks_under_8_px_is_flagged(tmp_path, monkeypatch, size, flagged):
+def test_text_a_slide_shrinks_under_8_px_is_flagged(size, flagged):
     """A slide shows a figure at most SLIDE_FIGURE_BOX (1089 x 600 px): one 16 in high at 100 dpi (its tight box
     70-100 % of 1600 px: the default margins cropped) is shown at under half its size, so its 10-pt labels
     (13.9 px inline) come out under 8 px; 16 in wide it is shown at over 68 %, its labels over 9 px."""
-    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
     fig, ax = plt.subplots(figsize=size, dpi=100)
     ax.plot([0, 1], [0, 1])
     ax.set_xlabel("time (s)", fontsize=10)
@@ -189,10 +188,34 @@ def test_text_a_slide_shrinks_under_8_px_is_flagged(tmp_path, monkeypatch, size,
         low, high = 10 * 100 / 72 * 600 / 1600, 10 * 100 / 72 * 600 / (0.7 * 1600)
         assert px and all(low <= v <= high for v in px), problems
         assert "shown at" in str(problems[0]) and "to fit 1089 x 600" in str(problems[0])
-        with pytest.raises(check.FigureError, match="'time \\(s\\)' is [0-9.]+ px high at 100 dpi, shown at"):
-            style.save_figure(fig, tmp_path / "tall", formats=("png",))
-    else:
-        style.save_figure(fig, tmp_path / "wide", formats=("png",))
+    plt.close(fig)
+
+
+def test_save_figure_checks_the_slide_box_only_for_the_course_s_figures_or_a_box_it_is_given(
+    tmp_path, monkeypatch
+):
+    """A figure 16 in high (shown on a slide at under half its size, its 10-pt labels under 8 px: the test above) is
+    refused where the course saves its figures (bl.report.figures_dir(), every notebook's) and where ``fit`` names a
+    box, and saved as it is elsewhere: a library user's figure for a paper is not a slide (before: refused
+    everywhere, 'shown at 46% of 362 x 1296 px to fit 1089 x 600')."""
+    from beatlite import report
+
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    fig, ax = plt.subplots(figsize=(4, 16), dpi=100)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("time (s)", fontsize=10)
+    ax.tick_params(labelsize=10)
+    slide = "'time \\(s\\)' is [0-9.]+ px high at 100 dpi, shown at [0-9]+% of .* to fit"
+    with pytest.raises(check.FigureError, match=slide + " 1089 x 600"):
+        style.save_figure(fig, report.figures_dir() / "00_tall", formats=("png",))
+    # a box of one's own: as low as a slide, then high enough to show the picture at its own size
+    with pytest.raises(check.FigureError, match=slide + " 1920 x 600"):
+        style.save_figure(fig, tmp_path / "own_slides", formats=("png",), fit=(1920, 600))
+    style.save_figure(fig, tmp_path / "own_slides", formats=("png",), fit=(1920, 1600))
+    written = style.save_figure(fig, tmp_path / "paper" / "fig_tall", formats=("png",))
+    assert [p.name for p in written] == ["fig_tall.png"]
+    assert not report.figures_dir().exists()  # nothing written where it was refused
     plt.close(fig)
 
 
