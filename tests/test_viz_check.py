@@ -120,6 +120,56 @@ def test_a_figure_legend_with_two_entries_in_one_colour_is_flagged():
     plt.close(fig)
 
 
+def test_legend_entries_made_with_proxy_handles_are_checked_for_colour():
+    """Legend entries that are no artist of the axes (``Line2D([], [], ...)``, ``Patch``): two in one colour, or one in
+    a colour nothing is drawn in, are flagged as for any series (before: neither was reported, the check read the
+    axes' labelled artists only)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(9, 3))
+    a.plot([0, 1], [0, 1], color="#1f77b4")
+    a.plot([0, 1], [1, 0], color="#ff7f0e")
+    a.legend(
+        handles=[Line2D([], [], color="#1f77b4", label="CaMN"), Line2D([], [], color="#1f77b4", label="HA2G")]
+    )
+    b.bar([0, 1], [1.0, 2.0], color=["#1f77b4", "#ff7f0e"])
+    b.legend(
+        handles=[Patch(color="#1f77b4", label="CaMN"), Patch(color="#2ca02c", label="S2G")]
+    )  # no green bar
+    c.scatter([0, 1], [0, 1], color="#9467bd")
+    fig.legend(handles=[Line2D([], [], marker="o", ls="", color="w", markerfacecolor="#8c564b", label="A2G")])
+    problems = check.check_figure(fig, dpi=150)
+    assert [str(p) for p in problems] == [
+        "shared colour: axes 1 of 3: 'CaMN' and 'HA2G' are both #1f77b4",
+        "legend colour: axes 2 of 3: 'S2G' is #2ca02c, a colour no plotted series has",
+        "legend colour: figure legend: 'A2G' is #8c564b, a colour no plotted series has",  # its marker's face
+    ]
+    plt.close(fig)
+
+
+def test_proxy_legend_entries_in_the_colours_drawn_pass():
+    """The usual proxies: a marker-only line for scatter points (white line, coloured face), a patch per bar colour
+    (plot_annotation_timeline), an event line drawn many times with one legend entry (a NaN line), an image's
+    colours."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(9, 3))
+    a.scatter([0, 1], [0, 1], color="#9467bd")
+    a.axvline(np.nan, color="#d62728", label="beats")
+    for x in (0.2, 0.6):
+        a.axvline(x, color="#d62728", alpha=0.6)
+    a.legend(handles=[Line2D([], [], marker="o", ls="", color="w", markerfacecolor="#9467bd", label="points"),
+                      *a.get_legend_handles_labels()[0]])  # fmt: skip
+    b.bar([0, 1], [1.0, 2.0], color=["#1f77b4", "#ff7f0e"], ec="white")
+    b.legend(handles=[Patch(color="#1f77b4", label="CaMN"), Patch(color="#ff7f0e", label="HA2G")])
+    c.imshow(np.array([[0, 1], [2, 2]]), cmap=plt.cm.tab10, vmin=0, vmax=9)
+    c.legend(handles=[Patch(color=plt.cm.tab10(k), label=f"class {k}") for k in range(3)])
+    assert check.check_figure(fig, dpi=150) == []
+    plt.close(fig)
+
+
 def bad_figure() -> plt.Figure:
     fig, (a, b) = plt.subplots(1, 2)
     a.plot([0, 1], [0, 1])

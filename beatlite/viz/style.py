@@ -180,8 +180,9 @@ def save_figure(
     beatlite.viz.check.FigureError
         With ``BEATLITE_FIGURE_CHECK=raise`` (``make run``, ``make test``), when
         :func:`beatlite.viz.check.check_figure` finds an empty panel, text under
-        8 px or two series in one colour (nothing is written); the default ``warn``
-        gives a :class:`~beatlite.viz.check.FigureWarning` and saves. Text is measured
+        8 px, two series in one colour or a legend colour nothing is drawn in (nothing
+        is written); the default ``warn`` gives a :class:`~beatlite.viz.check.FigureWarning`
+        and saves. Text is measured
         at the lower of the saved dpi (150) and the figure's own dpi (100), at which
         a notebook shows the figure inline, and, with a box to fit (``fit``, the course's
         slide for the course's figures), at the scale the box shows it.
