@@ -1131,3 +1131,37 @@ def test_score_scatter_labels_cover_no_marker_and_stay_inside():
         assert not any(box.contains(px, py) for px, py in points), text.get_text()
         assert sum(box.overlaps(other) for other in labels) == 1, text.get_text()
     plt.close("all")
+
+
+def _figures_made_outside_the_style(notebook: str) -> list[str]:
+    """Calls of a notebook that make a figure (``plt.subplots``, ``plt.figure``, ``plt.subplot_mosaic``) outside a
+    ``with bl.viz.figure_style():`` block, as ``"cell N: call"``."""
+    import ast
+    import json
+    from pathlib import Path
+
+    nb = json.loads((Path(__file__).resolve().parents[1] / "notebooks" / notebook).read_text())
+    found = []
+    for i, cell in enumerate(nb["cells"]):
+        if cell["cell_type"] != "code":
+            continue
+        lines = "".join(cell["source"]).splitlines()
+        tree = ast.parse("\n".join(line for line in lines if not line.lstrip().startswith(("%", "!"))))
+        styled = {
+            id(node)
+            for block in ast.walk(tree)
+            if isinstance(block, ast.With) and any("figure_style" in ast.unparse(w) for w in block.items)
+            for node in ast.walk(block)
+        }
+        for node in ast.walk(tree):
+            name = ast.unparse(node.func) if isinstance(node, ast.Call) else ""
+            if name in ("plt.subplots", "plt.figure", "plt.subplot_mosaic") and id(node) not in styled:
+                found.append(f"cell {i}: {name}")
+    return found
+
+
+def test_notebook_09_makes_its_figures_in_the_beatlite_style():
+    """Notebook 09's four figures are drawn inside ``bl.viz.figure_style()`` (fonts, grid, spines, the style's
+    colours), as the library's plot functions draw theirs (before: matplotlib's defaults, its one-series curves in
+    CaMN's blue)."""
+    assert _figures_made_outside_the_style("09_scoring.ipynb") == []
