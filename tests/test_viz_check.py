@@ -70,6 +70,33 @@ def test_text_under_8_px_at_the_saved_dpi_is_flagged(points, dpi, small):
     plt.close(fig)
 
 
+@pytest.mark.parametrize(
+    ("label", "points", "shrink"),
+    [
+        (r"$x_0$ error", 8, 0.7),  # 7.8 px: flagged
+        (r"$x_0$ error", 9, 0.7),  # 8.75 px
+        (r"$x_{a_b}$", 10, 0.7**2),  # 6.8 px: flagged
+        (r"$\epsilon$ error", 8, 1.0),  # 11.1 px: no script
+    ],
+)
+def test_mathtext_subscripts_are_measured_at_the_size_they_are_drawn(label, points, shrink):
+    """Mathtext draws a sub- or superscript at 0.7 of the font size (0.7**2 a level deeper): an 8-pt ``$x_0$``
+    legend entry at 100 dpi has 11.1 px letters but a 7.8 px subscript (before: measured at the font size, it
+    passed, as notebook 10's legends did)."""
+    fig, ax = plt.subplots(dpi=100)
+    ax.plot([0, 1], [0, 1], label=label)
+    ax.legend(fontsize=points)
+    problems = check.check_figure(fig, dpi=100)
+    px = points * 100 / 72 * shrink
+    if px < 8:
+        assert [str(p) for p in problems] == [
+            f"small text: {label!r} is {px:.1f} px high (its smallest math symbols) at 100 dpi (under 8 px)"
+        ]
+    else:
+        assert problems == []
+    plt.close(fig)
+
+
 def test_small_tick_labels_of_a_hidden_axis_are_not_text_on_the_picture():
     fig, ax = plt.subplots()
     ax.plot([0, 1], [0, 1])

@@ -13,7 +13,8 @@ What counts as a problem:
   off with nothing in it at all is a blank space, not a panel, and passes;
 - **small text**: a visible, non-empty text (titles, labels, tick labels, legend entries,
   annotations) whose font is smaller than :data:`MIN_TEXT_PX` pixels at the saved size
-  (font size in points x dpi / 72) or, with ``fit``, once the picture is scaled down to fit
+  (font size in points x dpi / 72; for mathtext, its smallest symbols: a sub- or superscript
+  is drawn at 0.7 of the font size) or, with ``fit``, once the picture is scaled down to fit
   that box (:data:`SLIDE_FIGURE_BOX`, the most a slide of the course shows: a figure much taller
   than wide is shown small, its text with it);
 - **shared colour**: two labelled series (lines, bars, scatter points, filled areas with
@@ -41,6 +42,7 @@ and on the animation players of notebooks 05 and 08 (``to_html(dpi=80)``).
 
 from __future__ import annotations
 
+import functools
 import os
 import warnings
 from collections.abc import Iterable
@@ -207,17 +209,42 @@ def _small_texts(
     seen: set[tuple[str, float]] = set()
     scale, shown = fit
     for name, text in _drawn_texts(fig):
-        px = text.get_fontsize() * dpi / 72.0 * scale
+        shrink = _math_shrink(text)
+        px = text.get_fontsize() * dpi / 72.0 * scale * shrink
         if px < min_px and (name, px) not in seen:
             seen.add((name, px))
             verb = "are" if name.startswith("tick labels") else "is"
+            math = " (its smallest math symbols)" if shrink < 1.0 else ""
             problems.append(
                 FigureProblem(
                     "small text",
-                    f"{name} {verb} {px:.1f} px high at {dpi:g} dpi{shown} (under {min_px:g} px)",
+                    f"{name} {verb} {px:.1f} px high{math} at {dpi:g} dpi{shown} (under {min_px:g} px)",
                 )
             )
     return problems
+
+
+@functools.cache
+def _math_parser() -> Any:
+    from matplotlib.mathtext import MathTextParser
+
+    return MathTextParser("path")
+
+
+def _math_shrink(text: Any) -> float:
+    """The smallest glyph of a text over its font size: 1 for plain text; for mathtext (``$x_0$``) the scale of its
+    sub/superscripts and fractions (0.7, 0.49 a level deeper: mathtext's shrink factor), read from its layout."""
+    from matplotlib import cbook
+
+    words = text.get_text()
+    if text.get_usetex() or not text.get_parse_math() or not cbook.is_math_text(words):
+        return 1.0
+    prop = text.get_fontproperties()
+    try:
+        sizes = [glyph[1] for glyph in _math_parser().parse(words, dpi=72, prop=prop).glyphs]
+    except ValueError:  # not valid mathtext: drawing it fails on its own
+        return 1.0
+    return min(1.0, min(sizes) / prop.get_size_in_points()) if sizes else 1.0
 
 
 def _drawn_texts(fig: Any) -> list[tuple[str, Any]]:
