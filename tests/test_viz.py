@@ -497,6 +497,61 @@ def test_every_system_of_the_course_has_one_fixed_colour_of_its_own():
     assert min(np.abs(a - b).max() for i, a in enumerate(rgb) for b in rgb[i + 1 :]) > 0.1
 
 
+# Dichromat simulation matrices on linear RGB (Machado, Oliveira & Fernandes 2009, severity 1), and sRGB's D65 matrix.
+_DICHROMAT = {
+    "protanopia": [
+        [0.152286, 1.052583, -0.204868],
+        [0.114503, 0.786281, 0.099216],
+        [-0.003882, -0.048116, 1.051998],
+    ],
+    "deuteranopia": [
+        [0.367322, 0.860646, -0.227968],
+        [0.280085, 0.672501, 0.047413],
+        [-0.01182, 0.04294, 0.968881],
+    ],
+}
+_SRGB_TO_XYZ = [[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]]
+
+
+def _cielab(colour, vision: str = "normal") -> np.ndarray:
+    """CIELAB (D65) of a colour as seen with normal vision or, simulated, a dichromat's."""
+    from matplotlib.colors import to_rgb
+
+    c = np.array(to_rgb(colour))
+    linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    if vision != "normal":
+        linear = np.clip(np.array(_DICHROMAT[vision]) @ linear, 0.0, 1.0)
+    t = np.array(_SRGB_TO_XYZ) @ linear / np.array(_SRGB_TO_XYZ).sum(axis=1)  # over white's XYZ
+    f = np.where(t > (6 / 29) ** 3, np.cbrt(t), t / (3 * (6 / 29) ** 2) + 4 / 29)
+    return np.array([116 * f[1] - 16, 500 * (f[0] - f[1]), 200 * (f[1] - f[2])])
+
+
+def test_the_cielab_measure_gives_the_reference_values():
+    assert np.allclose(_cielab("white"), [100, 0, 0], atol=1e-6) and np.allclose(
+        _cielab("black"), 0, atol=1e-6
+    )
+    assert np.allclose(_cielab("#ff0000"), [53.24, 80.09, 67.20], atol=0.05)  # sRGB red, published
+    for vision in _DICHROMAT:  # a dichromat sees greys as they are (each matrix row sums to 1)
+        assert np.allclose(_cielab("#777777", vision), _cielab("#777777"), atol=1e-3)
+
+
+def test_every_two_named_system_colours_are_clearly_apart():
+    """CIELAB ΔE (CIE76) of every two colours of NAMED_SYSTEM_COLOURS: at least 30 with normal vision, where the
+    other pairs start at 33.6 (ground truth (141 Euler channels) and random clip; a just noticeable difference is
+    2.3); before, A2G-style (#882255) and Joint Embedding-style (#7b4173), two dark purples side by side in notebook
+    07's benchmark, were 19.5 apart (9.8 in CIEDE2000). Simulated protanopia and deuteranopia cannot keep twelve
+    colours apart: their floor stays 7.5 (HA2G and Mean pose 7.7 for a protanope, Random clip and Trimodal-style 8.3
+    for a deuteranope), and Joint Embedding-style stays 30 from every other colour for them too."""
+    import itertools
+
+    colours = sorted(set(style.NAMED_SYSTEM_COLOURS.values()))
+    joint = style.system_colour("Joint Embedding-style")
+    for vision, floor in [("normal", 30.0), ("protanopia", 7.5), ("deuteranopia", 7.5)]:
+        for a, b in itertools.combinations(colours, 2):
+            distance = float(np.linalg.norm(_cielab(a, vision) - _cielab(b, vision)))
+            assert distance >= (30.0 if joint in (a, b) else floor), (vision, a, b, round(distance, 1))
+
+
 def test_the_same_system_has_the_same_colour_in_every_figure():
     """Two figures with different systems in different orders (notebook 07's ranked bars and points, key frames
     in rows and in columns, an animation's titles) give every label one colour, the one of ``system_colour``."""
@@ -1076,3 +1131,37 @@ def test_score_scatter_labels_cover_no_marker_and_stay_inside():
         assert not any(box.contains(px, py) for px, py in points), text.get_text()
         assert sum(box.overlaps(other) for other in labels) == 1, text.get_text()
     plt.close("all")
+
+
+def _figures_made_outside_the_style(notebook: str) -> list[str]:
+    """Calls of a notebook that make a figure (``plt.subplots``, ``plt.figure``, ``plt.subplot_mosaic``) outside a
+    ``with bl.viz.figure_style():`` block, as ``"cell N: call"``."""
+    import ast
+    import json
+    from pathlib import Path
+
+    nb = json.loads((Path(__file__).resolve().parents[1] / "notebooks" / notebook).read_text())
+    found = []
+    for i, cell in enumerate(nb["cells"]):
+        if cell["cell_type"] != "code":
+            continue
+        lines = "".join(cell["source"]).splitlines()
+        tree = ast.parse("\n".join(line for line in lines if not line.lstrip().startswith(("%", "!"))))
+        styled = {
+            id(node)
+            for block in ast.walk(tree)
+            if isinstance(block, ast.With) and any("figure_style" in ast.unparse(w) for w in block.items)
+            for node in ast.walk(block)
+        }
+        for node in ast.walk(tree):
+            name = ast.unparse(node.func) if isinstance(node, ast.Call) else ""
+            if name in ("plt.subplots", "plt.figure", "plt.subplot_mosaic") and id(node) not in styled:
+                found.append(f"cell {i}: {name}")
+    return found
+
+
+def test_notebook_09_makes_its_figures_in_the_beatlite_style():
+    """Notebook 09's four figures are drawn inside ``bl.viz.figure_style()`` (fonts, grid, spines, the style's
+    colours), as the library's plot functions draw theirs (before: matplotlib's defaults, its one-series curves in
+    CaMN's blue)."""
+    assert _figures_made_outside_the_style("09_scoring.ipynb") == []

@@ -70,6 +70,33 @@ def test_text_under_8_px_at_the_saved_dpi_is_flagged(points, dpi, small):
     plt.close(fig)
 
 
+@pytest.mark.parametrize(
+    ("label", "points", "shrink"),
+    [
+        (r"$x_0$ error", 8, 0.7),  # 7.8 px: flagged
+        (r"$x_0$ error", 9, 0.7),  # 8.75 px
+        (r"$x_{a_b}$", 10, 0.7**2),  # 6.8 px: flagged
+        (r"$\epsilon$ error", 8, 1.0),  # 11.1 px: no script
+    ],
+)
+def test_mathtext_subscripts_are_measured_at_the_size_they_are_drawn(label, points, shrink):
+    """Mathtext draws a sub- or superscript at 0.7 of the font size (0.7**2 a level deeper): an 8-pt ``$x_0$``
+    legend entry at 100 dpi has 11.1 px letters but a 7.8 px subscript (before: measured at the font size, it
+    passed, as notebook 10's legends did)."""
+    fig, ax = plt.subplots(dpi=100)
+    ax.plot([0, 1], [0, 1], label=label)
+    ax.legend(fontsize=points)
+    problems = check.check_figure(fig, dpi=100)
+    px = points * 100 / 72 * shrink
+    if px < 8:
+        assert [str(p) for p in problems] == [
+            f"small text: {label!r} is {px:.1f} px high (its smallest math symbols) at 100 dpi (under 8 px)"
+        ]
+    else:
+        assert problems == []
+    plt.close(fig)
+
+
 def test_small_tick_labels_of_a_hidden_axis_are_not_text_on_the_picture():
     fig, ax = plt.subplots()
     ax.plot([0, 1], [0, 1])
@@ -117,6 +144,56 @@ def test_a_figure_legend_with_two_entries_in_one_colour_is_flagged():
     fig.legend([first, second], ["train", "validation"])
     problems = check.check_figure(fig, dpi=150)
     assert kinds(problems) == ["shared colour"] and "figure legend" in problems[0].detail
+    plt.close(fig)
+
+
+def test_legend_entries_made_with_proxy_handles_are_checked_for_colour():
+    """Legend entries that are no artist of the axes (``Line2D([], [], ...)``, ``Patch``): two in one colour, or one in
+    a colour nothing is drawn in, are flagged as for any series (before: neither was reported, the check read the
+    axes' labelled artists only)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(9, 3))
+    a.plot([0, 1], [0, 1], color="#1f77b4")
+    a.plot([0, 1], [1, 0], color="#ff7f0e")
+    a.legend(
+        handles=[Line2D([], [], color="#1f77b4", label="CaMN"), Line2D([], [], color="#1f77b4", label="HA2G")]
+    )
+    b.bar([0, 1], [1.0, 2.0], color=["#1f77b4", "#ff7f0e"])
+    b.legend(
+        handles=[Patch(color="#1f77b4", label="CaMN"), Patch(color="#2ca02c", label="S2G")]
+    )  # no green bar
+    c.scatter([0, 1], [0, 1], color="#9467bd")
+    fig.legend(handles=[Line2D([], [], marker="o", ls="", color="w", markerfacecolor="#8c564b", label="A2G")])
+    problems = check.check_figure(fig, dpi=150)
+    assert [str(p) for p in problems] == [
+        "shared colour: axes 1 of 3: 'CaMN' and 'HA2G' are both #1f77b4",
+        "legend colour: axes 2 of 3: 'S2G' is #2ca02c, a colour no plotted series has",
+        "legend colour: figure legend: 'A2G' is #8c564b, a colour no plotted series has",  # its marker's face
+    ]
+    plt.close(fig)
+
+
+def test_proxy_legend_entries_in_the_colours_drawn_pass():
+    """The usual proxies: a marker-only line for scatter points (white line, coloured face), a patch per bar colour
+    (plot_annotation_timeline), an event line drawn many times with one legend entry (a NaN line), an image's
+    colours."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(9, 3))
+    a.scatter([0, 1], [0, 1], color="#9467bd")
+    a.axvline(np.nan, color="#d62728", label="beats")
+    for x in (0.2, 0.6):
+        a.axvline(x, color="#d62728", alpha=0.6)
+    a.legend(handles=[Line2D([], [], marker="o", ls="", color="w", markerfacecolor="#9467bd", label="points"),
+                      *a.get_legend_handles_labels()[0]])  # fmt: skip
+    b.bar([0, 1], [1.0, 2.0], color=["#1f77b4", "#ff7f0e"], ec="white")
+    b.legend(handles=[Patch(color="#1f77b4", label="CaMN"), Patch(color="#ff7f0e", label="HA2G")])
+    c.imshow(np.array([[0, 1], [2, 2]]), cmap=plt.cm.tab10, vmin=0, vmax=9)
+    c.legend(handles=[Patch(color=plt.cm.tab10(k), label=f"class {k}") for k in range(3)])
+    assert check.check_figure(fig, dpi=150) == []
     plt.close(fig)
 
 
@@ -172,11 +249,10 @@ def test_save_figure_checks_text_at_the_size_a_notebook_shows_it_inline_too(tmp_
 
 
 @pytest.mark.parametrize("size, flagged", [((4, 16), True), ((16, 4), False), ((6, 4), False)])
-def test_text_a_slide_shrinks_under_8_px_is_flagged(tmp_path, monkeypatch, size, flagged):
+def test_text_a_slide_shrinks_under_8_px_is_flagged(size, flagged):
     """A slide shows a figure at most SLIDE_FIGURE_BOX (1089 x 600 px): one 16 in high at 100 dpi (its tight box
     70-100 % of 1600 px: the default margins cropped) is shown at under half its size, so its 10-pt labels
     (13.9 px inline) come out under 8 px; 16 in wide it is shown at over 68 %, its labels over 9 px."""
-    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
     fig, ax = plt.subplots(figsize=size, dpi=100)
     ax.plot([0, 1], [0, 1])
     ax.set_xlabel("time (s)", fontsize=10)
@@ -189,10 +265,34 @@ def test_text_a_slide_shrinks_under_8_px_is_flagged(tmp_path, monkeypatch, size,
         low, high = 10 * 100 / 72 * 600 / 1600, 10 * 100 / 72 * 600 / (0.7 * 1600)
         assert px and all(low <= v <= high for v in px), problems
         assert "shown at" in str(problems[0]) and "to fit 1089 x 600" in str(problems[0])
-        with pytest.raises(check.FigureError, match="'time \\(s\\)' is [0-9.]+ px high at 100 dpi, shown at"):
-            style.save_figure(fig, tmp_path / "tall", formats=("png",))
-    else:
-        style.save_figure(fig, tmp_path / "wide", formats=("png",))
+    plt.close(fig)
+
+
+def test_save_figure_checks_the_slide_box_only_for_the_course_s_figures_or_a_box_it_is_given(
+    tmp_path, monkeypatch
+):
+    """A figure 16 in high (shown on a slide at under half its size, its 10-pt labels under 8 px: the test above) is
+    refused where the course saves its figures (bl.report.figures_dir(), every notebook's) and where ``fit`` names a
+    box, and saved as it is elsewhere: a library user's figure for a paper is not a slide (before: refused
+    everywhere, 'shown at 46% of 362 x 1296 px to fit 1089 x 600')."""
+    from beatlite import report
+
+    monkeypatch.setenv("BEATLITE_FIGURE_CHECK", "raise")
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    fig, ax = plt.subplots(figsize=(4, 16), dpi=100)
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("time (s)", fontsize=10)
+    ax.tick_params(labelsize=10)
+    slide = "'time \\(s\\)' is [0-9.]+ px high at 100 dpi, shown at [0-9]+% of .* to fit"
+    with pytest.raises(check.FigureError, match=slide + " 1089 x 600"):
+        style.save_figure(fig, report.figures_dir() / "00_tall", formats=("png",))
+    # a box of one's own: as low as a slide, then high enough to show the picture at its own size
+    with pytest.raises(check.FigureError, match=slide + " 1920 x 600"):
+        style.save_figure(fig, tmp_path / "own_slides", formats=("png",), fit=(1920, 600))
+    style.save_figure(fig, tmp_path / "own_slides", formats=("png",), fit=(1920, 1600))
+    written = style.save_figure(fig, tmp_path / "paper" / "fig_tall", formats=("png",))
+    assert [p.name for p in written] == ["fig_tall.png"]
+    assert not report.figures_dir().exists()  # nothing written where it was refused
     plt.close(fig)
 
 

@@ -1,4 +1,5 @@
-"""One check of a finished figure: empty panels, text too small to read, two series in one colour.
+"""One check of a finished figure: empty panels, text too small to read, two series in one colour, a legend
+colour nothing is drawn in.
 
 :func:`check_figure` returns the problems it finds, as :class:`FigureProblem` records;
 :func:`beatlite.viz.style.save_figure` calls it on every figure it saves and warns
@@ -12,12 +13,16 @@ What counts as a problem:
   off with nothing in it at all is a blank space, not a panel, and passes;
 - **small text**: a visible, non-empty text (titles, labels, tick labels, legend entries,
   annotations) whose font is smaller than :data:`MIN_TEXT_PX` pixels at the saved size
-  (font size in points x dpi / 72) or, with ``fit``, once the picture is scaled down to fit
+  (font size in points x dpi / 72; for mathtext, its smallest symbols: a sub- or superscript
+  is drawn at 0.7 of the font size) or, with ``fit``, once the picture is scaled down to fit
   that box (:data:`SLIDE_FIGURE_BOX`, the most a slide of the course shows: a figure much taller
   than wide is shown small, its text with it);
 - **shared colour**: two labelled series (lines, bars, scatter points, filled areas with
   different labels, as in a legend) of one axes or of the figure's legends drawn in the same
-  colour; the same label in several panels is one series and may keep its colour.
+  colour; the same label in several panels is one series and may keep its colour. Where a
+  legend is drawn, its own entries count, proxy handles (``Line2D([], [], ...)``, ``Patch``) too;
+- **legend colour**: a legend entry in a colour that nothing of the figure is drawn in (no
+  line, marker, bar, area or image pixel), e.g. a proxy handle left in another colour than its series.
 
 >>> import matplotlib.pyplot as plt
 >>> fig, (a, b) = plt.subplots(1, 2)
@@ -37,6 +42,7 @@ and on the animation players of notebooks 05 and 08 (``to_html(dpi=80)``).
 
 from __future__ import annotations
 
+import functools
 import os
 import warnings
 from collections.abc import Iterable
@@ -70,7 +76,8 @@ class FigureError(ValueError):
 
 @dataclass(frozen=True)
 class FigureProblem:
-    """One problem of a figure: ``kind`` is ``"empty panel"``, ``"small text"`` or ``"shared colour"``."""
+    """One problem of a figure: ``kind`` is ``"empty panel"``, ``"small text"``, ``"shared colour"`` or
+    ``"legend colour"``."""
 
     kind: str
     detail: str
@@ -94,7 +101,7 @@ def check_figure(
     min_text_px: float = MIN_TEXT_PX,
     fit: tuple[float, float] | None = None,
 ) -> list[FigureProblem]:
-    """The problems of a figure as it will be saved: empty panels, small text, shared colours.
+    """The problems of a figure as it will be saved: empty panels, small text, shared and legend colours.
 
     Parameters
     ----------
@@ -127,13 +134,15 @@ def check_figure(
     axes = [ax for ax in fig.axes if ax.get_visible()]
     problems = [p for i, ax in enumerate(axes) if (p := _empty_panel(ax, i, len(axes)))]
     problems += _small_texts(fig, float(dpi), float(min_text_px), _fit_scale(fig, float(dpi), fit))
-    for i, ax in enumerate(axes):
-        problems += _shared_colours(_series(ax), f"axes {i + 1} of {len(axes)}")
-    for legend in fig.legends:
-        pairs = zip(legend.legend_handles, (t.get_text() for t in legend.get_texts()), strict=False)
-        problems += _shared_colours(
-            [(label, c) for h, label in pairs if (c := _colour(h)) is not None], "figure legend"
-        )
+    legends = [(f"axes {i + 1} of {len(axes)}", ax, ax.get_legend()) for i, ax in enumerate(axes)]
+    legends += [("figure legend", None, legend) for legend in fig.legends]
+    drawn = _drawn_colours(axes)
+    for where, ax, legend in legends:
+        # what a legend shows: its own entries (proxy handles too), else the axes' labelled artists
+        shown = _series(ax) if legend is None else _legend_series(legend)
+        problems += _shared_colours(shown, where)
+        if legend is not None and drawn is not None:
+            problems += _unplotted_colours(shown, drawn, where)
     return problems
 
 
@@ -200,17 +209,42 @@ def _small_texts(
     seen: set[tuple[str, float]] = set()
     scale, shown = fit
     for name, text in _drawn_texts(fig):
-        px = text.get_fontsize() * dpi / 72.0 * scale
+        shrink = _math_shrink(text)
+        px = text.get_fontsize() * dpi / 72.0 * scale * shrink
         if px < min_px and (name, px) not in seen:
             seen.add((name, px))
             verb = "are" if name.startswith("tick labels") else "is"
+            math = " (its smallest math symbols)" if shrink < 1.0 else ""
             problems.append(
                 FigureProblem(
                     "small text",
-                    f"{name} {verb} {px:.1f} px high at {dpi:g} dpi{shown} (under {min_px:g} px)",
+                    f"{name} {verb} {px:.1f} px high{math} at {dpi:g} dpi{shown} (under {min_px:g} px)",
                 )
             )
     return problems
+
+
+@functools.cache
+def _math_parser() -> Any:
+    from matplotlib.mathtext import MathTextParser
+
+    return MathTextParser("path")
+
+
+def _math_shrink(text: Any) -> float:
+    """The smallest glyph of a text over its font size: 1 for plain text; for mathtext (``$x_0$``) the scale of its
+    sub/superscripts and fractions (0.7, 0.49 a level deeper: mathtext's shrink factor), read from its layout."""
+    from matplotlib import cbook
+
+    words = text.get_text()
+    if text.get_usetex() or not text.get_parse_math() or not cbook.is_math_text(words):
+        return 1.0
+    prop = text.get_fontproperties()
+    try:
+        sizes = [glyph[1] for glyph in _math_parser().parse(words, dpi=72, prop=prop).glyphs]
+    except ValueError:  # not valid mathtext: drawing it fails on its own
+        return 1.0
+    return min(1.0, min(sizes) / prop.get_size_in_points()) if sizes else 1.0
 
 
 def _drawn_texts(fig: Any) -> list[tuple[str, Any]]:
@@ -257,8 +291,59 @@ def _series(ax: Any) -> list[tuple[str, tuple[float, float, float]]]:
     return [(label, c) for h, label in zip(handles, labels, strict=True) if (c := _colour(h)) is not None]
 
 
+def _legend_series(legend: Any) -> list[tuple[str, tuple[float, float, float]]]:
+    """(label, colour) of each entry a legend shows, from the handles it draws (proxy artists included)."""
+    pairs = zip(legend.legend_handles, (t.get_text() for t in legend.get_texts()), strict=False)
+    return [(label, c) for h, label in pairs if (c := _colour(h)) is not None]
+
+
+def _drawn_colours(axes: list[Any]) -> np.ndarray | None:
+    """(K, 3) RGB of everything the axes draw as data (line, marker, face and edge colours, image pixels), or
+    None when an image's colours cannot be read (then any legend colour may be in it)."""
+    from matplotlib.colors import to_rgba, to_rgba_array
+    from matplotlib.image import AxesImage
+    from matplotlib.lines import Line2D
+
+    found = [np.zeros((0, 4))]
+    for ax in axes:
+        for artist in (a for a in (*ax.lines, *ax.patches, *ax.collections, *ax.images) if _has_data(a)):
+            try:
+                if isinstance(artist, Line2D):
+                    rgba = [to_rgba(c) for c in (artist.get_color(), artist.get_mfc(), artist.get_mec())]
+                elif isinstance(artist, AxesImage):
+                    rgba = artist.to_rgba(artist.get_array()).reshape(-1, 4)
+                    rgba = rgba / 255.0 if rgba.dtype == np.uint8 else rgba
+                else:
+                    rgba = [*to_rgba_array(artist.get_facecolor()), *to_rgba_array(artist.get_edgecolor())]
+            except (AttributeError, ValueError, TypeError):
+                if isinstance(artist, AxesImage):
+                    return None
+                continue
+            found.append(np.asarray(rgba, dtype=float).reshape(-1, 4))
+    rgba = np.concatenate(found)
+    return np.unique(rgba[rgba[:, 3] > 0, :3], axis=0)
+
+
+def _unplotted_colours(
+    shown: list[tuple[str, tuple[float, float, float]]], drawn: np.ndarray, where: str
+) -> list[FigureProblem]:
+    """A legend entry in a colour that nothing of the figure is drawn in (a proxy handle that matches no series)."""
+    from matplotlib.colors import to_hex
+
+    problems = []
+    for label, colour in dict(shown).items():
+        if not len(drawn) or np.abs(drawn - np.asarray(colour)).max(axis=1).min() >= COLOUR_TOLERANCE:
+            problems.append(
+                FigureProblem(
+                    "legend colour", f"{where}: {label!r} is {to_hex(colour)}, a colour no plotted series has"
+                )
+            )
+    return problems
+
+
 def _colour(artist: Any) -> tuple[float, float, float] | None:
-    """The RGB colour that identifies a series: a line's colour, a bar's or point's face (else edge) colour."""
+    """The RGB colour that identifies a series: a line's colour (a marker-only line's marker face, else edge
+    colour), a bar's or point's face (else edge) colour."""
     from matplotlib.colors import to_rgba
     from matplotlib.container import Container
     from matplotlib.lines import Line2D
@@ -271,6 +356,9 @@ def _colour(artist: Any) -> tuple[float, float, float] | None:
     try:
         if isinstance(artist, Line2D):
             rgba = to_rgba(artist.get_color())
+            if artist.get_linestyle() == "None" and str(artist.get_marker()).lower() not in ("none", ""):
+                face = to_rgba(artist.get_markerfacecolor())
+                rgba = face if face[3] > 0 else to_rgba(artist.get_markeredgecolor())
         else:
             faces = np.atleast_2d(artist.get_facecolor())
             if not faces.size or faces[0, 3] == 0:

@@ -59,8 +59,10 @@ SYSTEM_COLOURS: tuple[str, ...] = ("#333333", "#1f77b4", "#ff7f0e", "#2ca02c", "
 #: The colour of every system the course shows, by name (lower case): the ground truth's two rows, CaMN and
 #: HA2G (their ablations, e.g. "CaMN w/o text", start with the name and share its colour), the baselines and the
 #: other shipped recipes' rows (:data:`beatlite.train.recipes.RECIPES`' labels), so that a system keeps its colour
-#: in every figure. Chosen to stay apart for deuteranopes and protanopes where twelve colours allow (Paul Tol's
-#: muted and vibrant schemes) and readable as text on white (contrast >= 3:1).
+#: in every figure. Readable as text on white (contrast >= 3:1), mostly Paul Tol's muted and vibrant schemes, and
+#: every two at least 30 CIELAB ΔE apart (the closest: ground truth (141 Euler channels) and random clip, 33.6);
+#: for a simulated protanope or deuteranope twelve colours cannot all stay apart: HA2G and mean pose are 7.7 apart
+#: for one, random clip and trimodal 8.3 for the other (tests/test_viz.py measures them).
 NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
     {
         "ground truth": SYSTEM_COLOURS[0],
@@ -75,7 +77,7 @@ NAMED_SYSTEM_COLOURS: Mapping[str, str] = MappingProxyType(
         "trimodal-style": "#117733",
         "seq2seq-style": "#332288",
         "a2g-style": "#882255",
-        "joint embedding-style": "#7b4173",
+        "joint embedding-style": "#8866ff",  # a light violet: #7b4173 was 19.5 from A2G's wine
         "diffgesture-style": "#d62728",
     }
 )
@@ -145,6 +147,8 @@ def save_figure(
     fig: Any,
     path_stem: str | os.PathLike[str],
     formats: Sequence[str] = ("png", "svg"),
+    *,
+    fit: tuple[float, float] | None = None,
     **savefig_kwargs: Any,
 ) -> list[Path]:
     """Save ``fig`` once per format as ``<path_stem>.<fmt>``, atomically; create the folder if needed.
@@ -158,6 +162,12 @@ def save_figure(
         suffix that equals one of ``formats`` is dropped (``"a.png"`` -> ``"a"``).
     formats : sequence of str
         File extensions understood by matplotlib (``"png"``, ``"svg"``, ``"pdf"``, ...).
+    fit : (float, float), optional
+        A box, pixels (width, height), the picture is shown in, scaled down to fit when larger
+        (e.g. your slides): its text is checked at that scale. Default: the course's slide,
+        :data:`beatlite.viz.check.SLIDE_FIGURE_BOX`, for a figure saved in the course's figure
+        folder (:func:`beatlite.report.figures_dir`, where every notebook saves its figures);
+        elsewhere (a figure for a paper) none, the picture at its saved size.
     **savefig_kwargs
         Passed to ``fig.savefig`` (``dpi``, ``bbox_inches``, ...); the style's
         ``savefig.*`` rcParams apply otherwise.
@@ -172,11 +182,12 @@ def save_figure(
     beatlite.viz.check.FigureError
         With ``BEATLITE_FIGURE_CHECK=raise`` (``make run``, ``make test``), when
         :func:`beatlite.viz.check.check_figure` finds an empty panel, text under
-        8 px or two series in one colour (nothing is written); the default ``warn``
-        gives a :class:`~beatlite.viz.check.FigureWarning` and saves. Text is measured
+        8 px, two series in one colour or a legend colour nothing is drawn in (nothing
+        is written); the default ``warn`` gives a :class:`~beatlite.viz.check.FigureWarning`
+        and saves. Text is measured
         at the lower of the saved dpi (150) and the figure's own dpi (100), at which
-        a notebook shows the figure inline, and as a slide shows that picture (scaled
-        down to :data:`beatlite.viz.check.SLIDE_FIGURE_BOX` when larger).
+        a notebook shows the figure inline, and, with a box to fit (``fit``, the course's
+        slide for the course's figures), at the scale the box shows it.
     """
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -191,14 +202,14 @@ def save_figure(
     stem = Path(path_stem)
     if stem.suffix.lstrip(".").lower() in {f.lower().lstrip(".") for f in formats}:
         stem = stem.with_suffix("")
-    from beatlite.viz.check import SLIDE_FIGURE_BOX, check_figure, check_mode, report_problems
+    from beatlite.viz.check import check_figure, check_mode, report_problems
 
     if (mode := check_mode()) != "off":
         dpi = savefig_kwargs.get("dpi", save_params["savefig.dpi"])
         dpi = (
             fig.dpi if dpi == "figure" else min(float(dpi), fig.dpi)
         )  # saved, and shown inline at the figure's dpi
-        problems = check_figure(fig, dpi=dpi, fit=SLIDE_FIGURE_BOX)
+        problems = check_figure(fig, dpi=dpi, fit=_shown_in(stem, fit))
         report_problems(problems, f"save_figure({stem.name!r})", mode)
     stem.parent.mkdir(parents=True, exist_ok=True)
     written = []
@@ -209,6 +220,17 @@ def save_figure(
             fig.savefig(tmp, format=fmt, **savefig_kwargs)
         written.append(target)
     return written
+
+
+def _shown_in(stem: Path, fit: tuple[float, float] | None) -> tuple[float, float] | None:
+    """The box a saved picture is shown in: ``fit``, else the course's slide for a figure of the course's folder."""
+    if fit is not None:
+        return fit
+    from beatlite.report import figures_dir
+    from beatlite.viz.check import SLIDE_FIGURE_BOX
+
+    course = figures_dir().expanduser().resolve()
+    return SLIDE_FIGURE_BOX if stem.expanduser().resolve().is_relative_to(course) else None
 
 
 def _named_colour(label: str) -> str | None:
