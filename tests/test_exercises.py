@@ -237,6 +237,11 @@ RIGHT: dict[tuple[str, str], list[str]] = {
         "        keep &= speed < speed[np.minimum(idx + k, n - 1)]\n        keep &= speed < speed[np.maximum(idx - k, 0)]\n"
         "    return np.flatnonzero(keep) / fps"
     ],
+    # in torch's default float32, where 1 - abar_1 = 1e-4 is off by 1.7e-4 of itself: SNR(1) = 9997.3, not 9999
+    ("10", "snr_at"): [
+        "def snr_at(steps, beta_1, beta_T, t):\n    abar = torch.cumprod(1 - torch.linspace(beta_1, beta_T, steps), 0)[t - 1]\n"
+        "    return float(abar / (1 - abar))"
+    ],
 }
 
 
