@@ -243,6 +243,12 @@ RIGHT: dict[tuple[str, str], list[str]] = {
         "        keep &= speed < speed[np.minimum(idx + k, n - 1)]\n        keep &= speed < speed[np.maximum(idx - k, 0)]\n"
         "    return np.flatnonzero(keep) / fps"
     ],
+    # in torch, vectorised: the cell after the check called p.round(4), numpy's signature, on the tensor
+    ("09", "bt_update"): [
+        "def bt_update(p, wins):\n    import torch\n    w = torch.as_tensor(np.asarray(wins), dtype=torch.float64)\n"
+        "    p = torch.as_tensor(p, dtype=torch.float64)\n    d = (w + w.T) / (p[:, None] + p[None, :])\n"
+        "    new = w.sum(1) / (d.sum(1) - d.diagonal())\n    return new / new.sum()"
+    ],
     # in torch's default float32, where 1 - abar_1 = 1e-4 is off by 1.7e-4 of itself: SNR(1) = 9997.3, not 9999
     ("10", "snr_at"): [
         "def snr_at(steps, beta_1, beta_T, t):\n    abar = torch.cumprod(1 - torch.linspace(beta_1, beta_T, steps), 0)[t - 1]\n"
