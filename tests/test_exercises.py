@@ -13,7 +13,9 @@ exercise, in notebook order:
 2. for each wrong answer of :data:`WRONG`: its definition, then the stub cell without the stub, up to its last
    check: every check of that answer returns ``False``;
 3. for each right answer of :data:`RIGHT` (written otherwise than the solution: another dtype, an in-place
-   update, another formula): the same, and every check of that answer returns ``True``;
+   update, another formula, a list or a torch tensor): the whole stub cell, then the exercise's other cells before
+   its solution (what the student runs next, e.g. a ``check`` cell that uses the answer): every check of that
+   answer returns ``True`` and no later line fails on the answer's type;
 4. the solution cell: every check of the exercise returns ``True``.
 
 A new exercise needs a row in :data:`WRONG` (``test_every_exercise_has_a_wrong_answer`` says which).
@@ -230,12 +232,27 @@ RIGHT: dict[tuple[str, str], list[str]] = {
         "def my_pck(generated, ground_truth, delta):\n    generated -= ground_truth\n"
         "    return float(np.mean(np.linalg.norm(generated, axis=-1) < delta))"
     ],
+    ("07", "per_class_accuracy"): [  # a list, not an array (the lines after the check took its .mean())
+        "def per_class_accuracy(predicted, labels):\n"
+        "    return [float(np.mean(predicted[labels == c] == c)) for c in sorted(set(labels.tolist()))]"
+    ],
     ("08", "speed_minima"): [  # np.gradient over the frame times instead of a spacing
         "def speed_minima(positions, fps):\n    t = np.arange(len(positions)) / fps\n"
         "    speed = np.linalg.norm(np.gradient(positions, t, axis=0), axis=-1)\n"
         "    n = len(speed)\n    idx = np.arange(n)\n    keep = np.ones(n, dtype=bool)\n    for k in (1, 2):\n"
         "        keep &= speed < speed[np.minimum(idx + k, n - 1)]\n        keep &= speed < speed[np.maximum(idx - k, 0)]\n"
         "    return np.flatnonzero(keep) / fps"
+    ],
+    # in torch, vectorised: the cell after the check called p.round(4), numpy's signature, on the tensor
+    ("09", "bt_update"): [
+        "def bt_update(p, wins):\n    import torch\n    w = torch.as_tensor(np.asarray(wins), dtype=torch.float64)\n"
+        "    p = torch.as_tensor(p, dtype=torch.float64)\n    d = (w + w.T) / (p[:, None] + p[None, :])\n"
+        "    new = w.sum(1) / (d.sum(1) - d.diagonal())\n    return new / new.sum()"
+    ],
+    # in torch's default float32, where 1 - abar_1 = 1e-4 is off by 1.7e-4 of itself: SNR(1) = 9997.3, not 9999
+    ("10", "snr_at"): [
+        "def snr_at(steps, beta_1, beta_T, t):\n    abar = torch.cumprod(1 - torch.linspace(beta_1, beta_T, steps), 0)[t - 1]\n"
+        "    return float(abar / (1 - abar))"
     ],
 }
 
@@ -408,8 +425,8 @@ def _setup_cells(cells: list[dict], first: int, needed: set[str]) -> list[int]:
     return sorted(chosen)
 
 
-def _without_stubs(src: str, names: list[str]) -> str:
-    """The stub cell without the student's part, up to its last exercise call."""
+def _without_stubs(src: str, names: list[str], *, whole: bool = False) -> str:
+    """The stub cell without the student's part, up to its last exercise call (``whole``: to its end)."""
     tree = ast.parse(sheet._python(src))
     body = []
     for node in tree.body:
@@ -420,8 +437,23 @@ def _without_stubs(src: str, names: list[str]) -> str:
         ):
             continue
         body.append(node)
-    last = max(i for i, node in enumerate(body) if sheet.exercise_calls(ast.unparse(node)))
+    last = (
+        len(body) - 1
+        if whole
+        else max(i for i, node in enumerate(body) if sheet.exercise_calls(ast.unparse(node)))
+    )
     return ast.unparse(ast.Module(body=body[: last + 1], type_ignores=[]))
+
+
+def _follow_up(cells: list[dict], ex) -> list[int]:
+    """The code cells between an exercise's first stub and its first solution that are not stubs: what the student
+    runs next (a ``check`` cell, a cell that uses the answer through :func:`beatlite.exercise.resolve`)."""
+    stubs = {i for i, _ in ex.stubs}
+    return [
+        i
+        for i in range(min(stubs), min(i for i, _ in ex.solutions))
+        if cells[i]["cell_type"] == "code" and i not in stubs
+    ]
 
 
 def _run(path: Path, tmp: Path) -> list[tuple[str, str, str, object]]:
@@ -437,6 +469,7 @@ def _run(path: Path, tmp: Path) -> list[tuple[str, str, str, object]]:
     cells = nb["cells"]
     found = sheet.exercises(path)
     every = [src for ex in found for _, src in ex.stubs + ex.solutions]
+    every += ["".join(cells[i]["source"]) for ex in found for i in _follow_up(cells, ex)]
     every += [w for ex in found for n in ex.names for w in WRONG.get((path.name[:2], n), [])]
     every += [r for ex in found for n in ex.names for r in RIGHT.get((path.name[:2], n), [])]
     needed = set().union(*(_free_names(src) for src in every))
@@ -478,7 +511,12 @@ def _run(path: Path, tmp: Path) -> list[tuple[str, str, str, object]]:
                     exec(answer, ns)
                     for i, src in ex.stubs:
                         if name in sheet.student_names(src):
-                            exec(compile(_without_stubs(src, [name]), f"{path.name}[{i}]", "exec"), ns)
+                            code = _without_stubs(src, [name], whole=kind == "right")
+                            exec(compile(code, f"{path.name}[{i}]", "exec"), ns)
+                    if kind == "right":
+                        for i in _follow_up(cells, ex):
+                            code = sheet._python("".join(cells[i]["source"]))
+                            exec(compile(code, f"{path.name}[{i}]", "exec"), ns)
             step["step"] = "solution"
             for i, src in ex.solutions:
                 exec(compile(sheet._python(src), f"{path.name}[{i}]", "exec"), ns)
