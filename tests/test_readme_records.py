@@ -535,3 +535,46 @@ def test_the_readme_fit_command_sentences_are_the_record():
         f"({fresh['extractor_s']:,.0f} s of it the FGD extractor, trained once; {_minutes(again['wall_s'])} run again)"
         in guide
     )
+
+
+def test_the_documented_command_times_are_the_commands_record():
+    """README's bootstrap scoring, the guide's data_samples route and store build, architecture's rot6d extractor."""
+    record = _record("commands_cpu.json")
+    assert (
+        record["machine"]["cpu_capability"] == "AVX2" and record["machine"]["cpus"] == 2
+    )  # "2-core, without AVX-512"
+    rows = record["rows"]
+    readme, guide = " ".join(_readme().split()), " ".join(_guide().split())
+    boot = rows["score_bootstrap"]
+    assert "--bootstrap 200" in record["commands"]["score_bootstrap"]
+    assert (
+        f"took {boot['wall_s']:.0f} s wall, {boot['cpu_s']:.0f} s CPU and {boot['peak_rss_gib']:.2f} GiB peak RAM"
+        in readme
+    )
+    fit, export, score = (rows[k]["wall_s"] for k in ("fit", "export", "score"))
+    assert (
+        f"`fit camn_tiny --epochs 1` took {fit:.0f} s wall, the export of its checkpoint {export:.0f} s, the "
+        f"scoring {score:.0f} s" in guide
+    )
+    assert (
+        f"builds its window store: {rows['store']['wall_s']:.0f} s on a 2-core CPU without AVX-512" in guide
+    )
+    architecture = " ".join((ROOT / "docs" / "architecture.md").read_text().split())
+    assert (
+        f"({rows['extractor_rot6d']['wall_s']:.0f} s for rot6d on data_samples on a 2-core CPU"
+        in architecture
+    )
+
+
+def test_the_readme_cpu_bf16_sentence_is_the_avx2_record():
+    """Without AVX-512 bfloat16 trains slower than float32 (emulated products): the README's numbers."""
+    record = _record("bench_train_quick_cpu_avx2.json")
+    assert record["machine"]["cpu_capability"] == "AVX2"
+    assert record["peaks"]["cpu torch.bfloat16"] < record["peaks"]["cpu torch.float32"] / 10  # "emulated"
+    fit = {(r["model"], r["precision"]): r["fit_wps"] for r in record["rows"] if r["device"] == "cpu"}
+    assert all(fit[m, "bf16"] < fit[m, "fp32"] for m in ("camn", "ha2g"))
+    assert (
+        f"`fit` at {fit['camn', 'bf16']:.0f} against {fit['camn', 'fp32']:.0f} windows/s for CaMN tiny, "
+        f"{fit['ha2g', 'bf16']:.0f} against {fit['ha2g', 'fp32']:.0f} for HA2G tiny"
+        in " ".join(_readme().split())
+    )
