@@ -36,7 +36,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("BEATLITE_THREADS", "1")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_scale import make_corpus  # noqa: E402
+from bench_scale import make_corpus, run_step  # noqa: E402
 
 from beatlite.io.atomic import write_json  # noqa: E402
 from beatlite.paths import n_threads, record_about  # noqa: E402
@@ -100,17 +100,6 @@ def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None 
     return {**got, **phases(lines, got["wall_s"]), "output_tail": tail}
 
 
-def _run_step(args: list[str]) -> dict:
-    """Run this file with ``--step ...`` in a fresh interpreter; returns its JSON line."""
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
-    out = subprocess.run(
-        [sys.executable, __file__, *args], capture_output=True, text=True, env=env, check=False
-    )
-    if out.returncode != 0:
-        raise RuntimeError(f"step {args} failed:\n{out.stderr[-3000:]}")
-    return json.loads(out.stdout.strip().splitlines()[-1])
-
-
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--hours", type=float, default=4.0, help="corpus size to make (default 4)")
@@ -151,7 +140,7 @@ def main() -> int:
             epochs = (
                 [] if args.extractor_epochs is None else ["--extractor-epochs", str(args.extractor_epochs)]
             )
-            runs[name] = _run_step(["--step", args.recipe, str(corpus), str(base / "run"), *epochs])
+            runs[name] = run_step(["--step", args.recipe, str(corpus), str(base / "run"), *epochs], __file__)
             print(
                 f"{name}: {json.dumps({k: v for k, v in runs[name].items() if k != 'output_tail'})}",
                 flush=True,

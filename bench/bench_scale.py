@@ -308,11 +308,13 @@ def step_stats(corpus: Path, subset: bool) -> dict:
     return out
 
 
-def _run_step(args: list[str]) -> dict:
-    """Run this file with ``--step ...`` in a fresh interpreter; returns its JSON line."""
+def run_step(args: list[str], script: str = __file__) -> dict:
+    """Run ``script`` (this file, or another bench script) with ``args`` (``--step ...``) in a fresh interpreter,
+    so that the step's peak RSS is its own; returns the JSON of its last line (``RuntimeError`` with its stderr's
+    end when it fails)."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     out = subprocess.run(
-        [sys.executable, __file__, *args], capture_output=True, text=True, env=env, check=False
+        [sys.executable, script, *args], capture_output=True, text=True, env=env, check=False
     )
     if out.returncode != 0:
         raise RuntimeError(f"step {args[:2]} failed:\n{out.stderr[-3000:]}")
@@ -374,7 +376,7 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
     n_takes = make_corpus(args.data, corpus, hours, args.workers)
     row: dict = {"takes": n_takes, "make_s": time.perf_counter() - tic}
     row["source_gb"] = sum(p.stat().st_size for p in corpus.rglob("*") if p.is_file()) / 1e9
-    s = _run_step(["--step", "store", str(corpus), str(store), str(args.workers)])
+    s = run_step(["--step", "store", str(corpus), str(store), str(args.workers)])
     h = s["mocap_hours"]
     row["index_s"] = s["index_s"]
     row.update(hours=h, store_s=s["seconds"], noop_s=s["noop_rebuild_s"], store_gb=s["disk_gb"])
@@ -383,18 +385,18 @@ def run_size(hours: float, args: argparse.Namespace, tmp: Path) -> dict:
         train_windows=s["train_windows"], store_s_per_h=s["seconds"] / h, store_cpu_per_h=s["cpu_s"] / h
     )
     row["store_gb_per_h"] = s["disk_gb"] / h
-    e = _run_step(["--step", "epoch", str(store), str(args.loader_workers), ",".join(CAMN_KEYS)])
+    e = run_step(["--step", "epoch", str(store), str(args.loader_workers), ",".join(CAMN_KEYS)])
     row.update(
         epoch_wps=e["windows_per_s"], epoch_rss_main=e["rss_main_gib"], epoch_rss_child=e["rss_child_gib"]
     )
     row["epoch_cpu_ms"] = 1000 * e["cpu_s"] / e["windows"]
-    e0 = _run_step(["--step", "epoch", str(store), "0", ",".join(CAMN_KEYS)])
+    e0 = run_step(["--step", "epoch", str(store), "0", ",".join(CAMN_KEYS)])
     row.update(epoch0_wps=e0["windows_per_s"], epoch0_rss=e0["rss_main_gib"])
     if args.stats:
-        st = _run_step(["--step", "stats", str(corpus), "subset"])
+        st = run_step(["--step", "stats", str(corpus), "subset"])
         row.update(sep_s=st["seconds"], sep_rss=st["rss_main_gib"], sep_n=st["n"])
     if hours <= args.compare_max_hours:
-        b = _run_step(["--step", "build_windows", str(corpus), str(cache)])
+        b = run_step(["--step", "build_windows", str(corpus), str(cache)])
         row.update(bw_s=b["seconds"], bw_rss=b["rss_main_gib"], bw_gb=b["disk_gb"])
     print(
         f"  {hours:g} h: {json.dumps({k: round(v, 3) if isinstance(v, float) else v for k, v in row.items()})}"

@@ -21,7 +21,6 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -31,6 +30,7 @@ os.environ.setdefault("BEATLITE_THREADS", "1")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit_command import measure  # noqa: E402
+from bench_scale import run_step  # noqa: E402
 
 from beatlite.io.atomic import write_json  # noqa: E402
 from beatlite.paths import n_threads, record_about  # noqa: E402
@@ -73,16 +73,10 @@ def main() -> int:
         "commands": {k: " ".join(["python", *v]) for k, v in COMMANDS.items()},
     }
     work = Path(tempfile.mkdtemp(prefix="time_commands_"))
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     rows = {}
     try:
         for name in args.only:
-            done = subprocess.run([sys.executable, __file__, "--step", name, str(work)], capture_output=True,
-                                  text=True, env=env, check=False)  # fmt: skip
-            if done.returncode != 0:
-                raise RuntimeError(f"{name} failed:\n{done.stderr[-3000:]}")
-            rows[name] = json.loads(done.stdout.strip().splitlines()[-1])
-            r = rows[name]
+            rows[name] = r = run_step(["--step", name, str(work)], __file__)
             print(
                 f"{name}: {r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, {r['peak_rss_gib']:.2f} GiB",
                 flush=True,
