@@ -894,7 +894,7 @@ def _frames(
         n = preds[stem].n_frames if stem in preds else 0
         rows = (preds[stem].rows or n) if stem in preds else 0
         if rows >= MIN_FRAMES and not rate_given and max(n, have) >= RATE_FACTOR * min(n, have):
-            problems.append(_rate_problem(files[stem], preds[stem], have))
+            problems.append(_rate_problem(files[stem], preds[stem], rows, have))
         elif stem in preds and n < MIN_FRAMES:
             problems.append(
                 f"{files[stem]}: {n} frames at {FPS:g} fps, fewer than one {MIN_FRAMES}-frame window"
@@ -912,11 +912,11 @@ def _frames(
     return frames, trimmed
 
 
-def _rate_problem(path: Path, pred: Prediction, have: int) -> str:
-    """The error line of a prediction :data:`RATE_FACTOR` times off its take's length: the rate its rows would need."""
+def _rate_problem(path: Path, pred: Prediction, rows: int, have: int) -> str:
+    """The error line of a prediction of ``rows`` rows :data:`RATE_FACTOR` times off its take's ``have`` frames: the
+    rate its rows would need."""
     from beatlite.io import FormatError
 
-    rows = pred.n_frames if pred.rows is None else pred.rows
     field = {".npz": "mocap_frame_rate", ".npy": "shape"}.get(path.suffix.lower(), "Frame Time")
     fix = (
         "a .npy is read at 15 fps: resample it to 15 fps"

@@ -59,6 +59,12 @@ def _n(value: float) -> str:
     return f"{value:,.0f}"
 
 
+def _minutes(seconds: float) -> str:
+    """``1559.6`` -> ``"26 min 0 s"``."""
+    minutes, rest = divmod(round(seconds), 60)
+    return f"{minutes} min {rest} s"
+
+
 def test_the_readme_gpu_table_is_every_measured_row_of_the_record_rounded():
     seen = set()
     for run, name, precision, batch, compile, det, wps, ms, fit, mib, epoch in _table_rows():  # noqa: A001
@@ -345,12 +351,11 @@ def test_the_guide_run_times_and_the_headers_are_the_notebooks_record():
     assert [r["notebook"] for r in rows] == [p.stem for p in NOTEBOOKS] and all(r["ok"] for r in rows)
     assert record["settings"]["BEATLITE_MODE"] == "lecture" and record["settings"]["BEATLITE_THREADS"] == "1"
     total, user = record["total_wall_seconds"], sum(r["kernel_user_seconds"] for r in rows)
-    minutes, seconds = divmod(round(total), 60)
     guide = _guide()
     row = next(line for line in guide.splitlines() if line.startswith("| wall time (s) |"))
     cells = [c.strip() for c in row.strip().strip("|").split("|")][1:]
     assert cells == [f"{r['wall_seconds']:.1f}" for r in rows] + [
-        f"{total:.0f} ({minutes} min {seconds} s; {user:.0f} s of the kernels' user CPU, "
+        f"{total:.0f} ({_minutes(total)}; {user:.0f} s of the kernels' user CPU, "
         f"{record['largest_kernel_gib']:.2f} GiB resident at most in one kernel)"
     ]
     peak = (
@@ -478,11 +483,6 @@ def test_the_readme_store_scale_table_and_its_sums_are_the_record():
         f"building takes {min(cpu):.0f}–{max(cpu):.0f} CPU-seconds per hour of mocap (≈ {16 * c / 2 / 60:.0f} min for "
         f"16 h on 2 free cores, ≈ {76 * c / 2 / 60:.0f} min for 76 h" in text
     )
-
-
-def _minutes(seconds: float) -> str:
-    """``1559.6`` -> ``"26 min 0 s"``."""
-    return f"{int(round(seconds)) // 60} min {int(round(seconds)) % 60} s"
 
 
 def test_the_readme_fit_command_sentences_are_the_record():
