@@ -21,7 +21,8 @@ code name their results, too):
 ``{stem}.npy``         ``(T, 42, 3)`` TED-43 unit bone directions (HA2G's vector order,
                        :data:`beatlite.skeleton.ted.TED_BONES`), ``(T, 126)`` the same flattened, or
                        ``(T, 141)`` ``spine_neck_141`` Euler degrees (CaMN's output, BEAT's channel order).
-                       Read with ``allow_pickle=False``.
+                       Read with ``allow_pickle=False``, at 15 fps unless ``--pred-fps`` gives the rows' rate
+                       (then resampled as a BVH's rows are; directions interpolated and normalised).
 =====================  ===================================================================================
 
 ``--protocol clips`` scores HA2G's evaluation protocol instead of whole takes: one 34-frame prediction
@@ -47,7 +48,7 @@ scored against the take cut to the same length (one warning each saying by how m
 than a window (34 frames) is an error. One :data:`RATE_FACTOR` (1.5) times longer or shorter than its take is an
 error naming the rate at which its rows would span the take: its rows are at another rate than the file says
 (BEAT's code writes its 15 fps results under the 120 fps ``Frame Time: 0.008333`` of its template);
-``--pred-fps`` (``pred_fps=``) gives the rate of every ``.bvh``'s and ``.npz``'s rows, trusted. A file that
+``--pred-fps`` (``pred_fps=``) gives the rate of every file's rows, trusted. A file that
 cannot be converted (another skeleton, NaN, another shape) is a :class:`~beatlite.io.FormatError` naming the
 file and the field. Errors end the command with exit code 2 and no traceback.
 
@@ -138,10 +139,10 @@ class Prediction:
     form : str
         What the file was, e.g. ``"bvh 30 fps -> 15 fps"`` or ``"npy directions (T, 42, 3)"``.
     rows : int or None
-        Frames of the file before resampling (None: ``n_frames``, a ``.npy`` read at 15 fps).
+        Frames of the file before resampling (None: ``n_frames``).
     fps : float
-        The rate those rows were read at (the file's ``Frame Time`` or ``mocap_frame_rate``, or ``fps`` of
-        :func:`read_prediction`).
+        The rate those rows were read at (the file's ``Frame Time`` or ``mocap_frame_rate``, 15 for a ``.npy``, or
+        ``fps`` of :func:`read_prediction`).
     """
 
     directions: np.ndarray
@@ -320,11 +321,15 @@ def _channels_prediction(channels: np.ndarray, fps: float, form: str, path: Path
     return Prediction(directions, euler, form, rows=rows, fps=float(fps))
 
 
-def _npy_prediction(path: Path) -> Prediction:
-    """A ``.npy`` of (T, 42, 3) / (T, 126) directions or (T, 141) Euler degrees."""
+def _npy_prediction(path: Path, fps: float | None = None) -> Prediction:
+    """A ``.npy`` of (T, 42, 3) / (T, 126) directions or (T, 141) Euler degrees, its rows at ``fps`` (default 15):
+    resampled to 15 fps as a BVH's channels are (Euler angles along the shorter arc, directions interpolated and
+    normalised, :func:`_resample_directions`)."""
     from beatlite.io import FormatError
+    from beatlite.io.take import resample_frames
     from beatlite.skeleton.ted import euler_to_directions
 
+    rate = FPS if fps is None else float(fps)
     x = _load_npy(path)
     if not isinstance(x, np.ndarray) or x.dtype.kind not in "iuf":
         raise FormatError(
@@ -333,18 +338,44 @@ def _npy_prediction(path: Path) -> Prediction:
     x = np.asarray(x, np.float64)
     if x.ndim and not len(x):
         raise FormatError(path, f"no frames: shape {x.shape}", field="shape")
+    at = "" if rate == FPS else f" {rate:g} fps -> {FPS:g} fps"
     if x.ndim == 2 and x.shape[1] == 141:
         _check_finite(x, path)
-        return Prediction(euler_to_directions(x), x, "npy euler (T, 141)")
+        rows, form = len(x), "npy euler (T, 141)" + at
+        if at:
+            x = resample_frames(x, rate, FPS, angle_columns=np.arange(141))
+        return Prediction(euler_to_directions(x), x, form, rows=rows, fps=rate)
     if (x.ndim == 3 and x.shape[1:] == (42, 3)) or (x.ndim == 2 and x.shape[1] == 126):
         _check_finite(x, path)
-        return Prediction(
-            _unit_directions(x.reshape(len(x), 42, 3), path), None, f"npy directions {x.shape[1:]}"
-        )
+        d = _unit_directions(x.reshape(len(x), 42, 3), path)
+        form = f"npy directions {x.shape[1:]}" + at
+        return Prediction(_resample_directions(d, rate, path) if at else d, None, form, rows=len(x), fps=rate)
     raise FormatError(
         path, f"shape {x.shape} is none of (T, 42, 3) or (T, 126) TED-43 directions, (T, 141) Euler degrees",
         field="shape",
     )  # fmt: skip
+
+
+def _resample_directions(d: np.ndarray, fps: float, path: Path) -> np.ndarray:
+    """(T, 42, 3) unit directions at ``fps`` -> at 15 fps: each bone's vector interpolated linearly between the
+    two nearest rows (:func:`beatlite.io.take.resample_frames`; rows at integer positions copied) and normalised.
+    Halfway between two rows where a bone turns by 180° it has no direction: a :class:`~beatlite.io.FormatError`.
+    """
+    from beatlite.io import FormatError
+    from beatlite.io.take import resample_frames
+
+    out = resample_frames(d.reshape(len(d), -1), fps, FPS).reshape(-1, 42, 3)
+    norms = np.linalg.norm(out, axis=-1, keepdims=True)
+    if len(out) and norms.min() < 1e-6:
+        frame, bone = (int(i) for i in np.argwhere(norms[..., 0] < 1e-6)[0])
+        row = int(np.floor(frame * fps / FPS + 1e-9))
+        raise FormatError(
+            path,
+            f"bone {bone} turns by 180 degrees between rows {row} and {row + 1}: no direction halfway, where a "
+            f"{FPS:g} fps frame falls",
+            field="values",
+        )
+    return out / norms
 
 
 def _load_npy(path: Path) -> np.ndarray:
@@ -407,9 +438,9 @@ def read_prediction(path: str | Path, *, fps: float | None = None) -> Prediction
     ----------
     path : str or Path
     fps : float, optional
-        The rate of a ``.bvh``'s or ``.npz``'s rows instead of the file's own (``Frame Time``,
-        ``mocap_frame_rate``), e.g. 15 for BEAT's code's results, written under a 120 fps header. A ``.npy`` is
-        always read at 15 fps.
+        The rate of the rows instead of the file's own: a ``.bvh``'s ``Frame Time``, an ``.npz``'s
+        ``mocap_frame_rate`` (e.g. 15 for BEAT's code's results, written under a 120 fps header), a ``.npy``'s
+        15 fps (it states none; e.g. 30 for a model trained on BEAT2's 30 fps).
 
     Raises
     ------
@@ -423,7 +454,7 @@ def read_prediction(path: str | Path, *, fps: float | None = None) -> Prediction
     if name.endswith((".bvh", ".bvh.gz")):
         return _bvh_prediction(p, fps)
     if name.endswith(".npy"):
-        return _npy_prediction(p)
+        return _npy_prediction(p, fps)
     if name.endswith(".npz"):
         return _smplx_prediction(p, fps)
     raise FormatError(p, f"not a prediction file (expected one of {', '.join(_SUFFIXES)})")
@@ -582,7 +613,7 @@ class ScoreResult:
             lines.append(f"Missing takes (not scored): {', '.join(i['missing'])}.")
         if i.get("pred_fps"):
             lines.append(
-                f"The .bvh and .npz rows read at {i['pred_fps']:g} fps (--pred-fps), not at the files' own rates."
+                f"The predictions' rows read at {i['pred_fps']:g} fps (--pred-fps), not at the files' own rates."
             )
         if i.get("trimmed"):
             lines.append(
@@ -722,7 +753,7 @@ def score_folder(
     allow_missing : bool
         Score the takes that have a prediction when some have none (default: an error).
     pred_fps : float, optional
-        The rate of every ``.bvh``'s and ``.npz``'s rows instead of the file's own (:func:`read_prediction`),
+        The rate of every file's rows instead of the file's own (a ``.npy``'s: 15 fps; :func:`read_prediction`),
         trusted: a prediction :data:`RATE_FACTOR` times longer or shorter than its take is then scored on the
         overlap, not refused.
     test : EvaluationSet, optional
@@ -918,14 +949,14 @@ def _rate_problem(path: Path, pred: Prediction, rows: int, have: int) -> str:
     from beatlite.io import FormatError
 
     field = {".npz": "mocap_frame_rate", ".npy": "shape"}.get(path.suffix.lower(), "Frame Time")
-    fix = (
-        "a .npy is read at 15 fps: resample it to 15 fps"
+    why = (
+        "(a .npy states no rate: read at 15 fps)"
         if field == "shape"
-        else f"at {rows * FPS / have:.4g} fps they would span it: if that is their rate (BEAT's code writes 15 fps rows "
-        "under a 120 fps Frame Time), give it with --pred-fps"
+        else "(BEAT's code writes 15 fps rows under a 120 fps Frame Time)"
     )
     message = (
-        f"{rows} rows at {pred.fps:g} fps last {rows / pred.fps:.2f} s, the take {have / FPS:.2f} s; {fix}"
+        f"{rows} rows at {pred.fps:g} fps last {rows / pred.fps:.2f} s, the take {have / FPS:.2f} s; at "
+        f"{rows * FPS / have:.4g} fps they would span it: if that is their rate {why}, give it with --pred-fps"
     )
     return str(FormatError(path, message, field=field))
 
@@ -1336,8 +1367,8 @@ def _parser() -> argparse.ArgumentParser:
         "--pred-fps",
         type=float,
         metavar="FPS",
-        help="frame rate of the .bvh/.npz rows instead of the files' own (e.g. 15 for BEAT's code's results, "
-        "written under a 120 fps Frame Time); a prediction of another length is then scored on the overlap",
+        help="frame rate of the rows instead of the files' own (e.g. 15 for BEAT's code's results, written under a "
+        "120 fps Frame Time; a .npy's own is 15); a prediction of another length is then scored on the overlap",
     )
     p.add_argument("--export", metavar="CHECKPOINT", help="write CHECKPOINT's generations into PRED and stop")
     p.add_argument("--format", choices=("bvh", "npy"), default="bvh", help="--export file format")

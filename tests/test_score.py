@@ -742,6 +742,65 @@ def test_bvh_rows_under_another_rate_s_frame_time_are_refused_and_scored_with_pr
     assert result.info["trimmed"] == {}
 
 
+def test_npy_rows_at_another_rate_are_refused_and_resampled_with_pred_fps(test_set, tmp_path):
+    """A ``.npy`` states no rate: before, one of 30 fps rows (BEAT2's rate) was refused with "resample it to 15 fps"
+    and ``--pred-fps`` did not apply to it. Now the refusal names the 30 fps at which its rows span the take, and
+    ``pred_fps=30`` decimates them: every even row is the ground truth, every odd row noise that must not be read,
+    so the scores are those of the ground truth's rows saved at 15 fps."""
+    rng = np.random.default_rng(0)
+    folder, at_15 = tmp_path / "pred", tmp_path / "at_15"
+    folder.mkdir(), at_15.mkdir()
+    for k, stem in enumerate(test_set.takes):
+        truth = test_set.gt_euler[k] if k % 2 else test_set.gt_directions[k]  # both representations
+        rows = np.repeat(truth, 2, axis=0)
+        rows[1::2] += rng.normal(scale=30.0, size=rows[1::2].shape)
+        np.save(folder / f"{stem}.npy", rows)
+        np.save(at_15 / f"{stem}.npy", truth)
+    with pytest.raises(ScoreInputError) as info:
+        score_folder(folder, test=test_set, metrics=["MPJPE"])
+    assert len(info.value.lines) == len(test_set.takes), info.value.lines
+    for stem, line in zip(test_set.takes, info.value.lines, strict=True):
+        assert f"{stem}.npy" in line and "'shape'" in line and "at 30 fps they would span it" in line, line
+        assert "--pred-fps" in line, line
+    with pytest.warns(
+        ScoreWarning
+    ):  # the noisy odd direction rows are not unit vectors; the Euler metrics skipped
+        result = score_folder(folder, test=test_set, metrics=["FGD", "PCK", "MPJPE"], pred_fps=30)
+        want = score_folder(at_15, test=test_set, metrics=["FGD", "PCK", "MPJPE"]).evaluation.values()
+    got = result.evaluation.values()
+    for key in want:  # the same rows, the same arithmetic
+        np.testing.assert_allclose(got[key], want[key], rtol=1e-12, atol=0, err_msg=key)
+    assert result.info["trimmed"] == {} and "npy euler (T, 141) 30 fps -> 15 fps" in str(result.info["files"])
+
+
+def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
+    """20 fps rows -> 15 fps: output frame i is row position 4i/3. A bone turning at a constant rate in the x-y plane
+    (10 degrees per row) is, between rows a and a+10° at weight w, the normalised sum (1-w)u(a) + w u(a+10°):
+    at the angle a + atan2(w sin 10°, 1 - w + w cos 10°) (closed form), of norm 1. Halfway between two rows where a
+    bone turns by 180° it has no direction: a FormatError naming the rows."""
+    from beatlite.score import read_prediction
+
+    rows = 13
+    angle = np.deg2rad(10.0 * np.arange(rows))
+    d = np.zeros((rows, 42, 3))
+    d[..., 0], d[..., 1] = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    np.save(tmp_path / "turn.npy", d)
+    got = read_prediction(tmp_path / "turn.npy", fps=20).directions
+    pos = np.arange(len(got)) * 4 / 3
+    a, w, step = np.floor(pos + 1e-9), pos - np.floor(pos + 1e-9), np.deg2rad(10.0)
+    want = np.deg2rad(10.0 * a) + np.arctan2(w * np.sin(step), 1 - w + w * np.cos(step))
+    assert len(got) == 10  # positions 0, 4/3, ..., 12 inside the 13 rows
+    np.testing.assert_allclose(
+        np.arctan2(got[..., 1], got[..., 0]), np.repeat(want[:, None], 42, 1), atol=1e-12
+    )
+    np.testing.assert_allclose(np.linalg.norm(got, axis=-1), 1.0, atol=1e-12)
+    d[2, 5] = -d[1, 5]  # bone 5 flips between rows 1 and 2; at 22.5 fps, 15 fps frame 1 is row 1.5, halfway
+    np.save(tmp_path / "flip.npy", d)
+    with pytest.raises(FormatError, match=r"bone 5 turns by 180 degrees between rows 1 and 2") as info:
+        read_prediction(tmp_path / "flip.npy", fps=22.5)
+    assert info.value.field == "values"
+
+
 def test_predictions_named_in_another_case_or_as_beat_and_emage_write_them_are_matched(tmp_path):
     """BEAT's test code names a take's result ``res_{take}.bvh``, EMAGE's ``res_{take}.npz`` beside
     ``gt_{take}.npz``; before, such a folder (and one of ``2_Scott_0_1_1.BVH``) matched no take ('no prediction for
