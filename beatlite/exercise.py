@@ -112,9 +112,11 @@ def _call_text(name: str, args: tuple, kwargs: dict) -> str:
 def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -> str | None:
     """Why ``got`` is not ``want`` in one line, or ``None`` when they match (``numpy.isclose``, NaN == NaN).
 
-    For float32 (or float16) arrays, ``atol`` grows by what rounding alone may change: 16 units in the last place
-    of the largest finite ``|want|`` at that precision (float32: ``16 * 1.19e-7 * max|want|``), so that a solution
-    summing in another order than the reference (numpy's einsum against torch) matches on elements near zero.
+    For float32 (or float16, bfloat16) arrays, ``atol`` grows by what rounding alone may change: 16 units in the last
+    place of the largest finite ``|want|`` at that precision (float32: ``16 * 1.19e-7 * max|want|``), so that a
+    solution summing in another order than the reference (numpy's einsum against torch) matches on elements near zero.
+    Torch tensors are compared as their values (detached from autograd, copied to the CPU; bfloat16 at its own
+    precision).
 
     Examples
     --------
@@ -128,7 +130,7 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
     if got is None and want is not None:
         return "got None: does the function end with `return ...`?"
     try:
-        g, w = np.asarray(got), np.asarray(want)
+        (g, g_eps), (w, w_eps) = _values(got), _values(want)
     except (TypeError, ValueError):  # ragged containers
         return None if _equal(got, want) else f"got {describe(got)}, expected {describe(want)}"
     if g.dtype == object or w.dtype == object or g.dtype.kind in "USV" or w.dtype.kind in "USV":
@@ -137,7 +139,7 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
         return f"shape: got {g.shape}, expected {w.shape}"
     if g.ndim and _KINDS.get(g.dtype.kind) != _KINDS.get(w.dtype.kind):
         return f"dtype: got {_KINDS.get(g.dtype.kind, g.dtype)} ({g.dtype}), expected {_KINDS.get(w.dtype.kind, w.dtype)} ({w.dtype})"
-    atol = atol + _rounding(g, w)
+    atol = atol + _rounding(w, max(g_eps, w_eps))
     close = np.isclose(g.astype(float), w.astype(float), rtol=rtol, atol=atol, equal_nan=True)
     if close.all():
         return None
@@ -151,10 +153,22 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
     )
 
 
-def _rounding(got: np.ndarray, want: np.ndarray) -> float:
-    """16 units in the last place of ``max |want|`` at the lower float precision of the two (0 for float64 and
-    integers): how far two orders of the same float32 sums may fall apart."""
-    eps = max((np.finfo(a.dtype).eps for a in (got, want) if a.dtype.kind == "f"), default=0.0)
+def _values(x: Any) -> tuple[np.ndarray, float]:
+    """``x`` as a numpy array, and the machine epsilon of its float type (0.0 for integers and others): a torch
+    tensor detached and on the CPU, bfloat16 (which numpy lacks) as float32 with bfloat16's epsilon."""
+    if hasattr(x, "detach") and hasattr(x, "dtype") and hasattr(x, "is_floating_point"):  # a torch tensor
+        import torch
+
+        eps = torch.finfo(x.dtype).eps if x.is_floating_point() else 0.0
+        t = x.detach().cpu()
+        return (t.float() if t.dtype == torch.bfloat16 else t).numpy(), eps
+    a = np.asarray(x)
+    return a, (float(np.finfo(a.dtype).eps) if a.dtype.kind == "f" else 0.0)
+
+
+def _rounding(want: np.ndarray, eps: float) -> float:
+    """16 units in the last place of ``max |want|`` at the precision of epsilon ``eps``, the lower of the two
+    arrays' (0 for float64 and integers): how far two orders of the same float32 sums may fall apart."""
     if eps <= np.finfo(np.float64).eps:
         return 0.0
     finite = np.abs(want[np.isfinite(want)]) if want.dtype.kind in "fc" else np.abs(want)

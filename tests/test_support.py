@@ -137,6 +137,27 @@ def test_exercise_tolerance_and_nan_and_errors(capsys):
     assert "case 1 of 1 raised IndexError: broken(array([0., 0.]))" in capsys.readouterr().out
 
 
+def test_exercise_difference_reads_torch_tensors_that_need_grad_or_are_bfloat16():
+    """Before, a result that still required grad raised torch's "Can't call numpy() on Tensor that requires grad"
+    from inside the check, and a bfloat16 one "Boolean value of Tensor with more than one value is ambiguous":
+    neither told the student anything about the answer. Now both are compared as values, bfloat16 at its own
+    rounding (16 units of 2**-7 at max|want| = 3: an allowance of 0.375)."""
+    torch = pytest.importorskip("torch")
+    want = np.array([1.0, 2.0, 3.0])
+    grad = torch.tensor(want, requires_grad=True)
+    assert exercise.difference(grad * 1, want) is None
+    assert exercise.difference(grad * 2, want) == (
+        "first difference at index (0,): got 2.0, expected 1.0 (3 of 3 elements differ)"
+    )
+    assert exercise.difference(want, grad) is None  # a reference that needs grad
+    half = torch.tensor(want, dtype=torch.bfloat16)
+    assert exercise.difference(half + 0.25, want) is None  # within 0.375: bfloat16 rounding allows it
+    assert exercise.difference(half + 0.5, want) is not None  # beyond it
+    assert (
+        exercise.difference(torch.tensor(want, dtype=torch.float32) + 0.25, want) is not None
+    )  # float32's: 5.7e-6
+
+
 def test_exercise_choice_hides_the_answer_and_checks_it(capsys):
     options = {"a": "it is faster", "b": "a z-scored pose can be all zeros", "c": "the paper says so"}
     key = exercise.course_key("bit", "B")
