@@ -82,7 +82,7 @@ from beatlite.models.layers import use_frame_matmul
 from beatlite.paths import data_dir, n_threads, record_about
 from beatlite.train import TrainConfig, fit
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
-from beatlite.train.training import _Run, model_keys
+from beatlite.train.training import _Run, model_keys, set_deterministic
 
 QUICK_TAKES = ("2_scott_0_9_9", "4_lawrence_0_11_11", "6_carla_0_13_13")
 """The 3 train takes of ``--quick`` (those of the model contract suite)."""
@@ -245,7 +245,7 @@ def measure_step(
     """The step columns of one row: FLOPs, operators, windows/s and peak memory of ``fit``'s training step
     (and, with ``profile`` > 0, the ``torch.profiler`` table of one more step: its ``profile`` most costly
     operators)."""
-    torch.use_deterministic_algorithms(deterministic)  # (as fit sets it from its TrainConfig)
+    set_deterministic(deterministic, device)  # (as fit sets it from its TrainConfig)
     model = _model(name, preset, train, frame_matmul=frame_matmul)
     run = _Run(model, _config(device, precision, batch, compile, epochs=1), "bench", {})
     keys = model_keys(model)

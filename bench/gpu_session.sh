@@ -19,8 +19,10 @@
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  HA2G paper at 512, eager and compiled (reduce-overhead; its training pass compiles since the
 #                  style loss gathers its permutation: a new lead, not one tune left), both profiled
-#   STAGE later    after next (about 6 minutes): CaMN paper bf16 at 1024 compiled with cudnn.benchmark, then with
-#                  the LSTM traced into the graph and the frame matmul on (a longer limit)
+#   STAGE later    after next (about 7 minutes): HA2G paper bf16 at 256 eager with determinism on and off (on no
+#                  longer fills every new tensor on CUDA, set_deterministic: against full's 323 and 260 ms/step),
+#                  then CaMN paper bf16 at 1024 compiled with cudnn.benchmark, then with the LSTM traced into the
+#                  graph and the frame matmul on (a longer limit)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
@@ -83,6 +85,7 @@ if [ "$stage" = next ]; then
     exit 0
 fi
 if [ "$stage" = later ]; then
+    bench 70 ha2g --presets paper --devices cuda --precisions bf16 --deterministic on off --fit-steps 0 --profile 12 --batch-sizes 256
     bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --cudnn-benchmark
     bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
     exit 0

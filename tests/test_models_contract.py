@@ -243,3 +243,27 @@ def test_batches_of_ids_and_numbers_of_the_wrong_kind_are_named():
     check_batch(
         {"word": torch.zeros(2, 34, dtype=torch.int32), "audio": torch.zeros(2, 9)}, ("word", "audio"), "X"
     )
+
+
+def test_store_training_finds_a_model_that_reads_memory_it_never_wrote(
+    small_store_windows: tuple, tmp_path: Path
+) -> None:
+    """``fit`` turns deterministic mode's filling of new tensors off on CUDA (``set_deterministic``): a model that
+    reads a tensor it never wrote would then train on whatever the memory held. The contract trains the store route
+    unfilled and the in-memory route filled (NaN) and asks for the same bits, so such a model fails on the CPU."""
+    import torch
+
+    from beatlite.models.baselines import S2G
+    from beatlite.models.testing import check_store_training
+
+    class ReadsUnwrittenMemory(S2G):
+        def forward(self, batch):  # noqa: ANN001, ANN202
+            pose = super().forward(batch)["pose"]
+            return {"pose": pose + 0.0 * torch.empty_like(pose)}  # 0 * NaN is NaN once filled
+
+    train, reference = small_store_windows
+    check_store_training(
+        model_case("s2g", tmp_path, train=train, reference=reference)
+    )  # the model itself passes
+    with pytest.raises(AssertionError, match=re.escape("store route, new tensors unfilled")):
+        check_store_training(model_case(ReadsUnwrittenMemory, tmp_path, train=train, reference=reference))

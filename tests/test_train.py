@@ -876,3 +876,32 @@ def test_validating_every_n_steps_leaves_the_training_draws_alone(windows):
     scored = fit(diffgesture(), train, cfg(epochs=2, val_every=2), val_score=noisy_score)
     assert [h["train"] for h in scored.history] == [h["train"] for h in plain.history]
     assert [v["step"] for h in scored.history for v in h["validations"]] == [2, 4, 6]
+
+
+def test_set_deterministic_stops_filling_new_tensors_on_cuda_only():
+    """Deterministic mode fills every new tensor (NaN); on CUDA each fill is a kernel launch, so ``fit`` turns the
+    filling off there and leaves the CPU's (torch's default, on) as it is; the mode itself is set on both."""
+    import torch
+
+    from beatlite.train.training import set_deterministic
+
+    fill, mode = (
+        torch.utils.deterministic.fill_uninitialized_memory,
+        torch.are_deterministic_algorithms_enabled(),
+    )
+    try:
+        torch.utils.deterministic.fill_uninitialized_memory = True
+        set_deterministic(True, "cpu")
+        assert (
+            torch.are_deterministic_algorithms_enabled()
+            and torch.utils.deterministic.fill_uninitialized_memory
+        )
+        assert torch.isnan(torch.empty(3)).all()  # filled
+        set_deterministic(False, torch.device("cpu"))
+        assert not torch.are_deterministic_algorithms_enabled()
+        set_deterministic(True, "cuda")  # (a device name: no GPU needed)
+        assert torch.are_deterministic_algorithms_enabled()
+        assert not torch.utils.deterministic.fill_uninitialized_memory
+    finally:
+        torch.utils.deterministic.fill_uninitialized_memory = fill
+        torch.use_deterministic_algorithms(mode)

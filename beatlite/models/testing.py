@@ -411,10 +411,12 @@ def _fit_two_steps(
     amp: bool,
     on_device: str = "never",
     compile: str | None = None,  # noqa: A002
+    fill: bool = True,
 ) -> tuple[Any, list[dict[str, Any]]]:
     """A fresh model trained for two steps of 4 windows on ``windows`` (adversarial from the start);
     ``on_device``: ``TrainConfig.data_on_device`` (a store view read by the loader, or held on the device);
-    ``compile``: ``TrainConfig.compile``."""
+    ``compile``: ``TrainConfig.compile``; ``fill``: deterministic mode's filling of new tensors
+    (``torch.utils.deterministic.fill_uninitialized_memory``, which ``fit`` turns off on CUDA)."""
     from beatlite.train import TrainConfig, fit
 
     model = case.build()
@@ -422,22 +424,33 @@ def _fit_two_steps(
         epochs=1, batch_size=4, windows_per_epoch=8, seed=1, no_adv_epochs=0, progress=False, amp=amp,
         data_on_device=on_device, compile=compile,
     )  # fmt: skip
-    with CudaAutocastRules():
-        history = fit(model, windows, config).history
+    was = torch.utils.deterministic.fill_uninitialized_memory
+    torch.utils.deterministic.fill_uninitialized_memory = fill
+    try:
+        with CudaAutocastRules():
+            history = fit(model, windows, config).history
+    finally:
+        torch.utils.deterministic.fill_uninitialized_memory = was
     return model, history
 
 
 def check_store_training(case: ModelCase) -> None:
     """Two steps from a store view of exactly ``batch_keys``, read by the loader and held on the device
     (``data_on_device="always"``), equal two steps from the same windows in memory (same losses, weights and
-    buffers, bit for bit), with finite losses."""
+    buffers, bit for bit), with finite losses. The store route runs without deterministic mode's filling of new
+    tensors (as ``fit`` does on CUDA), the in-memory route with it: the model reads no memory it has not written
+    (a read of a filled tensor would give NaN, of an unfilled one other bits)."""
     view = _store_view(case)
-    stored, history = _fit_two_steps(case, view, amp=False)
-    memory, reference = _fit_two_steps(case, case.reference, amp=False)
+    stored, history = _fit_two_steps(case, view, amp=False, fill=False)
+    memory, reference = _fit_two_steps(case, case.reference, amp=False, fill=True)
     resident, held = _fit_two_steps(case, view, amp=False, on_device="always")
     _expect(len(history) == (1 if stored.trainable else 0), case, f"history has {len(history)} epochs")
     _expect(all(not _finite(h["train"]) for h in history), case, f"non-finite losses {history}")
-    _expect(history == reference, case, f"store route {history} != in-memory route {reference}")
+    _expect(
+        history == reference,
+        case,
+        f"store route, new tensors unfilled {history} != in-memory route, filled {reference}",
+    )
     _expect(held == reference, case, f"resident route {held} != in-memory route {reference}")
     a, b, c = stored.state_dict(), memory.state_dict(), resident.state_dict()
     _expect(

@@ -74,8 +74,9 @@ class TrainConfig:
     deterministic : bool
         What :func:`beatlite.train.fit` passes to ``torch.use_deterministic_algorithms`` (torch's setting is
         process-wide: it stays set after ``fit``). ``True`` (default): only deterministic kernels, what repeatable
-        CUDA runs need (whether two CUDA runs repeat to the bit was not measured here). ``False`` lets CUDA use its
-        faster nondeterministic kernels and skips deterministic mode's filling of every new tensor: on an H200 it
+        CUDA runs need (whether two CUDA runs repeat to the bit was not measured here; new tensors are not filled on
+        CUDA, :func:`~beatlite.train.training.set_deterministic`). ``False`` lets CUDA use its faster
+        nondeterministic kernels and skips deterministic mode's filling of every new tensor: on an H200 it
         took CaMN's paper preset (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260
         (``bench/bench_train.py --deterministic on off``; README, "Using real BEAT"); the same seed may then give
         slightly different numbers from run to run on a GPU. No effect on CPU results (its kernels are

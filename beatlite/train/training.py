@@ -183,15 +183,37 @@ def _needed_keys(model: GestureModel, windows: Any, who: str) -> tuple[str, ...]
     return keys
 
 
-def configure_torch(seed: int, threads: int | None, deterministic: bool = True) -> None:
-    """Seed torch, turn deterministic algorithms on (or off) and set the CPU thread count."""
+def configure_torch(seed: int, threads: int | None, deterministic: bool = True, device: Any = "cpu") -> None:
+    """Seed torch, set deterministic mode for ``device`` (:func:`set_deterministic`) and the CPU thread count."""
+    torch.manual_seed(seed)
+    set_deterministic(deterministic, device)
+    torch.set_num_threads(threads if threads is not None else paths.n_threads())
+
+
+def set_deterministic(deterministic: bool, device: Any = "cpu") -> None:
+    """``torch.use_deterministic_algorithms(deterministic)``, and on CUDA no filling of new tensors.
+
+    Deterministic mode also fills every new tensor (NaN, the integer maximum) so that a read of memory never
+    written shows (``torch.utils.deterministic.fill_uninitialized_memory``); torch documents turning that off
+    for a program that reads no such memory: "and still be deterministic". On CUDA each fill is a kernel launch
+    (2,408 per HA2G paper-preset step at batch 64 on an H200: README, "Using real BEAT"), so there the filling
+    is turned off (process-wide, as the mode is). On the CPU it stays torch's default (on): a fill is a memset
+    there, and it keeps guarding the tests. Every registered model trains to the same bits either way
+    (:func:`beatlite.models.testing.check_store_training`).
+
+    Parameters
+    ----------
+    deterministic : bool
+    device : torch.device or str
+        Where the model trains: ``"cuda"`` (any index) turns the filling off; others leave it as it is.
+    """
     import os
 
     # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
-    torch.manual_seed(seed)
     torch.use_deterministic_algorithms(deterministic)
-    torch.set_num_threads(threads if threads is not None else paths.n_threads())
+    if torch.device(device).type == "cuda":
+        torch.utils.deterministic.fill_uninitialized_memory = False
 
 
 def _mean_losses(sums: Mapping[str, Any], n: int) -> dict[str, float]:
@@ -322,7 +344,7 @@ def fit(
 
     check_compilable(type(model), config.compile)  # before any work
     data = _Data.of(model, train_windows)
-    configure_torch(config.seed, config.threads, config.deterministic)
+    configure_torch(config.seed, config.threads, config.deterministic, config.torch_device())
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
