@@ -794,6 +794,11 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
         np.arctan2(got[..., 1], got[..., 0]), np.repeat(want[:, None], 42, 1), atol=1e-12
     )
     np.testing.assert_allclose(np.linalg.norm(got, axis=-1), 1.0, atol=1e-12)
+    huge = np.zeros((4, 141))
+    huge[::2, 7], huge[1::2, 7] = -1.7e308, 1.7e308  # finite, but their difference is not
+    np.save(tmp_path / "huge.npy", huge)
+    with pytest.raises(FormatError, match="angles too large to interpolate between rows"):
+        read_prediction(tmp_path / "huge.npy", fps=20)
     d[2, 5] = -d[1, 5]  # bone 5 flips between rows 1 and 2; at 22.5 fps, 15 fps frame 1 is row 1.5, halfway
     np.save(tmp_path / "flip.npy", d)
     with pytest.raises(FormatError, match=r"bone 5 turns by 180 degrees between rows 1 and 2") as info:
