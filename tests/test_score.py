@@ -806,6 +806,36 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     assert info.value.field == "values"
 
 
+def test_random_npy_files_at_random_rates_read_or_are_format_errors(tmp_path):
+    """400 random .npy files (the three shapes and others, 1 to 60 rows, values from 1e-300 to 1e308, NaN, zeros,
+    antipodal neighbours) read at random rates: each gives finite unit directions (and finite Euler channels) or a
+    FormatError; no other exception, no non-finite value."""
+    from beatlite.score import read_prediction
+
+    rng = np.random.default_rng(28)
+    shapes = [(42, 3), (126,), (141,), (42, 2), (140,), ()]
+    for i in range(400):
+        rows, shape = int(rng.integers(1, 60)), shapes[int(rng.integers(len(shapes)))]
+        with np.errstate(over="ignore"):  # some become inf: refused as not finite
+            x = rng.normal(size=(rows, *shape)) * 10.0 ** rng.integers(-300, 309)
+        kind = rng.integers(6)
+        if kind == 0:
+            x.flat[int(rng.integers(x.size))] = np.nan
+        elif kind == 1:
+            x[int(rng.integers(rows))] = 0.0
+        elif kind == 2 and rows > 1:
+            x[1::2] = -x[:-1:2][: len(x[1::2])]  # every odd row the negation of the even row before it
+        np.save(tmp_path / "x.npy", x)
+        fps = [None, 15.0, 30.0, 20.0, 22.5, 7.5, 120.0][int(rng.integers(7))]
+        try:
+            pred = read_prediction(tmp_path / "x.npy", fps=fps)
+        except FormatError:
+            continue
+        assert np.isfinite(pred.directions).all(), (i, shape, fps)
+        np.testing.assert_allclose(np.linalg.norm(pred.directions, axis=-1), 1.0, atol=1e-9, err_msg=str(i))
+        assert pred.euler is None or np.isfinite(pred.euler).all(), (i, shape, fps)
+
+
 def test_predictions_named_in_another_case_or_as_beat_and_emage_write_them_are_matched(tmp_path):
     """BEAT's test code names a take's result ``res_{take}.bvh``, EMAGE's ``res_{take}.npz`` beside
     ``gt_{take}.npz``; before, such a folder (and one of ``2_Scott_0_1_1.BVH``) matched no take ('no prediction for
