@@ -381,6 +381,22 @@ def _resample_directions(d: np.ndarray, fps: float, path: Path) -> np.ndarray:
     return out / norms
 
 
+def _rate_error(fps: float) -> str | None:
+    """Why ``fps`` cannot be the rate of a prediction's rows, or None: the rates a BVH's ``Frame Time`` may give
+    (:data:`beatlite.io.bvh.FRAME_TIME_RANGE`), so that resampling to 15 fps stays bounded (1e-300 fps would ask
+    for 1e301 frames)."""
+    from beatlite.io.bvh import FRAME_TIME_RANGE
+
+    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))
+    try:
+        rate = float(fps)
+    except (TypeError, ValueError):
+        rate = math.nan
+    if math.isfinite(rate) and low <= rate <= high:
+        return None
+    return f"the rows' frame rate must be a number from {low:g} to {high:g} fps"
+
+
 def _load_npy(path: Path) -> np.ndarray:
     """``np.load`` of a ``.npy`` file whose header is checked first: its magic, and a shape whose bytes the file
     holds (a header may claim any size: read as is, it would allocate it)."""
@@ -449,9 +465,14 @@ def read_prediction(path: str | Path, *, fps: float | None = None) -> Prediction
     ------
     FormatError
         Naming the file and the field when it cannot be converted.
+    ValueError
+        When ``fps`` is outside the frame rates a BVH's ``Frame Time`` may give
+        (:data:`beatlite.io.bvh.FRAME_TIME_RANGE`: 1 to 100,000 fps).
     """
     from beatlite.io import FormatError
 
+    if fps is not None and _rate_error(fps):
+        raise ValueError(f"read_prediction: fps {fps}: {_rate_error(fps)}")
     p = Path(path)
     name = p.name.lower()
     if name.endswith((".bvh", ".bvh.gz")):
@@ -776,8 +797,8 @@ def score_folder(
     """
     from beatlite.paths import shareable
 
-    if pred_fps is not None and not (math.isfinite(pred_fps) and pred_fps > 0):
-        raise ScoreInputError([f"pred_fps {pred_fps}: the rows' frame rate must be a positive number"])
+    if pred_fps is not None and _rate_error(pred_fps):
+        raise ScoreInputError([f"pred_fps {pred_fps}: {_rate_error(pred_fps)}"])
     test = load_split(data, split) if test is None else test
     files, missing, extra = match_predictions(pred, test.takes)
     problems = []
@@ -952,11 +973,10 @@ def _rate_problem(path: Path, pred: Prediction, rows: int, have: int) -> str:
     from beatlite.io import FormatError
 
     field = {".npz": "mocap_frame_rate", ".npy": "shape"}.get(path.suffix.lower(), "Frame Time")
-    why = (
-        "(a .npy states no rate: read at 15 fps)"
-        if field == "shape"
-        else "(BEAT's code writes 15 fps rows under a 120 fps Frame Time)"
-    )
+    why = {
+        "shape": "(a .npy states no rate: read at 15 fps)",
+        "mocap_frame_rate": "(the file's mocap_frame_rate is not its rows' rate)",
+    }.get(field, "(BEAT's code writes 15 fps rows under a 120 fps Frame Time)")
     message = (
         f"{rows} rows at {pred.fps:g} fps last {rows / pred.fps:.2f} s, the take {have / FPS:.2f} s; at "
         f"{rows * FPS / have:.4g} fps they would span it: if that is their rate {why}, give it with --pred-fps"

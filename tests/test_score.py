@@ -456,6 +456,12 @@ def test_cli_mistakes_are_one_error_line(truth_files, tmp_path, capsys):
             [str(tmp_path / "empty"), "--data", data, "--allow-missing"],
             "any of the 8 takes",
         ),
+        # a rate below a BVH's 1 fps asked for 1e301 frames: a bare ValueError or ZeroDivisionError before
+        "--pred-fps 1e-300": (
+            [str(truth_files), "--data", data, "--pred-fps", "1e-300"],
+            "from 1 to 100000 fps",
+        ),
+        "--pred-fps 0": ([str(truth_files), "--data", data, "--pred-fps", "0"], "pred_fps 0.0"),
     }
     for label, (argv, text) in cases.items():
         assert main(argv) == 2, label
@@ -799,6 +805,9 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     np.save(tmp_path / "huge.npy", huge)
     with pytest.raises(FormatError, match="angles too large to interpolate between rows"):
         read_prediction(tmp_path / "huge.npy", fps=20)
+    for fps in (1e-300, 5e-324, 0.5, 2e5, float("nan")):  # outside a BVH Frame Time's 1 to 100,000 fps
+        with pytest.raises(ValueError, match="from 1 to 100000 fps"):
+            read_prediction(tmp_path / "turn.npy", fps=fps)
     d[2, 5] = -d[1, 5]  # bone 5 flips between rows 1 and 2; at 22.5 fps, 15 fps frame 1 is row 1.5, halfway
     np.save(tmp_path / "flip.npy", d)
     with pytest.raises(FormatError, match=r"bone 5 turns by 180 degrees between rows 1 and 2") as info:
@@ -806,6 +815,7 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     assert info.value.field == "values"
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 def test_random_npy_files_at_random_rates_read_or_are_format_errors(tmp_path):
     """400 random .npy files (the three shapes and others, 1 to 60 rows, values from 1e-300 to 1e308, NaN, zeros,
     antipodal neighbours) read at random rates: each gives finite unit directions (and finite Euler channels) or a
