@@ -112,11 +112,12 @@ def _call_text(name: str, args: tuple, kwargs: dict) -> str:
 def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -> str | None:
     """Why ``got`` is not ``want`` in one line, or ``None`` when they match (``numpy.isclose``, NaN == NaN).
 
-    For float32 (or float16, bfloat16) arrays, ``atol`` grows by what rounding alone may change: 16 units in the last
-    place of the largest finite ``|want|`` at that precision (float32: ``16 * 1.19e-7 * max|want|``), so that a
-    solution summing in another order than the reference (numpy's einsum against torch) matches on elements near zero.
-    Torch tensors are compared as their values (detached from autograd, copied to the CPU; bfloat16 at its own
-    precision).
+    For float32 (or float16) arrays, ``atol`` grows by what rounding alone may change: 16 units in the last place
+    of the largest finite ``|want|`` at that precision (float32: ``16 * 1.19e-7 * max|want|``), so that a solution
+    summing in another order than the reference (numpy's einsum against torch) matches on elements near zero.
+    Torch tensors (also inside a list or tuple) are compared as their values: detached from autograd, on the CPU;
+    a bfloat16 one within bfloat16's rounding of each element (``rtol`` at least ``2**-8``: the exact answer
+    rounded to bfloat16 matches, one computed in bfloat16 may not).
 
     Examples
     --------
@@ -126,12 +127,19 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
     'shape: got (3,), expected (4,)'
     >>> difference(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.5, 3.5]))
     'first difference at index (1,): got 2.0, expected 2.5 (2 of 3 elements differ)'
+    >>> difference((np.zeros(2), np.ones(3)), (np.zeros(2), np.zeros(3)))  # items of other shapes: one by one
+    'item 1: first difference at index (0,): got 1.0, expected 0.0 (3 of 3 elements differ)'
     """
     if got is None and want is not None:
         return "got None: does the function end with `return ...`?"
     try:
-        (g, g_eps), (w, w_eps) = _values(got), _values(want)
-    except (TypeError, ValueError):  # ragged containers
+        (g, g_eps, g_rtol), (w, w_eps, w_rtol) = _values(got), _values(want)
+    except (TypeError, ValueError):  # ragged containers: item by item
+        if isinstance(got, list | tuple) and isinstance(want, list | tuple):
+            if len(got) != len(want):
+                return f"length: got {len(got)} items, expected {len(want)}"
+            why = ((i, difference(a, b, rtol=rtol, atol=atol)) for i, (a, b) in enumerate(zip(got, want)))
+            return next((f"item {i}: {d}" for i, d in why if d is not None), None)
         return None if _equal(got, want) else f"got {describe(got)}, expected {describe(want)}"
     if g.dtype == object or w.dtype == object or g.dtype.kind in "USV" or w.dtype.kind in "USV":
         return None if _equal(got, want) else f"got {describe(got)}, expected {describe(want)}"
@@ -139,8 +147,9 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
         return f"shape: got {g.shape}, expected {w.shape}"
     if g.ndim and _KINDS.get(g.dtype.kind) != _KINDS.get(w.dtype.kind):
         return f"dtype: got {_KINDS.get(g.dtype.kind, g.dtype)} ({g.dtype}), expected {_KINDS.get(w.dtype.kind, w.dtype)} ({w.dtype})"
-    atol = atol + _rounding(w, max(g_eps, w_eps))
-    close = np.isclose(g.astype(float), w.astype(float), rtol=rtol, atol=atol, equal_nan=True)
+    atol, rtol = atol + _rounding(w, max(g_eps, w_eps)), max(rtol, g_rtol, w_rtol)
+    kind = complex if "c" in (g.dtype.kind, w.dtype.kind) else float  # (float would drop imaginary parts)
+    close = np.isclose(g.astype(kind), w.astype(kind), rtol=rtol, atol=atol, equal_nan=True)
     if close.all():
         return None
     if g.ndim == 0:
@@ -153,17 +162,26 @@ def difference(got: Any, want: Any, *, rtol: float = 1e-5, atol: float = 1e-8) -
     )
 
 
-def _values(x: Any) -> tuple[np.ndarray, float]:
-    """``x`` as a numpy array, and the machine epsilon of its float type (0.0 for integers and others): a torch
-    tensor detached and on the CPU, bfloat16 (which numpy lacks) as float32 with bfloat16's epsilon."""
-    if hasattr(x, "detach") and hasattr(x, "dtype") and hasattr(x, "is_floating_point"):  # a torch tensor
+def _values(x: Any) -> tuple[np.ndarray, float, float]:
+    """``x`` as a numpy array, the machine epsilon of its float type (0.0 for integers and others) and the least
+    ``rtol`` its precision allows (0.0 but for bfloat16, which numpy lacks: read as float32, its ``2**-8``); torch
+    tensors detached and on the CPU, also in a list or tuple."""
+    if _is_tensor(x):
         import torch
 
-        eps = torch.finfo(x.dtype).eps if x.is_floating_point() else 0.0
-        t = x.detach().cpu()
-        return (t.float() if t.dtype == torch.bfloat16 else t).numpy(), eps
+        t = x.detach()
+        if t.dtype == torch.bfloat16:
+            return t.float().numpy(force=True), 0.0, 2.0**-8
+        return t.numpy(force=True), (torch.finfo(t.dtype).eps if t.is_floating_point() else 0.0), 0.0
+    if isinstance(x, list | tuple) and any(_is_tensor(e) for e in x):
+        parts = [_values(e) for e in x]
+        return np.asarray([a for a, _, _ in parts]), max(e for _, e, _ in parts), max(r for _, _, r in parts)
     a = np.asarray(x)
-    return a, (float(np.finfo(a.dtype).eps) if a.dtype.kind == "f" else 0.0)
+    return a, (float(np.finfo(a.dtype).eps) if a.dtype.kind == "f" else 0.0), 0.0
+
+
+def _is_tensor(x: Any) -> bool:
+    return hasattr(x, "detach") and hasattr(x, "dtype") and hasattr(x, "is_floating_point")
 
 
 def _rounding(want: np.ndarray, eps: float) -> float:
@@ -178,7 +196,10 @@ def _rounding(want: np.ndarray, eps: float) -> float:
 def _equal(got: Any, want: Any) -> bool:
     try:
         return bool(got == want)
-    except ValueError:  # arrays inside a container
+    except (
+        ValueError,
+        RuntimeError,
+    ):  # arrays (numpy's ValueError) or tensors (torch's RuntimeError) inside a container
         return False
 
 

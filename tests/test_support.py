@@ -139,23 +139,30 @@ def test_exercise_tolerance_and_nan_and_errors(capsys):
 
 def test_exercise_difference_reads_torch_tensors_that_need_grad_or_are_bfloat16():
     """Before, a result that still required grad raised torch's "Can't call numpy() on Tensor that requires grad"
-    from inside the check, and a bfloat16 one "Boolean value of Tensor with more than one value is ambiguous":
-    neither told the student anything about the answer. Now both are compared as values, bfloat16 at its own
-    rounding (16 units of 2**-7 at max|want| = 3: an allowance of 0.375)."""
+    from inside the check, and a bfloat16 one "Boolean value of Tensor with more than one value is ambiguous",
+    also inside a tuple: neither told the student anything about the answer. Now they are compared as values, a
+    bfloat16 one within bfloat16's rounding of each element (relative 2**-8 = 0.39 %); a tuple of items of other
+    shapes (arrays too: never equal before) item by item."""
     torch = pytest.importorskip("torch")
-    want = np.array([1.0, 2.0, 3.0])
+    want = np.array([1.0, 2.0, 3.0]) * 1.001
     grad = torch.tensor(want, requires_grad=True)
     assert exercise.difference(grad * 1, want) is None
     assert exercise.difference(grad * 2, want) == (
-        "first difference at index (0,): got 2.0, expected 1.0 (3 of 3 elements differ)"
+        "first difference at index (0,): got 2.002, expected 1.001 (3 of 3 elements differ)"
     )
     assert exercise.difference(want, grad) is None  # a reference that needs grad
-    half = torch.tensor(want, dtype=torch.bfloat16)
-    assert exercise.difference(half + 0.25, want) is None  # within 0.375: bfloat16 rounding allows it
-    assert exercise.difference(half + 0.5, want) is not None  # beyond it
-    assert (
-        exercise.difference(torch.tensor(want, dtype=torch.float32) + 0.25, want) is not None
-    )  # float32's: 5.7e-6
+    assert exercise.difference((grad, grad * 1), (want, want)) is None  # inside a tuple
+    assert exercise.difference((grad, grad[:2]), (want, want[:2])) is None  # ragged: item by item
+    assert exercise.difference((grad, grad[:2]), (want, 2 * want[:2])).startswith("item 1: first difference")
+    assert exercise.difference([grad, grad[:2], grad], [want, want[:2]]) == "length: got 3 items, expected 2"
+    half = torch.tensor(want, dtype=torch.bfloat16)  # [1.0, 2.0, 3.0]: the exact answer rounded to bfloat16
+    assert np.abs(half.float().numpy() - want).max() > 1e-3  # beyond rtol 1e-5, within 2**-8
+    assert exercise.difference(half, want) is None and exercise.difference([half], [want]) is None
+    assert exercise.difference(half * 1.02, want) is not None  # 2 %: a wrong answer, not bfloat16's rounding
+    assert exercise.difference(torch.tensor(want, dtype=torch.float32) * 1.02, want) is not None
+    assert exercise.difference(torch.tensor([1 + 1j]).conj(), np.array([1 - 1j])) is None  # a conjugate view
+    # complex values were compared by their real parts (astype(float), with a ComplexWarning): 1+1j matched 1-1j
+    assert exercise.difference(np.array([1 + 1j]), np.array([1 - 1j])) is not None
 
 
 def test_exercise_choice_hides_the_answer_and_checks_it(capsys):
