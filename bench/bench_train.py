@@ -55,7 +55,8 @@ Per row:
 Devices that are not present print ``unmeasured``. Timings on a shared machine are noisy: compare rows of
 one run, on one machine. Issue 28's targets (benchmark, not tests): CaMN paper >= 10,000 windows/s in bf16
 and HA2G paper >= 3,000 on one H100/H200; tiny models on one CPU thread no slower than before (CaMN tiny
-about 150 windows/s). Measured on an H200: ``bench/records/bench_train_h200.json`` (README, "Using real BEAT").
+``fit`` about 150 windows/s on a CPU with AVX-512, ``bench/records/bench_train_quick_cpu.json``; 47 on one
+without, ``bench_train_quick_cpu_avx2.json``). Measured on an H200: ``bench/records/bench_train_h200.json`` (README, "Using real BEAT").
 """
 
 from __future__ import annotations

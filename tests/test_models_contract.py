@@ -250,7 +250,8 @@ def test_store_training_finds_a_model_that_reads_memory_it_never_wrote(
 ) -> None:
     """``fit`` turns deterministic mode's filling of new tensors off on CUDA (``set_deterministic``): a model that
     reads a tensor it never wrote would then train on whatever the memory held. The contract trains the store route
-    unfilled and the in-memory route filled (NaN) and asks for the same bits, so such a model fails on the CPU."""
+    unfilled and the in-memory route filled (NaN) and asks for the same bits, so such a model fails on the CPU: on
+    the bits of the unfilled read, or on NaN where the allocator hands back memory that an earlier fill wrote."""
     import torch
 
     from beatlite.models.baselines import S2G
@@ -265,5 +266,5 @@ def test_store_training_finds_a_model_that_reads_memory_it_never_wrote(
     check_store_training(
         model_case("s2g", tmp_path, train=train, reference=reference)
     )  # the model itself passes
-    with pytest.raises(AssertionError, match=re.escape("store route, new tensors unfilled")):
+    with pytest.raises(AssertionError, match="store route, new tensors unfilled|non-finite losses"):
         check_store_training(model_case(ReadsUnwrittenMemory, tmp_path, train=train, reference=reference))

@@ -880,7 +880,7 @@ def test_validating_every_n_steps_leaves_the_training_draws_alone(windows):
 
 def test_set_deterministic_stops_filling_new_tensors_on_cuda_only():
     """Deterministic mode fills every new tensor (NaN); on CUDA each fill is a kernel launch, so ``fit`` turns the
-    filling off there and leaves the CPU's (torch's default, on) as it is; the mode itself is set on both."""
+    filling off there and on again (torch's default) for the CPU, also after a CUDA run; the mode is set on both."""
     import torch
 
     from beatlite.train.training import set_deterministic
@@ -902,6 +902,8 @@ def test_set_deterministic_stops_filling_new_tensors_on_cuda_only():
         set_deterministic(True, "cuda")  # (a device name: no GPU needed)
         assert torch.are_deterministic_algorithms_enabled()
         assert not torch.utils.deterministic.fill_uninitialized_memory
+        set_deterministic(True, "cpu")  # a CPU run after a CUDA one in the same process: filled again
+        assert torch.utils.deterministic.fill_uninitialized_memory and torch.isnan(torch.empty(3)).all()
     finally:
         torch.utils.deterministic.fill_uninitialized_memory = fill
         torch.use_deterministic_algorithms(mode)

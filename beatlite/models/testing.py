@@ -439,7 +439,7 @@ def check_store_training(case: ModelCase) -> None:
     (``data_on_device="always"``), equal two steps from the same windows in memory (same losses, weights and
     buffers, bit for bit), with finite losses. The store route runs without deterministic mode's filling of new
     tensors (as ``fit`` does on CUDA), the in-memory route with it: the model reads no memory it has not written
-    (a read of a filled tensor would give NaN, of an unfilled one other bits)."""
+    (a read of a filled tensor would give NaN, of an unfilled one other bits or a NaN left by an earlier fill)."""
     view = _store_view(case)
     stored, history = _fit_two_steps(case, view, amp=False, fill=False)
     memory, reference = _fit_two_steps(case, case.reference, amp=False, fill=True)

@@ -197,23 +197,22 @@ def set_deterministic(deterministic: bool, device: Any = "cpu") -> None:
     written shows (``torch.utils.deterministic.fill_uninitialized_memory``); torch documents turning that off
     for a program that reads no such memory: "and still be deterministic". On CUDA each fill is a kernel launch
     (2,408 per HA2G paper-preset step at batch 64 on an H200: README, "Using real BEAT"), so there the filling
-    is turned off (process-wide, as the mode is). On the CPU it stays torch's default (on): a fill is a memset
-    there, and it keeps guarding the tests. Every registered model trains to the same bits either way
-    (:func:`beatlite.models.testing.check_store_training`).
+    is turned off (process-wide, as the mode is). On other devices it is torch's default (on), also after a CUDA
+    run in the same process: a fill is a memset on the CPU, and it keeps guarding the tests. Every registered
+    model trains to the same bits either way (:func:`beatlite.models.testing.check_store_training`).
 
     Parameters
     ----------
     deterministic : bool
     device : torch.device or str
-        Where the model trains: ``"cuda"`` (any index) turns the filling off; others leave it as it is.
+        Where the model trains: ``"cuda"`` (any index) turns the filling off, any other device on.
     """
     import os
 
     # deterministic cuBLAS needs a fixed workspace; it must be set before CUDA's first matrix product
     os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
     torch.use_deterministic_algorithms(deterministic)
-    if torch.device(device).type == "cuda":
-        torch.utils.deterministic.fill_uninitialized_memory = False
+    torch.utils.deterministic.fill_uninitialized_memory = torch.device(device).type != "cuda"
 
 
 def _mean_losses(sums: Mapping[str, Any], n: int) -> dict[str, float]:
