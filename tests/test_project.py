@@ -166,16 +166,21 @@ def test_checks_sit_in_check_cells(path):
     assert not found, f"{path.name}: move these assertions to a cell tagged `check`: {found}"
 
 
+def _code_cell_trees(path: Path) -> list[tuple[int, ast.Module]]:
+    """``(cell index, parsed source)`` of each code cell of a notebook, its ``%`` and ``!`` lines left out."""
+
+    def python(source: list[str]) -> str:
+        return "\n".join(ln for ln in "".join(source).splitlines() if not ln.lstrip().startswith(("%", "!")))
+
+    cells = json.loads(path.read_text())["cells"]
+    return [(i, ast.parse(python(c["source"]))) for i, c in enumerate(cells) if c["cell_type"] == "code"]
+
+
 def _figure_saves_not_via_save_figure(path: Path) -> list[str]:
     """Figure saves other than ``bl.viz.save_figure(fig, ...)``: ``savefig``, ``out=`` to a plot function, aliases."""
-    nb = json.loads(path.read_text())
     found = []
-    for i, cell in enumerate(nb["cells"]):
-        if cell["cell_type"] != "code":
-            continue
-        src = "".join(cell["source"])
-        src = "\n".join(line for line in src.splitlines() if not line.lstrip().startswith(("%", "!")))
-        for node in ast.walk(ast.parse(src)):
+    for i, tree in _code_cell_trees(path):
+        for node in ast.walk(tree):
             if not isinstance(node, ast.Call):
                 continue
             func = ast.unparse(node.func)
@@ -197,6 +202,65 @@ def test_figures_are_saved_one_way(path):
     """
     found = _figure_saves_not_via_save_figure(path)
     assert not found, f"{path.name}: save figures with bl.viz.save_figure: {found}"
+
+
+#: pyplot functions that make a figure (or one when none is open): a figure of its own, not a beatlite function's.
+_PYPLOT_FIGURE_MAKERS = {"figure", "subplots", "subplot", "subplot_mosaic", "axes", "plot", "imshow", "bar", "barh",
+                         "hist", "scatter", "errorbar", "semilogx", "semilogy", "loglog", "fill_between"}  # fmt: skip
+
+
+def _figures_outside_the_style(path: Path) -> list[str]:
+    """``plt.subplots(...)``, ``plt.figure(...)``, ``plt.plot(...)``, ... calls not inside ``with bl.viz.figure_style():``."""
+    found = []
+
+    def visit(node: ast.AST, styled: bool, i: int) -> None:
+        if isinstance(node, ast.With) and any(
+            isinstance(item.context_expr, ast.Call)
+            and ast.unparse(item.context_expr.func).endswith("figure_style")
+            for item in node.items
+        ):
+            styled = True
+        if isinstance(node, ast.Call) and not styled:
+            func = ast.unparse(node.func)
+            if func.startswith("plt.") and func[4:] in _PYPLOT_FIGURE_MAKERS:
+                found.append(f"cell {i} line {node.lineno}: {func}(...)")
+        for child in ast.iter_child_nodes(node):
+            visit(child, styled, i)
+
+    for i, tree in _code_cell_trees(path):
+        visit(tree, False, i)
+    return found
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_figures_are_drawn_in_the_course_style(path):
+    """A figure a notebook draws itself is made inside ``with bl.viz.figure_style():`` (beatlite's figure functions
+    apply it themselves): slide-size fonts, the style's grid and colour cycle, like every other figure of the course.
+
+    Notebooks 00, 01, 03, 05, 06, 07, 08 and 10 drew 14 figures with a bare ``plt.subplots``/``plt.figure`` (matplotlib's
+    defaults: 9-pt titles, boxed axes, the default colour cycle).
+    """
+    found = _figures_outside_the_style(path)
+    assert not found, f"{path.name}: draw these figures inside `with bl.viz.figure_style():`: {found}"
+
+
+def test_unstyled_figure_cells_are_found(tmp_path):
+    """The check of the test above, on a hand-made notebook: bare pyplot figures found, styled ones and
+    beatlite's figure functions not."""
+    cells = [
+        "fig, ax = plt.subplots()\nax.plot([0, 1])",  # bare: found
+        "with bl.viz.figure_style():\n    fig = plt.figure()\n    for k in range(2):\n        plt.plot([k])",
+        "fig = bl.viz.charts.plot_signals(t, curves, 'speed (cm/s)')\nplt.show()",  # styled by the library
+        "%matplotlib inline\nif True:\n    plt.imshow(image)",  # bare, nested: found
+        "with open('x') as f, bl.viz.figure_style(**{'font.size': 12}):\n    plt.subplots(1, 2)",
+    ]
+    nb = {"cells": [{"cell_type": "code", "source": c.splitlines(keepends=True)} for c in cells]}
+    path = tmp_path / "nb.ipynb"
+    path.write_text(json.dumps(nb))
+    assert _figures_outside_the_style(path) == [
+        "cell 0 line 1: plt.subplots(...)",
+        "cell 3 line 2: plt.imshow(...)",
+    ]
 
 
 _TEMP_MAKERS = ("TemporaryDirectory", "example_corpus", "example_beat2_corpus")
