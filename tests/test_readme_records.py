@@ -397,6 +397,34 @@ def test_the_guide_run_times_and_the_headers_are_the_notebooks_record():
     )
 
 
+def test_the_notebook_times_without_avx512_are_their_record():
+    """The guide's second row of notebook times, its ratio to the first and the README's sentence, from
+    ``scripts/run_notebooks.py --record`` of one lecture-mode run on a CPU whose torch capability is AVX2."""
+    record, first = _record("notebooks_cpu_avx2.json"), _record("notebooks_cpu.json")
+    rows = record["rows"]
+    assert [r["notebook"] for r in rows] == [r["notebook"] for r in first["rows"]] and all(
+        r["ok"] for r in rows
+    )
+    assert record["machine"]["cpu_capability"] == "AVX2"
+    assert record["settings"]["BEATLITE_MODE"] == "lecture" and record["settings"]["BEATLITE_THREADS"] == "1"
+    total, user = record["total_wall_seconds"], sum(r["kernel_user_seconds"] for r in rows)
+    guide = _guide()
+    row = next(
+        line for line in guide.splitlines() if line.startswith("| wall time on a CPU without AVX-512 (s) |")
+    )
+    cells = [c.strip() for c in row.strip().strip("|").split("|")][1:]
+    assert cells == [f"{r['wall_seconds']:.1f}" for r in rows] + [
+        f"{total:.0f} ({_minutes(total)}; {user:.0f} s of the kernels' user CPU, "
+        f"{record['largest_kernel_gib']:.2f} GiB resident at most in one kernel)"
+    ]
+    ratio = total / first["total_wall_seconds"]
+    assert f"{ratio:.1f} times as long in all" in " ".join(guide.split())
+    assert (
+        f"on a CPU without AVX-512 the same run took {total / 60:.1f} minutes, {total:.0f} s in "
+        "`bench/records/notebooks_cpu_avx2.json`" in " ".join(_readme().split())
+    )
+
+
 def test_the_numba_compile_times_are_the_record():
     record = _record("numba_cpu.json")
     cold = [r["warm_up_seconds"] for r in record["cold"]]
