@@ -1019,6 +1019,29 @@ def test_waveform_has_an_amplitude_axis_and_the_words_of_the_window():
     plt.close("all")
 
 
+def test_log_mel_spans_its_frames_in_seconds_with_its_bands_and_events():
+    """M frames at ``frame_rate`` span M / frame_rate seconds; B bands are labelled 0..B-1; each event is one line;
+    the colour bar says the level's reference; a 1-D input is refused."""
+    from beatlite.viz import charts
+
+    mel = np.linspace(-80.0, 0.0, 70 * 128).reshape(70, 128)
+    fig = charts.plot_log_mel(mel, 31.25, events=[0.5, 1.0], title="t")
+    ax, bar = fig.axes
+    assert ax.images[0].get_extent() == [0.0, 70 / 31.25, 0, 128] and ax.get_xlim() == (0.0, 70 / 31.25)
+    assert (
+        ax.get_ylabel() == "mel band (index, 0-127)"
+        and ax.get_xlabel() == "time (s)"
+        and ax.get_title() == "t"
+    )
+    assert sorted(line.get_xdata()[0] for line in ax.lines) == [0.5, 1.0]
+    assert bar.get_ylabel() == "level (dB, 0 = the take's peak)"
+    np.testing.assert_array_equal(ax.images[0].get_array(), mel.T)  # bands up, time across
+    assert charts.plot_log_mel(mel, 31.25, xlim=(0, 1)).axes[0].get_xlim() == (0.0, 1.0)
+    with pytest.raises(ValueError, match="non-empty"):
+        charts.plot_log_mel(np.zeros(70), 31.25)
+    plt.close("all")
+
+
 def test_blendshape_curves_show_the_most_active_not_the_flat_ones():
     w = np.zeros((120, 4))
     w[:, 2] = 0.5 + 0.5 * np.sin(np.arange(120) / 10)

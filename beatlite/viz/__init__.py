@@ -19,7 +19,8 @@ pyvista nor torch); the names below are importable from ``beatlite.viz``.
 ``charts``                   :func:`plot_training_curves`, :func:`plot_scores` (bars, outliers cut),
                              :func:`plot_score_scatter` (labelled points), :func:`plot_effects`
                              (ablation changes, paper vs ours ± error), :func:`plot_signals`
-                             (curves + event lines + markers), :func:`plot_waveform` (amplitude, words, onsets)
+                             (curves + event lines + markers), :func:`plot_waveform` (amplitude, words, onsets),
+                             :func:`plot_log_mel` (spectrogram, level bar, event lines)
 ``figures``                  multi-panel figures of notebooks 00-04: :func:`plot_corpus_overview`,
                              :func:`plot_transcript`, :func:`plot_annotations`, :func:`plot_onsets`,
                              :func:`plot_beat_curves`, :func:`plot_spread`
@@ -81,6 +82,7 @@ _EXPORTS: dict[str, str] = {
     "plot_effects": "charts",
     "plot_signals": "charts",
     "plot_waveform": "charts",
+    "plot_log_mel": "charts",
     "plot_corpus_overview": "figures",
     "plot_transcript": "figures",
     "plot_annotations": "figures",

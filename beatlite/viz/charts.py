@@ -561,3 +561,64 @@ def plot_waveform(
             ax.set_title(title)
         legend_outside(ax, "right")
     return ax.figure
+
+
+def plot_log_mel(
+    log_mel: Any,
+    frame_rate: float,
+    *,
+    events: Any = None,
+    xlim: tuple[float, float] | None = None,
+    title: str | None = None,
+    ax: Any = None,
+    figsize: tuple[float, float] = (9.0, 3.0),
+) -> Any:
+    """A log-mel spectrogram over time, with its level colour bar and optional event lines (e.g. word onsets).
+
+    Parameters
+    ----------
+    log_mel : (M, B) float, dB
+        M frames of B mel bands, as :func:`beatlite.data.windows.log_mel` gives them (0 dB = the take's peak).
+    frame_rate : float
+        Mel frames per second (``sr / hop``, e.g. 16000 / 512 = 31.25).
+    events : (E,) float seconds, optional
+        Times drawn as thin white lines over the picture.
+    xlim : (float, float), optional
+        Time range shown, seconds (default all M frames).
+    title : str, optional
+        Axes title.
+    ax : matplotlib Axes, optional
+        Draw into it; a new figure otherwise.
+    figsize : (float, float)
+        Size of a new figure, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> fig = plot_log_mel(np.zeros((70, 128)), 31.25)
+    >>> [float(t) for t in fig.axes[0].get_xlim()], fig.axes[0].get_ylabel()  # 70 frames at 31.25 per second
+    ([0.0, 2.24], 'mel band (index, 0-127)')
+    """
+    from beatlite.viz._inputs import check_fps
+
+    x = np.asarray(log_mel, dtype=np.float64)
+    if x.ndim != 2 or not x.size:
+        raise ValueError(
+            f"log_mel must be a non-empty (M, B) array of M frames and B bands, got shape {x.shape}"
+        )
+    frame_rate = check_fps(frame_rate, "frame_rate")
+    with figure_style():
+        ax = _new_axes(ax, figsize)
+        extent = (0.0, len(x) / frame_rate, 0, x.shape[1])
+        image = ax.imshow(x.T, origin="lower", aspect="auto", extent=extent, cmap="magma")
+        for t in np.asarray(events if events is not None else [], dtype=np.float64).reshape(-1):
+            ax.axvline(t, color="white", lw=0.5, alpha=0.6)
+        ax.set(xlim=xlim or extent[:2], xlabel="time (s)", ylabel=f"mel band (index, 0-{x.shape[1] - 1})")
+        if title:
+            ax.set_title(title)
+        ax.grid(False)  # no grid over the picture
+        ax.figure.colorbar(image, ax=ax, label="level (dB, 0 = the take's peak)")
+    return ax.figure
