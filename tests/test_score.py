@@ -815,7 +815,9 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     assert info.value.field == "values"
 
 
-@pytest.mark.filterwarnings("error::RuntimeWarning")
+@pytest.mark.filterwarnings(
+    "error::RuntimeWarning", "ignore::beatlite.score.ScoreWarning"
+)  # (not unit: normalised)
 def test_random_npy_files_at_random_rates_read_or_are_format_errors(tmp_path):
     """400 random .npy files (the three shapes and others, 1 to 60 rows, values from 1e-300 to 1e308, NaN, zeros,
     antipodal neighbours) read at random rates: each gives finite unit directions (and finite Euler channels) or a
