@@ -196,10 +196,8 @@ def _rounding(want: np.ndarray, eps: float) -> float:
 def _equal(got: Any, want: Any) -> bool:
     try:
         return bool(got == want)
-    except (
-        ValueError,
-        RuntimeError,
-    ):  # arrays (numpy's ValueError) or tensors (torch's RuntimeError) inside a container
+    # arrays (numpy's ValueError) or tensors (torch's RuntimeError) inside a container
+    except (ValueError, RuntimeError):
         return False
 
 

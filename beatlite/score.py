@@ -383,11 +383,11 @@ def _resample_directions(d: np.ndarray, fps: float, path: Path) -> np.ndarray:
 
 def _rate_error(fps: float) -> str | None:
     """Why ``fps`` cannot be the rate of a prediction's rows, or None: the rates a BVH's ``Frame Time`` may give
-    (:data:`beatlite.io.bvh.FRAME_TIME_RANGE`), so that resampling to 15 fps stays bounded (1e-300 fps would ask
+    (:data:`beatlite.io.bvh.FRAME_RATE_RANGE`), so that resampling to 15 fps stays bounded (1e-300 fps would ask
     for 1e301 frames)."""
-    from beatlite.io.bvh import FRAME_TIME_RANGE
+    from beatlite.io.bvh import FRAME_RATE_RANGE
 
-    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))
+    low, high = FRAME_RATE_RANGE
     try:
         rate = float(fps)
     except (TypeError, ValueError):
@@ -467,12 +467,12 @@ def read_prediction(path: str | Path, *, fps: float | None = None) -> Prediction
         Naming the file and the field when it cannot be converted.
     ValueError
         When ``fps`` is outside the frame rates a BVH's ``Frame Time`` may give
-        (:data:`beatlite.io.bvh.FRAME_TIME_RANGE`: 1 to 100,000 fps).
+        (:data:`beatlite.io.bvh.FRAME_RATE_RANGE`: 1 to 100,000 fps).
     """
     from beatlite.io import FormatError
 
-    if fps is not None and _rate_error(fps):
-        raise ValueError(f"read_prediction: fps {fps}: {_rate_error(fps)}")
+    if fps is not None and (why := _rate_error(fps)):
+        raise ValueError(f"read_prediction: fps {fps}: {why}")
     p = Path(path)
     name = p.name.lower()
     if name.endswith((".bvh", ".bvh.gz")):
@@ -797,8 +797,8 @@ def score_folder(
     """
     from beatlite.paths import shareable
 
-    if pred_fps is not None and _rate_error(pred_fps):
-        raise ScoreInputError([f"pred_fps {pred_fps}: {_rate_error(pred_fps)}"])
+    if pred_fps is not None and (why := _rate_error(pred_fps)):
+        raise ScoreInputError([f"pred_fps {pred_fps}: {why}"])
     test = load_split(data, split) if test is None else test
     files, missing, extra = match_predictions(pred, test.takes)
     problems = []

@@ -64,6 +64,8 @@ _FRAME_TIME_RE = re.compile(r"^\s*Frame\s+Time\s*:\s*(\S+)\s*$", re.IGNORECASE)
 _MAX_HEADER_LINES = 200_000
 #: Accepted ``Frame Time`` range in seconds (100 kHz .. 1 fps; resampling to 15 fps stays bounded).
 FRAME_TIME_RANGE = (1e-5, 1.0)
+#: The frame rates, frames per second, that :data:`FRAME_TIME_RANGE` allows (1 .. 100,000 fps).
+FRAME_RATE_RANGE = (1.0 / FRAME_TIME_RANGE[1], 1.0 / FRAME_TIME_RANGE[0])
 #: Largest integer factor between ``Frames`` and the row count that :func:`infer_row_rate` accepts.
 MAX_RATE_FACTOR = 16
 #: ``units=`` values of :func:`read_bvh` and their factor to centimetres.

@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from beatlite.io.bvh import FRAME_TIME_RANGE
+from beatlite.io.bvh import FRAME_RATE_RANGE
 from beatlite.io.errors import FormatError
 from beatlite.io.textfile import ZIP_MEMBER_ERRORS, describe_bytes, npy_header, zip_members
 
@@ -200,7 +200,7 @@ def _motion_arrays(
                      and poses.shape[1:] in ((165,), (55, 3)))  # fmt: skip
     trans = _numeric(fail, "trans", trans, f"({n}, 3)", trans.shape == (n, 3))
     fps = float(_numeric(fail, "mocap_frame_rate", rate, "a positive scalar", rate.size == 1).ravel()[0])
-    low, high = (1.0 / t for t in reversed(FRAME_TIME_RANGE))  # the frame rates a BVH may have
+    low, high = FRAME_RATE_RANGE  # the frame rates a BVH may have
     if not low <= fps <= high:
         raise fail(
             "mocap_frame_rate",
