@@ -343,10 +343,7 @@ def _npy_prediction(path: Path, fps: float | None = None) -> Prediction:
         _check_finite(x, path)
         rows, form = len(x), "npy euler (T, 141)" + at
         if at:
-            with np.errstate(over="ignore", invalid="ignore"):  # differences beyond float64: refused below
-                x = resample_frames(x, rate, FPS, angle_columns=np.arange(141))
-            if not np.isfinite(x).all():
-                raise FormatError(path, "angles too large to interpolate between rows", field="values")
+            x = resample_frames(x, rate, FPS, angle_columns=np.arange(141))
         return Prediction(euler_to_directions(x), x, form, rows=rows, fps=rate)
     if (x.ndim == 3 and x.shape[1:] == (42, 3)) or (x.ndim == 2 and x.shape[1] == 126):
         _check_finite(x, path)

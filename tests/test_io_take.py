@@ -159,6 +159,57 @@ def test_angles_interpolate_the_short_way() -> None:
     assert abs(((out[2, 0] + 170.0) + 180.0) % 360.0 - 180.0) < 1e-9  # -170 (mod 360)
 
 
+def test_finite_frames_resample_to_finite_frames_however_large() -> None:
+    # 2 -> 3 fps: source positions 0, 2/3, 4/3 and 2. A position pair +-1.7e308 apart interpolates as
+    # (1 - w) a + w b; an angle pair at 1.7e308 degrees (an even whole number, reduced mod 360 exactly with
+    # Python integers here) interpolates along the shorter arc between the two reduced angles.
+    a, b = -1.7e308, 1.7e308
+    values = np.array([[a, a], [b, b], [a, a]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warnings either
+        out = resample_frames(values, 2.0, 3.0, angle_columns=np.array([1]))
+    w = np.array([0.0, 2 / 3, 1 / 3])
+    np.testing.assert_allclose(
+        out[:, 0], [a, (1 - w[1]) * a + w[1] * b, (1 - w[2]) * b + w[2] * a, a], rtol=1e-12
+    )
+    ra, rb = int(a) % 360, int(b) % 360
+    arc = (rb - ra + 180) % 360 - 180
+    want = np.array([ra, ra + w[1] * arc, rb - w[2] * arc, ra])
+    assert np.all(np.abs((out[:, 1] - want + 180.0) % 360.0 - 180.0) < 1e-9)
+
+
+def test_ordinary_angles_resample_to_the_same_bits_as_the_shorter_arc_formula() -> None:
+    # Below ANGLE_EXACT nothing is reduced: a + w ((b - a + 180) % 360 - 180), bit for bit (the data records
+    # of stores and checkpoints were made with this formula).
+    rng = np.random.default_rng(0)
+    values = rng.uniform(-1e4, 1e4, (40, 6)) * rng.choice([1e-3, 1.0, 1e8], (40, 6))
+    out = resample_frames(values, 1.0, 4.0, angle_columns=np.array([0, 2, 4]))
+    pos = np.arange(len(out)) / 4  # 0, 1/4, 1/2, ...: exact in binary
+    i0 = np.floor(pos + 1e-9).astype(int)
+    w = (pos - i0)[:, None]
+    a, b = values[i0], values[np.minimum(i0 + 1, 39)]
+    delta = b - a
+    delta[:, [0, 2, 4]] = (delta[:, [0, 2, 4]] + 180.0) % 360.0 - 180.0
+    np.testing.assert_array_equal(out, a + w * delta)
+
+
+def test_random_finite_frames_of_any_size_resample_to_finite_frames() -> None:
+    rng = np.random.default_rng(1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for _ in range(200):
+            t, d = rng.integers(2, 9), rng.integers(1, 5)
+            exponent = np.where(
+                rng.random((t, d)) < 0.5, rng.uniform(307.5, 308.25, (t, d)), rng.uniform(-5, 5, (t, d))
+            )
+            values = rng.choice([-1, 1], (t, d)) * 10.0**exponent  # half near float64's largest
+            cols = np.flatnonzero(rng.random(d) < 0.5)
+            out = resample_frames(
+                values, float(rng.uniform(1, 100)), float(rng.uniform(1, 100)), angle_columns=cols
+            )
+            assert np.isfinite(out).all()
+
+
 # ----------------------------------------------------------------------------- readers never write
 
 

@@ -8,6 +8,7 @@ import re
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -779,6 +780,30 @@ def test_npy_rows_at_another_rate_are_refused_and_resampled_with_pred_fps(test_s
     assert result.info["trimmed"] == {} and "npy euler (T, 141) 30 fps -> 15 fps" in str(result.info["files"])
 
 
+def test_a_bvh_with_vast_values_at_another_rate_reads_finite_or_is_a_format_error(tmp_path):
+    # Resampled from 20 to 15 fps (resample_frames): a rotation flipping between +-1.7e308 degrees reads
+    # as its reduction mod 360 (finite directions, no overflow warning); a root flipping between +-1.7e308
+    # cm leaves every bone with zero length, a FormatError (it was NaN directions and RuntimeWarnings).
+    from beatlite.skeleton.beat import subset_columns
+
+    skeleton = beat_skeleton()
+    column = int(subset_columns(skeleton, "spine_neck_141")[7])
+    for name, col, flip in (("turn.bvh", column, None), ("root.bvh", 0, "zero-length")):
+        channels = np.zeros((8, skeleton.n_channels))
+        channels[::2, col], channels[1::2, col] = -1.7e308, 1.7e308
+        write_bvh(tmp_path / name, Motion(skeleton, channels, 20.0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            if flip is None:
+                got = read_prediction(tmp_path / name)
+                assert np.isfinite(got.directions).all() and np.isfinite(got.euler).all()
+                want = int(1.7e308) % 360 + ((int(-1.7e308) % 360 - int(1.7e308) % 360 + 180) % 360 - 180) / 3
+                assert abs((got.euler[1, 7] - want + 180.0) % 360.0 - 180.0) < 1e-9  # row 4/3
+            else:
+                with pytest.raises(FormatError, match="values too large to give directions"):
+                    read_prediction(tmp_path / name)
+
+
 def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     """20 fps rows -> 15 fps: output frame i is row position 4i/3. A bone turning at a constant rate in the x-y plane
     (10 degrees per row) is, between rows a and a+10° at weight w, the normalised sum (1-w)u(a) + w u(a+10°):
@@ -803,8 +828,11 @@ def test_npy_directions_between_rows_are_normalised_interpolations(tmp_path):
     huge = np.zeros((4, 141))
     huge[::2, 7], huge[1::2, 7] = -1.7e308, 1.7e308  # finite, but their difference is not
     np.save(tmp_path / "huge.npy", huge)
-    with pytest.raises(FormatError, match="angles too large to interpolate between rows"):
-        read_prediction(tmp_path / "huge.npy", fps=20)
+    big = read_prediction(tmp_path / "huge.npy", fps=20)  # reduced mod 360 (resample_frames), then turned
+    assert np.isfinite(big.directions).all()
+    ra, rb = int(-1.7e308) % 360, int(1.7e308) % 360  # 15 fps frame 1 is row 4/3: a third from row 1 to row 2
+    want = rb + ((ra - rb + 180) % 360 - 180) / 3
+    assert abs((big.euler[1, 7] - want + 180.0) % 360.0 - 180.0) < 1e-9
     for fps in (1e-300, 5e-324, 0.5, 2e5, float("nan")):  # outside a BVH Frame Time's 1 to 100,000 fps
         with pytest.raises(ValueError, match="from 1 to 100000 fps"):
             read_prediction(tmp_path / "turn.npy", fps=fps)

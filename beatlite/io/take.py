@@ -90,6 +90,9 @@ BEAT2_FOLDERS = {".wav": "wave16k", ".TextGrid": "textgrid"}
 #: Seconds by which motion may differ from the other modalities before its frame rate is questioned
 #: (the dataset index's ``MAX_DURATION_GAP``).
 RATE_GAP_S = 1.0
+#: Degrees from which a float64 angle holds no fraction of a degree (2**52): :func:`resample_frames` reduces
+#: such angles modulo 360 before interpolating them.
+ANGLE_EXACT = 2.0**52
 
 
 @dataclass(eq=False)
@@ -230,7 +233,10 @@ def resample_frames(
     shift : int
         First source frame used (BEAT's decimation starts at 1).
     angle_columns : (K,) int, optional
-        Columns holding angles in degrees, interpolated along the shorter arc.
+        Columns holding angles in degrees, interpolated along the shorter arc. A pair of angles at or
+        beyond :data:`ANGLE_EXACT` degrees is reduced modulo 360 first (such a float holds no fraction of
+        a degree, and the pair's difference may exceed float64); other pairs of finite values too far apart
+        for ``b - a`` interpolate as ``(1 - w) a + w b``. Finite frames give finite frames.
 
     Returns
     -------
@@ -246,6 +252,8 @@ def resample_frames(
     array([1., 5.])
     >>> resample_frames(np.array([[170.0], [-170.0]]), 10, 20, angle_columns=np.array([0]))[:, 0]  # the short arc
     array([ 170.,  180., -170.])
+    >>> resample_frames(np.array([[1e308], [-1e308]]), 10, 20)[:, 0]  # b - a is beyond float64; (a + b) / 2 is not
+    array([ 1.e+308,  0.e+000, -1.e+308])
     """
     v = np.asarray(values)
     if v.ndim != 2:
@@ -256,12 +264,18 @@ def resample_frames(
     if np.all(np.abs(w) < 1e-9):
         return v[i0].copy()
     i1 = np.minimum(i0 + 1, v.shape[0] - 1)
-    a = v[i0].astype(np.float64)
-    delta = v[i1].astype(np.float64) - a
-    if angle_columns is not None and len(angle_columns):
-        cols = np.asarray(angle_columns, dtype=np.int64)
+    a, b = v[i0].astype(np.float64), v[i1].astype(np.float64)
+    cols = np.asarray([] if angle_columns is None else angle_columns, dtype=np.int64)
+    vast = np.zeros(a.shape, bool)
+    vast[:, cols] = np.maximum(np.abs(a[:, cols]), np.abs(b[:, cols])) >= ANGLE_EXACT
+    a[vast], b[vast] = a[vast] % 360.0, b[vast] % 360.0
+    with np.errstate(over="ignore", invalid="ignore"):  # |b - a| beyond float64: the convex form below
+        delta = b - a
         delta[:, cols] = (delta[:, cols] + 180.0) % 360.0 - 180.0
-    return (a + w[:, None] * delta).astype(v.dtype)
+        out = a + w[:, None] * delta
+        far = ~np.isfinite(delta) & np.isfinite(a) & np.isfinite(b)
+    out[far] = (a * (1.0 - w[:, None]) + b * w[:, None])[far]
+    return out.astype(v.dtype)
 
 
 def rotation_columns(motion: Motion) -> np.ndarray:
