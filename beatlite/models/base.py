@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -190,7 +191,34 @@ def huber(pred: torch.Tensor, target: torch.Tensor, beta: float = 0.1) -> torch.
 
     Equals ``0.5 * d**2 / beta`` for ``|d| < beta`` and ``|d| - 0.5 * beta`` otherwise
     (``d = pred - target``), averaged over all elements.
+
+    Parameters
+    ----------
+    pred, target : float tensors of one shape
+        Any shape (the models pass (B, T, D) normalised poses); the loss has their units.
+    beta : float > 0
+        Where the loss turns from quadratic to linear, in the units of ``d``.
+
+    Returns
+    -------
+    () float tensor
+        The mean loss, differentiable in ``pred``.
+
+    Raises
+    ------
+    ValueError
+        ``beta`` is not a finite positive number (it divides: 0 gave ``nan``, a negative one a negative loss).
+
+    Examples
+    --------
+    Two errors at the default ``beta = 0.1``: ``d = 0.05`` is in the quadratic part,
+    ``0.5 * 0.05**2 / 0.1 = 0.0125``, and ``d = 1`` in the linear one, ``1 - 0.05 = 0.95``; the mean is 0.48125:
+
+    >>> round(float(huber(torch.tensor([0.05, 1.0]), torch.zeros(2))), 5)
+    0.48125
     """
+    if not math.isfinite(beta) or beta <= 0:
+        raise ValueError(f"huber: beta must be a positive number, got {beta!r}")
     return nn.functional.smooth_l1_loss(pred / beta, target / beta) * beta
 
 
