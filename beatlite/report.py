@@ -100,10 +100,29 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
 def write_markdown_and_json(stem: str | Path, markdown: str, data: object) -> tuple[Path, Path]:
     """Write ``<stem>.md`` (the text) and ``<stem>.json`` (``data``, indented, sorted keys) atomically.
 
+    Parameters
+    ----------
+    stem : str or Path
+        The files' path without suffix; the suffixes are appended, so a dot in it stays
+        (``"build/seeds_v1.2"`` gives ``seeds_v1.2.md``, as ``python -m beatlite.train seeds --out`` reads it back).
+    markdown : str
+        The text, written as given.
+    data : JSON-serialisable object
+
     Returns
     -------
     (Path, Path)
         The two files written (parent folders are created).
+
+    Examples
+    --------
+    The JSON file reads back as ``data``:
+
+    >>> import json, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     md, js = write_markdown_and_json(Path(tmp) / "runs" / "seeds_v1.2", "# Seeds", {"seeds": [1, 2]})
+    ...     md.name, js.name, json.loads(js.read_text()) == {"seeds": [1, 2]}
+    ('seeds_v1.2.md', 'seeds_v1.2.json', True)
     """
     import json
 
@@ -111,7 +130,7 @@ def write_markdown_and_json(stem: str | Path, markdown: str, data: object) -> tu
 
     stem = Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
-    md, js = stem.with_suffix(".md"), stem.with_suffix(".json")
+    md, js = stem.with_name(stem.name + ".md"), stem.with_name(stem.name + ".json")
     with atomic_write(md, "w") as fh:
         fh.write(markdown)
     with atomic_write(js, "w") as fh:
