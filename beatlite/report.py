@@ -59,12 +59,24 @@ def _cell(value: object, digits: int) -> str:
 
 
 def tables_dir() -> Path:
-    """Folder of the reproduced tables: ``<build>/tables``."""
+    """Folder of the reproduced tables: ``<build>/tables`` (:func:`beatlite.paths.build_dir`).
+
+    Examples
+    --------
+    >>> tables_dir() == build_dir() / "tables"
+    True
+    """
     return build_dir() / "tables"
 
 
 def figures_dir() -> Path:
-    """Folder of the saved figures: ``<build>/figures``."""
+    """Folder of the saved figures: ``<build>/figures`` (:func:`beatlite.paths.build_dir`).
+
+    Examples
+    --------
+    >>> figures_dir() == build_dir() / "figures"
+    True
+    """
     return build_dir() / "figures"
 
 
@@ -85,6 +97,28 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
     -------
     Path
         The file written.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is empty or has another character (a ``/`` or ``..`` could write outside the folder).
+
+    Examples
+    --------
+    A table written under a temporary build folder (``$BEATLITE_BUILD``) and read back:
+
+    >>> import os, tempfile
+    >>> from unittest import mock
+    >>> with tempfile.TemporaryDirectory() as tmp, mock.patch.dict(os.environ, {"BEATLITE_BUILD": tmp}):
+    ...     path = save_table("02_table1", markdown_table(["speaker", "minutes"], [["scott", 1.5]]), title="Table 1")
+    ...     print(path.relative_to(tmp).as_posix())
+    ...     print(path.read_text(), end="")
+    tables/02_table1.md
+    ### Table 1
+    <BLANKLINE>
+    | speaker | minutes |
+    |---|---|
+    | scott | 1.500 |
     """
     if not name or not all(c.isalnum() or c in "_-" for c in name):
         raise ValueError(f"save_table: name must be letters, digits, '_' or '-', got {name!r}")
