@@ -273,3 +273,13 @@ def test_require_and_setup(capsys):
     info = notebook.setup(seed=1)
     assert info["mode"] in paths.MODES
     assert "beatlite" in capsys.readouterr().out
+
+
+def test_require_reads_trailing_zeros_as_the_same_version(monkeypatch):
+    # 0.1.0 installed: require("0.1.0.0") raised "needs beatlite >= 0.1.0.0, installed is 0.1.0" ((0, 1, 0) < (0, 1, 0, 0))
+    monkeypatch.setattr(notebook, "__version__", "0.1.0")
+    for same_or_older in ("0.1", "0.1.0", "0.1.0.0", "0.0.9", "0"):
+        notebook.require(same_or_older)
+    for newer in ("0.1.0.1", "0.1.1", "0.2", "1"):
+        with pytest.raises(RuntimeError, match=f"beatlite >= {newer}, installed is 0.1.0"):
+            notebook.require(newer)
