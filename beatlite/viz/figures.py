@@ -285,6 +285,7 @@ def plot_beat_curves(
 
     t0, t_end = max(0.0, float(t_range[0])), float(t_range[1])
     y = np.asarray(audio)[: int(t_end * sr)]
+    onsets = np.asarray(onsets, dtype=np.float64).reshape(-1)
     with figure_style():
         fig, axes = plt.subplots(1 + len(curves), 1, figsize=(10, 1.6 + 1.5 * len(curves)), sharex=True)
         axes[0].plot(np.arange(len(y)) / sr, y, lw=0.3, color="0.5")
