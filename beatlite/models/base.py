@@ -318,6 +318,12 @@ def _reads_by_batch(windows: Any) -> bool:
     return hasattr(windows, "store") and callable(getattr(windows, "batch", None))
 
 
+def _check_key(windows: Any, key: str) -> None:
+    """``KeyError`` naming ``key`` and the keys there when the window set lacks it."""
+    if key not in windows:
+        raise KeyError(f"the windows have no {key!r} (keys: {sorted(windows.keys())})")
+
+
 def window_count(windows: Any, key: str) -> int:
     """Number of windows N of a window set (a numpy window dict, ``Windows`` or ``StoreWindows``).
 
@@ -328,8 +334,7 @@ def window_count(windows: Any, key: str) -> int:
     >>> window_count({"pose": np.zeros((5, 34, 141)), "speaker": np.zeros(5, dtype=np.int64)}, "pose")
     5
     """
-    if key not in windows:
-        raise KeyError(f"the windows have no {key!r} (keys: {sorted(windows.keys())})")
+    _check_key(windows, key)
     return len(windows) if _reads_by_batch(windows) else int(np.shape(windows[key])[0])
 
 
@@ -347,6 +352,7 @@ def window_rows(windows: Any, key: str, indices: Sequence[int] | np.ndarray) -> 
     >>> window_rows(windows, "speaker", [3, 0, 3])
     array([13, 10, 13])
     """
+    _check_key(windows, key)
     idx = np.asarray(indices, dtype=np.int64).reshape(-1)
     if _reads_by_batch(windows):
         return windows.batch(idx, keys=[key])[key]
@@ -375,6 +381,7 @@ def window_chunks(windows: Any, key: str, *, max_bytes: int = 2**28) -> Iterator
     >>> [c.shape for c in chunks], float(sum(c.sum() for c in chunks) / windows["pose"].size)
     ([(3, 2)], 2.5)
     """
+    _check_key(windows, key)
     if not _reads_by_batch(windows):
         yield np.asarray(windows[key])
         return
