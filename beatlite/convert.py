@@ -170,7 +170,36 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line: 0 on success, 2 when the input cannot be converted (one ``error:`` line)."""
+    """Command line: 0 on success, 2 when the input cannot be converted (one ``error:`` line).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after ``python -m beatlite.convert`` (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit code. On success it prints the file's frames and frame rate (for BVH -> npz also the five
+        largest bone-direction errors in degrees), or the takes written and skipped for a folder.
+
+    Examples
+    --------
+    :func:`convert` shows a conversion; here the two refusals a user meets first, as exit code 2 and one line on
+    stderr (captured to show it): a rate for a BVH, which keeps its source's, and a pair of files that are not
+    BVH and npz:
+
+    >>> import contextlib, io
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     main(["data_samples/2_scott_0_1_1.bvh.gz", "out.bvh", "--fps", "60"])
+    ...     main(["data_samples/2_scott_0_1_1.wav", "out.npz"])
+    2
+    2
+    >>> print(err.getvalue(), end="")
+    error: --fps is the rate of a written .npz; out.bvh keeps its source's rate
+    error: data_samples/2_scott_0_1_1.wav: cannot convert 2_scott_0_1_1.wav to out.npz: give .bvh -> .npz, .npz -> .bvh, or two folders
+    """
     from beatlite.io import FormatError
 
     args = _parser().parse_args(argv)

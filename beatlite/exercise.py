@@ -63,6 +63,21 @@ def resolve(student_fn: Callable[..., Any], reference_fn: Callable[..., Any]) ->
 
     When the student's function raises ``NotImplementedError`` a one-line
     message says so and the reference result is returned instead.
+
+    Examples
+    --------
+    A stub not filled in yet gives the reference's answer (with the message); once done, its own:
+
+    >>> def mean_speed(x):
+    ...     raise NotImplementedError
+    >>> speed = resolve(mean_speed, lambda x: sum(x) / len(x))
+    >>> speed([1.0, 2.0, 6.0])
+    [exercise] mean_speed not done yet: using the reference implementation
+    3.0
+    >>> def mean_speed(x):
+    ...     return max(x)  # a wrong answer is the student's to see: resolve does not check it
+    >>> resolve(mean_speed, lambda x: sum(x) / len(x))([1.0, 2.0, 6.0])
+    6.0
     """
 
     def call(*args: Any, **kwargs: Any) -> Any:

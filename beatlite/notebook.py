@@ -38,10 +38,28 @@ def defined_again(old: Any, new: Any) -> bool:
 
 
 def require(version: str) -> None:
-    """Raise ``RuntimeError`` when the installed beatlite is older than ``version`` (e.g. ``"0.1"``)."""
+    """Raise ``RuntimeError`` when the installed beatlite is older than ``version`` (e.g. ``"0.1"``).
+
+    Versions compare by their numeric dot-separated parts, trailing zeros ignored (``"0.1"`` is ``"0.1.0"``).
+
+    Examples
+    --------
+    The installed version itself and every older one pass; a newer one is refused, naming both:
+
+    >>> from beatlite import __version__
+    >>> require(__version__), require(__version__ + ".0"), require("0.0.1")
+    (None, None, None)
+    >>> require("99.0")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    RuntimeError: these notebooks need beatlite >= 99.0, installed is ...
+    """
 
     def parse(v: str) -> tuple[int, ...]:
-        return tuple(int(p) for p in v.split(".") if p.isdigit())
+        parts = [int(p) for p in v.split(".") if p.isdigit()]
+        while parts and parts[-1] == 0:  # 0.1.0 == 0.1: the shorter tuple would compare as older
+            parts.pop()
+        return tuple(parts)
 
     if parse(__version__) < parse(version):
         raise RuntimeError(

@@ -24,34 +24,96 @@ MODES = ("lecture", "full")
 
 
 def repo_root() -> Path:
-    """The repository root (the folder that holds ``beatlite/``)."""
+    """The repository root (the folder that holds ``beatlite/``).
+
+    Examples
+    --------
+    >>> (repo_root() / "beatlite" / "paths.py").is_file()
+    True
+    """
     return Path(__file__).resolve().parent.parent
 
 
 def data_dir() -> Path:
-    """The BEAT-format data folder: ``$BEATLITE_DATA`` or ``<repo>/data_samples``."""
+    """The BEAT-format data folder: ``$BEATLITE_DATA`` (``~`` expanded) or ``<repo>/data_samples``.
+
+    Examples
+    --------
+    The variable is read at every call, so a notebook can switch corpora without restarting:
+
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_DATA": "/data/beat_english_v0.2.1"}):
+    ...     data_dir().as_posix()
+    '/data/beat_english_v0.2.1'
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_DATA": ""}):
+    ...     data_dir() == repo_root() / "data_samples"
+    True
+    """
     env = os.environ.get("BEATLITE_DATA")
     return Path(env).expanduser() if env else repo_root() / "data_samples"
 
 
 def checkpoints_dir() -> Path:
-    """Folder of the shipped checkpoints: ``<repo>/checkpoints``."""
+    """Folder of the shipped checkpoints: ``<repo>/checkpoints`` (no variable moves it).
+
+    Examples
+    --------
+    >>> checkpoints_dir().relative_to(repo_root()).as_posix()
+    'checkpoints'
+    """
     return repo_root() / "checkpoints"
 
 
 def build_dir() -> Path:
-    """Output folder of the main job: ``$BEATLITE_BUILD`` or ``<repo>/build``."""
+    """Output folder of the main job: ``$BEATLITE_BUILD`` (``~`` expanded) or ``<repo>/build``.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_BUILD": "/scratch/run1"}):
+    ...     build_dir().as_posix(), cache_dir().as_posix()
+    ('/scratch/run1', '/scratch/run1/cache')
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_BUILD": ""}):
+    ...     build_dir().relative_to(repo_root()).as_posix()
+    'build'
+    """
     env = os.environ.get("BEATLITE_BUILD")
     return Path(env).expanduser() if env else repo_root() / "build"
 
 
 def cache_dir() -> Path:
-    """Folder for derived caches (the index cache, the window stores): ``<build>/cache``."""
+    """Folder for derived caches (the index cache, the window stores): ``<build>/cache``.
+
+    Examples
+    --------
+    >>> cache_dir() == build_dir() / "cache"
+    True
+    """
     return build_dir() / "cache"
 
 
 def mode() -> str:
-    """``"lecture"`` (load checkpoints, the default) or ``"full"`` (train live) from ``$BEATLITE_MODE``."""
+    """``"lecture"`` (load checkpoints, the default) or ``"full"`` (train live) from ``$BEATLITE_MODE``.
+
+    Case and surrounding spaces are ignored; an empty value means ``"lecture"``.
+
+    Raises
+    ------
+    ValueError
+        Any other value.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_MODE": " Full "}):
+    ...     mode()
+    'full'
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_MODE": "train"}):
+    ...     mode()
+    Traceback (most recent call last):
+    ...
+    ValueError: BEATLITE_MODE must be one of ('lecture', 'full'), got 'train'
+    """
     value = os.environ.get("BEATLITE_MODE", "lecture").strip().lower() or "lecture"
     if value not in MODES:
         raise ValueError(f"BEATLITE_MODE must be one of {MODES}, got {value!r}")
@@ -63,6 +125,23 @@ def n_threads() -> int:
 
     One thread is the safe default on a shared 2-core machine: two OpenMP
     threads next to any other busy process spin-wait and run 10x slower.
+
+    Raises
+    ------
+    ValueError
+        The value is not an integer >= 1.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_THREADS": "4"}):
+    ...     n_threads()
+    4
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_THREADS": "0"}):
+    ...     n_threads()
+    Traceback (most recent call last):
+    ...
+    ValueError: BEATLITE_THREADS must be a positive integer, got '0'
     """
     value = os.environ.get("BEATLITE_THREADS", "1")
     try:
@@ -79,6 +158,16 @@ def on_data_samples() -> bool:
 
     Notebooks assert the effects planted in ``data_samples/`` only when this is true; on any other
     BEAT-format folder they report the same quantities without asserting them.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_DATA": str(repo_root() / "data_samples")}):
+    ...     on_data_samples()
+    True
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_DATA": "/data/beat_english_v0.2.1"}):
+    ...     on_data_samples()
+    False
     """
     return data_dir().resolve() == (repo_root() / "data_samples").resolve()
 
@@ -113,7 +202,16 @@ def shareable(path: str | os.PathLike[str]) -> str:
 
 def code_revision() -> str:
     """The repository's commit, for the records the benchmarks write: ``git rev-parse --short HEAD``, with
-    ``+changes`` when tracked files differ from it, or ``"unknown"`` outside a git checkout."""
+    ``+changes`` when tracked files differ from it, or ``"unknown"`` outside a git checkout.
+
+    Examples
+    --------
+    The value differs from checkout to checkout; its form does not:
+
+    >>> import re
+    >>> re.fullmatch(r"[0-9a-f]{4,40}([+]changes)?|unknown", code_revision()) is not None
+    True
+    """
     import subprocess
 
     def git(*args: str) -> str:

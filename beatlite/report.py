@@ -59,12 +59,24 @@ def _cell(value: object, digits: int) -> str:
 
 
 def tables_dir() -> Path:
-    """Folder of the reproduced tables: ``<build>/tables``."""
+    """Folder of the reproduced tables: ``<build>/tables`` (:func:`beatlite.paths.build_dir`).
+
+    Examples
+    --------
+    >>> tables_dir() == build_dir() / "tables"
+    True
+    """
     return build_dir() / "tables"
 
 
 def figures_dir() -> Path:
-    """Folder of the saved figures: ``<build>/figures``."""
+    """Folder of the saved figures: ``<build>/figures`` (:func:`beatlite.paths.build_dir`).
+
+    Examples
+    --------
+    >>> figures_dir() == build_dir() / "figures"
+    True
+    """
     return build_dir() / "figures"
 
 
@@ -85,6 +97,28 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
     -------
     Path
         The file written.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is empty or has another character (a ``/`` or ``..`` could write outside the folder).
+
+    Examples
+    --------
+    A table written under a temporary build folder (``$BEATLITE_BUILD``) and read back:
+
+    >>> import os, tempfile
+    >>> from unittest import mock
+    >>> with tempfile.TemporaryDirectory() as tmp, mock.patch.dict(os.environ, {"BEATLITE_BUILD": tmp}):
+    ...     path = save_table("02_table1", markdown_table(["speaker", "minutes"], [["scott", 1.5]]), title="Table 1")
+    ...     print(path.relative_to(tmp).as_posix())
+    ...     print(path.read_text(), end="")
+    tables/02_table1.md
+    ### Table 1
+    <BLANKLINE>
+    | speaker | minutes |
+    |---|---|
+    | scott | 1.500 |
     """
     if not name or not all(c.isalnum() or c in "_-" for c in name):
         raise ValueError(f"save_table: name must be letters, digits, '_' or '-', got {name!r}")
@@ -100,10 +134,29 @@ def save_table(name: str, markdown: str, *, title: str | None = None) -> Path:
 def write_markdown_and_json(stem: str | Path, markdown: str, data: object) -> tuple[Path, Path]:
     """Write ``<stem>.md`` (the text) and ``<stem>.json`` (``data``, indented, sorted keys) atomically.
 
+    Parameters
+    ----------
+    stem : str or Path
+        The files' path without suffix; the suffixes are appended, so a dot in it stays
+        (``"build/seeds_v1.2"`` gives ``seeds_v1.2.md``, as ``python -m beatlite.train seeds --out`` reads it back).
+    markdown : str
+        The text, written as given.
+    data : JSON-serialisable object
+
     Returns
     -------
     (Path, Path)
         The two files written (parent folders are created).
+
+    Examples
+    --------
+    The JSON file reads back as ``data``:
+
+    >>> import json, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     md, js = write_markdown_and_json(Path(tmp) / "runs" / "seeds_v1.2", "# Seeds", {"seeds": [1, 2]})
+    ...     md.name, js.name, json.loads(js.read_text()) == {"seeds": [1, 2]}
+    ('seeds_v1.2.md', 'seeds_v1.2.json', True)
     """
     import json
 
@@ -111,7 +164,7 @@ def write_markdown_and_json(stem: str | Path, markdown: str, data: object) -> tu
 
     stem = Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
-    md, js = stem.with_suffix(".md"), stem.with_suffix(".json")
+    md, js = stem.with_name(stem.name + ".md"), stem.with_name(stem.name + ".json")
     with atomic_write(md, "w") as fh:
         fh.write(markdown)
     with atomic_write(js, "w") as fh:

@@ -101,6 +101,13 @@ def test_huber_matches_hand_values():
     assert float(huber(torch.tensor([1.0]), torch.tensor([0.0]))) == pytest.approx(0.95)
 
 
+@pytest.mark.parametrize("beta", [0.0, -0.1, float("nan"), float("inf")])
+def test_huber_refuses_a_beta_that_is_not_a_positive_number(beta):
+    # beta = 0 gave nan (0/0), beta = -0.1 gave the loss -0.95 for |d| = 1, beta = inf gave nan
+    with pytest.raises(ValueError, match="beta must be a positive number"):
+        huber(torch.tensor([1.0]), torch.tensor([0.0]), beta=beta)
+
+
 def test_reconstruction_loss_zero_on_target_and_semantic_weighting(batch):
     model = tiny()
     assert float(model.reconstruction_loss(batch, batch["pose"].clone())) == 0.0

@@ -40,6 +40,23 @@ def test_window_helpers_read_a_store_as_the_windows_in_memory(small_store_window
     assert len(list(window_chunks(reference, "dirvec"))) == 1
 
 
+def test_window_helpers_name_a_missing_key_and_the_keys_there() -> None:
+    """A window dict without the key: window_count named it and listed the keys, window_rows and window_chunks
+    raised a bare KeyError('dirvec')."""
+    import numpy as np
+
+    from beatlite.models.base import window_chunks, window_count, window_rows
+
+    windows = {"pose": np.zeros((3, 34, 141)), "speaker": np.zeros(3, dtype=np.int64)}
+    message = r"no 'dirvec' \(keys: \['pose', 'speaker'\]\)"
+    with pytest.raises(KeyError, match=message):
+        window_count(windows, "dirvec")
+    with pytest.raises(KeyError, match=message):
+        window_rows(windows, "dirvec", [0])
+    with pytest.raises(KeyError, match=message):
+        next(window_chunks(windows, "dirvec"))
+
+
 def test_a_store_view_without_a_key_the_losses_read_is_refused_by_name(small_store_windows: tuple) -> None:
     """CaMN's loss reads ``semantic``, which its forward pass (``keys_for``) does not: ``batch_keys`` has it,
     and a view of ``keys_for`` alone is refused before any step, naming the key."""

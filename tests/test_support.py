@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 
@@ -48,6 +49,16 @@ def test_save_table_is_atomic_and_validated(monkeypatch, tmp_path):
         os.umask(old)
     with pytest.raises(ValueError, match="name"):
         report.save_table("../evil", "x")
+
+
+def test_write_markdown_and_json_appends_the_suffixes_to_a_stem_with_a_dot(tmp_path):
+    # `beatlite.train seeds --only X --out STEM` reads back f"{STEM}.json"; with_suffix wrote seeds_v1.md and
+    # seeds_v1.json for the stem seeds_v1.2, so the table it merges with was never found
+    md, js = report.write_markdown_and_json(tmp_path / "seeds_v1.2", "# title\n", {"b": 1, "a": [0.5]})
+    assert (md, js) == (tmp_path / "seeds_v1.2.md", tmp_path / "seeds_v1.2.json")
+    assert md.read_text() == "# title\n"
+    assert json.loads(js.read_text()) == {"a": [0.5], "b": 1}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["seeds_v1.2.json", "seeds_v1.2.md"]
 
 
 def _square(x):
@@ -262,3 +273,13 @@ def test_require_and_setup(capsys):
     info = notebook.setup(seed=1)
     assert info["mode"] in paths.MODES
     assert "beatlite" in capsys.readouterr().out
+
+
+def test_require_reads_trailing_zeros_as_the_same_version(monkeypatch):
+    # 0.1.0 installed: require("0.1.0.0") raised "needs beatlite >= 0.1.0.0, installed is 0.1.0" ((0, 1, 0) < (0, 1, 0, 0))
+    monkeypatch.setattr(notebook, "__version__", "0.1.0")
+    for same_or_older in ("0.1", "0.1.0", "0.1.0.0", "0.0.9", "0"):
+        notebook.require(same_or_older)
+    for newer in ("0.1.0.1", "0.1.1", "0.2", "1"):
+        with pytest.raises(RuntimeError, match=f"beatlite >= {newer}, installed is 0.1.0"):
+            notebook.require(newer)

@@ -802,6 +802,21 @@ def test_annotation_legend_gives_every_gesture_type_its_own_colour():
     plt.close("all")
 
 
+def test_beat_curves_take_onsets_and_beats_as_lists():
+    """Times as plain lists, as elsewhere in the viz API: ``onsets`` raised "'>=' not supported between instances
+    of 'list' and 'float'". Only the onsets inside ``t_range`` draw a line, on every panel."""
+    from beatlite.viz import figures
+
+    speed = np.abs((np.arange(90) / 15) % 1.0 - 0.5) * 80  # 6 s at 15 fps
+    curves = {"speed": (speed, [0.5, 1.5], "cm/s")}
+    fig = figures.plot_beat_curves(np.zeros(6000), 1000, [1.0, 2.0, 7.0], curves, 15, t_range=(0.0, 6.0))
+    for ax in fig.axes:
+        onset_lines = [line for line in ax.lines if list(line.get_xdata()) in ([1.0, 1.0], [2.0, 2.0])]
+        assert len(onset_lines) == 2
+        assert not [line for line in ax.lines if list(line.get_xdata()) == [7.0, 7.0]]  # outside t_range
+    plt.close(fig)
+
+
 def _slide_animation(**kwargs):
     sr = 1000
     audio = np.sin(2 * np.pi * 5 * np.arange(2 * sr) / sr)

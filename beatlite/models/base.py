@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -141,12 +142,39 @@ def config_from_preset(
 ) -> Any:
     """Build ``config_class(**presets[preset], **overrides, preset=preset)`` with checked names.
 
+    Parameters
+    ----------
+    config_class : dataclass type with a ``preset`` field
+        A :class:`ModelConfig` subclass.
+    presets : mapping
+        Preset name -> ``{field: value}`` (what :func:`beatlite.models.presets` returns).
+    preset : str
+        The preset to start from (recorded in the config's ``preset`` field).
+    **overrides
+        Fields set on top of the preset.
+
     Raises
     ------
     ValueError
         Unknown preset name.
     TypeError
         An override that is not a field of ``config_class``.
+
+    Examples
+    --------
+    An override wins over the preset, which wins over the dataclass default:
+
+    >>> @dataclasses.dataclass
+    ... class Config(ModelConfig):
+    ...     hidden: int = 256
+    ...     dropout: float = 0.1
+    >>> table = {"paper": {}, "tiny": {"hidden": 32}}
+    >>> config_from_preset(Config, table, "tiny", dropout=0.0)
+    Config(preset='tiny', hidden=32, dropout=0.0)
+    >>> config_from_preset(Config, table, "tiny", hiden=8)
+    Traceback (most recent call last):
+    ...
+    TypeError: Config: unknown option(s) ['hiden']; known: ['dropout', 'hidden', 'preset']
     """
     if preset not in presets:
         raise ValueError(f"{config_class.__name__}: preset must be one of {sorted(presets)}, got {preset!r}")
@@ -173,6 +201,18 @@ def seed_input(pose: torch.Tensor, n_pre: int = N_PRE) -> torch.Tensor:
     (B, T, D + 1) float tensor
         Frames ``< n_pre`` hold ``pose`` and an indicator bit 1 in the last channel;
         later frames are all zero.
+
+    Examples
+    --------
+    Four frames of a 2-channel pose with two seed frames: the first two rows keep the pose and gain the bit 1,
+    the last two are zero:
+
+    >>> pose = torch.arange(1.0, 9.0).reshape(1, 4, 2)
+    >>> seed_input(pose, n_pre=2)[0]
+    tensor([[1., 2., 1.],
+            [3., 4., 1.],
+            [0., 0., 0.],
+            [0., 0., 0.]])
     """
     if pose.ndim != 3:
         raise ValueError(f"pose must be (B, T, D), got shape {tuple(pose.shape)}")
@@ -190,7 +230,34 @@ def huber(pred: torch.Tensor, target: torch.Tensor, beta: float = 0.1) -> torch.
 
     Equals ``0.5 * d**2 / beta`` for ``|d| < beta`` and ``|d| - 0.5 * beta`` otherwise
     (``d = pred - target``), averaged over all elements.
+
+    Parameters
+    ----------
+    pred, target : float tensors of one shape
+        Any shape (the models pass (B, T, D) normalised poses); the loss has their units.
+    beta : float > 0
+        Where the loss turns from quadratic to linear, in the units of ``d``.
+
+    Returns
+    -------
+    () float tensor
+        The mean loss, differentiable in ``pred``.
+
+    Raises
+    ------
+    ValueError
+        ``beta`` is not a finite positive number (it divides: 0 gave ``nan``, a negative one a negative loss).
+
+    Examples
+    --------
+    Two errors at the default ``beta = 0.1``: ``d = 0.05`` is in the quadratic part,
+    ``0.5 * 0.05**2 / 0.1 = 0.0125``, and ``d = 1`` in the linear one, ``1 - 0.05 = 0.95``; the mean is 0.48125:
+
+    >>> round(float(huber(torch.tensor([0.05, 1.0]), torch.zeros(2))), 5)
+    0.48125
     """
+    if not math.isfinite(beta) or beta <= 0:
+        raise ValueError(f"huber: beta must be a positive number, got {beta!r}")
     return nn.functional.smooth_l1_loss(pred / beta, target / beta) * beta
 
 
@@ -251,10 +318,23 @@ def _reads_by_batch(windows: Any) -> bool:
     return hasattr(windows, "store") and callable(getattr(windows, "batch", None))
 
 
-def window_count(windows: Any, key: str) -> int:
-    """Number of windows N of a window set (a numpy window dict, ``Windows`` or ``StoreWindows``)."""
+def _check_key(windows: Any, key: str) -> None:
+    """``KeyError`` naming ``key`` and the keys there when the window set lacks it."""
     if key not in windows:
         raise KeyError(f"the windows have no {key!r} (keys: {sorted(windows.keys())})")
+
+
+def window_count(windows: Any, key: str) -> int:
+    """Number of windows N of a window set (a numpy window dict, ``Windows`` or ``StoreWindows``).
+
+    Examples
+    --------
+    A window dict holds N windows along the first axis of every key (here 5 windows of T = 34 frames):
+
+    >>> window_count({"pose": np.zeros((5, 34, 141)), "speaker": np.zeros(5, dtype=np.int64)}, "pose")
+    5
+    """
+    _check_key(windows, key)
     return len(windows) if _reads_by_batch(windows) else int(np.shape(windows[key])[0])
 
 
@@ -265,7 +345,14 @@ def window_rows(windows: Any, key: str, indices: Sequence[int] | np.ndarray) -> 
     -------
     (len(indices), ...) ndarray
         In the order of ``indices`` (repeats allowed).
+
+    Examples
+    --------
+    >>> windows = {"speaker": np.array([10, 11, 12, 13])}
+    >>> window_rows(windows, "speaker", [3, 0, 3])
+    array([13, 10, 13])
     """
+    _check_key(windows, key)
     idx = np.asarray(indices, dtype=np.int64).reshape(-1)
     if _reads_by_batch(windows):
         return windows.batch(idx, keys=[key])[key]
@@ -278,7 +365,23 @@ def window_chunks(windows: Any, key: str, *, max_bytes: int = 2**28) -> Iterator
     A numpy window dict (or ``Windows``) gives its whole array as one chunk; a window store is read
     chunk by chunk, so statistics over a corpus larger than memory stream (one chunk when it fits in
     ``max_bytes``: then a statistic equals the in-memory one bit for bit).
+
+    Yields
+    ------
+    (n, ...) ndarray
+        Consecutive windows; the ``n`` of all chunks sum to :func:`window_count`.
+
+    Examples
+    --------
+    A mean over chunks, weighted by their lengths, is the mean of the whole set (here 3 windows in memory,
+    one chunk):
+
+    >>> windows = {"pose": np.arange(6.0).reshape(3, 2)}
+    >>> chunks = list(window_chunks(windows, "pose"))
+    >>> [c.shape for c in chunks], float(sum(c.sum() for c in chunks) / windows["pose"].size)
+    ([(3, 2)], 2.5)
     """
+    _check_key(windows, key)
     if not _reads_by_batch(windows):
         yield np.asarray(windows[key])
         return
@@ -300,6 +403,23 @@ class GestureModel(nn.Module):
     ----------
     config : ModelConfig subclass instance
         The model's configuration (stored in checkpoints via :meth:`to_config`).
+
+    Examples
+    --------
+    The smallest subclass: a model that echoes its target. :meth:`generate` gives it only the ``n_pre`` seed
+    frames (4), so every later frame of what it returns is zero, whatever the batch held:
+
+    >>> class Echo(GestureModel):
+    ...     name = "echo"
+    ...     input_keys = ("pose",)
+    ...     def forward(self, batch):
+    ...         return {"pose": batch["pose"] * 1.0}
+    >>> model = Echo(ModelConfig())
+    >>> out = model.generate({"pose": torch.ones(2, 34, 141)})
+    >>> tuple(out.shape), float(out[:, : model.n_pre].mean()), float(out[:, model.n_pre :].abs().max())
+    ((2, 34, 141), 1.0, 0.0)
+    >>> model.to_config(), model.batch_keys(model.config), model.trainable
+    ({'name': 'echo', 'preset': 'tiny'}, ('pose',), False)
     """
 
     name: ClassVar[str] = "base"

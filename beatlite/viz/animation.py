@@ -168,6 +168,31 @@ def save_animation(anim: Any, path: str | Path, *, fps: float, dpi: float | None
     -------
     Path
         ``path``.
+
+    Raises
+    ------
+    ValueError
+        Another suffix.
+    RuntimeError
+        ``.mp4`` without ffmpeg on ``PATH`` (:func:`ffmpeg_available`).
+    beatlite.viz.check.FigureError
+        Under ``BEATLITE_FIGURE_CHECK=raise``, a figure with text under 8 px at ``dpi`` (nothing is written).
+
+    Examples
+    --------
+    Three animation frames of a moving clip make a GIF of three frames, 960 px wide:
+
+    >>> import tempfile
+    >>> from PIL import Image
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up
+    >>> clip = np.repeat(pose[None], 30, axis=0)
+    >>> clip[:, 3, 1] += 2.0 * np.arange(30)  # the right hand rises 2 cm per frame
+    >>> anim = animate_skeletons(clip, parents, fps=30, max_frames=3)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     gif = Image.open(save_animation(anim, Path(tmp) / "clip.gif", fps=anim.fps))
+    ...     gif.n_frames, gif.size[0]
+    (3, 960)
     """
     path = Path(path)
     fps = check_fps(fps)
@@ -217,6 +242,15 @@ class Timeline:
         Audio beat / onset times, seconds (full-height lines).
     motion_beats : (M,) float array, optional
         Motion beat times, seconds (short ticks at the bottom).
+
+    Examples
+    --------
+    >>> Timeline(audio=np.zeros(32000), sr=16000).duration  # seconds
+    2.0
+    >>> Timeline(sr=16000).checked()
+    Traceback (most recent call last):
+    ...
+    ValueError: timeline: give audio, audio_beats or motion_beats
     """
 
     audio: Any = None
@@ -261,6 +295,16 @@ class FacePanel:
         Show only the ``top`` blendshapes that vary most over the clip (largest
         standard deviation), in their original order, so that every label is
         readable; ``None`` shows all K.
+
+    Examples
+    --------
+    :func:`animate_skeletons` draws what :meth:`checked` keeps: with ``top=1``, the one blendshape that moves:
+
+    >>> weights = np.zeros((60, 3))
+    >>> weights[:, 1] = np.linspace(0.0, 1.0, 60)
+    >>> shown = FacePanel(weights, ["eyeBlinkLeft", "jawOpen", "mouthSmileLeft"], fps=60, top=1).checked(15)
+    >>> shown.names, shown.weights.shape, shown.fps
+    (['jawOpen'], (60, 1), 60.0)
     """
 
     weights: Any
@@ -517,6 +561,22 @@ def animate_skeletons(
     -------
     SkeletonAnimation
         A ``FuncAnimation``; ends a notebook cell -> inline player; ``.save_as("x.gif")``.
+
+    Examples
+    --------
+    One second at 30 fps played at 15 fps is 15 animation frames, 1/15 s apart; the shorter second panel holds
+    its last frame. A frame drawn as an image is 960 px wide:
+
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up
+    >>> clip = np.repeat(pose[None], 30, axis=0)
+    >>> clip[:, 3, 1] += 2.0 * np.arange(30)  # the right hand rises 2 cm per frame
+    >>> anim = animate_skeletons({"ground truth": clip, "CaMN": clip[:20]}, parents, fps=30,
+    ...                          timeline=Timeline(audio=np.zeros(16000), sr=16000, audio_beats=[0.5]))
+    >>> anim.fps, len(anim.times), np.round(anim.times[:3], 4).tolist()
+    (15.0, 15, [0.0, 0.0667, 0.1333])
+    >>> [ax.get_title() for ax in anim.figure.axes[:2]], anim.frame_image(-1).shape[1:]
+    (['ground truth', 'CaMN'], (960, 3))
     """
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_agg import FigureCanvasAgg

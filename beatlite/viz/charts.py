@@ -95,6 +95,23 @@ def plot_training_curves(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Three epochs of a loss ``1 / (epoch + 1)``; the run logged no ``val_score``, so the second panel says so
+    instead of staying empty:
+
+    >>> import matplotlib.pyplot as plt
+    >>> history = [{"epoch": e, "train": {"rec": 1 / (e + 1)}, "val": {"rec": 1.2 / (e + 1)}} for e in range(3)]
+    >>> fig = plot_training_curves(history, {"reconstruction loss (Huber)": {"train": "train.rec",
+    ...                                                                      "validation": "val.rec"},
+    ...                                      "validation FGD": {"validation takes": "val_score"}})
+    >>> train = fig.axes[0].get_lines()[0]
+    >>> train.get_label(), np.round(train.get_ydata(), 3).tolist()
+    ('train', [1.0, 0.5, 0.333])
+    >>> [t.get_text() for t in fig.axes[1].texts]
+    ['not logged in this run']
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 
@@ -170,6 +187,25 @@ def plot_scores(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        No score, or one that is not finite or is negative.
+
+    Examples
+    --------
+    The mean pose's 25 is more than 3 times the median 4 of the positive scores (3, 4, 25), so its bar is cut
+    at ``1.12 * 4`` (the longest bar that fits is 4) and its value written after it:
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig = plot_scores({"CaMN": 3.0, "HA2G": 4.0, "mean pose": 25.0}, "FGD")
+    >>> ax = fig.axes[0]
+    >>> [round(float(bar.get_width()), 2) for bar in ax.patches], [t.get_text() for t in ax.texts]
+    ([3.0, 4.0, 4.48], [' 3', ' 4', ' 25 (cut)'])
+    >>> ax.get_xlabel()
+    'FGD (lower is better)'
+    >>> plt.close(fig)
     """
     labels = list(scores)
     values = _check_scores(scores)
@@ -250,6 +286,23 @@ def plot_score_scatter(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        No system has two finite scores.
+
+    Examples
+    --------
+    A system without a BC is left out; the other two are one labelled point each, at (FGD, BC):
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig = plot_score_scatter({"CaMN": 3.0, "HA2G": 4.0, "Seq2Seq": 9.0}, {"CaMN": 0.7, "HA2G": 0.6},
+    ...                          "FGD (lower is better)", "BC (higher is better)")
+    >>> ax = fig.axes[0]
+    >>> [c.get_offsets().tolist()[0] for c in ax.collections], [t.get_text() for t in ax.texts]
+    ([[3.0, 0.7], [4.0, 0.6]], ['CaMN', 'HA2G'])
+    >>> plt.close(fig)
     """
     keep = [k for k in x if _finite_pair(x.get(k), y.get(k))]
     if not keep:
@@ -533,6 +586,23 @@ def plot_waveform(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Two seconds of a 5 Hz tone, amplitude 0.25 then 0.5, shown over its first second: only that second's
+    samples set the scale (from ``-1.05 * 0.25`` up to ``1.45 * 0.25``, the top margin holding the words), and
+    only the word inside it is written:
+
+    >>> import matplotlib.pyplot as plt
+    >>> sr = 1000
+    >>> t = np.arange(2 * sr) / sr
+    >>> audio = np.where(t < 1, 0.25, 0.5) * np.sin(2 * np.pi * 5 * t)
+    >>> words = ([0.2, 1.1], [0.6, 1.5], ["hello", "world"])
+    >>> fig = plot_waveform(audio, sr, words=words, onsets={"audio onsets": [0.2, 1.1]}, xlim=(0.0, 1.0))
+    >>> ax = fig.axes[0]
+    >>> [round(float(v), 4) for v in ax.get_ylim()], [t.get_text() for t in ax.texts]
+    ([-0.2625, 0.3625], ['hello'])
+    >>> plt.close(fig)
     """
     from beatlite.viz._inputs import check_fps, check_words
 

@@ -87,7 +87,25 @@ class FigureProblem:
 
 
 def check_mode() -> str:
-    """``BEATLITE_FIGURE_CHECK`` (``warn`` when unset): ``warn``, ``raise`` or ``off``."""
+    """``BEATLITE_FIGURE_CHECK`` (``warn`` when unset): ``warn``, ``raise`` or ``off``.
+
+    Case and surrounding spaces are ignored; read at every call.
+
+    Raises
+    ------
+    ValueError
+        Any other value.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_FIGURE_CHECK": " Raise "}):
+    ...     check_mode()
+    'raise'
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_FIGURE_CHECK": ""}):
+    ...     check_mode()
+    'warn'
+    """
     mode = os.environ.get("BEATLITE_FIGURE_CHECK", "warn").strip().lower() or "warn"
     if mode not in CHECK_MODES:
         raise ValueError(f"BEATLITE_FIGURE_CHECK must be one of {CHECK_MODES}, got {mode!r}")
@@ -121,6 +139,23 @@ def check_figure(
     -------
     list of FigureProblem
         Empty when the figure passes; in figure order (axes by axes).
+
+    Examples
+    --------
+    A font of ``s`` points is ``s * dpi / 72`` pixels high: at 150 dpi, 4 pt is 8.3 px and passes the 8 px
+    limit, 3.5 pt is 7.3 px and does not:
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots()
+    >>> _ = ax.plot([0, 1], [0, 1])
+    >>> _ = ax.tick_params(labelsize=9)
+    >>> _ = ax.set_xlabel("time (s)", fontsize=4)
+    >>> check_figure(fig, dpi=150)
+    []
+    >>> _ = ax.set_xlabel("time (s)", fontsize=3.5)
+    >>> [str(p) for p in check_figure(fig, dpi=150)]
+    ["small text: 'time (s)' is 7.3 px high at 150 dpi (under 8 px)"]
+    >>> plt.close(fig)
     """
     import matplotlib as mpl
     from matplotlib.figure import Figure
@@ -150,6 +185,29 @@ def report_problems(problems: Iterable[FigureProblem], what: str, mode: str | No
     """Warn (:class:`FigureWarning`) or raise (:class:`FigureError`) about ``problems``, as ``mode`` says.
 
     ``mode`` defaults to :func:`check_mode`; nothing happens when there is no problem or the mode is ``off``.
+
+    Parameters
+    ----------
+    problems : iterable of FigureProblem
+        What :func:`check_figure` found.
+    what : str
+        The figure, for the message (e.g. ``"save_figure('fig2')"``).
+    mode : {"warn", "raise", "off"}, optional
+
+    Examples
+    --------
+    >>> problem = FigureProblem("empty panel", "axes 1 of 1 shows no data")
+    >>> report_problems([problem], "fig2", mode="raise")
+    Traceback (most recent call last):
+    ...
+    beatlite.viz.check.FigureError: fig2: 1 figure problem(s):
+      empty panel: axes 1 of 1 shows no data
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     report_problems([problem], "fig2", mode="warn")
+    ...     report_problems([problem], "fig2", mode="off")
+    >>> [w.category.__name__ for w in caught]
+    ['FigureWarning']
     """
     problems = list(problems)
     mode = check_mode() if mode is None else mode

@@ -48,11 +48,38 @@ def plot_corpus_overview(index: Any, *, out: str | Path | None = None):
     Parameters
     ----------
     index : TakeIndex
+        :func:`beatlite.data.index.index_folder`'s table; its usable takes are counted (durations in seconds,
+        drawn in minutes).
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Three takes made by hand (what :func:`~beatlite.data.index.index_folder` reads from a folder): speaker 2 has
+    2 minutes of train and 1 of validation, speaker 4 half a minute of test, so the stacked bars read
+    (train, val, test) = (2, 0) (0, 1) and (0, 0.5) minutes for (scott, lawrence):
+
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.data.index import TakeIndex, TakeRecord
+    >>> def take(stem, speaker_id, split, emotion, seconds):
+    ...     files = {"motion": Path(stem + ".bvh"), "audio": Path(stem + ".wav")}
+    ...     return TakeRecord(stem, speaker_id=speaker_id, speaker=stem.split("_")[1], split=split,
+    ...                       emotion_name=emotion, files=files, durations={"motion": seconds, "audio": seconds})
+    >>> index = TakeIndex([take("2_scott_0_1_1", 2, "train", "neutral", 120.0),
+    ...                    take("2_scott_0_2_2", 2, "val", "neutral", 60.0),
+    ...                    take("4_lawrence_0_65_65", 4, "test", "happiness", 30.0)])
+    >>> fig = plot_corpus_overview(index)
+    >>> by_split, by_emotion = fig.axes
+    >>> [t.get_text() for t in by_split.get_xticklabels()], [float(b.get_height()) for b in by_split.patches]
+    (['2_scott', '4_lawrence'], [2.0, 0.0, 1.0, 0.0, 0.0, 0.5])
+    >>> [float(b.get_width()) for b in by_emotion.patches][:2]  # neutral, happiness
+    [3.0, 0.5]
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 
@@ -93,16 +120,33 @@ def plot_transcript(
     Parameters
     ----------
     audio : (N,) float, [-1, 1]
+        Mono waveform.
     sr : int
+        Sample rate of ``audio``, Hz.
     tiers : mapping tier name -> intervals with ``start``, ``end`` (s) and ``text``
         :func:`beatlite.io.read_textgrid`'s result; ``words`` and ``phones`` are drawn.
     t_end : float
-        Seconds shown.
+        Seconds shown, from 0.
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Only the intervals with text are shaded and written (the pause between the words is not):
+
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.io.textgrid import Interval
+    >>> tiers = {"words": [Interval(0.0, 0.5, "hello"), Interval(0.5, 0.7, ""), Interval(0.7, 1.2, "world")],
+    ...          "phones": [Interval(0.0, 0.2, "HH"), Interval(0.2, 0.5, "AH")]}
+    >>> fig = plot_transcript(np.zeros(2 * 16000), 16000, tiers, t_end=2.0)
+    >>> [[t.get_text() for t in ax.texts] for ax in fig.axes[1:]], [float(x) for x in fig.axes[2].get_xlim()]
+    ([['hello', 'world'], ['HH', 'AH']], [0.0, 2.0])
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 
@@ -155,10 +199,29 @@ def plot_annotations(
     fps, duration : float
         Frame rate and take length (s).
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    A beat gesture scoring 0.5 and a deictic one scoring 1 around a pause (``00_nogesture``, score 0: no bar, no
+    legend entry); the bars are as high as the scores:
+
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.io import EmotionSegment, SemanticSegment, semantic_to_frames
+    >>> semantic = [SemanticSegment("01_beat_align", 0.2, 0.6, 0.4, 0.5),
+    ...             SemanticSegment("00_nogesture", 0.6, 1.0, 0.4, 0.0),
+    ...             SemanticSegment("02_deictic_l", 1.0, 1.6, 0.6, 1.0)]
+    >>> frames = semantic_to_frames(semantic, 30, 15)  # 2 s at 15 fps
+    >>> fig = plot_annotations([EmotionSegment("neutral", 0.0, 2.0, 2.0, 0)], semantic, frames, 15, 2.0)
+    >>> scores = fig.axes[1]
+    >>> [t.get_text() for t in scores.get_legend().get_texts()], [float(b.get_height()) for b in scores.patches]
+    (['01_beat_align', '02_deictic_l'], [0.5, 1.0])
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 
@@ -206,7 +269,9 @@ def plot_onsets(
     Parameters
     ----------
     audio : (N,) float, [-1, 1]
+        Mono waveform.
     sr : int
+        Sample rate of ``audio``, Hz.
     onsets : (A,) float, seconds
         beatlite's peak picking (:func:`beatlite.metrics.audio_beats`).
     onsets_librosa : (B,) float, optional
@@ -216,8 +281,10 @@ def plot_onsets(
     hop_length : int
         Hop of the onset strength (512).
     t_end : float
-        Seconds shown.
+        Seconds shown, from 0.
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
@@ -267,7 +334,9 @@ def plot_beat_curves(
     Parameters
     ----------
     audio : (N,) float, [-1, 1]
+        Mono waveform.
     sr : int
+        Sample rate of ``audio``, Hz.
     onsets : (A,) float, seconds
     curves : mapping label -> (curve (T,), beat times (K,) s, y label with units)
         One panel each, e.g. ``{"right wrist speed": (speed, minima, "cm/s")}``.
@@ -276,15 +345,35 @@ def plot_beat_curves(
     t_range : (float, float)
         Seconds shown (start it at the speech to keep a swing before it from setting the scale).
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    A wrist speed that falls to 0 every second (at 0.5 s, 1.5 s, ...) and peaks at 40 cm/s: the motion beats
+    are drawn on the curve, the scale tops at ``1.1 * 40`` and the onset at 7 s, outside the 6 s shown, draws
+    no line:
+
+    >>> import matplotlib.pyplot as plt
+    >>> t = np.arange(90) / 15
+    >>> speed = np.abs(t % 1.0 - 0.5) * 80
+    >>> curves = {"right wrist speed": (speed, [0.5, 1.5, 2.5, 3.5, 4.5, 5.5], "speed (cm/s)")}
+    >>> fig = plot_beat_curves(np.zeros(6 * 16000), 16000, [1.0, 2.0, 7.0], curves, 15)
+    >>> [ax.get_ylabel() for ax in fig.axes], round(float(fig.axes[1].get_ylim()[1]), 3)
+    (['amplitude', 'speed (cm/s)'], 44.0)
+    >>> sorted({float(line.get_xdata()[0]) for line in fig.axes[1].lines if len(line.get_xdata()) == 2})
+    [1.0, 2.0]
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 
     t0, t_end = max(0.0, float(t_range[0])), float(t_range[1])
     y = np.asarray(audio)[: int(t_end * sr)]
+    onsets = np.asarray(onsets, dtype=np.float64).reshape(-1)
     with figure_style():
         fig, axes = plt.subplots(1 + len(curves), 1, figsize=(10, 1.6 + 1.5 * len(curves)), sharex=True)
         axes[0].plot(np.arange(len(y)) / sr, y, lw=0.3, color="0.5")
@@ -326,10 +415,28 @@ def plot_spread(
     titles : (str, str)
         Panel titles, with units.
     out : str or Path, optional
+        Also save the figure there: a path stem, written as ``.png`` and ``.svg``
+        (:func:`beatlite.viz.style.save_figure`).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    One box per system and metric; a box's middle line is the median of the subsets' values:
+
+    >>> import matplotlib.pyplot as plt
+    >>> spread = {"Ground truth": ([0.20, 0.25, 0.30], [10.0, 11.0, 12.0]),
+    ...           "CaMN": ([0.1, 0.2, 0.3], [8.0, 9.0, 10.0])}
+    >>> fig = plot_spread(spread)
+    >>> srgr = fig.axes[0]
+    >>> [t.get_text() for t in srgr.get_xticklabels()], srgr.get_ylabel(), fig.axes[1].get_ylabel()
+    (['Ground truth', 'CaMN'], 'SRGR per subset', 'L1 diversity per subset')
+    >>> medians = fig.axes[1].lines[5::6]  # each box draws 6 lines: box, 2 whiskers, 2 caps, median
+    >>> [float(line.get_ydata()[0]) for line in medians]
+    [11.0, 9.0]
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 

@@ -73,6 +73,24 @@ class SkeletonArtist:
         Joint marker size in points (0 hides joints).
     alpha : float
         Opacity of bones and joints.
+
+    Examples
+    --------
+    An animation moves the same six lines (bones and joints of body, hands, head) to each frame; a joint at
+    ``(x, y, z)`` is drawn at plot ``(x, -z, y)``:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> from beatlite.viz._inputs import bone_groups
+    >>> fig = plt.figure()
+    >>> ax = fig.add_subplot(projection="3d")
+    >>> artist = SkeletonArtist(ax, bone_groups(parents))
+    >>> artist.update(pose)
+    >>> joints = artist.artists[3]  # the body's joints
+    >>> len(artist.artists), [np.round(c, 1).tolist()[3] for c in joints.get_data_3d()]  # the right hand
+    (6, [40.0, -10.0, 140.0])
+    >>> plt.close(fig)
     """
 
     def __init__(
@@ -132,6 +150,15 @@ def half_extents(positions: np.ndarray | Sequence[np.ndarray], margin: float = 5
         Half-widths along plot x, y (both the larger ground-plane half-width) and
         z (height). Pass them to :func:`setup_axes` as ``half=`` for every panel: a
         100 cm arm is then equally long in every panel.
+
+    Examples
+    --------
+    The toy pose spans 80 cm in x, 10 cm in z and 50 cm in height: half-widths 40, 5 and 25 plus the 5 cm
+    margin, the ground plane's two made equal (45):
+
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])
+    >>> half_extents(pose[None]).tolist()
+    [45.0, 45.0, 30.0]
     """
     arrays = [positions] if isinstance(positions, np.ndarray) else list(positions)
     half = np.zeros(3)
@@ -188,6 +215,21 @@ def setup_axes(
         Half-widths of the box in plot axes, centimetres (:func:`half_extents` of
         every panel, for one scale across panels; the box is then aligned on the
         highest joint, so heads line up); default: this axes' own data, centred.
+
+    Examples
+    --------
+    The limits are the box of :func:`half_extents` around the middle of the data (plot axes x, -z, y): heights
+    100 to 150 cm give z limits ``125 ± 30``; ``"side"`` looks along the character's x axis:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> fig = plt.figure()
+    >>> ax = fig.add_subplot(projection="3d")
+    >>> setup_axes(ax, pose[None], view="side")
+    >>> [float(v) for v in ax.get_zlim()], [float(v) for v in ax.get_xlim()], (ax.elev, ax.azim)
+    ([95.0, 155.0], [-45.0, 45.0], (0.0, 0.0))
+    >>> plt.close(fig)
     """
     arrays = [positions] if isinstance(positions, np.ndarray) else list(positions)
     pts = to_plot_coords(np.concatenate([np.asarray(a, dtype=np.float64).reshape(-1, 3) for a in arrays]))
@@ -275,6 +317,22 @@ def plot_frame(
     -------
     matplotlib.figure.Figure
         The figure drawn into.
+
+    Examples
+    --------
+    A clip of 10 frames in which the right hand rises 2 cm per frame; the last frame (``-1``) has it at
+    140 + 18 = 158 cm, drawn at plot height 158:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> clip = np.repeat(pose[None], 10, axis=0)
+    >>> clip[:, 3, 1] += 2.0 * np.arange(10)
+    >>> fig = plot_frame(clip, parents, frame=-1, view="front")
+    >>> x, minus_z, height = fig.axes[0].lines[1].get_data_3d()  # the body's joints
+    >>> np.round(height, 1).tolist()
+    [100.0, 150.0, 140.0, 158.0]
+    >>> plt.close(fig)
     """
     pos, bones = _prepare(positions, skeleton, names)
     k = _check_frame(frame, len(pos))
@@ -327,6 +385,18 @@ def plot_filmstrip(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Four frames evenly spaced over 10 are frames 0, 3, 6 and 9: at 15 fps, 0.2 s apart:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> fig = plot_filmstrip(np.repeat(pose[None], 10, axis=0), parents, n=4, fps=15)
+    >>> [ax.get_title() for ax in fig.axes]
+    ['t = 0.00 s', 't = 0.20 s', 't = 0.40 s', 't = 0.60 s']
+    >>> plt.close(fig)
     """
     pos, bones = _prepare(positions, skeleton, names)
     if frames is None:
@@ -381,6 +451,18 @@ def plot_views(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    One panel per view, its camera the angles ``(elev, azim)`` of :data:`VIEWS`:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> fig = plot_views(pose, parents)
+    >>> [(ax.get_title(), (ax.elev, ax.azim) == VIEWS[ax.get_title()]) for ax in fig.axes]
+    [('front', True), ('side', True), ('top', True)]
+    >>> plt.close(fig)
     """
     pos, bones = _prepare(positions, skeleton, names)
     k = _check_frame(frame, len(pos))
@@ -456,6 +538,24 @@ def plot_trajectories(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    With joint names, the default paths are the hands' (and the head's, when there is one); the right hand's
+    path rises 2 cm per frame:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up, facing +Z
+    >>> clip = np.repeat(pose[None], 5, axis=0)
+    >>> clip[:, 3, 1] += 2.0 * np.arange(5)
+    >>> fig = plot_trajectories(clip, parents, names=["Hips", "Chest", "LeftHand", "RightHand"])
+    >>> ax = fig.axes[0]
+    >>> labels = ax.get_legend_handles_labels()[1]
+    >>> path = ax.lines[-len(labels) + labels.index("RightHand")]
+    >>> labels, path.get_data_3d()[2].tolist()
+    (['RightHand', 'LeftHand'], [140.0, 142.0, 144.0, 146.0, 148.0])
+    >>> plt.close(fig)
     """
     pos, bones = _prepare(positions, skeleton, names)
     if isinstance(skeleton, Skeleton):
@@ -698,6 +798,18 @@ def plot_bone_levels(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Two cumulative levels of the toy skeleton's three bones (the spine, then both arms); a level's title counts
+    its bones and their 3 coordinates each:
+
+    >>> import matplotlib.pyplot as plt
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])
+    >>> fig = plot_bone_levels(pose, [[0, 1], [1, 2], [1, 3]], [[0], [0, 1, 2]])
+    >>> [ax.get_title() for ax in fig.axes]
+    ['level 1: 1 bones, 3 dims', 'level 2: 3 bones, 9 dims']
+    >>> plt.close(fig)
     """
     pos = check_positions(positions)[0]
     bones = _check_bones(bones, len(pos))

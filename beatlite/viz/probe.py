@@ -80,7 +80,19 @@ class RenderProbe:
 
 
 def candidate_windows() -> list[str | None]:
-    """Render-window classes to try, in order (``None`` = VTK's platform default); see the module docstring."""
+    """Render-window classes to try, in order (``None`` = VTK's platform default); see the module docstring.
+
+    Examples
+    --------
+    On Linux without ``$DISPLAY``, a class the user set comes first and is not tried twice:
+
+    >>> from unittest import mock
+    >>> with mock.patch.object(sys, "platform", "linux"), mock.patch.dict(
+    ...     os.environ, {ENV_WINDOW: "vtkOSOpenGLRenderWindow", "DISPLAY": ""}
+    ... ):
+    ...     candidate_windows()
+    ['vtkOSOpenGLRenderWindow', 'vtkEGLRenderWindow']
+    """
     out: list[str | None] = []
     user = os.environ.get(ENV_WINDOW, "").strip()
     if user:
@@ -171,7 +183,18 @@ def probe_offscreen(timeout: float = 60.0) -> RenderProbe:
 
 
 def pyvista_status() -> RenderProbe:
-    """The probe answer, honouring ``BEATLITE_PYVISTA=off`` (read at call time)."""
+    """The probe answer, honouring ``BEATLITE_PYVISTA=off`` (read at call time).
+
+    Examples
+    --------
+    Switched off, nothing is probed (no child process):
+
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {ENV_SWITCH: "off"}):
+    ...     status = pyvista_status()
+    >>> status.ok, status.reason
+    (False, 'BEATLITE_PYVISTA=off turns pyvista off')
+    """
     if os.environ.get(ENV_SWITCH, "").strip().lower() in ("off", "0", "false", "no"):
         return RenderProbe(False, None, f"{ENV_SWITCH}={os.environ[ENV_SWITCH]} turns pyvista off")
     return probe_offscreen()
@@ -200,6 +223,24 @@ def use_pyvista(backend: str = "auto") -> bool:
     bool
         True when pyvista should be used; then ``VTK_DEFAULT_OPENGL_WINDOW`` is set in
         this process to the window class that the probe found working.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``backend``.
+
+    Examples
+    --------
+    ``"matplotlib"`` decides without probing; with ``BEATLITE_PYVISTA=off`` ``"auto"`` falls back to matplotlib
+    (with its one warning, silenced here):
+
+    >>> from unittest import mock
+    >>> use_pyvista("matplotlib")
+    False
+    >>> with mock.patch.dict(os.environ, {ENV_SWITCH: "off"}), warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     use_pyvista("auto")
+    False
     """
     if backend not in ("auto", "pyvista", "matplotlib"):
         raise ValueError(f"backend must be 'auto', 'pyvista' or 'matplotlib', got {backend!r}")

@@ -122,7 +122,33 @@ def project(
 ) -> np.ndarray:
     """(N, 3) world points -> (N, 2) pixel (column, row) of a perspective camera, row 0 at the top.
 
-    ``view_angle`` (degrees) is the vertical field of view, as in VTK.
+    Parameters
+    ----------
+    points : (N, 3) float
+        World points (centimetres for beatlite's scenes).
+    position, focal : (3,) float
+        Camera position and the point it looks at (same units).
+    up : (3,) float
+        The camera's up direction (made orthogonal to the viewing direction).
+    size : (width, height)
+        Image size in pixels.
+    view_angle : float
+        Vertical field of view in degrees, as in VTK.
+
+    Returns
+    -------
+    (N, 2) float64
+        Pixel column and row (fractional; row 0 at the top).
+
+    Examples
+    --------
+    A 100 x 100 image with a 90-degree field of view: at 10 cm in front of the camera the image spans +-10 cm,
+    so the focal point lands at the centre (50, 50), 1 cm to the right 5 px right, 5 cm up 25 px up:
+
+    >>> points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 5, 0]])
+    >>> pixels = project(points, np.array([0.0, 0, 10]), np.zeros(3), (0, 1, 0), (100, 100), view_angle=90)
+    >>> np.round(pixels, 6).tolist()
+    [[50.0, 50.0], [55.0, 50.0], [50.0, 25.0]]
     """
     w, h = size
     back = np.asarray(position, dtype=np.float64) - focal
@@ -176,6 +202,20 @@ def frame_camera(
         Camera position and the point it looks at, centimetres.
     up : (3,) float tuple
         The view's up vector.
+
+    Examples
+    --------
+    A 180 cm tall box seen from the front: the camera is on the +z axis level with its centre, and its height
+    sets the distance, so its corners reach the 4 % margin of the 720 px height (28.8 px) at top and bottom:
+
+    >>> box = np.array([[-50.0, 0, -10], [50, 180, 10]])
+    >>> position, focal, up = frame_camera(box, "front", (960, 720))
+    >>> focal.tolist(), position[:2].tolist(), up
+    ([0.0, 90.0, 0.0], [0.0, 90.0], (0.0, 1.0, 0.0))
+    >>> corners = np.array([[x, y, z] for x in box[:, 0] for y in box[:, 1] for z in box[:, 2]])
+    >>> rows = project(corners, position, focal, up, (960, 720))[:, 1]
+    >>> round(float(rows.min()), 1), round(float(rows.max()), 1)
+    (28.8, 691.2)
     """
     if view not in CAMERAS:
         raise ValueError(f"view must be one of {sorted(CAMERAS)}, got {view!r}")
@@ -342,6 +382,17 @@ def render_frame(
     -------
     (height, width, 3) uint8 ndarray
         The RGB image.
+
+    Examples
+    --------
+    The image has the size asked, as (rows, columns, RGB); here drawn by matplotlib, as where pyvista cannot
+    render:
+
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up
+    >>> image = render_frame(pose, parents, size=(160, 120), backend="matplotlib")
+    >>> image.shape, image.dtype
+    ((120, 160, 3), dtype('uint8'))
     """
     bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
@@ -439,6 +490,30 @@ def render_animation(
     -------
     Path
         ``path``.
+
+    Raises
+    ------
+    ValueError
+        ``path`` does not end in ``.gif`` or ``.mp4``.
+    RuntimeError
+        ``.mp4`` without ffmpeg on ``PATH``.
+
+    Examples
+    --------
+    Four frames of a rising hand at 15 fps, played at 15 fps: a GIF of four frames of the size asked (here drawn
+    by matplotlib):
+
+    >>> import tempfile
+    >>> from PIL import Image
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up
+    >>> clip = np.repeat(pose[None], 4, axis=0)
+    >>> clip[:, 3, 1] += 5.0 * np.arange(4)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     gif = Image.open(render_animation(clip, parents, Path(tmp) / "clip.gif", fps=15, size=(320, 240),
+    ...                                       backend="matplotlib"))
+    ...     gif.n_frames, gif.size
+    (4, (320, 240))
     """
     bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
@@ -492,6 +567,11 @@ def notebook_backend() -> str:
     ``make test``, which set ``BEATLITE_INTERACTIVE=off``) with the ``interactive`` extra installed
     (``trame-pyvista`` and ``ipywidgets``: ``pip install -e ".[interactive]"``, done by ``make lab``);
     ``"static"`` (a PNG) otherwise.
+
+    Examples
+    --------
+    >>> notebook_backend()  # a plain Python process (or BEATLITE_INTERACTIVE=off) is not a live kernel
+    'static'
     """
     from beatlite.notebook import interactive
 
@@ -542,6 +622,19 @@ def show_skeleton(
         In a notebook, what ``Plotter.show`` returns (it displays a trame widget or a
         static image); outside a notebook the ``(H, W, 3) uint8`` image; a matplotlib
         Figure when pyvista cannot render.
+
+    Examples
+    --------
+    With matplotlib (``backend="matplotlib"``, or where pyvista cannot render) the view is a figure of the size
+    asked, 100 px per inch:
+
+    >>> import matplotlib.pyplot as plt
+    >>> parents = [-1, 0, 1, 1]  # hips, chest, left hand, right hand
+    >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])  # cm, Y up
+    >>> fig = show_skeleton(pose, parents, size=(320, 240), backend="matplotlib")
+    >>> type(fig).__name__, fig.get_size_inches().tolist()
+    ('Figure', [3.2, 2.4])
+    >>> plt.close(fig)
     """
     bones = bone_groups(skeleton)
     pos = check_positions(positions, bones.n_joints)
@@ -581,6 +674,16 @@ def no_wasm_download() -> str:
     when its first trame server starts, for client-side rendering. beatlite's views are rendered by the kernel's
     VTK and do not use it; with the folder set, nothing is downloaded (offline, the attempt printed a traceback
     in the cell). Returns the folder (a temporary one of this process).
+
+    Examples
+    --------
+    A folder already set is kept:
+
+    >>> import os
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"VTK_WASM_DIR_OVERRIDE": "/opt/vtk-wasm"}):
+    ...     no_wasm_download()
+    '/opt/vtk-wasm'
     """
     import os
     import tempfile

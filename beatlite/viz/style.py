@@ -7,9 +7,9 @@ for a block of code with :func:`figure_style` (a ``plt.rc_context``), or pass
 The style's rules, which every figure function of :mod:`beatlite.viz` and
 :mod:`beatlite.stats` follows:
 
-- **Slide size.** A saved figure is at least :data:`SLIDE_WIDTH_PX` (960) pixels
-  wide: the default figure is 6.4 inches at ``savefig.dpi`` 150; animations are
-  drawn at :data:`SLIDE_WIDTH_PX` wide (:func:`slide_figsize`).
+- **Slide size.** The default figure is 6.4 inches at ``savefig.dpi`` 150, :data:`SLIDE_WIDTH_PX` (960)
+  pixels, less the white margin that ``savefig.bbox = "tight"`` crops (a one-panel line plot is saved about
+  860 px wide); animations are drawn at :data:`SLIDE_WIDTH_PX` wide (:func:`slide_figsize`).
 - **Fonts** readable on a projector: 10-12 pt text, 9 pt ticks and legends.
 - **Legends outside the data**: :func:`legend_outside` puts them right of or
   above the axes, never over bars or curves.
@@ -134,6 +134,16 @@ def figure_style(**overrides: Any) -> Iterator[None]:
     ------
     None
         Figures created inside the block use the style; rcParams are restored on exit.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> before = plt.rcParams["font.size"]
+    >>> with figure_style(**{"font.size": 12}):
+    ...     plt.rcParams["font.size"], plt.rcParams["savefig.dpi"], plt.rcParams["legend.frameon"]
+    (12.0, 150.0, False)
+    >>> plt.rcParams["font.size"] == before
+    True
     """
     import matplotlib.pyplot as plt
 
@@ -188,6 +198,36 @@ def save_figure(
         at the lower of the saved dpi (150) and the figure's own dpi (100), at which
         a notebook shows the figure inline, and, with a box to fit (``fit``, the course's
         slide for the course's figures), at the scale the box shows it.
+
+    Examples
+    --------
+    A ``.png`` suffix in the stem is dropped, so one call writes both formats; a figure with an empty panel is
+    refused under ``BEATLITE_FIGURE_CHECK=raise`` and nothing more is written:
+
+    >>> import tempfile
+    >>> from unittest import mock
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.viz.check import FigureError
+    >>> with figure_style():
+    ...     fig, ax = plt.subplots()
+    ...     _ = ax.plot([0.0, 1.0], [0.0, 30.0])
+    ...     _ = ax.set(xlabel="time (s)", ylabel="speed (cm/s)")
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     print([p.name for p in save_figure(fig, Path(tmp) / "speed.png")])
+    ...     empty, _ = plt.subplots(1, 2)
+    ...     with mock.patch.dict(os.environ, {"BEATLITE_FIGURE_CHECK": "raise"}):
+    ...         try:
+    ...             save_figure(empty, Path(tmp) / "empty")
+    ...         except FigureError as error:
+    ...             print(error)
+    ...     print(sorted(p.name for p in Path(tmp).iterdir()))
+    ['speed.png', 'speed.svg']
+    save_figure('empty'): 2 figure problem(s):
+      empty panel: axes 1 of 2 shows no data
+      empty panel: axes 2 of 2 shows no data
+    ['speed.png', 'speed.svg']
+    >>> plt.close(fig)
+    >>> plt.close(empty)
     """
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -381,6 +421,26 @@ def legend_outside(ax: Any, where: str = "right", **kwargs: Any) -> Any:
     -------
     matplotlib.legend.Legend
         The legend (``None`` when the axes has no labelled artist).
+
+    Raises
+    ------
+    ValueError
+        ``where`` is neither ``"right"`` nor ``"top"``.
+
+    Examples
+    --------
+    ``"top"`` puts every entry in one row, just above the axes (y = 1.01 in axes units):
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots()
+    >>> _ = ax.plot([0, 1], [0, 1], label="CaMN")
+    >>> _ = ax.plot([0, 1], [1, 0], label="HA2G")
+    >>> legend = legend_outside(ax, "top")
+    >>> [t.get_text() for t in legend.get_texts()], legend._ncols
+    (['CaMN', 'HA2G'], 2)
+    >>> legend_outside(fig.add_subplot(2, 2, 4)) is None  # nothing labelled: no legend
+    True
+    >>> plt.close(fig)
     """
     handles, labels = ax.get_legend_handles_labels()
     if "handles" not in kwargs and not handles:
