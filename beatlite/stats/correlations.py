@@ -99,6 +99,22 @@ def _pearson(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.divide((b * a).sum(axis=-1), den, out=np.zeros(den.shape), where=den > 0)
 
 
+def _group_shifts(size: np.ndarray, n_permutations: int, rng: np.random.Generator) -> tuple[np.ndarray, bool]:
+    """Circular shifts (K, G) of G groups of ``size`` values, and whether they are every combination.
+
+    When the groups allow at most ``n_permutations`` combinations of shifts, all of them, the identity
+    included (the exact null: each counted once); else ``n_permutations`` random non-zero shifts per group.
+    """
+    if np.prod(size.astype(np.float64)) <= n_permutations:
+        grids = np.meshgrid(*[np.arange(m) for m in size], indexing="ij")
+        return np.stack([g.ravel() for g in grids], axis=1).astype(np.int64), True
+    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
+    for k, m in enumerate(size):  # group by group, as the draws have always been made
+        if m > 1:
+            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    return shifts, False
+
+
 def correlation_test(
     x: np.ndarray,
     y: np.ndarray,
@@ -121,7 +137,15 @@ def correlation_test(
     n_permutations : int
         Number of shifted copies, made in blocks of about 2^20 values (memory does not grow as
         ``N * n_permutations``: 999 copies of BEAT's 76 h in 2-s windows would be 1 GB per array).
+        When the groups allow no more combinations of shifts than this (a few short takes), every
+        combination is used once, the identity included, and the p-value is exact.
     seed : int
+
+    Returns
+    -------
+    CorrelationResult
+        ``p_permutation`` is ``(1 + #{|rho_null| >= |rho|}) / (1 + n_permutations)`` over random shifts, or
+        ``#{|rho_null| >= |rho|} / K`` over all K combinations of shifts (at least ``1 / K``).
     """
     from scipy.stats import spearmanr
 
@@ -148,18 +172,16 @@ def correlation_test(
     rng = np.random.default_rng(seed)
     order = np.argsort(g, kind="stable")  # positions group by group, in time order within each
     _, first, member, size = np.unique(g[order], return_index=True, return_inverse=True, return_counts=True)
-    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
-    for k, m in enumerate(size):  # group by group, as the draws have always been made
-        if m > 1:
-            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    shifts, exact = _group_shifts(size, n_permutations, rng)
     start, m, r = first[member], size[member], np.arange(len(x)) - first[member]
     block = max(1, (1 << 20) // len(x))  # shifted copies at once: about 8 MB per (block, N) array
-    null = np.empty(n_permutations)
-    for b in range(0, n_permutations, block):
-        perm = np.empty((min(block, n_permutations - b), len(x)), dtype=np.int64)
+    null = np.empty(len(shifts))
+    for b in range(0, len(shifts), block):
+        perm = np.empty((min(block, len(shifts) - b), len(x)), dtype=np.int64)
         perm[:, order] = order[start + (r + shifts[b : b + block, member]) % m]
         null[b : b + len(perm)] = _pearson(rx, ry[perm])
-    p_perm = (1 + int(np.sum(np.abs(null) >= abs(rho) - 1e-12))) / (1 + n_permutations)
+    extreme = int(np.sum(np.abs(null) >= abs(rho) - 1e-12))
+    p_perm = extreme / len(null) if exact else (1 + extreme) / (1 + n_permutations)
     return CorrelationResult(
         rho=rho,
         p_value=float(res.pvalue),
