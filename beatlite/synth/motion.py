@@ -539,6 +539,20 @@ def _normalize(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
+def _elbow_side(pole: np.ndarray, towards: np.ndarray) -> np.ndarray:
+    """Unit directions (T, 3) perpendicular to ``towards`` (T, 3, unit) on the side of ``pole`` (T, 3).
+
+    Where ``pole`` lies along ``towards`` (or is zero) every elbow plane is as good: the
+    coordinate axis least aligned with ``towards`` gives one.
+    """
+    perp = pole - np.sum(pole * towards, axis=1, keepdims=True) * towards
+    free = np.linalg.norm(perp, axis=1) <= 1e-9 * np.linalg.norm(pole, axis=1)
+    if np.any(free):
+        axis = np.eye(3)[np.argmin(np.abs(towards[free]), axis=1)]
+        perp[free] = axis - np.sum(axis * towards[free], axis=1, keepdims=True) * towards[free]
+    return _normalize(perp)
+
+
 def two_bone_ik(
     target: np.ndarray,
     root: np.ndarray,
@@ -557,7 +571,8 @@ def two_bone_ik(
     upper, lower : (3,) float
         Elbow offset (in the shoulder's frame) and wrist offset (in the elbow's frame) at rest.
     pole : (T, 3) or (3,) float
-        Direction the elbow should point to, same frame as ``target``.
+        Direction the elbow should point to, same frame as ``target``. Where it lies along the
+        shoulder-target line (or is zero) any elbow plane reaches the target and one is chosen.
 
     Returns
     -------
@@ -591,7 +606,7 @@ def two_bone_ik(
     cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
     sin_a = np.sqrt(1.0 - cos_a**2)
     pole = np.broadcast_to(np.asarray(pole, dtype=np.float64), v.shape)
-    n = _normalize(pole - np.sum(pole * vh, axis=1, keepdims=True) * vh)
+    n = _elbow_side(pole, vh)
     a_dir = cos_a[:, None] * vh + sin_a[:, None] * n
     wrist = d[:, None] * vh
     f_dir = _normalize(wrist - l1 * a_dir)
