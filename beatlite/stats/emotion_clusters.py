@@ -603,13 +603,15 @@ def tsne_embedding(features: np.ndarray, *, perplexity: float = 30.0, seed: int 
     Examples
     --------
     Two blobs far apart in 6-D stay apart in 2-D: every point's nearest neighbour has its label.
+    Skipped by the doctests (500 t-SNE iterations take 1-5 s on a 2-core CPU; :func:`plot_emotion_tsne`'s
+    Example runs it).
 
     >>> rng = np.random.default_rng(0)
     >>> features = np.concatenate([rng.normal(0, 1, (10, 6)), rng.normal(20, 1, (10, 6))])
-    >>> emb = tsne_embedding(features)
-    >>> d = np.linalg.norm(emb[:, None] - emb[None], axis=-1) + np.diag(np.full(20, np.inf))
+    >>> emb = tsne_embedding(features)  # doctest: +SKIP
+    >>> d = np.linalg.norm(emb[:, None] - emb[None], axis=-1) + np.diag(np.full(20, np.inf))  # doctest: +SKIP
     >>> labels = np.repeat([0, 1], 10)
-    >>> emb.shape, bool(np.all(labels[d.argmin(axis=1)] == labels))
+    >>> emb.shape, bool(np.all(labels[d.argmin(axis=1)] == labels))  # doctest: +SKIP
     ((20, 2), True)
     """
     from sklearn.decomposition import PCA
