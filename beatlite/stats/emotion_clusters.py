@@ -201,7 +201,8 @@ def window_features(windows: np.ndarray, *, kind: str = "stats") -> np.ndarray:
 
     >>> np.round(window_features(np.array([[[0.0], [2.0], [4.0]]])), 3).tolist()
     [[2.0, 1.633, 2.0]]
-    >>> window_features(np.zeros((5, 30, 27))).shape, window_features(np.zeros((5, 30, 27)), kind="flat").shape
+    >>> windows = np.zeros((5, 30, 27))  # 5 windows of 30 frames x 27 channels
+    >>> window_features(windows).shape, window_features(windows, kind="flat").shape
     ((5, 81), (5, 810))
     """
     x = np.asarray(windows, dtype=np.float64)
@@ -417,7 +418,8 @@ def per_group_standardize(features: np.ndarray, groups: np.ndarray) -> np.ndarra
     --------
     Speaker 2 moves at 1 or 3 cm/s, speaker 4 at 10 or 30: each becomes -1, +1 within its speaker.
 
-    >>> per_group_standardize(np.array([[1.0], [3.0], [10.0], [30.0]]), np.array([2, 2, 4, 4])).ravel().tolist()
+    >>> speed, speaker = np.array([[1.0], [3.0], [10.0], [30.0]]), np.array([2, 2, 4, 4])
+    >>> per_group_standardize(speed, speaker).ravel().tolist()
     [-1.0, 1.0, -1.0, 1.0]
     """
     x = np.asarray(features, dtype=np.float64).copy()
@@ -505,7 +507,8 @@ def emotion_features(
     >>> rng = np.random.default_rng(0)
     >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
     ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
-    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=np.full(90, emotion), speaker_id=2)
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
     >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
     >>> ef = emotion_features(takes)
     >>> ef.features.shape, ef.emotion.tolist()[::3], ef.take.tolist()[:6]
@@ -581,7 +584,8 @@ def emotion_separability(
     >>> rng = np.random.default_rng(0)
     >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
     ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
-    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=np.full(90, emotion), speaker_id=2)
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
     >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
     >>> sep = emotion_separability(takes, k=3)
     >>> sep.n, sep.n_classes, sep.balanced_accuracy, sep.uniform_chance
@@ -667,7 +671,8 @@ def plot_emotion_tsne(
     >>> rng = np.random.default_rng(0)
     >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
     ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
-    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=np.full(90, emotion), speaker_id=2)
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
     >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
     >>> fig, sep = plot_emotion_tsne(takes)
     >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()], sep.k, sep.balanced_accuracy

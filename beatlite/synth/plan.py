@@ -231,8 +231,9 @@ def make_plan(
     gets a beat only half of the time).
 
     >>> from beatlite.synth.styles import SPEAKERS
-    >>> words = [TimedWord(0.5, 0.9, "we", 0), TimedWord(1.0, 1.5, "walked", 0),
-    ...          TimedWord(1.6, 2.0, "home", 0), TimedWord(2.4, 2.9, "idea", 0), TimedWord(3.5, 4.0, "works", 0)]
+    >>> timing = [(0.5, 0.9, "we"), (1.0, 1.5, "walked"), (1.6, 2.0, "home"), (2.4, 2.9, "idea"),
+    ...           (3.5, 4.0, "works")]
+    >>> words = [TimedWord(start, end, word, 0) for start, end, word in timing]  # all neutral
     >>> plan = make_plan(words, SPEAKERS[2], 5.0, np.random.default_rng(0))
     >>> [b.time for b in plan.beats]
     [1.0, 1.6]
