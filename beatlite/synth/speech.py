@@ -273,15 +273,19 @@ def resample_to_output(y: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    (round(N * 16000 / 22050),) float32
+    (ceil(N * 320 / 441),) float32
+        :func:`scipy.signal.resample_poly`'s length (16000 / 22050 = 320 / 441, rounded up).
 
     Examples
     --------
-    One second of a 440-Hz sine: 16000 samples, and the RMS of a unit sine, 1 / sqrt(2).
+    One second of a 440-Hz sine: 16000 samples, and the RMS of a unit sine, 1 / sqrt(2). Two samples
+    become ceil(640 / 441) = 2, not round(1.45) = 1.
 
     >>> y = resample_to_output(np.sin(2 * np.pi * 440 * np.arange(ESPEAK_SR) / ESPEAK_SR))
     >>> y.shape, y.dtype, round(float(np.sqrt(np.mean(y**2))), 2)
     ((16000,), dtype('float32'), 0.71)
+    >>> resample_to_output(np.ones(2)).shape, resample_to_output(np.ones(6)).shape
+    ((2,), (5,))
     """
     from scipy.signal import resample_poly
 
