@@ -98,6 +98,38 @@ def test_spearman_hand_case_and_permutation_bounds() -> None:
     assert 1 / 51 <= r.p_permutation <= 1.0 and r.n == 4
 
 
+def test_circular_shift_p_value_counts_each_shift_once_when_there_are_few() -> None:
+    # 4 values in one group have 4 circular shifts of y (identity included), with Spearman rho
+    # 0.8, -0.4, 0.0, -0.4 (1 - 6 sum d^2 / 60 for sum d^2 = 2, 14, 10, 14): exactly 1 of the 4 is
+    # as extreme as the observed 0.8, so p = 1/4, whatever the number of draws. 1000 draws among
+    # the 3 non-identity shifts reported 1/1001.
+    x, y = np.array([1.0, 2, 3, 4]), np.array([1.0, 3, 2, 4])
+    for n in (50, 1000):
+        r = correlation_test(x, y, n_permutations=n)
+        assert r.p_permutation == pytest.approx(1 / 4)
+        assert r.null_mean == pytest.approx(0.0, abs=1e-12)
+        assert r.null_std == pytest.approx(np.sqrt((0.64 + 0.16 + 0.0 + 0.16) / 4))
+
+
+def test_circular_shift_p_value_of_two_groups_matches_brute_force() -> None:
+    from itertools import product
+
+    from scipy.stats import spearmanr
+
+    rng = np.random.default_rng(3)
+    x, y = rng.normal(size=7), rng.normal(size=7)
+    groups = np.array([0, 0, 0, 1, 1, 1, 1])
+    rho = spearmanr(x, y).statistic
+    null = [
+        spearmanr(x, np.concatenate([np.roll(y[:3], a), np.roll(y[3:], b)])).statistic
+        for a, b in product(range(3), range(4))
+    ]
+    expected = np.mean(np.abs(null) >= abs(rho) - 1e-12)  # 12 combinations, the identity among them
+    r = correlation_test(x, y, groups=groups, n_permutations=500)
+    assert r.p_permutation == pytest.approx(expected)
+    assert r.null_mean == pytest.approx(np.mean(null)) and r.null_std == pytest.approx(np.std(null))
+
+
 def test_planted_correlation_is_significant_and_independent_is_not() -> None:
     rng = np.random.default_rng(1)
     groups = np.repeat(np.arange(10), 30)

@@ -172,6 +172,20 @@ def test_two_bone_ik_reaches_reachable_targets() -> None:
         two_bone_ik(np.zeros(3), arm, fore, hand, np.array([0.0, -1.0, 0.0]))
 
 
+def test_two_bone_ik_reaches_targets_in_line_with_the_pole() -> None:
+    # a pole along the shoulder-target line leaves the elbow plane free; any plane must still give
+    # rotations that reach the target. It used to give a singular "rotation" (det 0) that put the
+    # wrist 42.97 cm away for a target 40 cm away.
+    upper, lower, root = np.array([0.0, -30.0, 0.0]), np.array([0.0, -25.0, 0.0]), np.zeros(3)
+    targets = np.array([[0.0, 0.0, 40.0], [0.0, 0.0, -30.0], [0.0, 0.0, 40.0]])
+    for pole in (np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.0, 2.0]), np.zeros(3)):
+        shoulder, elbow = two_bone_ik(targets, root, upper, lower, pole)
+        wrist = root + np.einsum("tij,tj->ti", shoulder, upper + np.einsum("tij,j->ti", elbow, lower))
+        assert np.allclose(wrist, targets, atol=1e-6), pole
+        assert np.allclose(np.linalg.det(shoulder), 1.0) and np.allclose(np.linalg.det(elbow), 1.0)
+        assert np.allclose(np.einsum("tji,tjk->tik", shoulder, shoulder), np.eye(3), atol=1e-9)
+
+
 def test_two_bone_ik_limits_elbow_flexion() -> None:
     sk = beat_skeleton()
     arm, fore, hand = (sk.offsets[sk.index(n)] for n in ("RightArm", "RightForeArm", "RightHand"))

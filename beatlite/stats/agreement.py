@@ -316,6 +316,15 @@ class TauResult:
         Coverage of the interval.
     method : str
         How the interval was made (``"items"``, ``"votes"`` or ``""``).
+
+    Examples
+    --------
+    ``str`` gives the one line a report prints (the interval only when one was made):
+
+    >>> print(TauResult(tau=0.6667, p_value=0.3333, low=float("nan"), high=float("nan"), n=4))
+    tau = +0.67, p = 0.333 (n = 4)
+    >>> print(TauResult(tau=0.5, p_value=0.04, low=0.1, high=0.8, n=10, method="items"))
+    tau = +0.50, 95 % interval [+0.10, +0.80], p = 0.04 (n = 10)
     """
 
     tau: float

@@ -64,6 +64,20 @@ class CorpusTake:
     conversation : bool
         A conversation take (its take-level ``emotion`` is 0 from the name; the turns' emotions are in
         ``emotion_frames``).
+
+    Examples
+    --------
+    A 14.8-s take of ``data_samples/`` at 15 fps: every per-frame stream has 14.8 x 15 = 222 frames, and
+    every word has a start and an end.
+
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.paths import repo_root
+    >>> index = index_folder(repo_root() / "data_samples", recursive=False, cache=False, read_durations=False)
+    >>> take = corpus_take(index["2_scott_0_1_1"])
+    >>> take.n_frames, take.rotations.shape, take.speed.shape, take.audio_rms.shape, take.face_activity.shape
+    (222, (222, 141), (222,), (222,), (222,))
+    >>> len(take.words) == len(take.word_starts) == len(take.word_ends), take.words[:4]
+    (True, ('my', 'idea', 'is', 'to'))
     """
 
     stem: str
@@ -111,6 +125,27 @@ def frame_rms(audio: np.ndarray, n_frames: int, fps: float, sr: int) -> np.ndarr
     """RMS of ``audio`` over the samples ``[floor(i*sr/fps), floor((i+1)*sr/fps))`` of each frame, (T,).
 
     Frames beyond the audio get 0.
+
+    Parameters
+    ----------
+    audio : (N,) float, samples at ``sr``
+    n_frames : int
+        T, frames wanted.
+    fps : float
+        Frame rate, frames per second.
+    sr : int
+        Sample rate of ``audio``, Hz.
+
+    Returns
+    -------
+    (T,) float64, RMS in the units of ``audio`` (full scale for BEAT's WAVs).
+
+    Examples
+    --------
+    8 samples at 8 Hz cut into 2-fps frames of 4 samples: a +-1 square wave, then a +-3 one, then no audio.
+
+    >>> frame_rms(np.array([1.0, -1, 1, -1, 3, -3, 3, -3]), 3, fps=2, sr=8).tolist()
+    [1.0, 3.0, 0.0]
     """
     y = np.asarray(audio, dtype=np.float64)
     edges = np.floor(np.arange(n_frames + 1) * sr / fps + 1e-9).astype(np.int64)
@@ -122,7 +157,38 @@ def frame_rms(audio: np.ndarray, n_frames: int, fps: float, sr: int) -> np.ndarr
 
 
 def corpus_take(record: TakeRecord, *, fps: float = FPS, sr: int = SR) -> CorpusTake:
-    """Load one take (:func:`beatlite.io.load_take`, at the index's ``record.bvh_fps``) and compute its streams."""
+    """Load one take (:func:`beatlite.io.load_take`, at the index's ``record.bvh_fps``) and compute its streams.
+
+    Parameters
+    ----------
+    record : TakeRecord
+        A row of :func:`beatlite.data.index.index_folder` with a motion file.
+    fps : float
+        Frame rate of the streams, frames per second (default 15, the models' rate).
+    sr : int
+        Sample rate the audio is resampled to before its per-frame RMS, Hz.
+
+    Returns
+    -------
+    CorpusTake
+        Every stream cut to the shortest modality.
+
+    Examples
+    --------
+    A take is as long as the shortest of its files: ``record.duration`` seconds x ``fps`` frames.
+
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> tmp = example_corpus()
+    >>> record = index_folder(tmp.name, cache=False)["2_scott_0_9_9"]
+    >>> take = corpus_take(record, fps=15)
+    >>> take.stem, take.split, record.duration, take.n_frames
+    ('2_scott_0_9_9', 'train', 14.8, 222)
+    >>> take = corpus_take(record, fps=30)
+    >>> take.n_frames, bool(take.speed.min() >= 0)
+    (444, True)
+    >>> tmp.cleanup()
+    """
     from beatlite.io import load_take
     from beatlite.skeleton import forward_kinematics, subset_columns
 
@@ -180,6 +246,41 @@ def iter_corpus(
     :func:`beatlite.stats.emotion_separability`, which keeps 81 features per 2-s window)
     stream over a corpus of any size. A take that fails to load is skipped; its
     ``"stem: error"`` is appended to ``skipped`` when a list is given.
+
+    Parameters
+    ----------
+    index : TakeIndex
+    fps : float
+        Frame rate of the streams, frames per second.
+    sr : int
+        Audio sample rate, Hz.
+    splits : tuple of str, optional
+        Keep only the takes of these splits (``"train"``, ``"val"``, ``"test"``, ...).
+    skipped : list, optional
+        Receives ``"stem: error"`` of each take that failed to load.
+
+    Yields
+    ------
+    CorpusTake
+        In index order.
+
+    Examples
+    --------
+    Of the two example takes, only one is in the train split; a take whose motion file broke after
+    indexing is skipped and named.
+
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> from pathlib import Path
+    >>> tmp = example_corpus()
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> [t.stem for t in iter_corpus(index, splits=("train",))]
+    ['2_scott_0_9_9']
+    >>> _ = (Path(tmp.name) / "2_scott_0_1_1.bvh.gz").write_bytes(b"not a BVH")
+    >>> skipped = []
+    >>> [t.stem for t in iter_corpus(index, skipped=skipped)], [s.split(":")[0] for s in skipped]
+    (['2_scott_0_9_9'], ['2_scott_0_1_1'])
+    >>> tmp.cleanup()
     """
     for r in index:
         if not r.usable or (splits is not None and r.split not in splits):
@@ -202,6 +303,34 @@ def load_corpus(
     skipped with a warning naming it; ``ValueError`` if no take is left. Memory grows with the
     corpus (about 0.6 KB per frame, 30 MB per hour at 15 fps, mostly the 141 rotations): for
     large corpora pass :func:`iter_corpus` to the analyses that accept an iterable.
+
+    Parameters
+    ----------
+    index : TakeIndex
+    fps : float
+        Frame rate of the streams, frames per second.
+    sr : int
+        Audio sample rate, Hz.
+    splits : tuple of str, optional
+        Keep only the takes of these splits.
+
+    Returns
+    -------
+    list of CorpusTake
+        In index order.
+
+    Examples
+    --------
+    Two 14.8-s takes: 2 x 222 frames at 15 fps, the index's total duration.
+
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> tmp = example_corpus()
+    >>> index = index_folder(tmp.name, cache=False)
+    >>> takes = load_corpus(index)
+    >>> [t.stem for t in takes], sum(t.n_frames for t in takes) / 15, index.total_duration
+    (['2_scott_0_1_1', '2_scott_0_9_9'], 29.6, 29.6)
+    >>> tmp.cleanup()
     """
     failed: list[str] = []
     takes = list(iter_corpus(index, fps=fps, sr=sr, splits=splits, skipped=failed))

@@ -45,7 +45,8 @@ class CorrelationResult:
     p_value : float
         scipy.stats.spearmanr (independence assumed).
     p_permutation : float
-        ``(1 + #{|rho_null| >= |rho|}) / (1 + n_permutations)``.
+        ``(1 + #{|rho_null| >= |rho|}) / (1 + n_permutations)``, or the exact share of all shift
+        combinations when there are no more than ``n_permutations`` (see :func:`correlation_test`).
     null_mean, null_std : float
         Mean and spread of rho under the permutation null.
     n : int
@@ -99,6 +100,22 @@ def _pearson(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.divide((b * a).sum(axis=-1), den, out=np.zeros(den.shape), where=den > 0)
 
 
+def _group_shifts(size: np.ndarray, n_permutations: int, rng: np.random.Generator) -> tuple[np.ndarray, bool]:
+    """Circular shifts (K, G) of G groups of ``size`` values, and whether they are every combination.
+
+    When the groups allow at most ``n_permutations`` combinations of shifts, all of them, the identity
+    included (the exact null: each counted once); else ``n_permutations`` random non-zero shifts per group.
+    """
+    if np.prod(size.astype(np.float64)) <= n_permutations:
+        grids = np.meshgrid(*[np.arange(m) for m in size], indexing="ij")
+        return np.stack([g.ravel() for g in grids], axis=1).astype(np.int64), True
+    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
+    for k, m in enumerate(size):  # group by group, as the draws have always been made
+        if m > 1:
+            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    return shifts, False
+
+
 def correlation_test(
     x: np.ndarray,
     y: np.ndarray,
@@ -121,7 +138,25 @@ def correlation_test(
     n_permutations : int
         Number of shifted copies, made in blocks of about 2^20 values (memory does not grow as
         ``N * n_permutations``: 999 copies of BEAT's 76 h in 2-s windows would be 1 GB per array).
+        When the groups allow no more combinations of shifts than this (a few short takes), every
+        combination is used once, the identity included, and the p-value is exact.
     seed : int
+
+    Returns
+    -------
+    CorrelationResult
+        ``p_permutation`` is ``(1 + #{|rho_null| >= |rho|}) / (1 + n_permutations)`` over random shifts, or
+
+        ``#{|rho_null| >= |rho|} / K`` over all K combinations of shifts (at least ``1 / K``).
+
+    Examples
+    --------
+    Ranks 1 2 3 4 against 1 3 2 4: rho = 1 - 6 sum d^2 / (n (n^2 - 1)) = 1 - 6 * 2 / 60 = 0.8. Of the
+    4 circular shifts of ``y`` (rho 0.8, -0.4, 0, -0.4) only the unshifted one reaches 0.8: p = 1/4.
+
+    >>> r = correlation_test(np.array([1.0, 2, 3, 4]), np.array([1.0, 3, 2, 4]))
+    >>> round(r.rho, 4), r.p_permutation, r.n
+    (0.8, 0.25, 4)
     """
     from scipy.stats import spearmanr
 
@@ -148,18 +183,16 @@ def correlation_test(
     rng = np.random.default_rng(seed)
     order = np.argsort(g, kind="stable")  # positions group by group, in time order within each
     _, first, member, size = np.unique(g[order], return_index=True, return_inverse=True, return_counts=True)
-    shifts = np.zeros((n_permutations, len(size)), dtype=np.int64)
-    for k, m in enumerate(size):  # group by group, as the draws have always been made
-        if m > 1:
-            shifts[:, k] = rng.integers(1, m, size=n_permutations)
+    shifts, exact = _group_shifts(size, n_permutations, rng)
     start, m, r = first[member], size[member], np.arange(len(x)) - first[member]
     block = max(1, (1 << 20) // len(x))  # shifted copies at once: about 8 MB per (block, N) array
-    null = np.empty(n_permutations)
-    for b in range(0, n_permutations, block):
-        perm = np.empty((min(block, n_permutations - b), len(x)), dtype=np.int64)
+    null = np.empty(len(shifts))
+    for b in range(0, len(shifts), block):
+        perm = np.empty((min(block, len(shifts) - b), len(x)), dtype=np.int64)
         perm[:, order] = order[start + (r + shifts[b : b + block, member]) % m]
         null[b : b + len(perm)] = _pearson(rx, ry[perm])
-    p_perm = (1 + int(np.sum(np.abs(null) >= abs(rho) - 1e-12))) / (1 + n_permutations)
+    extreme = int(np.sum(np.abs(null) >= abs(rho) - 1e-12))
+    p_perm = extreme / len(null) if exact else (1 + extreme) / (1 + n_permutations)
     return CorrelationResult(
         rho=rho,
         p_value=float(res.pvalue),
@@ -183,7 +216,31 @@ def _eta2(values: np.ndarray, labels: np.ndarray) -> float:
 def group_effect_test(
     values: np.ndarray, labels: np.ndarray, *, n_permutations: int = 1000, seed: int = 0
 ) -> GroupEffectResult:
-    """One-way ANOVA + eta^2 + label-permutation p-value of per-take ``values`` (N,) by ``labels`` (N,)."""
+    """One-way ANOVA + eta^2 + label-permutation p-value of per-take ``values`` (N,) by ``labels`` (N,).
+
+    Parameters
+    ----------
+    values : (N,) float
+        One value per take (e.g. mean gesture speed, cm/s), all finite.
+    labels : (N,)
+        Group of each take (emotion id, speaker id, ...): at least 2 groups, one with 2 or more takes.
+    n_permutations : int
+        Label shuffles for ``p_permutation``.
+    seed : int
+
+    Returns
+    -------
+    GroupEffectResult
+
+    Examples
+    --------
+    Two groups of three takes around 2 and 12: the squares about the grand mean 7 sum to 154, of which
+    3 x 5^2 x 2 = 150 lie between the groups (eta^2 = 150/154), and F = (150 / 1) / (4 / 4) = 150.
+
+    >>> r = group_effect_test(np.array([1.0, 2, 3, 11, 12, 13]), np.array(["a", "a", "a", "b", "b", "b"]))
+    >>> round(r.eta2, 4), round(150 / 154, 4), round(r.f_stat, 6), r.group_means, r.n_takes
+    (0.974, 0.974, 150.0, {'a': 2.0, 'b': 12.0}, 6)
+    """
     from scipy.stats import f_oneway
 
     v = np.asarray(values, dtype=np.float64)
@@ -215,10 +272,28 @@ def group_effect_test(
 def window_means(takes: Iterable[CorpusTake], *, seconds: float = 2.0) -> dict[str, np.ndarray]:
     """Means of gesture speed, audio RMS and face activity over non-overlapping windows.
 
+    Parameters
+    ----------
+    takes : iterable of CorpusTake
+        Read once, in order.
+    seconds : float
+        Window length, seconds (``round(seconds * fps)`` frames); a take's last partial window is dropped.
+
     Returns
     -------
     dict with (N,) arrays ``speed`` (cm/s), ``audio`` (RMS), ``face`` (1/s, NaN without JSON),
     ``take`` (index into ``takes``), ``emotion``, ``speaker``.
+
+    Examples
+    --------
+    A 5-frame take at 1 fps in 2-s windows: frames (0, 1) and (2, 3); frame 4 is a partial window.
+
+    >>> from types import SimpleNamespace
+    >>> take = SimpleNamespace(fps=1.0, n_frames=5, speed=np.array([0.0, 1, 2, 3, 4]), audio_rms=np.ones(5),
+    ...                        face_activity=None, emotion=2, speaker_id=4)
+    >>> wm = window_means([take], seconds=2.0)
+    >>> wm["speed"].tolist(), wm["face"].tolist(), wm["take"].tolist(), wm["emotion"].tolist()
+    ([0.5, 2.5], [nan, nan], [0, 0], [2, 2])
     """
     out: dict[str, list] = {k: [] for k in ("speed", "audio", "face", "take", "emotion", "speaker")}
     for i, t in enumerate(takes):
@@ -248,6 +323,20 @@ def speed_by_emotion(takes: Iterable[CorpusTake]) -> dict[str, float]:
 
     Each frame counts under its own emotion (``emotion_frames``: a speech take's from its name, a conversation's
     turn by turn).
+
+    Returns
+    -------
+    dict
+        Emotion name -> mean speed (cm/s), in emotion id order, emotions with frames only.
+
+    Examples
+    --------
+    A conversation that turns angry halfway: (1 + 3) / 2 cm/s neutral, (10 + 20) / 2 angry.
+
+    >>> from types import SimpleNamespace
+    >>> take = SimpleNamespace(emotion_frames=np.array([0, 0, 2, 2]), speed=np.array([1.0, 3, 10, 20]))
+    >>> speed_by_emotion([take])
+    {'neutral': 2.0, 'anger': 15.0}
     """
     sums = np.zeros(len(EMOTION_NAMES))
     counts = np.zeros(len(EMOTION_NAMES), np.int64)
@@ -272,6 +361,22 @@ def gesture_correlations(
         take has a JSON); ``"emotion"``, ``"speaker"``: :class:`GroupEffectResult` over takes
         (speaker only with >= 2 speakers; emotion over self-talk takes only, with >= 2 emotions:
         a conversation take is neutral by its name but changes emotion turn by turn).
+
+    Examples
+    --------
+    Two neutral 14.8-s takes of one speaker: 7 windows of 2 s each (14 in all), no emotion or speaker
+    contrast to test. Each take has 7 circular shifts, so the exact null has 7 x 7 = 49 combinations
+    and no p-value is below 1/49.
+
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.stats.corpus import load_corpus
+    >>> tmp = example_corpus()
+    >>> takes = load_corpus(index_folder(tmp.name, cache=False))
+    >>> res = gesture_correlations(takes)
+    >>> list(res), res["audio"].n, bool(res["audio"].p_permutation >= 1 / 49)
+    (['audio', 'face'], 14, True)
+    >>> tmp.cleanup()
     """
     per_take: list[tuple[float, int, int | None, bool]] = []  # speed, emotion, speaker, conversation
     wm = window_means(_noting_takes(takes, per_take), seconds=seconds)
@@ -305,7 +410,16 @@ def _noting_takes(takes: Iterable[CorpusTake], notes: list) -> Iterator[CorpusTa
 
 
 def correlations_markdown(results: dict[str, CorrelationResult | GroupEffectResult]) -> str:
-    """A Markdown table of :func:`gesture_correlations` results."""
+    """A Markdown table of :func:`gesture_correlations` results: a header, a rule, one row per result.
+
+    Examples
+    --------
+    >>> r = CorrelationResult(rho=0.8, p_value=0.2, p_permutation=0.25, null_mean=0.0, null_std=0.49, n=4)
+    >>> print(correlations_markdown({"audio": r}))
+    | gesture energy vs | statistic | p (parametric) | p (permutation) | null |
+    |---|---|---|---|---|
+    | audio | Spearman rho = 0.800 (n=4 windows) | 0.2 | 0.25 | rho +0.000 +- 0.490 |
+    """
     lines = [
         "| gesture energy vs | statistic | p (parametric) | p (permutation) | null |",
         "|---|---|---|---|---|",
@@ -335,9 +449,36 @@ def plot_correlations(
 
     Takes without facial data get no facial-activity panel (two panels, none empty).
 
+    Parameters
+    ----------
+    takes : sequence of CorpusTake
+        Read twice (give a list).
+    seconds : float
+        Window length of the scatter panels, seconds.
+    out : str or Path, optional
+        Path stem to save the figure to with :func:`beatlite.viz.style.save_figure`.
+    formats : tuple of str
+        Formats to save.
+
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Two takes with facial data: three panels, 2 x 7 two-second windows in each scatter.
+
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.stats.corpus import load_corpus
+    >>> tmp = example_corpus()
+    >>> takes = load_corpus(index_folder(tmp.name, cache=False))
+    >>> fig = plot_correlations(takes)
+    >>> len(fig.axes), len(fig.axes[0].collections[0].get_offsets())
+    (3, 14)
+    >>> plt.close(fig)
+    >>> tmp.cleanup()
     """
     import matplotlib.pyplot as plt
 

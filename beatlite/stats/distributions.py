@@ -53,6 +53,27 @@ def speaker_split_table(index: TakeIndex, *, splits: tuple[str, ...] | None = No
     -------
     str
         Columns ``speaker``, ``<split> takes`` ..., ``<split> min`` ... (minutes with 1 decimal).
+
+    Examples
+    --------
+    BEAT's names give the split (sequence 1 of a speech session is a test take, a conversation's is
+    train): speaker 2 has a 60-s train take and two 30-s test takes, speaker 10 one 30-s test take.
+
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
+    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+    ...     r = index_take(stem, files, read_durations=False)
+    ...     r.durations["motion"] = seconds
+    ...     return r
+    >>> index = TakeIndex([record("2_scott_1_2_2", 60.0), record("2_scott_0_1_1", 30.0),
+    ...                    record("2_scott_0_73_73", 30.0), record("10_kieks_0_1_1", 30.0)])
+    >>> print(speaker_split_table(index))
+    | speaker | train takes | test takes | train min | test min |
+    |---|---|---|---|---|
+    | 2_scott | 1 | 2 | 1.0 | 1.0 |
+    | 10_kieks | 0 | 1 | 0.0 | 0.5 |
+    | **all** | 1 | 3 | 1.0 | 1.5 |
     """
     from beatlite.io.names import SPLITS
     from beatlite.report import markdown_table
@@ -95,6 +116,31 @@ def emotion_shares(index: TakeIndex, *, speech_only: bool = True) -> dict[str, f
     speech_only : bool
         Count self-talk (speech) takes only, as the paper's Fig. 2c does (conversations are
         all neutral).
+
+    Returns
+    -------
+    dict
+        Emotion name (:data:`EMOTION_NAMES`) -> fraction of the seconds, summing to 1.
+
+    Examples
+    --------
+    45 s of neutral speech (sequence 1), 15 s of angry speech (sequence 73) and a 60-s conversation:
+    the speech is 45/60 neutral; with the conversation, (45 + 60)/120.
+
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
+    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+    ...     r = index_take(stem, files, read_durations=False)
+    ...     r.durations["motion"] = seconds
+    ...     return r
+    >>> index = TakeIndex([record("2_scott_0_1_1", 45.0), record("2_scott_0_73_73", 15.0),
+    ...                    record("2_scott_1_2_2", 60.0)])
+    >>> shares = emotion_shares(index)
+    >>> shares["neutral"], shares["anger"], shares["sadness"]
+    (0.75, 0.25, 0.0)
+    >>> emotion_shares(index, speech_only=False)["neutral"]
+    0.875
     """
     chosen = index.where(conversation=False) if speech_only else index
     shares = _shares(chosen, lambda r: r.emotion, normalise=True)
@@ -102,12 +148,49 @@ def emotion_shares(index: TakeIndex, *, speech_only: bool = True) -> dict[str, f
 
 
 def language_shares(index: TakeIndex) -> dict[str, float]:
-    """Fraction of the duration per language (languages present only)."""
+    """Fraction of the duration per language (languages present only).
+
+    Returns
+    -------
+    dict
+        Language (``"english"``, ``"chinese"``, ``"spanish"``, ``"japanese"``) -> fraction of the
+        seconds, largest first, summing to 1.
+
+    Examples
+    --------
+    The session type of a BEAT name gives the language (0, 1 English; 2, 3 Chinese): 90 s against 30 s.
+
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
+    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+    ...     r = index_take(stem, files, read_durations=False)
+    ...     r.durations["motion"] = seconds
+    ...     return r
+    >>> index = TakeIndex([record("2_scott_0_1_1", 90.0), record("12_zhao_2_1_1", 30.0)])
+    >>> language_shares(index)
+    {'english': 0.75, 'chinese': 0.25}
+    """
     return dict(sorted(_shares(index, lambda r: r.language, normalise=True).items(), key=lambda kv: -kv[1]))
 
 
 def speaker_durations(index: TakeIndex) -> dict[str, float]:
-    """Seconds of usable takes per speaker, keyed ``"{id}_{name}"``, in speaker id order."""
+    """Seconds of usable takes per speaker, keyed ``"{id}_{name}"``, in speaker id order.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
+    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+    ...     r = index_take(stem, files, read_durations=False)
+    ...     r.durations["motion"] = seconds
+    ...     return r
+    >>> index = TakeIndex([record("10_kieks_0_1_1", 30.0), record("2_scott_0_1_1", 45.0),
+    ...                    record("2_scott_0_73_73", 15.0)])
+    >>> speaker_durations(index)
+    {'2_scott': 60.0, '10_kieks': 30.0}
+    """
     totals = _shares(index, lambda r: (r.speaker_id, r.speaker), normalise=False)
     return {f"{sid}_{name}": v for (sid, name), v in sorted(totals.items())}
 
@@ -142,6 +225,23 @@ def plot_figure2(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    The left panel's two bar series are this corpus's and the paper's 8 emotion shares.
+
+    >>> from pathlib import Path
+    >>> from beatlite.data.index import TakeIndex, index_take
+    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
+    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+    ...     r = index_take(stem, files, read_durations=False)
+    ...     r.durations["motion"] = seconds
+    ...     return r
+    >>> import matplotlib.pyplot as plt
+    >>> fig = plot_figure2(TakeIndex([record("2_scott_0_1_1", 45.0), record("2_scott_0_73_73", 15.0)]))
+    >>> len(fig.axes), len(fig.axes[0].patches)
+    (3, 16)
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 

@@ -193,13 +193,46 @@ def table6(
     Returns
     -------
     dict row name -> :meth:`EmotionClassifier.per_class_accuracy` (fractions, with ``"avg"``).
+
+    Examples
+    --------
+    A still neutral take and a swinging surprised one (a 30-degree sine on every channel) to train on,
+    two new takes of each kind to test: every test window is classified right.
+
+    >>> rng = np.random.default_rng(0)
+    >>> def take(amplitude, n=100):  # (n, 141) Euler degrees
+    ...     return amplitude * np.sin(np.arange(n) / 2)[:, None] + rng.normal(size=(n, 141))
+    >>> labels = [np.zeros(100, int), np.full(100, 5)]  # neutral, surprise
+    >>> rows = table6(([take(0.0), take(30.0)], labels), {"real": ([take(0.0), take(30.0)], labels)})
+    >>> rows["real"]
+    {'neutral': 1.0, 'surprise': 1.0, 'avg': 1.0, 'overall': 1.0}
     """
     clf = EmotionClassifier(seed=seed).fit(*table6_windows(*train))
     return {name: clf.per_class_accuracy(*table6_windows(*takes)) for name, takes in rows.items()}
 
 
 def table6_markdown(real: dict[str, float], generated: dict[str, float] | None = None) -> str:
-    """Markdown table: the paper's Table 6 rows (%) and this corpus's real (and generated) rows."""
+    """Markdown table: the paper's Table 6 rows (%) and this corpus's real (and generated) rows.
+
+    Parameters
+    ----------
+    real, generated : dict str -> float
+        Accuracy in [0, 1] per emotion name and ``"avg"`` (:meth:`EmotionClassifier.per_class_accuracy`);
+        a class absent from the dict is shown as ``-``.
+
+    Returns
+    -------
+    str
+        Header, rule, the 3 paper rows, then 1 or 2 beatlite rows, in percent with 2 decimals.
+
+    Examples
+    --------
+    >>> lines = table6_markdown({"neutral": 0.5, "anger": 1.0, "avg": 0.75}).splitlines()
+    >>> len(lines), lines[0]
+    (6, '| row | neutral | happiness | sadness | anger | surprise | contempt | fear | disgust | avg |')
+    >>> lines[-1]
+    '| beatlite real | 50.00 | - | - | 100.00 | - | - | - | - | 75.00 |'
+    """
     cols = ["neutral", "happiness", "sadness", "anger", "surprise", "contempt", "fear", "disgust", "avg"]
     lines = ["| row | " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in range(len(cols) + 1)) + "|"]
     for name, row in PAPER_TABLE6.items():
@@ -244,6 +277,17 @@ def plot_table6(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Three rows of bars (the paper's real and generated rows, this corpus's real one) over 8 emotions
+    and their average: 27 bars, on a 0-100 % axis.
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig = plot_table6({"neutral": 0.5, "anger": 1.0, "avg": 0.75})
+    >>> len(fig.axes[0].patches), tuple(float(v) for v in fig.axes[0].get_ylim())
+    (27, (0.0, 100.0))
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 

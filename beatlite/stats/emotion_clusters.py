@@ -84,6 +84,26 @@ def rotation_windows(
         Window length (2 s = 30 frames at 15 fps).
     stride_seconds : float, optional
         Hop between windows (default: ``seconds``, non-overlapping).
+
+    Returns
+    -------
+    RotationWindows
+        ``floor(T / L)`` windows of ``L = round(seconds * fps)`` frames per take (non-overlapping).
+
+    Examples
+    --------
+    A 75-frame take at 15 fps holds two 30-frame windows (frames 0-29, 30-59); its emotion turns from
+    neutral to anger at frame 40, so the second window's middle frame (45) is angry. A 29-frame take
+    holds none.
+
+    >>> from types import SimpleNamespace
+    >>> long = SimpleNamespace(fps=15.0, rotations=np.zeros((75, 141)), speaker_id=2,
+    ...                        emotion_frames=np.repeat([0, 2], [40, 35]))
+    >>> short = SimpleNamespace(fps=15.0, rotations=np.zeros((29, 141)), speaker_id=4,
+    ...                         emotion_frames=np.zeros(29, int))
+    >>> rw = rotation_windows([long, short], seconds=2.0)
+    >>> rw.windows.shape, rw.emotion.tolist(), rw.take.tolist(), rw.speaker.tolist()
+    ((2, 30, 141), [0, 2], [0, 0], [2, 2])
     """
     parts, emo, spk, tk = [], [], [], []
     for i, t, w, e in _windows_by_take(takes, seconds, stride_seconds, "rotation_windows"):
@@ -136,6 +156,16 @@ def subset_dims(joints: str) -> np.ndarray:
     Returns
     -------
     (3K,) int64, e.g. 27 dims for ``"body27"`` (0-17 and 75-83).
+
+    Examples
+    --------
+    3 Euler angles for each of the 9 body joints: the 6 joints before the right hand's 25, then the 3 after.
+
+    >>> dims = subset_dims("body27")
+    >>> len(dims), dims[:18].tolist() == list(range(18)), dims[18:].tolist()
+    (27, True, [75, 76, 77, 78, 79, 80, 81, 82, 83])
+    >>> len(subset_dims("hands114")) + len(dims) == len(subset_dims("spine_neck_141"))
+    True
     """
     from beatlite.skeleton import JOINT_SUBSETS
 
@@ -162,6 +192,18 @@ def window_features(windows: np.ndarray, *, kind: str = "stats") -> np.ndarray:
     Returns
     -------
     (N, F) float64
+        ``F = 3 D`` for ``"stats"`` (means, then standard deviations, then mean speeds, each in
+        ``windows``' units per frame), ``L D`` for ``"flat"``.
+
+    Examples
+    --------
+    One channel moving 0, 2, 4 degrees: mean 2, standard deviation sqrt(8/3) = 1.633, 2 degrees per frame.
+
+    >>> np.round(window_features(np.array([[[0.0], [2.0], [4.0]]])), 3).tolist()
+    [[2.0, 1.633, 2.0]]
+    >>> windows = np.zeros((5, 30, 27))  # 5 windows of 30 frames x 27 channels
+    >>> window_features(windows).shape, window_features(windows, kind="flat").shape
+    ((5, 81), (5, 810))
     """
     x = np.asarray(windows, dtype=np.float64)
     if x.ndim != 3 or x.shape[1] < 2:
@@ -288,6 +330,24 @@ def separability(
         Label shuffles for :attr:`Separability.p_permutation` (0: skip).
     seed : int
         Seed of the folds and the shuffles.
+
+    Returns
+    -------
+    Separability
+
+    Examples
+    --------
+    Two blobs 20 standard deviations apart, 10 rows each: every row's nearest neighbours share its
+    label (accuracy 1 against chance 1/2).
+
+    >>> rng = np.random.default_rng(0)
+    >>> features = np.concatenate([rng.normal(0, 1, (10, 4)), rng.normal(20, 1, (10, 4))])
+    >>> labels = np.repeat([0, 1], 10)
+    >>> sep = separability(features, labels, k=3)
+    >>> sep.knn_accuracy, sep.balanced_accuracy, sep.chance, sep.uniform_chance, sep.n, sep.n_classes
+    (1.0, 1.0, 0.5, 0.5, 20, 2)
+    >>> bool(sep.silhouette > 0.9)
+    True
     """
     from scipy.spatial.distance import cdist
     from sklearn.metrics import silhouette_score
@@ -343,6 +403,24 @@ def per_group_standardize(features: np.ndarray, groups: np.ndarray) -> np.ndarra
 
     Removes each speaker's overall style (mean pose, typical speed) so that what remains is
     the within-speaker variation, e.g. by emotion. Uses no labels.
+
+    Parameters
+    ----------
+    features : (N, F) float
+    groups : (N,)
+        Group of each row (e.g. speaker id).
+
+    Returns
+    -------
+    (N, F) float64, mean 0 and standard deviation 1 per column within each group.
+
+    Examples
+    --------
+    Speaker 2 moves at 1 or 3 cm/s, speaker 4 at 10 or 30: each becomes -1, +1 within its speaker.
+
+    >>> speed, speaker = np.array([[1.0], [3.0], [10.0], [30.0]]), np.array([2, 2, 4, 4])
+    >>> per_group_standardize(speed, speaker).ravel().tolist()
+    [-1.0, 1.0, -1.0, 1.0]
     """
     x = np.asarray(features, dtype=np.float64).copy()
     g = np.asarray(groups)
@@ -401,6 +479,43 @@ def emotion_features(
     Only the features are kept (O(N F) memory, e.g. 81 numbers per window for ``"stats"`` of
     ``"body27"``), so ``takes`` may be a single-pass iterator (:func:`beatlite.stats.iter_corpus`).
     ``per_speaker``: standardised within each speaker (:func:`per_group_standardize`) over all windows.
+
+    Parameters
+    ----------
+    takes : iterable of CorpusTake
+        Each needs ``fps``, ``rotations`` (T, 141) degrees, ``emotion_frames`` (T,) and ``speaker_id``.
+    seconds : float
+        Window length, seconds.
+    kind : {"stats", "flat"}
+        See :func:`window_features`.
+    joints : str
+        See :func:`subset_dims`.
+    per_speaker : bool
+        Standardise within each speaker.
+
+    Returns
+    -------
+    EmotionFeatures
+        (N, F) features: F = 3 x 27 = 81 for ``"stats"`` of ``"body27"``.
+
+    Examples
+    --------
+    Six 6-s takes of one speaker hold 6 x 3 two-second windows;
+    :meth:`EmotionFeatures.subsample` keeps a seeded subset in order.
+
+    >>> from types import SimpleNamespace
+    >>> rng = np.random.default_rng(0)
+    >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
+    ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
+    >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
+    >>> ef = emotion_features(takes)
+    >>> ef.features.shape, ef.emotion.tolist()[::3], ef.take.tolist()[:6]
+    ((18, 81), [0, 0, 0, 2, 2, 2], [0, 0, 0, 1, 1, 1])
+    >>> sub = ef.subsample(5)
+    >>> len(sub), bool(np.all(np.diff(sub.take) >= 0))
+    (5, True)
     """
     dims = subset_dims(joints)
     feats, emo, spk, tk = [], [], [], []
@@ -455,6 +570,26 @@ def emotion_separability(
         so its numbers do not depend on it. None: always all windows.
     seed : int
         Seed of the subset, the folds and the permutations.
+
+    Returns
+    -------
+    Separability
+
+    Examples
+    --------
+    Three still takes against three swinging ones (30-degree sine on every channel): each held-out
+    take's windows find their 3 nearest neighbours among the other takes of their emotion.
+
+    >>> from types import SimpleNamespace
+    >>> rng = np.random.default_rng(0)
+    >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
+    ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
+    >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
+    >>> sep = emotion_separability(takes, k=3)
+    >>> sep.n, sep.n_classes, sep.balanced_accuracy, sep.uniform_chance
+    (18, 2, 1.0, 0.5)
     """
     ef = emotion_features(takes, seconds=seconds, kind=kind, joints=joints, per_speaker=per_speaker)
     ef = ef.subsample(max_windows, seed)
@@ -464,7 +599,25 @@ def emotion_separability(
 
 
 def tsne_embedding(features: np.ndarray, *, perplexity: float = 30.0, seed: int = 0) -> np.ndarray:
-    """2-D t-SNE (scikit-learn, PCA init) of standardised ``features`` (N, F) -> (N, 2) float64."""
+    """2-D t-SNE (scikit-learn, PCA init) of standardised ``features`` (N, F) -> (N, 2) float64.
+
+    The perplexity is capped at ``(N - 1) / 3`` (t-SNE needs more points than 3 x perplexity); 500
+    iterations. Distances in the embedding have no unit; only neighbourhoods are meaningful.
+
+    Examples
+    --------
+    Two blobs far apart in 6-D stay apart in 2-D: every point's nearest neighbour has its label.
+    Skipped by the doctests (500 t-SNE iterations take 1-5 s on a 2-core CPU; :func:`plot_emotion_tsne`'s
+    Example runs it).
+
+    >>> rng = np.random.default_rng(0)
+    >>> features = np.concatenate([rng.normal(0, 1, (10, 6)), rng.normal(20, 1, (10, 6))])
+    >>> emb = tsne_embedding(features)  # doctest: +SKIP
+    >>> d = np.linalg.norm(emb[:, None] - emb[None], axis=-1) + np.diag(np.full(20, np.inf))  # doctest: +SKIP
+    >>> labels = np.repeat([0, 1], 10)
+    >>> emb.shape, bool(np.all(labels[d.argmin(axis=1)] == labels))  # doctest: +SKIP
+    ((20, 2), True)
+    """
     from sklearn.decomposition import PCA
     from sklearn.manifold import TSNE
     from sklearn.preprocessing import StandardScaler
@@ -494,9 +647,37 @@ def plot_emotion_tsne(
     Features and the ``max_windows`` subset (seeded, for the t-SNE too) as in
     :func:`emotion_separability` (per-speaker standardised by default).
 
+    Parameters
+    ----------
+    takes : iterable of CorpusTake
+    seconds, kind, joints, per_speaker, max_windows, seed
+        See :func:`emotion_separability`.
+    out : str or Path, optional
+        Path stem to save the figure to with :func:`beatlite.viz.style.save_figure`.
+    formats : tuple of str
+        Formats to save.
+
     Returns
     -------
     (matplotlib.figure.Figure, Separability)
+
+    Examples
+    --------
+    One scatter per emotion present, named in the legend; the 5-NN scores are those of
+    :func:`emotion_separability` with ``k=5``.
+
+    >>> import matplotlib.pyplot as plt
+    >>> from types import SimpleNamespace
+    >>> rng = np.random.default_rng(0)
+    >>> def take(emotion, amplitude):  # 6 s at 15 fps (three 2-s windows) of one speaker, degrees
+    ...     rotations = amplitude * np.sin(np.arange(90) / 2)[:, None] + rng.normal(size=(90, 141))
+    ...     emotion_frames = np.full(90, emotion)
+    ...     return SimpleNamespace(fps=15.0, rotations=rotations, emotion_frames=emotion_frames, speaker_id=2)
+    >>> takes = [take(0, 0.0) for _ in range(3)] + [take(2, 30.0) for _ in range(3)]  # still vs swinging
+    >>> fig, sep = plot_emotion_tsne(takes)
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()], sep.k, sep.balanced_accuracy
+    (['neutral', 'anger'], 5, 1.0)
+    >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
 

@@ -44,7 +44,31 @@ class ScoreHistogram:
 
 
 def score_histogram(takes: Iterable[CorpusTake], *, bins: int = 10) -> ScoreHistogram:
-    """Histogram of the scores of all annotated semantic segments (one count per gesture)."""
+    """Histogram of the scores of all annotated semantic segments (one count per gesture).
+
+    Parameters
+    ----------
+    takes : iterable of CorpusTake
+        Their ``semantic_scores`` (S,) in [0, 1] are pooled.
+    bins : int
+        Equal-width bins over [0, 1].
+
+    Returns
+    -------
+    ScoreHistogram
+
+    Examples
+    --------
+    Five gestures scored 0, 0.1, 0.2, 0.5 and 1: three are at or below the paper's 0.2 threshold,
+    three fall in the lower half of [0, 1].
+
+    >>> from types import SimpleNamespace
+    >>> takes = [SimpleNamespace(semantic_scores=np.array([0.0, 0.1, 0.5])),
+    ...          SimpleNamespace(semantic_scores=np.array([0.2, 1.0]))]
+    >>> h = score_histogram(takes, bins=2)
+    >>> h.counts.tolist(), h.edges.tolist(), h.share_low, h.n
+    ([3, 2], [0.0, 0.5, 1.0], 0.6, 5)
+    """
     scores = np.concatenate([np.zeros(0, np.float32), *(t.semantic_scores for t in takes)])
     if scores.size == 0:
         raise ValueError("score_histogram: no semantic segments in the takes")
@@ -63,6 +87,18 @@ def word_scores(takes: Iterable[CorpusTake], *, top: int = 9) -> list[tuple[str,
     Returns
     -------
     list of (word, count, mean score), by decreasing count then alphabetically.
+
+    Examples
+    --------
+    At 1 fps "the" covers frames 0 and 2 (scores 0.1 and 0.5), "idea" frame 1 (0.9).
+
+    >>> from types import SimpleNamespace
+    >>> take = SimpleNamespace(fps=1.0, semantic=np.array([0.1, 0.9, 0.5]), words=("The", "idea", "the"),
+    ...                        word_starts=np.array([0.0, 1.0, 2.0]), word_ends=np.array([1.0, 2.0, 3.0]))
+    >>> [(w, n, round(s, 3)) for w, n, s in word_scores([take])]
+    [('the', 2, 0.3), ('idea', 1, 0.9)]
+    >>> word_scores([take], top=1)[0][0]
+    'the'
     """
     scores = word_occurrence_scores(takes)
     ranked = sorted(scores, key=lambda w: (-len(scores[w]), w))[:top]
@@ -70,7 +106,18 @@ def word_scores(takes: Iterable[CorpusTake], *, top: int = 9) -> list[tuple[str,
 
 
 def word_occurrence_scores(takes: Iterable[CorpusTake]) -> dict[str, list[float]]:
-    """Lower-cased word -> the score of each of its occurrences (see :func:`word_scores`)."""
+    """Lower-cased word -> the score of each of its occurrences (see :func:`word_scores`).
+
+    Examples
+    --------
+    At 2 fps, "idea" from 0.5 s to 1.5 s covers frames 1 and 2 (0.4 and 0.8): its score is 0.6.
+
+    >>> from types import SimpleNamespace
+    >>> take = SimpleNamespace(fps=2.0, semantic=np.array([0.0, 0.4, 0.8, 0.0]), words=("my", "Idea"),
+    ...                        word_starts=np.array([0.0, 0.5]), word_ends=np.array([0.5, 1.5]))
+    >>> {w: [round(s, 3) for s in v] for w, v in word_occurrence_scores([take]).items()}
+    {'my': [0.0], 'idea': [0.6]}
+    """
     scores: dict[str, list[float]] = defaultdict(list)
     for t in takes:
         for start, end, word in zip(t.word_starts, t.word_ends, t.words):
@@ -127,7 +174,21 @@ def word_class_scores(
 
 
 def speaker_scores(takes: Iterable[CorpusTake]) -> dict[int, dict[str, float]]:
-    """Per speaker id: ``mean`` segment score, ``share_low`` (<= 0.2) and ``n`` segments."""
+    """Per speaker id: ``mean`` segment score, ``share_low`` (<= 0.2) and ``n`` segments.
+
+    Returns
+    -------
+    dict speaker id -> {"mean": float in [0, 1], "share_low": float in [0, 1], "n": int}, in id order;
+    speakers without segments are left out.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> takes = [SimpleNamespace(speaker_id=4, semantic_scores=np.array([0.0, 1.0])),
+    ...          SimpleNamespace(speaker_id=2, semantic_scores=np.array([0.0, 0.125, 0.25, 0.625]))]
+    >>> speaker_scores(takes)  # speaker 2: mean 1.0 / 4, two of four <= 0.2
+    {2: {'mean': 0.25, 'share_low': 0.5, 'n': 4}, 4: {'mean': 0.5, 'share_low': 0.5, 'n': 2}}
+    """
     by: dict[int, list[np.ndarray]] = defaultdict(list)
     for t in takes:
         by[t.speaker_id].append(t.semantic_scores)
@@ -156,9 +217,36 @@ def plot_figure4(
     share of gestures at or below it; every axis has its unit. Takes without word
     timings (no TextGrid) get no panel (c) (two panels, none empty).
 
+    Parameters
+    ----------
+    takes : sequence of CorpusTake
+        Read three times (give a list).
+    top : int
+        Words in panel (c).
+    out : str or Path, optional
+        Path stem to save the figure to with :func:`beatlite.viz.style.save_figure`.
+    formats : tuple of str
+        Formats to save.
+
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    Two takes of ``data_samples/`` with their TextGrids: three panels, one bar per speaker in (a),
+    ``top`` words in (c).
+
+    >>> import matplotlib.pyplot as plt
+    >>> from beatlite.data.index import index_folder
+    >>> from beatlite.data.examples import example_corpus
+    >>> from beatlite.stats.corpus import load_corpus
+    >>> tmp = example_corpus()
+    >>> fig = plot_figure4(load_corpus(index_folder(tmp.name, cache=False)), top=5)
+    >>> len(fig.axes), len(fig.axes[0].patches), len(fig.axes[2].patches)
+    (3, 1, 5)
+    >>> plt.close(fig)
+    >>> tmp.cleanup()
     """
     import matplotlib.pyplot as plt
 

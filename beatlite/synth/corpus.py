@@ -55,6 +55,17 @@ class TakeSpec:
         Sequence id (start = end).
     target_s : float
         Wanted amount of speech, seconds (the take ends after the sentence that reaches it).
+
+    Examples
+    --------
+    Speech sequence 65 is the first of the happiness block (65-72); BEAT's split rule puts
+    speaker 2's sequence 65 in test.
+
+    >>> spec = TakeSpec(2, 0, 65, 10.0)
+    >>> spec.name, spec.speaker.name, EMOTION_NAMES[spec.emotion], spec.split
+    ('2_scott_0_65_65', 'scott', 'happiness', 'test')
+    >>> TakeSpec(2, 1, 2, 18.0).emotion  # a conversation is neutral by its name
+    0
     """
 
     speaker_id: int
@@ -104,6 +115,18 @@ def corpus_specs() -> list[TakeSpec]:
     -------
     list of TakeSpec
         44 takes, speaker by speaker, speech before conversation.
+
+    Examples
+    --------
+    4 speakers x (10 speech takes + 1 conversation), each speaker with takes in every split:
+
+    >>> specs = corpus_specs()
+    >>> len(specs), sum(s.session == 1 for s in specs), sorted({s.speaker_id for s in specs})
+    (44, 4, [2, 4, 6, 8])
+    >>> sorted({s.split for s in specs if s.speaker_id == 2})
+    ['test', 'train', 'val']
+    >>> specs[0].name, specs[0].target_s == SPEECH_TARGET_S
+    ('2_scott_0_9_9', True)
     """
     specs: list[TakeSpec] = []
     for sid, splits in _SPEECH_SEQUENCES.items():
@@ -170,6 +193,21 @@ def synthesize_speech(spec: TakeSpec, rng: np.random.Generator) -> Speech:
     Returns
     -------
     Speech
+
+    Examples
+    --------
+    Skipped by the doctests (needs espeak-ng; word lengths depend on its version). The take is a whole
+    number of 0.2-s steps of 16-kHz audio, spoken in one emotion, its words in order and apart:
+
+    >>> speech = synthesize_speech(TakeSpec(2, 0, 65, 2.0), np.random.default_rng(0))  # doctest: +SKIP
+    >>> round(speech.duration / DURATION_STEP_S, 6).is_integer()  # doctest: +SKIP
+    True
+    >>> speech.audio.shape == (round(speech.duration * OUTPUT_SR),)  # doctest: +SKIP
+    True
+    >>> speech.emotions == ((0.0, speech.duration, 1),)  # doctest: +SKIP
+    True
+    >>> all(a.end < b.start for a, b in zip(speech.words, speech.words[1:]))  # doctest: +SKIP
+    True
     """
     placed, words, turn_bounds = _lay_out_words(spec, rng)
     end = words[-1].end + 0.8
@@ -301,6 +339,21 @@ def generate_take(
     Returns
     -------
     TakeResult
+
+    Examples
+    --------
+    Skipped by the doctests (needs espeak-ng). Six files in BEAT's formats, which index as one
+    usable take whose name gives its emotion and split:
+
+    >>> import tempfile  # doctest: +SKIP
+    >>> from beatlite.data.index import index_folder  # doctest: +SKIP
+    >>> with tempfile.TemporaryDirectory() as tmp:  # doctest: +SKIP
+    ...     result = generate_take(TakeSpec(2, 0, 65, 2.0), tmp, seed=0)
+    ...     record = index_folder(tmp, cache=False)["2_scott_0_65_65"]
+    ...     print([p.name.split(".", 1)[1] for p in result.paths])
+    ...     print(record.usable, record.emotion_name, record.split, record.duration == result.duration)
+    ['bvh.gz', 'wav', 'json.gz', 'TextGrid', 'txt', 'csv']
+    True happiness test True
     """
     if not isinstance(spec, TakeSpec):
         raise TypeError(f"generate_take: spec must be a TakeSpec, got {type(spec).__name__}")
@@ -424,6 +477,17 @@ def generate_corpus(
     Returns
     -------
     list of TakeResult, in the order of ``specs``.
+
+    Examples
+    --------
+    Skipped by the doctests (needs espeak-ng). Two short takes of :func:`corpus_specs`' speakers, in
+    this process:
+
+    >>> import tempfile  # doctest: +SKIP
+    >>> with tempfile.TemporaryDirectory() as tmp:  # doctest: +SKIP
+    ...     results = generate_corpus(tmp, specs=[TakeSpec(2, 0, 1, 1.0), TakeSpec(4, 0, 65, 1.0)], workers=1)
+    ...     print([r.name for r in results], len(list(Path(tmp).iterdir())))
+    ['2_scott_0_1_1', '4_lawrence_0_65_65'] 12
     """
     _check_fps(fps, "generate_corpus")
     espeak_path()  # fail early with the install hint

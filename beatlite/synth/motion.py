@@ -98,7 +98,23 @@ _ELBOW_POLE = np.array([-0.45, -1.0, -0.35])
 
 # ----------------------------------------------------------------------------- time profiles
 def min_jerk(x: np.ndarray) -> np.ndarray:
-    """Minimum-jerk ramp ``10x^3 - 15x^4 + 6x^5`` of ``x`` clipped to [0, 1] (zero speed at both ends)."""
+    """Minimum-jerk ramp ``10x^3 - 15x^4 + 6x^5`` of ``x`` clipped to [0, 1] (zero speed at both ends).
+
+    Parameters
+    ----------
+    x : (...) float, normalised time (0 = start, 1 = end of the ramp)
+
+    Returns
+    -------
+    (...) float64 in [0, 1]
+
+    Examples
+    --------
+    0 before the ramp, 1 after it, half-way at its middle (10/8 - 15/16 + 6/32 = 0.5):
+
+    >>> min_jerk(np.array([-1.0, 0.0, 0.5, 1.0, 2.0])).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0]
+    """
     x = np.clip(x, 0.0, 1.0)
     return x**3 * (10.0 - 15.0 * x + 6.0 * x**2)
 
@@ -115,6 +131,13 @@ def smooth_box(t: np.ndarray, start: float, end: float, ramp_in: float, ramp_out
     Returns
     -------
     (T,) float64 in [0, 1]
+
+    Examples
+    --------
+    1 on [1, 3] s, half-way up 0.5 s before (the ramp's middle) and half-way down 0.5 s after:
+
+    >>> smooth_box(np.array([0.0, 0.5, 1.0, 2.0, 3.0, 3.5, 4.0]), 1.0, 3.0, 1.0, 1.0).tolist()
+    [0.0, 0.5, 1.0, 1.0, 1.0, 0.5, 0.0]
     """
     rise = min_jerk((t - (start - ramp_in)) / ramp_in)
     fall = 1.0 - min_jerk((t - end) / ramp_out)
@@ -134,6 +157,14 @@ def beat_phase(s: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T,) float64, radians
+
+    Examples
+    --------
+    ``phi(1/4) = pi/2 - sin(pi/2) = 0.5708``: a quarter of the time covers less than a quarter of
+    the loop (slow start); the middle is at ``pi``, the end at ``2 pi``.
+
+    >>> np.round(beat_phase(np.array([0.0, 0.25, 0.5, 1.0])), 4).tolist()
+    [0.0, 0.5708, 3.1416, 6.2832]
     """
     s = np.clip(np.asarray(s, dtype=np.float64), 0.0, 1.0)
     return 2.0 * np.pi * s - np.sin(2.0 * np.pi * s)
@@ -161,6 +192,17 @@ def loop_phase(t: np.ndarray, start: float, end: float, accents: tuple[float, ..
     Returns
     -------
     (T,) float64, radians: 0 before ``start``, ``2 pi`` after ``end``.
+
+    Examples
+    --------
+    Without accents, a loop on [0, 2] s is half done at 1 s (:func:`beat_phase` of 1/2); an accent
+    at 0.5 s changes the path in between, not the ends.
+
+    >>> np.round(loop_phase(np.array([-1.0, 0.0, 1.0, 2.0, 3.0]), 0.0, 2.0), 4).tolist()
+    [0.0, 0.0, 3.1416, 6.2832, 6.2832]
+    >>> phi = loop_phase(np.linspace(0.0, 2.0, 41), 0.0, 2.0, accents=(0.5,))
+    >>> float(round(phi[0], 4)), float(round(phi[-1], 4)), bool(np.all(np.diff(phi) > 0))
+    (0.0, 6.2832, True)
     """
     t = np.asarray(t, dtype=np.float64)
     if not accents:
@@ -203,6 +245,19 @@ def beat_lift(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
         Height of the loop (0 at every beat time, ``A_k`` at its middle).
     loop : (T,) float64
         Sideways displacement of the loop (0 at the beat times and the middles).
+
+    Examples
+    --------
+    A 5-cm beat at 1 s whose loop lasts 1 s (longer than :data:`FULL_LOOP_S`, so full size): the hand
+    is 5 cm up half-way (``phi = pi``), back at the beat; a quarter of the way in ``phi = 0.5708``
+    (:func:`beat_phase`), so ``lift = 2.5 (1 - cos phi)`` and ``loop = 2.5 sin phi``.
+
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> plan = Plan(words=(), phrases=(), beats=(Beat(time=1.0, amplitude=5.0, stroke=0.5, prep=0.5),),
+    ...             gestures=(), duration=2.0)
+    >>> lift, loop = beat_lift(np.array([0.25, 0.5, 1.0, 1.5]), plan)
+    >>> np.round(lift, 3).tolist(), np.round(loop, 3).tolist()
+    ([0.396, 5.0, 0.0, 0.0], [1.351, 0.0, 0.0, 0.0])
     """
     t = np.asarray(t, dtype=np.float64)
     lift = np.zeros_like(t)
@@ -242,6 +297,17 @@ def syllable_pulse(t: np.ndarray, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     up, side : (T,) float64, unitless in [0, 1] and [-0.5, 0.5]
+
+    Examples
+    --------
+    Onsets at 1 and 2 s: the bob is at the top (``up = 1``, ``side = 0``) half-way between them and
+    at rest on them.
+
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> plan = Plan(words=(), phrases=(), beats=(), gestures=(), duration=3.0, syllables=(1.0, 2.0))
+    >>> up, side = syllable_pulse(np.array([0.5, 1.0, 1.5, 2.0, 2.5]), plan)
+    >>> np.round(up, 3).tolist(), np.round(np.abs(side), 3).tolist()
+    ([1.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0])
     """
     t = np.asarray(t, dtype=np.float64)
     up = np.zeros_like(t)
@@ -271,6 +337,18 @@ def gesture_weight(t: np.ndarray, g: Gesture) -> np.ndarray:
     Returns
     -------
     (T,) float64 in [0, 1]
+
+    Examples
+    --------
+    Preparation 0.5-1 s, hold 1-2 s, retraction 2-2.5 s; each ramp is half-way at its middle.
+
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> g = Gesture(kind="idea", onset=1.0, hold_end=2.0, ramp_in=0.5, ramp_out=0.5, word="idea",
+    ...             label="08_metaphoric_l", amplitude=1.0)
+    >>> g.start, g.end
+    (0.5, 2.5)
+    >>> np.round(gesture_weight(np.array([0.5, 0.75, 1.0, 1.5, 2.0, 2.25, 2.5]), g), 4).tolist()
+    [0.0, 0.5, 1.0, 1.0, 1.0, 0.5, 0.0]
     """
     t = np.asarray(t, dtype=np.float64)
     rise_acc = tuple(a for a in g.accents if g.start < a < g.onset)
@@ -294,6 +372,16 @@ def phrase_envelope(t: np.ndarray, plan: Plan) -> np.ndarray:
     Returns
     -------
     (T,) float64 in [0, 1]
+
+    Examples
+    --------
+    One phrase from 1 to 2 s: 1 on [1, 2.25] s, half-way 0.3 s before (the 0.6-s ramp's middle) and
+    0.4 s after (the 0.8-s ramp's), 0 outside.
+
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> plan = Plan(words=(), phrases=((1.0, 2.0),), beats=(), gestures=(), duration=4.0)
+    >>> np.round(phrase_envelope(np.array([0.3, 0.7, 1.0, 2.25, 2.65, 3.1]), plan), 4).tolist()
+    [0.0, 0.5, 1.0, 1.0, 0.5, 0.0]
     """
     rise, fall, after = 0.6, 0.8, 0.25
     merged: list[list[float]] = []
@@ -314,9 +402,28 @@ def emotion_track(t: np.ndarray, plan: Plan, field: str) -> np.ndarray:
     Each word's emotion holds from its start until the next word; before the first word the
     first emotion holds. Changes are smoothed over 0.5 s.
 
+    Parameters
+    ----------
+    t : (T,) float64, seconds, evenly spaced
+    plan : Plan
+    field : str
+        A field of :class:`beatlite.synth.styles.EmotionStyle` (``"amplitude"``, ``"head_pitch"``, ...).
+
     Returns
     -------
-    (T,) float64
+    (T,) float64, in the field's unit
+
+    Examples
+    --------
+    A neutral word, then an angry one at 1 s: the beat amplitude multiplier rises smoothly from
+    neutral's 1.0 to anger's 1.5 (:data:`beatlite.synth.styles.EMOTION_STYLES`).
+
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> plan = Plan(words=(TimedWord(0.0, 0.9, "well", 0), TimedWord(1.0, 1.5, "no", 2)), phrases=(),
+    ...             beats=(), gestures=(), duration=3.0)
+    >>> amp = emotion_track(np.arange(30) / 10, plan, "amplitude")
+    >>> float(amp[0]), float(amp[-1]), bool(np.all(np.diff(amp) >= 0))
+    (1.0, 1.5, True)
     """
     if not plan.words:
         return np.full_like(t, getattr(EMOTION_STYLES[0], field))
@@ -337,6 +444,14 @@ def emotion_ids(t: np.ndarray, plan: Plan) -> np.ndarray:
     Returns
     -------
     (T,) int64
+
+    Examples
+    --------
+    >>> from beatlite.synth.plan import Beat, Gesture, Plan, TimedWord
+    >>> plan = Plan(words=(TimedWord(0.5, 0.9, "well", 0), TimedWord(1.0, 1.5, "no", 2)), phrases=(),
+    ...             beats=(), gestures=(), duration=3.0)
+    >>> emotion_ids(np.array([0.0, 0.99, 1.0, 2.5]), plan).tolist()
+    [0, 0, 2, 2]
     """
     t = np.asarray(t, dtype=np.float64)
     if not plan.words:
@@ -405,6 +520,24 @@ def wrist_paths(
     -------
     dict side -> {"wrist": (T, 3) cm chest frame, "curl": (T, 5) in [0, 1], "roll": (T,) degrees,
     "flex": (T,) degrees}, sides ``"right"``, ``"left"``.
+
+    Examples
+    --------
+    With nothing said (no phrase, beat or gesture) both wrists rest at the speaker's ``rest`` (the left
+    one mirrored in x), moved only by the three slow drift sinusoids of :data:`DRIFT_CM` each.
+
+    >>> from beatlite.synth.plan import Plan
+    >>> from beatlite.synth.styles import SPEAKERS
+    >>> speaker = SPEAKERS[2]
+    >>> silent = Plan(words=(), phrases=(), beats=(), gestures=(), duration=2.0)
+    >>> paths = wrist_paths(np.arange(30) / 15, silent, speaker, np.random.default_rng(0))
+    >>> {k: v.shape for k, v in paths["right"].items()}
+    {'wrist': (30, 3), 'curl': (30, 5), 'roll': (30,), 'flex': (30,)}
+    >>> rest = np.array(speaker.rest)
+    >>> bool(np.abs(paths["right"]["wrist"] - rest).max() <= 3 * DRIFT_CM)
+    True
+    >>> bool(np.abs(paths["left"]["wrist"] - rest * [-1, 1, 1]).max() <= 3 * DRIFT_CM)
+    True
     """
     lift, loop = beat_lift(t, plan)
     drive = _HandDrive(
@@ -539,6 +672,20 @@ def _normalize(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
+def _elbow_side(pole: np.ndarray, towards: np.ndarray) -> np.ndarray:
+    """Unit directions (T, 3) perpendicular to ``towards`` (T, 3, unit) on the side of ``pole`` (T, 3).
+
+    Where ``pole`` lies along ``towards`` (or is zero) every elbow plane is as good: the
+    coordinate axis least aligned with ``towards`` gives one.
+    """
+    perp = pole - np.sum(pole * towards, axis=1, keepdims=True) * towards
+    free = np.linalg.norm(perp, axis=1) <= 1e-9 * np.linalg.norm(pole, axis=1)
+    if np.any(free):
+        axis = np.eye(3)[np.argmin(np.abs(towards[free]), axis=1)]
+        perp[free] = axis - np.sum(axis * towards[free], axis=1, keepdims=True) * towards[free]
+    return _normalize(perp)
+
+
 def two_bone_ik(
     target: np.ndarray,
     root: np.ndarray,
@@ -557,7 +704,8 @@ def two_bone_ik(
     upper, lower : (3,) float
         Elbow offset (in the shoulder's frame) and wrist offset (in the elbow's frame) at rest.
     pole : (T, 3) or (3,) float
-        Direction the elbow should point to, same frame as ``target``.
+        Direction the elbow should point to, same frame as ``target``. Where it lies along the
+        shoulder-target line (or is zero) any elbow plane reaches the target and one is chosen.
 
     Returns
     -------
@@ -571,6 +719,19 @@ def two_bone_ik(
     The shoulder-wrist distance saturates smoothly (``tanh``): beyond ``0.85 (l1 + l2)``
     towards ``0.97 (l1 + l2)`` (the elbow keeps ~28 degrees of flexion and never snaps straight)
     and below the distance of :data:`MAX_ELBOW_FLEX_DEG` flexion (+ 4 cm) towards that distance.
+
+    Examples
+    --------
+    A 30-cm upper arm and a 25-cm forearm hanging down; a target 35 cm from the shoulder is reached
+    exactly (forward kinematics ``root + S (upper + E lower)``); one 100 cm away is not, and the
+    wrist stops short of 0.97 x 55 cm.
+
+    >>> upper, lower, root = np.array([0.0, -30.0, 0.0]), np.array([0.0, -25.0, 0.0]), np.zeros(3)
+    >>> target = np.array([[0.0, -28.0, 21.0], [60.0, 0.0, 80.0]])  # 35 cm and 100 cm away
+    >>> s, e = two_bone_ik(target, root, upper, lower, pole=np.array([0.0, 0.0, -1.0]))
+    >>> wrist = root + np.einsum("tij,tj->ti", s, upper + np.einsum("tij,j->ti", e, lower))
+    >>> bool(np.allclose(wrist[0], target[0])), bool(52.0 < np.linalg.norm(wrist[1]) < 0.97 * 55.0)
+    (True, True)
     """
     target = np.asarray(target, dtype=np.float64)
     if target.ndim != 2 or target.shape[1] != 3:
@@ -591,7 +752,7 @@ def two_bone_ik(
     cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
     sin_a = np.sqrt(1.0 - cos_a**2)
     pole = np.broadcast_to(np.asarray(pole, dtype=np.float64), v.shape)
-    n = _normalize(pole - np.sum(pole * vh, axis=1, keepdims=True) * vh)
+    n = _elbow_side(pole, vh)
     a_dir = cos_a[:, None] * vh + sin_a[:, None] * n
     wrist = d[:, None] * vh
     f_dir = _normalize(wrist - l1 * a_dir)
@@ -623,6 +784,14 @@ def continuous_euler(angles: np.ndarray) -> np.ndarray:
     Returns
     -------
     (T, 3) float64, degrees
+
+    Examples
+    --------
+    An XYZ rotation passing from 89 to 91 degrees about Y: the second frame, given as the equivalent
+    (180, 89, 180), is rewritten as the (0, 91, 0) next to the first.
+
+    >>> continuous_euler(np.array([[0.0, 89.0, 0.0], [180.0, 89.0, 180.0]])).tolist()
+    [[0.0, 89.0, 0.0], [0.0, 91.0, 0.0]]
     """
     out = unwrap_degrees(np.asarray(angles, dtype=np.float64))
     if out.shape[0] < 2 or np.abs(np.diff(out, axis=0)).max() < 90.0:
@@ -693,6 +862,22 @@ def body_channels(
     (T, 228) float64
         Hips position in centimetres, rotations in degrees (each joint's CHANNELS order),
         unwrapped along time.
+
+    Examples
+    --------
+    2 s at 15 fps of a silent take: 6 channels of the hips and 3 of each of the other 74 joints per
+    frame; the motion is a function of the seed alone.
+
+    >>> from beatlite.skeleton.beat import beat_skeleton
+    >>> from beatlite.synth.plan import Plan
+    >>> from beatlite.synth.styles import SPEAKERS
+    >>> skeleton, t = beat_skeleton(), np.arange(30) / 15
+    >>> silent = Plan(words=(), phrases=(), beats=(), gestures=(), duration=2.0)
+    >>> ch = body_channels(skeleton, t, silent, SPEAKERS[2], np.random.default_rng(0))
+    >>> ch.shape, 6 + 3 * (skeleton.n_joints - 1)
+    ((30, 228), 228)
+    >>> bool(np.array_equal(ch, body_channels(skeleton, t, silent, SPEAKERS[2], np.random.default_rng(0))))
+    True
     """
     t = np.asarray(t, dtype=np.float64)
     ch = np.zeros((t.size, skeleton.n_channels))

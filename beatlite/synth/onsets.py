@@ -50,6 +50,17 @@ def onset_envelope(audio: np.ndarray, sr: int) -> np.ndarray:
     -------
     (F,) float64
         Frame ``f`` is the rise into the frame centred on sample ``f * HOP``; ``env[0] = 0``.
+
+    Examples
+    --------
+    One second at 16 kHz has ``1 + 16000 // 512 = 32`` centred frames; a noise burst starting at
+    sample 8000 first enters the 2048-sample window of frame 14 (centred on 7168, reaching 8192).
+
+    >>> y = np.zeros(16000)
+    >>> y[8000:9600] = 0.5 * np.random.default_rng(0).normal(size=1600)
+    >>> env = onset_envelope(y, 16000)
+    >>> env.shape, float(env[0]), int(env.argmax())
+    ((32,), 0.0, 14)
     """
     y = np.asarray(audio, dtype=np.float64)
     if y.ndim != 1:
@@ -87,6 +98,18 @@ def speech_onsets(audio: np.ndarray, sr: int, *, delta: float = 0.07) -> np.ndar
     -------
     (K,) float64
         Increasing onset times, seconds (librosa's convention: the flux frame + ``N_FFT // (2 HOP)``).
+
+    Examples
+    --------
+    Three 0.1-s noise bursts at 0.5, 1.3 and 2.1 s are found on the 32-ms hop grid, within 1.5 hops of
+    their starts (e.g. frame 14 + 2 = 16 hops = 0.512 s).
+
+    >>> sr, rng = 16000, np.random.default_rng(0)
+    >>> y = np.zeros(3 * sr)
+    >>> for start in (0.5, 1.3, 2.1):
+    ...     y[int(start * sr) : int(start * sr) + 1600] = 0.5 * rng.normal(size=1600)
+    >>> np.round(speech_onsets(y, sr), 3).tolist()
+    [0.512, 1.312, 2.112]
     """
     env = onset_envelope(audio, sr)
     if env.size < 3 or env.max() <= env.min():

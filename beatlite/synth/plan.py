@@ -165,6 +165,14 @@ def find_phrases(words: Sequence[TimedWord], gap: float = PHRASE_GAP_S) -> list[
     Returns
     -------
     list of (start, end) in seconds.
+
+    Examples
+    --------
+    A 0.1-s gap stays inside a phrase, a 1.5-s pause starts a new one:
+
+    >>> find_phrases([TimedWord(0.0, 0.4, "we", 0), TimedWord(0.5, 1.0, "walked", 0),
+    ...               TimedWord(2.5, 3.0, "home", 0)])
+    [(0.0, 1.0), (2.5, 3.0)]
     """
     phrases: list[tuple[float, float]] = []
     for w in words:
@@ -213,6 +221,32 @@ def make_plan(
     Returns
     -------
     Plan
+
+    Examples
+    --------
+    "idea" is a keyword: its gesture's stroke ends on the word (2.4 s), its preparation takes
+    ``PREP_S x 1.3 = 0.585`` s (a far-travelling kind, :data:`SLOW_KINDS`) and its retraction
+    ``RETRACT_S x 1.3 = 0.78`` s after the word's end (2.9 s); the beats before it sit on word
+    onsets, and "works" (3.5 s) comes too soon after the retraction for one ("we", two letters,
+    gets a beat only half of the time).
+
+    >>> from beatlite.synth.styles import SPEAKERS
+    >>> timing = [(0.5, 0.9, "we"), (1.0, 1.5, "walked"), (1.6, 2.0, "home"), (2.4, 2.9, "idea"),
+    ...           (3.5, 4.0, "works")]
+    >>> words = [TimedWord(start, end, word, 0) for start, end, word in timing]  # all neutral
+    >>> plan = make_plan(words, SPEAKERS[2], 5.0, np.random.default_rng(0))
+    >>> [b.time for b in plan.beats]
+    [1.0, 1.6]
+    >>> [(g.kind, g.onset, round(g.start, 3), round(g.end, 3)) for g in plan.gestures]
+    [('idea', 2.4, 1.815, 3.68)]
+    >>> plan.phrases
+    ((0.5, 4.0),)
+
+    Given the audio's onsets, the beats move onto them:
+
+    >>> onsets = [0.52, 1.02, 1.62, 2.42, 3.52]
+    >>> [b.time for b in make_plan(words, SPEAKERS[2], 5.0, np.random.default_rng(0), onsets=onsets).beats]
+    [1.02, 1.62]
     """
     onset_arr = None if onsets is None else merge_onsets(onsets)
     state = _PlanState()
@@ -351,6 +385,13 @@ def merge_onsets(onsets: Sequence[float] | np.ndarray, gap: float | None = None)
     Returns
     -------
     (K',) float64 increasing, seconds.
+
+    Examples
+    --------
+    Runs closer than 0.2 s become their mean: (1.0 + 1.1) / 2 and (2.0 + 2.12 + 2.24) / 3.
+
+    >>> np.round(merge_onsets([1.0, 1.1, 1.5, 2.0, 2.12, 2.24], gap=0.2), 3).tolist()
+    [1.05, 1.5, 2.12]
     """
     gap = ACCENT_GAP_S if gap is None else float(gap)
     x = np.sort(np.asarray(onsets, dtype=np.float64).reshape(-1))
@@ -411,6 +452,22 @@ def semantic_segments(plan: Plan) -> list[tuple[str, float, float, float, str]]:
     -------
     list of (label, start, end, score, keyword)
         Contiguous, non-overlapping, rounded to milliseconds.
+
+    Examples
+    --------
+    A beat at 1 s (its 1-s loop from 0 s, annotated until 1.2 s) and an "idea" gesture from 2 to
+    3.5 s in a 5-s take; scores from :data:`beatlite.synth.styles.SEMANTIC_SCORES`.
+
+    >>> beat = Beat(time=1.0, amplitude=5.0, stroke=0.5, prep=0.5)
+    >>> idea = Gesture(kind="idea", onset=2.5, hold_end=3.0, ramp_in=0.5, ramp_out=0.5, word="idea",
+    ...                label="08_metaphoric_l", amplitude=1.0)
+    >>> plan = Plan(words=(), phrases=(), beats=(beat,), gestures=(idea,), duration=5.0)
+    >>> for segment in semantic_segments(plan):
+    ...     print(segment)
+    ('01_beat_align', 0.0, 1.2, 0.1, '')
+    ('00_nogesture', 1.2, 2.0, 0.0, '')
+    ('08_metaphoric_l', 2.0, 3.5, 0.8, 'idea')
+    ('00_nogesture', 3.5, 5.0, 0.0, '')
     """
     marks = [(max(g.start, 0.0), min(g.end, plan.duration), g.label, g.word) for g in plan.gestures]
     for start, end in _beat_runs(plan.beats):

@@ -98,6 +98,19 @@ def espeak_path() -> str:
     ------
     EspeakNotFoundError
         When it is not on ``PATH``, with the command that installs it.
+
+    Examples
+    --------
+    With an empty ``PATH`` nothing is found, and the error says how to install it:
+
+    >>> import os
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"PATH": ""}):
+    ...     try:
+    ...         espeak_path()
+    ...     except EspeakNotFoundError as e:
+    ...         print("apt-get install espeak-ng" in str(e))
+    True
     """
     path = shutil.which("espeak-ng")
     if path is None:
@@ -122,6 +135,13 @@ def split_phonemes(text: str) -> tuple[str, ...]:
     tuple of str
         e.g. ``("s", "3:", "k", "@L")``; stress and syllable marks are dropped,
         an unknown character becomes a phone of its own.
+
+    Examples
+    --------
+    The longest phone that matches wins ("oU", not "o" then "U"); the stress mark ``'`` is dropped:
+
+    >>> split_phonemes("h@l'oU"), split_phonemes("s'3:k@L")
+    (('h', '@', 'l', 'oU'), ('s', '3:', 'k', '@L'))
     """
     phones: list[str] = []
     i = 0
@@ -158,6 +178,15 @@ def trim_silence(y: np.ndarray, *, threshold: float = 0.02, margin_s: float = 0.
     -------
     (M,) float32
         The trimmed waveform (unchanged when all samples are silent).
+
+    Examples
+    --------
+    100 loud samples in 1000: kept with ``0.005 x 22050 = 110`` samples of margin on each side.
+
+    >>> y = np.zeros(1000)
+    >>> y[400:500] = 0.5
+    >>> trim_silence(y).size, 100 + 2 * 110
+    (320, 320)
     """
     y = np.asarray(y, dtype=np.float32)
     if y.ndim != 1:
@@ -199,6 +228,17 @@ def speak_words(
     -------
     list of SpokenWord
         One per input word, in order.
+
+    Examples
+    --------
+    Skipped by the doctests (needs espeak-ng). A repeated word is spoken once:
+
+    >>> voice = Voice("en-us+m3", rate=175, pitch=50, amplitude=100)  # doctest: +SKIP
+    >>> spoken = speak_words(["hello", "world", "hello"], voice)  # doctest: +SKIP
+    >>> [w.word for w in spoken], spoken[0] is spoken[2], spoken[0].phones  # doctest: +SKIP
+    (['hello', 'world', 'hello'], True, ('h', '@', 'l', 'oU'))
+    >>> spoken[0].audio.dtype, bool(np.abs(spoken[0].audio).max() <= 1.0)  # doctest: +SKIP
+    (dtype('float32'), True)
     """
     exe = espeak_path()
     spoken: dict[tuple[str, Voice], SpokenWord] = {} if cache is None else cache
@@ -233,7 +273,19 @@ def resample_to_output(y: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    (round(N * 16000 / 22050),) float32
+    (ceil(N * 320 / 441),) float32
+        :func:`scipy.signal.resample_poly`'s length (16000 / 22050 = 320 / 441, rounded up).
+
+    Examples
+    --------
+    One second of a 440-Hz sine: 16000 samples, and the RMS of a unit sine, 1 / sqrt(2). Two samples
+    become ceil(640 / 441) = 2, not round(1.45) = 1.
+
+    >>> y = resample_to_output(np.sin(2 * np.pi * 440 * np.arange(ESPEAK_SR) / ESPEAK_SR))
+    >>> y.shape, y.dtype, round(float(np.sqrt(np.mean(y**2))), 2)
+    ((16000,), dtype('float32'), 0.71)
+    >>> resample_to_output(np.ones(2)).shape, resample_to_output(np.ones(6)).shape
+    ((2,), (5,))
     """
     from scipy.signal import resample_poly
 

@@ -121,5 +121,15 @@ def sentence_order(rng: np.random.Generator) -> list[str]:
     -------
     list of str
         A permutation of :data:`SENTENCES`.
+
+    Examples
+    --------
+    Every sentence once, in an order fixed by the seed:
+
+    >>> order = sentence_order(np.random.default_rng(0))
+    >>> sorted(order) == sorted(SENTENCES), order == sentence_order(np.random.default_rng(0))
+    (True, True)
+    >>> order == sentence_order(np.random.default_rng(1))
+    False
     """
     return [SENTENCES[i] for i in rng.permutation(len(SENTENCES))]
