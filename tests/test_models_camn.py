@@ -453,3 +453,27 @@ def test_run_lstm_under_cpu_bf16_autocast_is_the_lstm_on_any_cpu(monkeypatch):
     # 7 * 2 * 2**-8 < 2**-4; without it, the fallback's float32 exactly
     assert torch.allclose(here.float(), fp32, atol=2**-4 if works else 0, rtol=0)
     assert torch.equal(layers.run_lstm(lstm, x), fp32)  # no autocast: lstm(x)[0] itself
+
+
+ABLATIONS = ({"use_audio": False}, {"use_face": False}, {"use_text": False}, {"cascade": False}, {})
+
+
+@pytest.mark.parametrize("switches", ABLATIONS)
+def test_input_widths_follow_the_switches(switches):
+    """``input_widths`` of an ablated configuration equals the widths of the layers built from it (0 for a
+    part that is not built): it counted every modality whatever the switches (use_audio=False: 238, built 206)."""
+    from beatlite.models import build_model
+    from beatlite.models.camn import input_widths
+
+    model = build_model("camn", preset="tiny", vocab_size=20, **switches)
+    built = {
+        "audio fusion in": model.audio_fusion,
+        "face fusion in": model.face_fusion,
+        "body decoder in": model.body_decoder,
+        "hands decoder in": model.hands_decoder,
+    }
+    want = {
+        k: 0 if part is None else (part.lstm.input_size if k.endswith("decoder in") else part[0].in_features)
+        for k, part in built.items()
+    }
+    assert input_widths(model.config) == want

@@ -483,26 +483,37 @@ def input_widths(config: CaMNConfig) -> dict[str, int]:
     The context is emotion + speaker + text features; the audio fusion reads the last audio
     channels and the context; the face fusion the last face channels, the fused audio and the
     context; the body decoder the seed pose (141 angles + 1 indicator bit), the context and both
-    fused features; the hands decoder the same plus the 27 body outputs.
+    fused features; the hands decoder the same plus the 27 body outputs. The ``use_*`` switches and
+    ``cascade`` are honoured: a modality switched off adds nothing, and a part that is not built (a fusion
+    of a modality switched off, both fusions and the hands decoder without the cascade) has width 0.
 
     Returns
     -------
     dict
-        ``{"audio fusion in", "face fusion in", "body decoder in", "hands decoder in"}`` -> width.
+        ``{"audio fusion in", "face fusion in", "body decoder in", "hands decoder in"}`` -> width
+        (channels per frame).
 
     Examples
     --------
     >>> w = input_widths(CaMNConfig(**PRESETS["paper"], preset="paper"))
     >>> w["body decoder in"], w["hands decoder in"]  # 142 + 144 + 128 + 32 and + 27
     (446, 473)
+
+    Without audio the body decoder reads 128 channels fewer and the audio fusion is not built:
+
+    >>> w = input_widths(CaMNConfig(**PRESETS["paper"], preset="paper", use_audio=False))
+    >>> w["audio fusion in"], w["body decoder in"]
+    (0, 318)
     """
-    ctx = config.emotion_features + config.speaker_features + config.text_features
-    body = POSE_DIM + 1 + ctx + config.audio_fused + config.face_fused
+    ctx = _context_width(config)
+    audio_out, face_out = _fused_widths(config)
+    body = POSE_DIM + 1 + ctx + audio_out + face_out
+    cascade = config.cascade
     return {
-        "audio fusion in": config.audio_channels[-1] + ctx,
-        "face fusion in": config.face_channels[-1] + config.audio_fused + ctx,
+        "audio fusion in": config.audio_channels[-1] + ctx if cascade and config.use_audio else 0,
+        "face fusion in": config.face_channels[-1] + audio_out + ctx if cascade and config.use_face else 0,
         "body decoder in": body,
-        "hands decoder in": body + BODY_DIM,
+        "hands decoder in": body + BODY_DIM if cascade else 0,
     }
 
 
