@@ -477,3 +477,18 @@ def test_input_widths_follow_the_switches(switches):
         for k, part in built.items()
     }
     assert input_widths(model.config) == want
+
+
+@pytest.mark.parametrize("switches", [*ABLATIONS, {"adversarial": False}])
+def test_part_parameters_of_an_ablation_count_absent_parts_as_zero(switches):
+    """``part_parameters`` of a model without a part (an ablation, no discriminator) gives that part 0 and
+    the parts still add up to the total (it raised AttributeError on the absent part)."""
+    from beatlite.models import build_model
+    from beatlite.models.camn import PARTS, part_parameters
+
+    model = build_model("camn", preset="tiny", vocab_size=20, **switches)
+    counts = part_parameters(model)
+    for part in PARTS:
+        module = getattr(model, part)
+        assert counts[part] == (0 if module is None else sum(p.numel() for p in module.parameters()))
+    assert sum(counts[p] for p in PARTS) == counts["total"] == sum(p.numel() for p in model.parameters())

@@ -518,6 +518,22 @@ def input_widths(config: CaMNConfig) -> dict[str, int]:
 
 
 def part_parameters(model: CaMN) -> dict[str, int]:
-    """Number of parameters of each of :data:`PARTS` of ``model``, plus ``"total"``."""
-    counts = {part: sum(p.numel() for p in getattr(model, part).parameters()) for part in PARTS}
+    """Number of parameters of each of :data:`PARTS` of ``model`` (0 for a part not built), plus ``"total"``.
+
+    Examples
+    --------
+    The speaker encoder of the ``tiny`` preset is an ``Embedding(30, 8)`` and a ``Linear(8, 8)``:
+    ``30 * 8 + 8 * 8 + 8 = 312`` parameters. Without audio there is no audio encoder or audio fusion,
+    and the parts still add up to the total.
+
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.camn import PARTS, part_parameters
+    >>> part_parameters(build_model("camn", preset="tiny"))["speaker_encoder"]
+    312
+    >>> counts = part_parameters(build_model("camn", preset="tiny", use_audio=False))
+    >>> counts["audio_encoder"], counts["audio_fusion"], sum(counts[p] for p in PARTS) == counts["total"]
+    (0, 0, True)
+    """
+    modules = {part: getattr(model, part) for part in PARTS}
+    counts = {k: 0 if m is None else sum(p.numel() for p in m.parameters()) for k, m in modules.items()}
     return {**counts, "total": int(model.n_parameters())}
