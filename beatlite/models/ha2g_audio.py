@@ -36,6 +36,7 @@ import torch
 from torch import nn
 
 from beatlite.constants import WINDOW_LENGTH
+from beatlite.models.layers import match_length
 
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
@@ -280,16 +281,8 @@ class HierarchicalAudioEncoder(nn.Module):
         out = {}
         for level in self.levels:
             y = self.streams[level](feats[level])
-            out[level] = _match_length(y, self.n_frames)
+            out[level] = match_length(y, self.n_frames)
         return out
-
-
-def _match_length(x: torch.Tensor, n: int) -> torch.Tensor:
-    """Crop or last-frame-pad ``(B, T, C)`` to ``(B, n, C)``."""
-    t = x.shape[1]
-    if t >= n:
-        return x[:, :n]
-    return torch.cat([x, x[:, -1:].expand(-1, n - t, -1)], dim=1)
 
 
 class StyleCoordinator(nn.Module):
