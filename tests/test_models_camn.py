@@ -460,3 +460,42 @@ def test_run_lstm_under_cpu_bf16_autocast_is_the_lstm_on_any_cpu(monkeypatch):
     # 7 * 2 * 2**-8 < 2**-4; without it, the fallback's float32 exactly
     assert torch.allclose(here.float(), fp32, atol=2**-4 if works else 0, rtol=0)
     assert torch.equal(layers.run_lstm(lstm, x), fp32)  # no autocast: lstm(x)[0] itself
+
+
+ABLATIONS = ({"use_audio": False}, {"use_face": False}, {"use_text": False}, {"cascade": False}, {})
+
+
+@pytest.mark.parametrize("switches", ABLATIONS)
+def test_input_widths_follow_the_switches(switches):
+    """``input_widths`` of an ablated configuration equals the widths of the layers built from it (0 for a
+    part that is not built): it counted every modality whatever the switches (use_audio=False: 238, built 206)."""
+    from beatlite.models import build_model
+    from beatlite.models.camn import input_widths
+
+    model = build_model("camn", preset="tiny", vocab_size=20, **switches)
+    built = {
+        "audio fusion in": model.audio_fusion,
+        "face fusion in": model.face_fusion,
+        "body decoder in": model.body_decoder,
+        "hands decoder in": model.hands_decoder,
+    }
+    want = {
+        k: 0 if part is None else (part.lstm.input_size if k.endswith("decoder in") else part[0].in_features)
+        for k, part in built.items()
+    }
+    assert input_widths(model.config) == want
+
+
+@pytest.mark.parametrize("switches", [*ABLATIONS, {"adversarial": False}])
+def test_part_parameters_of_an_ablation_count_absent_parts_as_zero(switches):
+    """``part_parameters`` of a model without a part (an ablation, no discriminator) gives that part 0 and
+    the parts still add up to the total (it raised AttributeError on the absent part)."""
+    from beatlite.models import build_model
+    from beatlite.models.camn import PARTS, part_parameters
+
+    model = build_model("camn", preset="tiny", vocab_size=20, **switches)
+    counts = part_parameters(model)
+    for part in PARTS:
+        module = getattr(model, part)
+        assert counts[part] == (0 if module is None else sum(p.numel() for p in module.parameters()))
+    assert sum(counts[p] for p in PARTS) == counts["total"] == sum(p.numel() for p in model.parameters())

@@ -110,6 +110,20 @@ class MeanPose(_Untrained):
 
     ``prepare(train_windows)`` stores ``mean over windows and frames of train_windows["pose"]``;
     before it, the mean is 0 (the z-scoring mean).
+
+    Shapes: ``batch["pose"]`` (B, T, 141) (only its shape and dtype are read) -> ``{"pose": (B, T, 141)}``.
+
+    Examples
+    --------
+    Two training windows, one all 1 and one all 3: every generated frame is their mean, 2.
+
+    >>> import numpy as np, torch
+    >>> from beatlite.models import build_model
+    >>> model = build_model("mean_pose")
+    >>> model.prepare({"pose": np.stack([np.ones((34, 141)), np.full((34, 141), 3.0)])})
+    >>> pose = model.generate({"pose": torch.zeros(2, 34, 141)})
+    >>> tuple(pose.shape), torch.unique(pose).tolist()
+    ((2, 34, 141), [2.0])
     """
 
     name = "mean_pose"
@@ -142,6 +156,28 @@ class RandomClip(_Untrained):
     Draws are deterministic: call ``k`` (counted from construction or :meth:`reset`) uses
     ``torch.Generator().manual_seed(seed + k)``. Sequences longer than ``n_frames`` are
     made of consecutive random clips.
+
+    Shapes: ``batch["pose"]`` (B, T, 141) (only its shape and dtype are read) -> ``{"pose": (B, T, 141)}``.
+
+    Examples
+    --------
+    Five training windows, window ``i`` constant at ``i``; a bank of three of them, ten frames per clip. A
+    25-frame request is made of three consecutive clips (frames 0-9, 10-19, 20-24), each one constant bank
+    window, and ``reset`` replays the draws.
+
+    >>> import numpy as np, torch
+    >>> from beatlite.models import build_model
+    >>> model = build_model("random_clip", n_clips=3, n_frames=10)
+    >>> train = {"pose": np.arange(5.0).reshape(5, 1, 1) * np.ones((5, 10, 141))}
+    >>> model.prepare(train)
+    >>> bank = sorted(model.bank[:, 0, 0].tolist())
+    >>> pose = model.generate({"pose": torch.zeros(1, 25, 141)})
+    >>> pieces = [pose[0, a:b] for a, b in ((0, 10), (10, 20), (20, 25))]
+    >>> all(bool((p == p[0, 0]).all()) and p[0, 0].item() in bank for p in pieces)
+    True
+    >>> model.reset()
+    >>> torch.equal(model.generate({"pose": torch.zeros(1, 25, 141)}), pose)
+    True
     """
 
     name = "random_clip"
@@ -238,8 +274,30 @@ class S2G(_Adversarial):
     (two stride-2 downsamplings, nearest upsampling with additive skips) and a 1x1
     convolution output 141 channels. It ignores the seed pose (as S2G has none).
 
-    Shapes: ``batch["mel"]`` (B, M, 128), ``batch["pose"]`` (B, T, 141) (only T is read)
+    Shapes: ``batch["mel"]`` (B, M, 128) dB, ``batch["pose"]`` (B, T, 141) (only T is read)
     -> ``{"pose": (B, T, 141)}``.
+
+    Parameters
+    ----------
+    config : S2GConfig
+        Build one with ``beatlite.models.build_model("s2g", preset="tiny")``.
+
+    Examples
+    --------
+    A tiny S2G on two fake windows of 70 mel frames: the pose has the batch's T = 34 frames, and any pose
+    values give the same output (the audio alone drives it).
+
+    >>> import torch
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = build_model("s2g", preset="tiny").eval()
+    >>> batch = fake_batch(2)
+    >>> pose = model({"mel": batch["mel"], "pose": batch["pose"]})["pose"]
+    >>> tuple(batch["mel"].shape), tuple(pose.shape)
+    ((2, 70, 128), (2, 34, 141))
+    >>> torch.equal(model({"mel": batch["mel"], "pose": torch.zeros(2, 34, 141)})["pose"], pose)
+    True
     """
 
     name = "s2g"
@@ -310,7 +368,35 @@ class Trimodal(_Adversarial):
     The speaker style ``z`` is sampled with the reparameterisation trick while training
     and is its mean ``mu`` in eval mode (deterministic generation).
 
-    Returns ``{"pose": (B, T, 141), "z_mu": (B, Z), "z_logvar": (B, Z)}``.
+    Shapes: ``batch["pose"]`` (B, T, 141) (the first ``n_pre`` frames seed it), ``batch["audio"]`` (B, S)
+    16 kHz, ``batch["word"]`` (B, T) int64, ``batch["speaker"]`` (B,) int64 -> ``{"pose": (B, T, 141),
+    "z_mu": (B, Z), "z_logvar": (B, Z)}`` with Z = ``speaker_z``.
+
+    Parameters
+    ----------
+    config : TrimodalConfig
+        Build one with ``beatlite.models.build_model("trimodal", preset="tiny")``.
+
+    Examples
+    --------
+    A tiny Trimodal on two fake windows: the pose and the speaker style's Gaussian (Z = 16); the ``kld`` loss
+    term is the closed-form KL of that Gaussian from N(0, I), averaged over its elements.
+
+    >>> import torch
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.a2g import kl_standard_normal
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = build_model("trimodal", preset="tiny")
+    >>> batch = fake_batch(2, vocab_size=1000)
+    >>> out = model(batch)
+    >>> tuple(out["pose"].shape), tuple(out["z_mu"].shape)
+    ((2, 34, 141), (2, 16))
+    >>> losses = model.losses(batch, out, epoch=0)
+    >>> bool(torch.isclose(losses["kld"], kl_standard_normal(out["z_mu"], out["z_logvar"])))
+    True
+    >>> sorted(losses)  # the adversarial term is 0 before epoch no_adv_epochs
+    ['adv', 'kld', 'rec', 'total']
     """
 
     name = "trimodal"

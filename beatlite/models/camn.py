@@ -166,7 +166,19 @@ def _assembly_index() -> torch.Tensor:
 
 
 class SpeakerEncoder(nn.Module):
-    """``Embedding(n, f) -> Linear(f, f) -> LReLU(0.1)``: (B,) int64 -> (B, f)."""
+    """``Embedding(n, f) -> Linear(f, f) -> LReLU(0.1)``: (B,) int64 speaker ids in ``0..n-1`` -> (B, f).
+
+    Examples
+    --------
+    One feature vector per window; two windows of one speaker get the same one.
+
+    >>> import torch
+    >>> from beatlite.models.camn import SpeakerEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> z = SpeakerEncoder(n_speakers=4, features=8)(torch.tensor([3, 1, 3]))
+    >>> tuple(z.shape), torch.equal(z[0], z[2])
+    ((3, 8), True)
+    """
 
     def __init__(self, n_speakers: int, features: int, slope: float = 0.1) -> None:
         super().__init__()
@@ -183,7 +195,15 @@ class SpeakerEncoder(nn.Module):
 class EmotionEncoder(nn.Module):
     """``Embedding(8, f) -> Linear(f, f)`` then 4 x [Conv1d(k9, p4) + BN + LReLU(0.3)], f -> f -> 2f -> 2f -> f.
 
-    Shapes: (B, T) int64 -> (B, T, f).
+    Shapes: (B, T) int64 emotion ids in ``0..n_emotions-1`` -> (B, T, f); the k9 convolutions keep T.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.camn import EmotionEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> tuple(EmotionEncoder(n_emotions=8, features=8)(torch.zeros(2, 34, dtype=torch.long)).shape)
+    (2, 34, 8)
     """
 
     def __init__(self, n_emotions: int, features: int) -> None:
@@ -208,7 +228,15 @@ class FaceEncoder(nn.Module):
     """51 ARKit weights -> ``channels[-1]`` features per frame with 4 length-preserving BasicBlocks.
 
     Blocks (docs/reference_code.md#camn-encoders): (51 -> c0, k7, p3)*, (c0 -> c1, k3, p1)*, (c1 -> c2, k3, p1), (c2 -> c3, k3, p1)*.
-    Shapes: (B, T, 51) -> (B, T, channels[-1]).
+    Shapes: (B, T, 51) blendshape weights in [0, 1] -> (B, T, channels[-1]).
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.camn import FaceEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> tuple(FaceEncoder((8, 8, 8, 16))(torch.rand(2, 34, 51)).shape)
+    (2, 34, 16)
     """
 
     def __init__(self, channels: tuple[int, ...] = (16, 16, 16, 32)) -> None:
@@ -300,6 +328,28 @@ class CaMN(GestureModel):
     ``forward(batch)`` returns ``{"pose": (B,T,141), "body": (B,T,27), "hands": (B,T,114)}``
     (without the cascade ``body``/``hands`` are the corresponding slices of ``pose``).
     Reads ``batch["pose"]`` only through its first ``n_pre = 4`` frames (the seed).
+
+    Examples
+    --------
+    A tiny CaMN on two fake windows of every modality: the body decoder's 27 channels and the hands decoder's
+    114 are interleaved into the reference's 141-channel layout, whose first 18 channels are the body's first 18.
+
+    >>> import torch
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = build_model("camn", preset="tiny")
+    >>> batch = fake_batch(2, vocab_size=1000)
+    >>> out = model(batch)
+    >>> tuple(out["pose"].shape), tuple(out["body"].shape), tuple(out["hands"].shape)
+    ((2, 34, 141), (2, 34, 27), (2, 34, 114))
+    >>> torch.equal(out["pose"][..., :18], out["body"][..., :18])
+    True
+
+    The ablation switches change what the model reads (and :meth:`batch_keys` adds the loss's ``semantic``):
+
+    >>> type(model).batch_keys(build_model("camn", preset="tiny", use_audio=False, use_face=False).config)
+    ('pose', 'word', 'emotion', 'speaker', 'semantic')
     """
 
     name = "camn"
@@ -483,30 +533,57 @@ def input_widths(config: CaMNConfig) -> dict[str, int]:
     The context is emotion + speaker + text features; the audio fusion reads the last audio
     channels and the context; the face fusion the last face channels, the fused audio and the
     context; the body decoder the seed pose (141 angles + 1 indicator bit), the context and both
-    fused features; the hands decoder the same plus the 27 body outputs.
+    fused features; the hands decoder the same plus the 27 body outputs. The ``use_*`` switches and
+    ``cascade`` are honoured: a modality switched off adds nothing, and a part that is not built (a fusion
+    of a modality switched off, both fusions and the hands decoder without the cascade) has width 0.
 
     Returns
     -------
     dict
-        ``{"audio fusion in", "face fusion in", "body decoder in", "hands decoder in"}`` -> width.
+        ``{"audio fusion in", "face fusion in", "body decoder in", "hands decoder in"}`` -> width
+        (channels per frame).
 
     Examples
     --------
     >>> w = input_widths(CaMNConfig(**PRESETS["paper"], preset="paper"))
     >>> w["body decoder in"], w["hands decoder in"]  # 142 + 144 + 128 + 32 and + 27
     (446, 473)
+
+    Without audio the body decoder reads 128 channels fewer and the audio fusion is not built:
+
+    >>> w = input_widths(CaMNConfig(**PRESETS["paper"], preset="paper", use_audio=False))
+    >>> w["audio fusion in"], w["body decoder in"]
+    (0, 318)
     """
-    ctx = config.emotion_features + config.speaker_features + config.text_features
-    body = POSE_DIM + 1 + ctx + config.audio_fused + config.face_fused
+    ctx = _context_width(config)
+    audio_out, face_out = _fused_widths(config)
+    body = POSE_DIM + 1 + ctx + audio_out + face_out
+    cascade = config.cascade
     return {
-        "audio fusion in": config.audio_channels[-1] + ctx,
-        "face fusion in": config.face_channels[-1] + config.audio_fused + ctx,
+        "audio fusion in": config.audio_channels[-1] + ctx if cascade and config.use_audio else 0,
+        "face fusion in": config.face_channels[-1] + audio_out + ctx if cascade and config.use_face else 0,
         "body decoder in": body,
-        "hands decoder in": body + BODY_DIM,
+        "hands decoder in": body + BODY_DIM if cascade else 0,
     }
 
 
 def part_parameters(model: CaMN) -> dict[str, int]:
-    """Number of parameters of each of :data:`PARTS` of ``model``, plus ``"total"``."""
-    counts = {part: sum(p.numel() for p in getattr(model, part).parameters()) for part in PARTS}
+    """Number of parameters of each of :data:`PARTS` of ``model`` (0 for a part not built), plus ``"total"``.
+
+    Examples
+    --------
+    The speaker encoder of the ``tiny`` preset is an ``Embedding(30, 8)`` and a ``Linear(8, 8)``:
+    ``30 * 8 + 8 * 8 + 8 = 312`` parameters. Without audio there is no audio encoder or audio fusion,
+    and the parts still add up to the total.
+
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.camn import PARTS, part_parameters
+    >>> part_parameters(build_model("camn", preset="tiny"))["speaker_encoder"]
+    312
+    >>> counts = part_parameters(build_model("camn", preset="tiny", use_audio=False))
+    >>> counts["audio_encoder"], counts["audio_fusion"], sum(counts[p] for p in PARTS) == counts["total"]
+    (0, 0, True)
+    """
+    modules = {part: getattr(model, part) for part in PARTS}
+    counts = {k: 0 if m is None else sum(p.numel() for p in m.parameters()) for k, m in modules.items()}
     return {**counts, "total": int(model.n_parameters())}

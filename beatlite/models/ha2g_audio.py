@@ -36,6 +36,7 @@ import torch
 from torch import nn
 
 from beatlite.constants import WINDOW_LENGTH
+from beatlite.models.layers import match_length
 
 AUDIO_LEVELS: tuple[str, ...] = ("low", "mid", "high")
 """Names of the three audio feature levels, in the order of the style-coordinator weights."""
@@ -52,7 +53,19 @@ class SEBlock2d(nn.Module):
 
     Shapes
     ------
-    (B, C, H, W) -> (B, C, H, W)
+    (B, C, H, W) -> (B, C, H, W); each channel scaled by its gate in (0, 1).
+
+    Examples
+    --------
+    With the last layer's weights and bias zeroed every gate is ``sigmoid(0) = 0.5``: the input halved.
+
+    >>> import torch
+    >>> from beatlite.models.ha2g_audio import SEBlock2d
+    >>> se = SEBlock2d(4, reduction=2)
+    >>> _ = torch.nn.init.zeros_(se.fc[2].weight), torch.nn.init.zeros_(se.fc[2].bias)
+    >>> x = torch.arange(24.0).reshape(1, 4, 2, 3)
+    >>> torch.equal(se(x), x / 2)
+    True
     """
 
     def __init__(self, channels: int, reduction: int) -> None:
@@ -75,6 +88,17 @@ class SEBasicBlock2d(nn.Module):
     Shapes
     ------
     (B, in_ch, H, W) -> (B, out_ch, ceil(H / stride), ceil(W / stride))
+
+    Examples
+    --------
+    Stride 2 on a 7 x 5 map: ``ceil(7 / 2) = 4`` by ``ceil(5 / 2) = 3``; the final ReLU leaves no negative value.
+
+    >>> import torch
+    >>> from beatlite.models.ha2g_audio import SEBasicBlock2d
+    >>> _ = torch.manual_seed(0)
+    >>> y = SEBasicBlock2d(4, 8, stride=2, reduction=4)(torch.randn(2, 4, 7, 5))
+    >>> tuple(y.shape), bool((y >= 0).all())
+    ((2, 8, 4, 3), True)
     """
 
     def __init__(self, in_ch: int, out_ch: int, stride: int, reduction: int, order: str = "beatlite") -> None:
@@ -174,6 +198,22 @@ class HierarchicalAudioEncoder(nn.Module):
     ------
     mel (B, M, 128) float, dB (``power_to_db(ref=max)``, about [-80, 0]; scaled by
     ``mel / 40 + 1`` inside) -> dict level -> (B, T, F).
+
+    Examples
+    --------
+    The ``tiny`` HA2G's encoder on the 70 mel frames of a 34-frame window: every level gives 34 frames of
+    F = 16 features; an ablation reading one level builds only that stream.
+
+    >>> import torch
+    >>> from beatlite.models.ha2g_audio import HierarchicalAudioEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> encoder = HierarchicalAudioEncoder((4, 8, 16, 32), (1, 1, 1, 1), 4, 16, freq_stride=2)
+    >>> mel = -80.0 * torch.rand(2, 70, 128)
+    >>> {level: tuple(f.shape) for level, f in encoder(mel).items()}
+    {'low': (2, 34, 16), 'mid': (2, 34, 16), 'high': (2, 34, 16)}
+    >>> low_only = HierarchicalAudioEncoder((4, 8, 16, 32), (1, 1, 1, 1), 4, 16, levels=("low",), freq_stride=2)
+    >>> list(low_only(mel)), low_only.layer3 is None
+    (['low'], True)
     """
 
     def __init__(
@@ -241,16 +281,8 @@ class HierarchicalAudioEncoder(nn.Module):
         out = {}
         for level in self.levels:
             y = self.streams[level](feats[level])
-            out[level] = _match_length(y, self.n_frames)
+            out[level] = match_length(y, self.n_frames)
         return out
-
-
-def _match_length(x: torch.Tensor, n: int) -> torch.Tensor:
-    """Crop or last-frame-pad ``(B, T, C)`` to ``(B, n, C)``."""
-    t = x.shape[1]
-    if t >= n:
-        return x[:, :n]
-    return torch.cat([x, x[:, -1:].expand(-1, n - t, -1)], dim=1)
 
 
 class StyleCoordinator(nn.Module):
@@ -264,6 +296,15 @@ class StyleCoordinator(nn.Module):
     Shapes
     ------
     (B, z_dim) -> (B, 3, H); every column sums to 1.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.ha2g_audio import StyleCoordinator
+    >>> _ = torch.manual_seed(0)
+    >>> w = StyleCoordinator(z_dim=8, hidden=16, n_body_levels=6)(torch.randn(2, 8))
+    >>> tuple(w.shape), bool(torch.allclose(w.sum(1), torch.ones(2, 6))), bool((w > 0).all())
+    ((2, 3, 6), True, True)
     """
 
     def __init__(self, z_dim: int, hidden: int, n_body_levels: int) -> None:
@@ -293,6 +334,19 @@ def blend_audio(features: dict[str, torch.Tensor], weights: torch.Tensor) -> tor
     -------
     (B, H, T, F)
         The blended audio feature of every body level.
+
+    Examples
+    --------
+    Constant levels 1 (low), 2 (mid) and 3 (high); body level 0 weighs low and mid by half each (1.5),
+    body level 1 takes the high level alone (3).
+
+    >>> import torch
+    >>> from beatlite.models.ha2g_audio import blend_audio
+    >>> features = {level: torch.full((1, 2, 1), v) for level, v in (("low", 1.0), ("mid", 2.0), ("high", 3.0))}
+    >>> weights = torch.tensor([[[0.5, 0.0], [0.5, 0.0], [0.0, 1.0]]])  # (B, 3 audio levels, H = 2)
+    >>> blend_audio(features, weights)[0, :, :, 0]
+    tensor([[1.5000, 1.5000],
+            [3.0000, 3.0000]])
     """
     stacked = torch.stack([features[level] for level in AUDIO_LEVELS], dim=1)  # (B, 3, T, F)
     return torch.einsum("bsh,bstf->bhtf", weights, stacked)

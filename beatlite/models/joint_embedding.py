@@ -158,6 +158,32 @@ class JointEmbedding(GestureModel):
     (B, T, 141) -> ``{"pose", "pose_recon"}`` (B, T, 141), ``{"z_context", "context_mu",
     "context_logvar", "z_pose"}`` (B, embed_dim). ``"pose"`` reads only the words, the audio and the
     first ``n_pre`` pose frames.
+
+    Parameters
+    ----------
+    config : JointEmbeddingConfig
+        Build one with ``beatlite.models.build_model("joint_embedding", preset="tiny")``.
+
+    Examples
+    --------
+    A tiny model on two fake windows: both decodings have the pose's shape, both embeddings ``embed_dim``
+    channels; with ``eval_z="mean"`` inference uses the speech embedding's mean, and the loss is
+    ``rec_weight`` (0.5) times the sum of the two L1 reconstructions.
+
+    >>> import torch
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = build_model("joint_embedding", preset="tiny", eval_z="mean").eval()
+    >>> batch = {k: v for k, v in fake_batch(2, vocab_size=1000).items() if k in ("pose", "word", "audio")}
+    >>> out = model(batch)
+    >>> tuple(out["pose"].shape), tuple(out["pose_recon"].shape), tuple(out["z_context"].shape)
+    ((2, 34, 141), (2, 34, 141), (2, 32))
+    >>> torch.equal(out["z_context"], out["context_mu"])
+    True
+    >>> losses = model.losses(batch, out, epoch=0)
+    >>> bool(torch.isclose(losses["total"], 0.5 * (losses["speech_rec"] + losses["pose_rec"])))
+    True
     """
 
     name = "joint_embedding"

@@ -48,6 +48,21 @@ class BasicBlock1d(nn.Module):
     Shapes
     ------
     (B, in_ch, L) -> (B, out_ch, floor((L + 2 padding - kernel) / stride) + 1)
+
+    Examples
+    --------
+    100 samples, kernel 15, stride 5, padding 7: ``floor((100 + 14 - 15) / 5) + 1 = 20`` frames. An identity
+    shortcut needs the shape kept:
+
+    >>> import torch
+    >>> from beatlite.models.layers import BasicBlock1d
+    >>> _ = torch.manual_seed(0)
+    >>> tuple(BasicBlock1d(1, 4, 15, 5, 7, downsample=True)(torch.randn(2, 1, 100)).shape)
+    (2, 4, 20)
+    >>> BasicBlock1d(1, 4, 15, 5, 7)
+    Traceback (most recent call last):
+    ...
+    ValueError: BasicBlock1d: an identity shortcut needs in_ch == out_ch, stride 1 and 'same' padding; got in_ch=1, out_ch=4, stride=5, padding=7, kernel=15
     """
 
     frames_as_matmul: bool = False
@@ -187,6 +202,16 @@ class WavEncoder(nn.Module):
     Shapes
     ------
     (B, S) float waveform -> (B, T', channels[-1]) with T' = 34 for S = 36266.
+
+    Examples
+    --------
+    The ``tiny`` CaMN's widths on one 34-frame window of 16 kHz audio:
+
+    >>> import torch
+    >>> from beatlite.models.layers import WavEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> tuple(WavEncoder((4, 8, 8, 16, 16, 32))(torch.zeros(1, 36266)).shape)
+    (1, 34, 32)
     """
 
     def __init__(self, channels: Sequence[int] = (32, 32, 32, 64, 64, 128)) -> None:
@@ -221,7 +246,16 @@ class PlainWavEncoder(nn.Module):
 
     Shapes
     ------
-    (B, S) -> (B, T', channels[-1])
+    (B, S) float waveform, 16 kHz -> (B, T', channels[-1]); S = 36266 samples give
+    ``(36266 + 3200 - 15) // 5 + 1 = 7891 -> 1313 -> 217 -> 34`` frames.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.layers import PlainWavEncoder
+    >>> _ = torch.manual_seed(0)
+    >>> tuple(PlainWavEncoder()(torch.zeros(1, 36266)).shape)
+    (1, 34, 32)
     """
 
     def __init__(self, channels: Sequence[int] = (16, 32, 64, 32)) -> None:
@@ -290,7 +324,23 @@ class TextEncoderTCN(nn.Module):
 
     Shapes
     ------
-    (B, T) int64 -> (B, T, out_features)
+    (B, T) int64 word ids in ``0..vocab_size-1`` -> (B, T, out_features)
+
+    Examples
+    --------
+    The TCN is causal: a frame's features read its word and the earlier ones, so changing the last word
+    changes only the last frame.
+
+    >>> import torch
+    >>> from beatlite.models.layers import TextEncoderTCN
+    >>> _ = torch.manual_seed(0)
+    >>> encoder = TextEncoderTCN(20, 8, hidden=16, n_layers=2, out_features=4, dropout=0.0).eval()
+    >>> words = torch.tensor([[3, 5, 7, 9, 11]])
+    >>> changed = words.clone()
+    >>> changed[0, -1] = 2
+    >>> a, b = encoder(words), encoder(changed)
+    >>> tuple(a.shape), torch.equal(a[:, :-1], b[:, :-1]), torch.equal(a[:, -1], b[:, -1])
+    ((1, 5, 4), True, False)
     """
 
     def __init__(
@@ -329,6 +379,15 @@ class ConvDiscriminator(nn.Module):
     Shapes
     ------
     (B, T, D) -> (B, 1) logits; ``n_frames`` = T must be given at construction.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.layers import ConvDiscriminator
+    >>> _ = torch.manual_seed(0)
+    >>> d = ConvDiscriminator(141, hidden=16, n_layers=1, n_frames=34)
+    >>> tuple(d(torch.zeros(3, 34, 141)).shape)
+    (3, 1)
     """
 
     def __init__(
@@ -399,6 +458,16 @@ def check_ids(ids: torch.Tensor, n: int, what: str) -> None:
     construction (the store's vocabulary and speaker ids); generation and evaluation (no gradients) check.
 
     Shapes: ids any shape, integer.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.layers import check_ids
+    >>> check_ids(torch.tensor([0, 4]), 5, "speaker ids")  # in range: nothing
+    >>> check_ids(torch.tensor([4, 5]), 5, "speaker ids")
+    Traceback (most recent call last):
+    ...
+    ValueError: speaker ids must be in [0, 5), got range [4, 5]
     """
     training_on_device = ids.device.type != "cpu" and torch.is_grad_enabled()
     if not ids.numel() or training_on_device or torch.compiler.is_compiling():
@@ -409,7 +478,16 @@ def check_ids(ids: torch.Tensor, n: int, what: str) -> None:
 
 
 def mlp(sizes: Sequence[int], slope: float = 0.1, *, last_act: bool = True) -> nn.Sequential:
-    """``Linear -> LeakyReLU(slope)`` for each consecutive pair of ``sizes`` (no act after the last if asked)."""
+    """``Linear -> LeakyReLU(slope)`` for each consecutive pair of ``sizes`` (no act after the last if asked).
+
+    Shapes: (..., sizes[0]) -> (..., sizes[-1]).
+
+    Examples
+    --------
+    >>> from beatlite.models.layers import mlp
+    >>> [type(layer).__name__ for layer in mlp([4, 8, 2], last_act=False)]
+    ['Linear', 'LeakyReLU', 'Linear']
+    """
     layers: list[nn.Module] = []
     for i in range(len(sizes) - 1):
         layers.append(nn.Linear(sizes[i], sizes[i + 1]))
@@ -457,12 +535,29 @@ def _cpu_autocast_lstm_works() -> bool:
 
 
 def sum_directions(seq: torch.Tensor, hidden: int) -> torch.Tensor:
-    """Sum the forward and backward halves of a bidirectional RNN output ``(B, T, 2H) -> (B, T, H)``."""
+    """Sum the forward and backward halves of a bidirectional RNN output ``(B, T, 2H) -> (B, T, H)``.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.layers import sum_directions
+    >>> sum_directions(torch.tensor([[[1.0, 2.0, 10.0, 20.0]]]), 2)
+    tensor([[[11., 22.]]])
+    """
     return seq[..., :hidden] + seq[..., hidden:]
 
 
 def match_length(x: torch.Tensor, n: int) -> torch.Tensor:
-    """Crop or repeat-last-frame pad ``(B, T, C)`` to ``(B, n, C)`` (the reference's length fix-ups)."""
+    """Crop or repeat-last-frame pad ``(B, T, C)`` to ``(B, n, C)`` (the reference's length fix-ups).
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.layers import match_length
+    >>> x = torch.tensor([1.0, 2.0, 3.0]).reshape(1, 3, 1)
+    >>> match_length(x, 5).flatten().tolist(), match_length(x, 2).flatten().tolist()
+    ([1.0, 2.0, 3.0, 3.0, 3.0], [1.0, 2.0])
+    """
     t = x.shape[1]
     if t == n:
         return x
@@ -474,10 +569,48 @@ def match_length(x: torch.Tensor, n: int) -> torch.Tensor:
 
 
 def ns_gan_d_loss(real_logit: torch.Tensor, fake_logit: torch.Tensor) -> torch.Tensor:
-    """Discriminator NS-GAN loss ``-mean(log D(real) + log(1 - D(fake)))`` from logits."""
+    """Discriminator NS-GAN loss ``-mean(log D(real) + log(1 - D(fake)))`` from logits.
+
+    Parameters
+    ----------
+    real_logit, fake_logit : (B, 1) float tensors
+        The discriminator's logits (``D = sigmoid(logit)``) of real and generated windows.
+
+    Returns
+    -------
+    scalar tensor, nats.
+
+    Examples
+    --------
+    An undecided discriminator (logits 0, D = 1/2) pays ``2 log 2``:
+
+    >>> import torch
+    >>> from beatlite.models.layers import ns_gan_d_loss
+    >>> round(float(ns_gan_d_loss(torch.zeros(4, 1), torch.zeros(4, 1))), 4)
+    1.3863
+    """
     return -(nn.functional.logsigmoid(real_logit) + nn.functional.logsigmoid(-fake_logit)).mean()
 
 
 def ns_gan_g_loss(fake_logit: torch.Tensor) -> torch.Tensor:
-    """Generator non-saturating loss ``-mean(log D(fake))`` from logits."""
+    """Generator non-saturating loss ``-mean(log D(fake))`` from logits.
+
+    Parameters
+    ----------
+    fake_logit : (B, 1) float tensor
+        The discriminator's logits of generated windows.
+
+    Returns
+    -------
+    scalar tensor, nats.
+
+    Examples
+    --------
+    ``log 2`` when D = 1/2; about 0 once the discriminator takes the fakes for real (logit 10):
+
+    >>> import torch
+    >>> from beatlite.models.layers import ns_gan_g_loss
+    >>> round(float(ns_gan_g_loss(torch.zeros(4, 1))), 4), round(float(ns_gan_g_loss(torch.full((4, 1), 10.0))), 4)
+    (0.6931, 0.0)
+    """
     return -nn.functional.logsigmoid(fake_logit).mean()

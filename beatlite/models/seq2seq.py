@@ -83,6 +83,20 @@ class BahdanauAttention(nn.Module):
     ------
     ``keys(enc)``: (B, S, H) -> (B, S, H) (``W_e enc``, computed once per sequence);
     ``forward(h, enc, keys)``: h (B, H), enc (B, S, H) -> context (B, H), weights (B, S).
+
+    Examples
+    --------
+    With ``v`` zeroed every energy is 0: uniform weights ``1 / S`` and the context is the mean of ``enc``.
+
+    >>> import torch
+    >>> from beatlite.models.seq2seq import BahdanauAttention
+    >>> _ = torch.manual_seed(0)
+    >>> attention = BahdanauAttention(4)
+    >>> _ = torch.nn.init.zeros_(attention.v.weight)
+    >>> enc = torch.randn(2, 5, 4)
+    >>> context, weights = attention(torch.randn(2, 4), enc, attention.keys(enc))
+    >>> bool(torch.allclose(weights, torch.full((2, 5), 1 / 5))), bool(torch.allclose(context, enc.mean(1)))
+    (True, True)
     """
 
     def __init__(self, hidden: int) -> None:
@@ -107,6 +121,30 @@ class Seq2Seq(GestureModel):
 
     Shapes: ``batch["word"]`` (B, T) int64, ``batch["pose"]`` (B, T, 141) (only the first
     ``n_pre`` frames are read) -> ``{"pose": (B, T, 141), "attention": (B, T - 1, T)}``.
+
+    Parameters
+    ----------
+    config : Seq2SeqConfig
+        Build one with ``beatlite.models.build_model("seq2seq", preset="tiny")``.
+
+    Examples
+    --------
+    A tiny Seq2Seq on two fake windows: frame 0 is the seed's first frame, each of the T - 1 decoded frames
+    attends over the T words with weights summing to 1.
+
+    >>> import torch
+    >>> from beatlite.models import build_model
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = build_model("seq2seq", preset="tiny").eval()
+    >>> batch = {k: v for k, v in fake_batch(2, vocab_size=1000).items() if k in ("pose", "word")}
+    >>> out = model(batch)
+    >>> tuple(out["pose"].shape), tuple(out["attention"].shape)
+    ((2, 34, 141), (2, 33, 34))
+    >>> torch.equal(out["pose"][:, 0], batch["pose"][:, 0])
+    True
+    >>> bool(torch.allclose(out["attention"].sum(-1), torch.ones(2, 33)))
+    True
     """
 
     name = "seq2seq"

@@ -69,6 +69,19 @@ def fake_windows(
         ``"audio"`` (N, S) float32 in [-1, 1]; ``"mel"`` (N, M, 128) float32 in [-80, 0] dB;
         ``"face"`` (N, T, 51) float32 in [0, 1]; ``"word"`` (N, T) int64; ``"emotion"`` (N, T) int64
         in 0..7; ``"semantic"`` (N, T) float32 in [0, 1]; ``"speaker"`` (N,) int64.
+
+    Examples
+    --------
+    Ten frames (2/3 s) give ``floor(10 / 15 * 16000) = 10666`` audio samples and
+    ``round((10666.7 - 1024) / 512 + 1) = 20`` mel frames; one seed gives the same windows.
+
+    >>> import numpy as np
+    >>> from beatlite.models.testing import fake_windows
+    >>> w = fake_windows(2, n_frames=10)
+    >>> w["pose"].shape, w["audio"].shape, w["mel"].shape, w["speaker"].shape
+    ((2, 10, 141), (2, 10666), (2, 20, 128), (2,))
+    >>> bool(np.array_equal(fake_windows(2, n_frames=10)["pose"], w["pose"]))
+    True
     """
     if n < 1 or n_frames < 1:
         raise ValueError(f"n and n_frames must be >= 1, got n={n}, n_frames={n_frames}")
@@ -91,7 +104,15 @@ def fake_windows(
 
 
 def fake_batch(b: int = 2, *, seed: int = 0, **kwargs: int) -> dict[str, torch.Tensor]:
-    """:func:`fake_windows` as a dict of torch tensors (float32 / int64), batch size ``b``."""
+    """:func:`fake_windows` as a dict of torch tensors (float32 / int64), batch size ``b``.
+
+    Examples
+    --------
+    >>> from beatlite.models.testing import fake_batch
+    >>> batch = fake_batch(2)
+    >>> tuple(batch["pose"].shape), batch["pose"].dtype, tuple(batch["word"].shape), batch["word"].dtype
+    ((2, 34, 141), torch.float32, (2, 34), torch.int64)
+    """
     return {k: torch.from_numpy(v) for k, v in fake_windows(b, seed=seed, **kwargs).items()}
 
 
@@ -117,6 +138,18 @@ class ModelCase:
         A small window store's train view (the store checks need it).
     reference : Windows or dict of ndarray, optional
         The same windows in memory (``build_windows`` with the store view's statistics and vocabulary).
+
+    Examples
+    --------
+    A case builds a fresh seeded model and a fake batch of exactly the keys it reads:
+
+    >>> import tempfile
+    >>> from beatlite.models.testing import model_case
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     case = model_case("s2g", folder)
+    ...     model = case.build()
+    ...     sorted(case.batch(model)), model.training
+    (['mel', 'pose'], True)
     """
 
     cls: type
@@ -252,7 +285,24 @@ def check_shapes(case: ModelCase) -> None:
     """``batch_keys`` covers ``keys_for`` and the target; on a batch of exactly those keys ``forward`` (a dict)
     and ``generate`` give a finite (B, T, D) pose in the batch's dtype, leave the batch unchanged, ``generate``
     gives the same pose twice and reads only the ``n_pre`` seed frames (and leaves a model in training mode
-    there)."""
+    there).
+
+    Examples
+    --------
+    A model that drops a frame fails, the message naming the model and the rule:
+
+    >>> import tempfile
+    >>> from beatlite.models.baselines import MeanPose
+    >>> from beatlite.models.testing import check_shapes, model_case
+    >>> class Short(MeanPose):
+    ...     def forward(self, batch):
+    ...         return {"pose": super().forward(batch)["pose"][:, 1:]}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     check_shapes(model_case(Short, folder))
+    Traceback (most recent call last):
+    ...
+    AssertionError: Short (tiny): forward pose has shape (2, 33, 141), not (B, T, D) = (2, 34, 141)
+    """
     model = _prepared(case, case.build())
     keys = set(type(model).batch_keys(model.config))
     missing = (set(type(model).keys_for(model.config)) | {model.target_key}) - keys
@@ -378,6 +428,16 @@ class CudaAutocastRules(torch.overrides.TorchFunctionMode):
     CPU autocast promotes ``index_copy`` to the widest input dtype; CUDA autocast does not, so a float32
     destination and a bfloat16 source fail on the GPU only (``index_copy_(): self and source expected to
     have the same dtype``). Inside this mode they fail on the CPU too, so a CPU test covers the GPU rule.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from beatlite.models.testing import CudaAutocastRules
+    >>> with CudaAutocastRules():
+    ...     torch.zeros(3).index_copy(0, torch.tensor([1]), torch.ones(1, dtype=torch.bfloat16))
+    Traceback (most recent call last):
+    ...
+    RuntimeError: index_copy: self and source expected to have the same dtype (CUDA autocast), got torch.float32 and torch.bfloat16
     """
 
     OPS = (torch.Tensor.index_copy, torch.Tensor.index_copy_, torch.index_copy)
@@ -474,7 +534,21 @@ def check_bf16_training(case: ModelCase) -> None:
 class HostToDevice(TorchDispatchMode):
     """Records the operators that bring host data to another device: a copy of a CPU tensor there, or an
     operator with a CPU tensor of at least one dimension among its inputs and a result there (a 0-dim CPU
-    tensor in arithmetic is read as a number, as a Python float is)."""
+    tensor in arithmetic is read as a number, as a Python float is).
+
+    Examples
+    --------
+    On a CPU-only machine the ``meta`` device stands in for the accelerator: the copy there is recorded,
+    arithmetic on the host is not.
+
+    >>> import torch
+    >>> from beatlite.models.testing import HostToDevice
+    >>> with HostToDevice() as copies:
+    ...     on_device = torch.ones(3).to("meta")
+    ...     on_host = torch.ones(3) + 1
+    >>> copies.found
+    ['aten._to_copy.default']
+    """
 
     COPIES = ("_to_copy", "copy_", "_copy_from")
 
@@ -560,7 +634,26 @@ STORE_CHECKS = {
 
 def model_case(model: str | type, folder: str | Path, *, preset: str = "tiny", train: Any = None,
                reference: Any = None, **overrides: Any) -> ModelCase:  # fmt: skip
-    """The :class:`ModelCase` of a registry name or model class (``vocab_size`` from ``train``'s vocabulary)."""
+    """The :class:`ModelCase` of a registry name or model class (``vocab_size`` from ``train``'s vocabulary).
+
+    Parameters
+    ----------
+    model : str or GestureModel subclass
+    folder : str or Path
+        Scratch folder for checkpoints.
+    preset : str
+    train, reference : optional
+        A small window store's train view and the same windows in memory (:func:`check_model`).
+    **overrides
+        Config overrides.
+
+    Examples
+    --------
+    >>> from beatlite.models.testing import model_case
+    >>> case = model_case("camn", "unused", use_audio=False)
+    >>> case.cls.__name__, case.preset, case.overrides
+    ('CaMN', 'tiny', {'use_audio': False})
+    """
     from beatlite.models import model_class
 
     cls = model_class(model) if isinstance(model, str) else model
@@ -596,6 +689,17 @@ def check_model(model: str | type, folder: str | Path, *, train: Any = None, ref
     -------
     list of str
         The names of the checks run (all passed).
+
+    Examples
+    --------
+    The mean-pose baseline passes every check that needs no window store (each raises ``AssertionError``
+    naming the model and the broken rule; :func:`check_shapes` shows one):
+
+    >>> import tempfile
+    >>> from beatlite.models.testing import check_model
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     check_model("mean_pose", folder)
+    ['shapes', 'gradients', 'determinism', 'generate_modes', 'checkpoint', 'no_host_reads']
     """
     if (train is None) != (reference is None):
         raise ValueError(
