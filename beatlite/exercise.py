@@ -48,6 +48,7 @@ Used by the Exercises section at the end of every notebook (first in notebooks/0
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import numbers
 from collections.abc import Callable, Mapping
@@ -74,12 +75,15 @@ def resolve(student_fn: Callable[..., Any], reference_fn: Callable[..., Any]) ->
     >>> speed([1.0, 2.0, 6.0])
     [exercise] mean_speed not done yet: using the reference implementation
     3.0
+    >>> speed.__name__  # the student's function's name and docstring stay
+    'mean_speed'
     >>> def mean_speed(x):
     ...     return max(x)  # a wrong answer is the student's to see: resolve does not check it
     >>> resolve(mean_speed, lambda x: sum(x) / len(x))([1.0, 2.0, 6.0])
     6.0
     """
 
+    @functools.wraps(student_fn)
     def call(*args: Any, **kwargs: Any) -> Any:
         try:
             return student_fn(*args, **kwargs)

@@ -808,7 +808,7 @@ def plot_bone_levels(
     >>> pose = np.array([[0.0, 100, 0], [0, 150, 0], [-40, 140, 10], [40, 140, 10]])
     >>> fig = plot_bone_levels(pose, [[0, 1], [1, 2], [1, 3]], [[0], [0, 1, 2]])
     >>> [ax.get_title() for ax in fig.axes]
-    ['level 1: 1 bones, 3 dims', 'level 2: 3 bones, 9 dims']
+    ['level 1: 1 bone, 3 dims', 'level 2: 3 bones, 9 dims']
     >>> plt.close(fig)
     """
     pos = check_positions(positions)[0]
@@ -838,7 +838,8 @@ def plot_bone_levels(
                              ghost=sorted(keep) if not shown else ())  # fmt: skip
                 if v == 0:
                     ax.set_title(
-                        f"level {k + 1}: {len(levels[k])} bones, {3 * len(levels[k])} dims", fontsize=10
+                        f"level {k + 1}: {len(levels[k])} bone{'s' * (len(levels[k]) != 1)}, {3 * len(levels[k])} dims",
+                        fontsize=10,
                     )
                 else:
                     below = names[root] if names else root
