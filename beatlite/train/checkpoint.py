@@ -17,9 +17,9 @@ Files are written to a temporary file in the same folder and moved into place wi
 :func:`os.replace`, so a crash never leaves a half-written checkpoint.
 
 Loading never runs code from the file: :func:`load_checkpoint` uses ``torch.load(weights_only=True)``
-(tensors and plain Python values only). numpy arrays in the metadata are saved as float64 tensors and
-given back as numpy arrays; checkpoints written before that (numpy arrays pickled as such, e.g. the
-shipped ones) load through an allow-list (:data:`NUMPY_ARRAY_GLOBALS`: an ndarray's reconstructor, its
+(tensors and plain Python values only). numpy arrays in the metadata (nested in dicts and lists too) are
+saved as tensors of their dtype and given back as numpy arrays; checkpoints written before that (numpy arrays
+pickled as such, e.g. the shipped ones) load through an allow-list (:data:`NUMPY_ARRAY_GLOBALS`: an ndarray's reconstructor, its
 class, ``numpy.dtype`` and the numeric dtype classes), which rebuilds arrays and nothing else.
 
 Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkpoint) and notebooks/07_benchmark.ipynb, section 1 (exporting one).
@@ -179,8 +179,9 @@ def _check_crcs(path: Path) -> None:
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
     """Read a checkpoint dict on the CPU, running no code from the file (``weights_only=True``).
 
-    The metadata's arrays come back as float64 numpy arrays (saved as tensors, or as numpy arrays by
-    older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`).
+    The metadata's arrays, nested in dicts, lists and tuples too, come back as numpy arrays of their dtype
+    (saved as tensors, or as numpy arrays by older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`; a floating dtype
+    numpy lacks, e.g. bfloat16, as float64).
 
     Raises
     ------
@@ -201,10 +202,32 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         if key not in data:
             raise FormatError(path, f"checkpoint has no {key!r}", field=key)
     if isinstance(data.get("meta"), dict):
-        data["meta"] = {
-            k: _meta_array(path, k, v) if torch.is_tensor(v) else v for k, v in data["meta"].items()
-        }
+        memo: dict[int, Any] = {}
+        data["meta"] = {k: _numpy_for_tensors(path, k, v, memo) for k, v in data["meta"].items()}
     return data
+
+
+def _numpy_for_tensors(path: Path, key: Any, value: Any, memo: dict[int, Any]) -> Any:
+    """``value`` (metadata entry ``key``) with every tensor, in dicts, lists and tuples too, as a numpy array
+    (:func:`_meta_array`): the inverse of what :func:`save_checkpoint` stores. Each object is converted once
+    (``memo``, by ``id``), so shared parts stay shared and cycles stay cycles."""
+    if id(value) in memo:
+        return memo[id(value)]
+    if torch.is_tensor(value):
+        memo[id(value)] = out = _meta_array(path, key, value)
+        return out
+    if isinstance(value, dict):
+        memo[id(value)] = out = {}
+        out.update((k, _numpy_for_tensors(path, key, v, memo)) for k, v in value.items())
+        return out
+    if isinstance(value, list):
+        memo[id(value)] = out = []
+        out.extend(_numpy_for_tensors(path, key, v, memo) for v in value)
+        return out
+    if isinstance(value, tuple):
+        memo[id(value)] = out = tuple(_numpy_for_tensors(path, key, v, memo) for v in value)
+        return out
+    return value
 
 
 def _meta_array(path: Path, key: Any, value: torch.Tensor) -> np.ndarray:
