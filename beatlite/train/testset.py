@@ -81,6 +81,22 @@ class EvaluationSet:
     folder : str
         The data folder the takes were read from (the index's root, absolute; "" = unknown): the scores'
         captions name it.
+
+    Examples
+    --------
+    :func:`load_test_set` makes one from a corpus' window store; a one-take set built by hand (a 54-frame
+    take of the mean pose, the shipped checkpoints' train statistics) shows the layout:
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test.n_frames, len(test.takes), test.streams[0]["pose"].shape
+    (54, 1, (54, 141))
     """
 
     takes: list[str]
@@ -209,6 +225,22 @@ def clip_test_set(test: EvaluationSet, *, stride: int = WINDOW_STRIDE) -> Evalua
         Takes named ``{stem}@{start}``; streams cut by :func:`beatlite.train.generation.unit_streams`, as a unit
         of generation is (frames, the audio samples of the clip's 34 / 15 s, its 70 log-mel frames); the train
         statistics shared.
+
+    Examples
+    --------
+    A 54-frame take holds the 34-frame clips starting at 0, 10 and 20 (``(54 - 34) // 10 + 1 = 3``):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> clips = clip_test_set(test)
+    >>> clips.takes, clips.streams[0]["pose"].shape, clips.audio[0].shape
+    (['take@0', 'take@10', 'take@20'], (34, 141), (36266,))
     """
     from beatlite.train.generation import unit_streams
 
@@ -439,7 +471,23 @@ def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any)
 
 def rot6d_features(euler: list[np.ndarray], extractor: Any) -> np.ndarray:
     """(N, F) float64 features of the 34-frame windows (stride 10) of the 6D rotations of the Euler channels
-    (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself)."""
+    (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself).
+
+    Parameters
+    ----------
+    euler : list of (T_k, 141) float, degrees
+    extractor : callable
+        (N, 34, 282) float32 -> (N, F): 47 joints x 6.
+
+    Examples
+    --------
+    A 54-frame take at rest has 3 windows; a joint at rest is the identity rotation, whose 6D representation
+    is its first two columns, ``(1, 0, 0)`` and ``(0, 1, 0)``. An extractor that flattens the windows shows it:
+
+    >>> features = rot6d_features([np.zeros((54, 141))], lambda w: w.reshape(len(w), -1))
+    >>> features.shape, bool(np.allclose(features[:, :6], [1.0, 0.0, 0.0, 0.0, 1.0, 0.0]))
+    ((3, 9588), True)
+    """
     windows = sliding_windows([euler_to_6d(x) for x in euler])
     if not len(windows):
         raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
@@ -584,6 +632,25 @@ def generated_euler(
     ------
     ValueError
         ``model`` predicts directions (``dirvec126``): it has no Euler angles.
+
+    Examples
+    --------
+    The shipped mean-pose baseline on a one-take set: every frame is its pose in degrees,
+    ``z * std + mean`` with the train statistics.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> euler = generated_euler("mean_pose", test)
+    >>> from beatlite.train.checkpoint import load_model
+    >>> pose = load_model("mean_pose")[0].mean.numpy()
+    >>> euler[0].shape, bool(np.allclose(euler[0], normalizers.inverse_transform(pose, "euler141")))
+    ((54, 141), True)
     """
     import torch
 
