@@ -352,6 +352,27 @@ def generate_takes(
     -------
     (directions, euler)
         Per take (T, 42, 3) unit directions, and (T, 141) Euler degrees (None for direction models).
+
+    Examples
+    --------
+    The shipped mean-pose baseline on a one-take set (as :class:`EvaluationSet` builds it): its 54 frames as 42
+    bone directions of unit length and as 141 Euler channels.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> import torch
+    >>> from beatlite.train.checkpoint import load_model
+    >>> model = load_model("mean_pose")[0]
+    >>> with torch.no_grad():
+    ...     directions, euler = generate_takes(model, test, None)
+    >>> directions[0].shape, euler[0].shape, bool(np.allclose(np.linalg.norm(directions[0], axis=-1), 1.0))
+    ((54, 42, 3), (54, 141), True)
     """
     from beatlite.train.generation import generate_sequences
 
@@ -568,6 +589,31 @@ def load_checkpoint_for(source: str, test: EvaluationSet) -> tuple[Any, Normaliz
     vocabulary differs from the test set's, or normalisation statistics in its meta that do not make
     :class:`~beatlite.data.normalize.Normalizers`, are a :class:`~beatlite.io.FormatError` (field ``meta.vocab``,
     ``meta``), as are the checkpoint's own problems (:func:`beatlite.train.checkpoint.load_model`).
+
+    Examples
+    --------
+    The shipped mean-pose checkpoint against a set with its own train statistics (as :class:`EvaluationSet`
+    builds it), then against one whose statistics differ (another corpus): stale, with a warning.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> model, stats, fingerprint, stale = load_checkpoint_for("mean_pose", test)
+    >>> type(model).__name__, stats.matches(normalizers), stale
+    ('MeanPose', True, False)
+    >>> import warnings
+    >>> from beatlite.data.normalize import Normalizer
+    >>> shifted = Normalizers(Normalizer(normalizers.pose.mean + 1.0, normalizers.pose.std), normalizers.dirvec)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     stale = load_checkpoint_for("mean_pose", dataclasses.replace(test, normalizers=shifted))[3]
+    >>> stale, "was trained on other data" in str(caught[0].message)
+    (True, True)
     """
     from beatlite.train.checkpoint import load_model
 
