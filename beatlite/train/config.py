@@ -31,7 +31,9 @@ class TrainConfig:
     epochs : int
         Number of epochs (total, also when resuming).
     batch_size : int
-        Windows per step. A last batch of a single window is dropped (BatchNorm needs 2).
+        Windows per step. A last batch of a single window is dropped (BatchNorm needs 2); fewer than 2
+        training windows per epoch (per micro-batch) are a ``ValueError`` of :func:`beatlite.train.fit`
+        (:func:`beatlite.train.training.check_window_count`).
     lr : float or None
         Generator learning rate; ``None`` = ``5e-4 * batch_size / 256`` (the reference's
         ``lr_base * batch / 128`` with ``lr_base = 2.5e-4``).

@@ -460,6 +460,8 @@ def fit(
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
+    if run.g_opt is not None:  # (an untrained baseline takes no step)
+        check_window_count(data.n, config, run.world)
     resumed = False
     if config.resume:
         wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
@@ -640,6 +642,30 @@ def check_batch_split(config: TrainConfig, world: int) -> None:
             f"{'es' if world > 1 else ''}, micro_batches={config.micro_batches}) leaves fewer than 2 windows in "
             f"one (BatchNorm needs 2: no step would train); batch_size must be >= {2 * parts} (it is the global "
             "batch, split over the processes)"
+        )
+
+
+def check_window_count(n: int, config: TrainConfig, world: int) -> None:
+    """Raise ``ValueError`` when an epoch's ``n`` training windows (at most ``config.windows_per_epoch``) cannot fill
+    one step: each of its ``max(micro_batches, world)`` micro-batches needs 2 windows (BatchNorm), so every step
+    would be skipped and nothing trained (:func:`check_batch_split` is the same for the batch size).
+
+    Examples
+    --------
+    >>> check_window_count(2, TrainConfig(batch_size=8), world=1)
+    >>> check_window_count(3, TrainConfig(batch_size=8, micro_batches=2), world=1)
+    Traceback (most recent call last):
+    ...
+    ValueError: fit: 3 training windows per epoch fill no step: each of its 2 micro-batches needs 2 windows (BatchNorm), so nothing would train; give at least 4
+    """
+    parts = max(config.micro_batches, world)
+    used = n if config.windows_per_epoch is None else min(n, config.windows_per_epoch)
+    if used < 2 * parts:
+        cut = f" (windows_per_epoch={config.windows_per_epoch} of {n})" if used < n else ""
+        raise ValueError(
+            f"fit: {used} training window{'s' if used != 1 else ''} per epoch{cut} fill{'s' if used == 1 else ''} no step: each of its "
+            f"{parts} micro-batch{'es' if parts > 1 else ''} needs 2 windows (BatchNorm), so nothing would "
+            f"train; give at least {2 * parts}"
         )
 
 
