@@ -46,7 +46,7 @@ class GeneratedTake:
         Euler models: a 228-channel BEAT :class:`Motion` at 15 fps (the 141 predicted
         channels denormalised to degrees, every other channel 0 = rest pose, root at the
         origin). ``None`` for direction models (no IK).
-    positions : (T, J, 3) float64 or None, centimetres
+    positions : (T, 43, 3) float64 or None, centimetres
         Direction models: TED-43 joint positions from the denormalised unit directions
         and the BEAT rest-pose bone lengths (root at the origin; the common space of the
         results tables, :func:`beatlite.skeleton.ted.rest_bone_lengths`). Euler models: ``None``
