@@ -455,6 +455,8 @@ def fit(
 
     check_compilable(type(model), config.compile)  # before any work
     data = _Data.of(model, train_windows)
+    if val_windows is not None:  # before any step, not at the first validation after an epoch
+        _check_val_windows(model, val_windows)
     configure_torch(config.seed, config.threads, config.deterministic, config.torch_device())
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
@@ -487,6 +489,19 @@ def fit(
     if config.epochs == 0 and not resumed:  # no epoch: the initial weights' checkpoint (as a baseline's)
         run.save(0)
     return run.result()
+
+
+def _check_val_windows(model: GestureModel, windows: Any) -> None:
+    """``KeyError`` / ``ValueError`` (naming ``val_windows``) when validation windows lack a key ``model`` reads or
+    (in memory) hold arrays of different lengths: what :func:`evaluate_losses` would find after an epoch."""
+    who = "fit: val_windows"
+    if isinstance(windows, ResidentWindows):
+        _needed_keys(model, dict.fromkeys(windows.keys), who)
+    elif _is_store_view(windows):
+        _needed_keys(model, windows, who)
+    else:
+        arrays = as_arrays(windows)
+        _n_windows(arrays, _needed_keys(model, arrays, who), who)
 
 
 def _backward(totals: list[torch.Tensor], ddp: Any) -> None:
