@@ -481,12 +481,68 @@ def fgd_scorer(
 
 # ------------------------------------------------------------------------------------ scoring
 def direction_features(directions: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
-    """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes."""
+    """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes.
+
+    Parameters
+    ----------
+    directions : list of (T_k, 42, 3) float
+        Per take, TED-43 unit bone directions.
+    test : EvaluationSet
+        Its ``normalizers.dirvec`` mean is subtracted (the train split's).
+    extractor : callable
+        (N, 34, 126) float32 -> (N, F).
+
+    Examples
+    --------
+    A 54-frame take has 3 windows; a take holding the train mean direction on every frame is all zeros once the
+    mean is subtracted. An extractor that flattens the windows shows both (one-take set as :class:`EvaluationSet`
+    builds it):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> mean = np.broadcast_to(normalizers.dirvec.mean.reshape(42, 3), (n, 42, 3))
+    >>> features = direction_features([mean], test, lambda w: w.reshape(len(w), -1))
+    >>> features.shape, float(np.abs(features).max())
+    ((3, 4284), 0.0)
+    """
     return _window_features(directions, "dirvec126", test, extractor)
 
 
 def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
-    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10)."""
+    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10).
+
+    Parameters
+    ----------
+    euler : list of (T_k, 141) float, degrees
+    test : EvaluationSet
+        Its ``normalizers.pose`` z-scores the windows (the train split's statistics).
+    extractor : callable
+        (N, 34, 141) float32 -> (N, F).
+
+    Examples
+    --------
+    A take one train standard deviation above the train mean on every channel z-scores to 1 everywhere
+    (one-take set as :class:`EvaluationSet` builds it, a flattening extractor):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> above = np.tile(normalizers.pose.mean + normalizers.pose.std, (n, 1))
+    >>> features = euler_features([above], test, lambda w: w.reshape(len(w), -1))
+    >>> features.shape, bool(np.allclose(features, 1.0))
+    ((3, 4794), True)
+    """
     return _window_features(euler, "euler141", test, extractor)
 
 
