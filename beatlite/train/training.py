@@ -404,6 +404,18 @@ def fit(
     -------
     FitResult
 
+    Raises
+    ------
+    KeyError
+        ``train_windows`` or ``val_windows`` lack a key the model reads (before any step).
+    ValueError
+        Before any step: arrays of different lengths, a batch or an epoch's windows too small to fill a step
+        (:func:`check_batch_split`, :func:`check_window_count`), a model inductor cannot compile
+        (:func:`check_compilable`). (Non-finite windows are not refused: the losses and weights become NaN and
+        the checkpoint then does not load.)
+    ResumeError
+        ``config.resume`` from a checkpoint of other data, another model config or (mid-epoch) another plan.
+
     Notes
     -----
     Per step: the forward pass, then (when ``model.adversarial_active(epoch)``) a
