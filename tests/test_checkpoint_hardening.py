@@ -275,3 +275,16 @@ def test_a_member_zipfile_cannot_open_is_a_format_error(tmp_path, damage):
     path.write_bytes(bytes(data))
     with pytest.raises(FormatError, match="truncated or corrupted"):
         load_model(path)
+
+
+def test_numpy_arrays_nested_in_the_metadata_come_back_as_numpy_arrays_of_their_dtype(shipped, tmp_path):
+    """save_checkpoint stores every numpy array of the metadata as a tensor, nested ones too, but load_checkpoint
+    gave only the top-level ones back as numpy arrays: an array in a dict or list came back a torch tensor."""
+    mean = np.array([0.5, -1.25], dtype=np.float32)
+    counts = np.array([3, 4], dtype=np.int64)
+    path = save_checkpoint(
+        tmp_path / "nested.pt", {**shipped, "meta": {"stats": {"mean": mean}, "n": [counts]}}
+    )
+    back = load_checkpoint(path)["meta"]
+    for got, want in ((back["stats"]["mean"], mean), (back["n"][0], counts)):
+        assert isinstance(got, np.ndarray) and got.dtype == want.dtype and np.array_equal(got, want)

@@ -198,6 +198,46 @@ def test_fit_refuses_a_batch_too_small_for_its_micro_batches(windows, monkeypatc
         fit(camn(), train, cfg(batch_size=6))
 
 
+def test_fit_refuses_too_few_windows_to_take_one_step(windows):
+    """One training window, or 3 split into 2 micro-batches (2 + 1), fill no micro-batch of 2 windows (BatchNorm):
+    every step was skipped and ``fit`` returned as if it had trained (history ``"train": {}``, a checkpoint of the
+    epoch). It refuses before a step, also when ``windows_per_epoch`` is what leaves too few; 2 windows train."""
+    train, _ = windows
+
+    def first(n):
+        return {k: v[:n] for k, v in train.items()}
+
+    model = camn()
+    before = {k: v.clone() for k, v in model.named_parameters()}
+    with pytest.raises(
+        ValueError, match=r"fit: 1 training window per epoch fills no step: .* give at least 2"
+    ):
+        fit(model, first(1), cfg(epochs=1))
+    assert all(torch.equal(before[k], v) for k, v in model.named_parameters())
+    with pytest.raises(ValueError, match=r"fit: 3 training windows per epoch .* give at least 4"):
+        fit(camn(), first(3), cfg(epochs=1, batch_size=4, micro_batches=2))
+    with pytest.raises(ValueError, match=r"fit: 3 training windows per epoch \(windows_per_epoch=3 of 24\)"):
+        fit(camn(), train, cfg(epochs=1, batch_size=4, micro_batches=2, windows_per_epoch=3))
+    assert fit(camn(), first(2), cfg(epochs=1)).history[0]["train"]["rec"] > 0
+
+
+def test_fit_checks_the_validation_windows_before_training(windows, tmp_path):
+    """Validation windows lacking a key the model reads, or with arrays of different lengths, were found only
+    by the first validation, after a whole epoch of training (minutes to hours on real BEAT), whose checkpoint
+    was then never written. ``fit`` now refuses them before a step, naming ``val_windows``."""
+    train, val = windows
+    model = camn()
+    before = {k: v.clone() for k, v in model.named_parameters()}
+    lacking = {k: v for k, v in val.items() if k != "audio"}
+    with pytest.raises(KeyError, match=r"fit: val_windows: windows lack \['audio'\] needed by CaMN"):
+        fit(model, train, cfg(epochs=1, checkpoint=tmp_path / "a.pt"), lacking)
+    assert all(torch.equal(before[k], v) for k, v in model.named_parameters())
+    uneven = {**val, "pose": val["pose"][:5]}
+    with pytest.raises(ValueError, match=r"fit: val_windows: window arrays have different lengths"):
+        fit(model, train, cfg(epochs=1), uneven)
+    assert all(torch.equal(before[k], v) for k, v in model.named_parameters())
+
+
 def test_export_is_small_and_equivalent(windows, tmp_path):
     train, _ = windows
     model = camn()

@@ -17,9 +17,9 @@ Files are written to a temporary file in the same folder and moved into place wi
 :func:`os.replace`, so a crash never leaves a half-written checkpoint.
 
 Loading never runs code from the file: :func:`load_checkpoint` uses ``torch.load(weights_only=True)``
-(tensors and plain Python values only). numpy arrays in the metadata are saved as float64 tensors and
-given back as numpy arrays; checkpoints written before that (numpy arrays pickled as such, e.g. the
-shipped ones) load through an allow-list (:data:`NUMPY_ARRAY_GLOBALS`: an ndarray's reconstructor, its
+(tensors and plain Python values only). numpy arrays in the metadata (nested in dicts and lists too) are
+saved as tensors of their dtype and given back as numpy arrays; checkpoints written before that (numpy arrays
+pickled as such, e.g. the shipped ones) load through an allow-list (:data:`NUMPY_ARRAY_GLOBALS`: an ndarray's reconstructor, its
 class, ``numpy.dtype`` and the numeric dtype classes), which rebuilds arrays and nothing else.
 
 Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkpoint) and notebooks/07_benchmark.ipynb, section 1 (exporting one).
@@ -101,10 +101,32 @@ def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
     ``.{name}.{pid}.*.tmp`` in the same folder, fsync, ``os.replace``; temp files of killed writers
     are removed by the next save). Numpy arrays of ``payload["meta"]`` are stored as tensors.
 
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (its folders are created).
+    payload : mapping
+        The checkpoint dict (module docstring): ``"format"``, ``"model"``, ``"state"``, ...
+
     Returns
     -------
     Path
         The written path.
+
+    Examples
+    --------
+    A mean-pose model's checkpoint, written into a new folder and read back: the metadata's float32 array
+    comes back as it was, and no temporary file is left beside it.
+
+    >>> import tempfile
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> payload = {"format": FORMAT, "model": model.to_config(), "state": model.state_dict(),
+    ...            "meta": {"pose_std": np.full(3, 2.5, dtype=np.float32)}}
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = save_checkpoint(Path(tmp) / "run" / "mean.pt", payload)
+    ...     back = load_checkpoint(path)
+    ...     print([p.name for p in path.parent.iterdir()], back["model"], back["meta"]["pose_std"])
+    ['mean.pt'] {'name': 'mean_pose', 'preset': 'tiny'} [2.5 2.5 2.5]
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -127,6 +149,22 @@ def read_plain(path: Path) -> Any:
     beatlite.io.FormatError
         Truncated or damaged (a ZIP member failing its CRC-32 included), a decompression bomb, or a pickle of
         anything but tensors and plain values (refused, never executed).
+
+    Examples
+    --------
+    Any ``torch.save`` of tensors and plain values reads; a pickled object (here a path) is refused unread.
+
+    >>> import pathlib, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     torch.save({"w": torch.ones(2), "step": 3}, Path(tmp) / "plain.pt")
+    ...     print(read_plain(Path(tmp) / "plain.pt"))
+    ...     torch.save({"data": pathlib.PurePosixPath("/data")}, Path(tmp) / "object.pt")
+    ...     try:
+    ...         read_plain(Path(tmp) / "object.pt")
+    ...     except FormatError as err:
+    ...         print("refused:", "not a plain torch checkpoint" in str(err))
+    {'w': tensor([1., 1.]), 'step': 3}
+    refused: True
     """
     if zipfile.is_zipfile(path):
         zip_members(path)
@@ -179,8 +217,9 @@ def _check_crcs(path: Path) -> None:
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
     """Read a checkpoint dict on the CPU, running no code from the file (``weights_only=True``).
 
-    The metadata's arrays come back as float64 numpy arrays (saved as tensors, or as numpy arrays by
-    older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`).
+    The metadata's arrays, nested in dicts, lists and tuples too, come back as numpy arrays of their dtype
+    (saved as tensors, or as numpy arrays by older checkpoints: :data:`NUMPY_ARRAY_GLOBALS`; a floating dtype
+    numpy lacks, e.g. bfloat16, as float64).
 
     Raises
     ------
@@ -189,6 +228,17 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     beatlite.io.FormatError
         The file is truncated or corrupted, is not a beatlite checkpoint, or holds anything but tensors and
         plain values (a pickled object that would run code when loaded is refused, never executed).
+
+    Examples
+    --------
+    The shipped mean-pose checkpoint: the model's config, its one buffer (the 141 pose channels) and the
+    train split's normalisation statistics, 141 Euler channels and 126 direction-vector ones.
+
+    >>> data = load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")
+    >>> data["format"], data["model"]["name"], tuple(data["state"]["mean"].shape)
+    ('beatlite-checkpoint/1', 'mean_pose', (141,))
+    >>> data["meta"]["pose_mean"].shape, data["meta"]["dirvec_mean"].shape
+    ((141,), (126,))
     """
 
     path = Path(path)
@@ -201,10 +251,32 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         if key not in data:
             raise FormatError(path, f"checkpoint has no {key!r}", field=key)
     if isinstance(data.get("meta"), dict):
-        data["meta"] = {
-            k: _meta_array(path, k, v) if torch.is_tensor(v) else v for k, v in data["meta"].items()
-        }
+        memo: dict[int, Any] = {}
+        data["meta"] = {k: _numpy_for_tensors(path, k, v, memo) for k, v in data["meta"].items()}
     return data
+
+
+def _numpy_for_tensors(path: Path, key: Any, value: Any, memo: dict[int, Any]) -> Any:
+    """``value`` (metadata entry ``key``) with every tensor, in dicts, lists and tuples too, as a numpy array
+    (:func:`_meta_array`): the inverse of what :func:`save_checkpoint` stores. Each object is converted once
+    (``memo``, by ``id``), so shared parts stay shared and cycles stay cycles."""
+    if id(value) in memo:
+        return memo[id(value)]
+    if torch.is_tensor(value):
+        memo[id(value)] = out = _meta_array(path, key, value)
+        return out
+    if isinstance(value, dict):
+        memo[id(value)] = out = {}
+        out.update((k, _numpy_for_tensors(path, key, v, memo)) for k, v in value.items())
+        return out
+    if isinstance(value, list):
+        memo[id(value)] = out = []
+        out.extend(_numpy_for_tensors(path, key, v, memo) for v in value)
+        return out
+    if isinstance(value, tuple):
+        memo[id(value)] = out = tuple(_numpy_for_tensors(path, key, v, memo) for v in value)
+        return out
+    return value
 
 
 def _meta_array(path: Path, key: Any, value: torch.Tensor) -> np.ndarray:
@@ -228,6 +300,14 @@ def check_state(state: Any, path: str | Path | None, field: str = "state") -> No
     beatlite.io.FormatError
         Naming ``path`` and ``field`` (and the first bad key): not a mapping, a value that is not a dense
         real tensor, or a floating tensor holding NaN or infinity.
+
+    Examples
+    --------
+    >>> check_state({"w": torch.zeros(2), "steps": torch.tensor(3)}, "run.pt")  # fine: returns None
+    >>> check_state({"w": torch.tensor([1.0, float("nan")])}, "run.pt")
+    Traceback (most recent call last):
+    ...
+    beatlite.io.errors.FormatError: run.pt, field 'state': 'w': non-finite or complex weights
     """
     if not isinstance(state, Mapping):
         raise FormatError(
@@ -242,7 +322,20 @@ def check_state(state: Any, path: str | Path | None, field: str = "state") -> No
 
 
 def state_mismatch(model: torch.nn.Module, state: Mapping[str, Any]) -> str | None:
-    """The first difference between ``model``'s state dict and ``state`` (names and shapes), or None."""
+    """The first difference between ``model``'s state dict and ``state`` (names and shapes), or None.
+
+    Examples
+    --------
+    A ``Linear(2, 3)`` holds ``weight`` (3, 2) and ``bias`` (3,):
+
+    >>> layer = torch.nn.Linear(2, 3)
+    >>> print(state_mismatch(layer, {"weight": torch.zeros(3, 2), "bias": torch.zeros(3)}))
+    None
+    >>> state_mismatch(layer, {"weight": torch.zeros(2, 3), "bias": torch.zeros(3)})
+    "'weight' of shape (2, 3), the model's is (3, 2)"
+    >>> state_mismatch(layer, {"weight": torch.zeros(3, 2)})
+    "no weights 'bias' (the model's shape (3,))"
+    """
     own = model.state_dict()
     for key, value in own.items():
         if key not in state:
@@ -267,6 +360,16 @@ def model_from_checkpoint(data: Mapping[str, Any], path: str | Path | None = Non
         ``field="state"``: not a mapping of names to dense tensors with finite floating values
         (:func:`check_state`), or weights of other names or shapes than the model its config builds (the first
         such key and both shapes named); ``path`` names the file (None: in memory).
+
+    Examples
+    --------
+    A checkpoint dict built in memory: the rebuilt model holds the same weights, in eval mode.
+
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> _ = model.mean.fill_(0.5)
+    >>> copy = model_from_checkpoint({"model": model.to_config(), "state": model.state_dict()})
+    >>> type(copy).__name__, copy.training, bool(torch.equal(copy.mean, model.mean))
+    ('MeanPose', False, True)
     """
     check_state(data["state"], path)
     try:
@@ -310,6 +413,17 @@ def load_model(path_or_name: str | Path) -> tuple[GestureModel, dict[str, Any]]:
     beatlite.io.FormatError
         Not a plain beatlite checkpoint (:func:`load_checkpoint`); weights that are not finite tensors, or of
         other shapes or names than the model its config builds (field ``state``); an unknown config field.
+
+    Examples
+    --------
+    The shipped mean-pose baseline by name: its pose is the train windows' mean in z-scored units, so every
+    channel is near 0.
+
+    >>> model, data = load_model("mean_pose")
+    >>> type(model).__name__, model.training, data["epoch"]
+    ('MeanPose', False, 0)
+    >>> bool(model.mean.abs().max() < 0.1)
+    True
     """
 
     path = Path(path_or_name)
@@ -346,6 +460,24 @@ def export_checkpoint(src: str | Path, dst: str | Path, *, half: bool = True, be
     are written as :func:`beatlite.paths.shareable` names them (relative to the repository, else the file's or
     folder's name), also when ``src`` was written by an older beatlite with absolute ones; the data fingerprint
     identifies the data.
+
+    Examples
+    --------
+    Exporting a checkpoint whose weight is 0.1 and which carries an optimiser state: the copy drops the
+    optimiser and loads back within float16's rounding of 0.1 (half its spacing there, ``2**-4 * 2**-11``).
+
+    >>> import tempfile
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> _ = model.mean.fill_(0.1)
+    >>> payload = {"format": FORMAT, "model": model.to_config(), "state": model.state_dict(),
+    ...            "optimizer": {"state": {}}, "epoch": 3}
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     small = export_checkpoint(save_checkpoint(Path(tmp) / "train.pt", payload), Path(tmp) / "small.pt")
+    ...     copy, data = load_model(small)
+    >>> "optimizer" in data, data["state"]["mean"].dtype, copy.mean.dtype
+    (False, torch.float16, torch.float32)
+    >>> bool((copy.mean - 0.1).abs().max() <= 2**-4 * 2**-11)
+    True
     """
     data = load_checkpoint(src)
     keep = {
@@ -401,6 +533,21 @@ def convert_legacy(src: str | Path, dst: str | Path, *, trust: bool = False) -> 
     ------
     PermissionError
         ``trust`` is not True.
+
+    Examples
+    --------
+    A checkpoint that pickled a ``pathlib`` path: :func:`load_checkpoint` refuses it; the converted copy records
+    the path as a string and loads.
+
+    >>> import pathlib, tempfile
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> old = {"format": FORMAT, "model": model.to_config(), "state": model.state_dict(),
+    ...        "meta": {"data": pathlib.PurePosixPath("/data/beat")}}
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     torch.save(old, Path(tmp) / "old.pt")
+    ...     new = convert_legacy(Path(tmp) / "old.pt", Path(tmp) / "new.pt", trust=True)
+    ...     print(load_checkpoint(new)["meta"])
+    {'data': '/data/beat'}
     """
     if trust is not True:
         raise PermissionError(

@@ -31,7 +31,9 @@ class TrainConfig:
     epochs : int
         Number of epochs (total, also when resuming).
     batch_size : int
-        Windows per step. A last batch of a single window is dropped (BatchNorm needs 2).
+        Windows per step. A last batch of a single window is dropped (BatchNorm needs 2); fewer than 2
+        training windows per epoch (per micro-batch) are a ``ValueError`` of :func:`beatlite.train.fit`
+        (:func:`beatlite.train.training.check_window_count`).
     lr : float or None
         Generator learning rate; ``None`` = ``5e-4 * batch_size / 256`` (the reference's
         ``lr_base * batch / 128`` with ``lr_base = 2.5e-4``).
@@ -120,6 +122,24 @@ class TrainConfig:
         micro-batch in both). ``batch_size`` must be at least twice the parts (BatchNorm needs 2 windows per
         micro-batch): :func:`beatlite.train.fit` raises ``ValueError`` otherwise
         (:func:`beatlite.train.training.check_batch_split`).
+
+    Examples
+    --------
+    Without ``lr``, the learning rate follows the batch size, ``5e-4 * 128 / 256``; the cosine schedule halves
+    it at the middle epoch, ``(1 + cos(pi / 2)) / 2``, and reaches 0 at the end:
+
+    >>> config = TrainConfig(epochs=4, batch_size=128, lr_schedule="cosine")
+    >>> config.learning_rate, [round(config.lr_factor(e), 4) for e in range(5)]
+    (0.00025, [1.0, 0.8536, 0.5, 0.1464, 0.0])
+
+    What a checkpoint records names no folder of this machine:
+
+    >>> TrainConfig(checkpoint="/home/alice/run/camn_tiny.pt").to_dict()["checkpoint"]
+    'camn_tiny.pt'
+    >>> TrainConfig(batch_size=1)
+    Traceback (most recent call last):
+    ...
+    ValueError: TrainConfig: batch_size must be >= 2 (BatchNorm), got 1
     """
 
     epochs: int = 30

@@ -45,6 +45,13 @@ def distributed_rank() -> tuple[int, int]:
     exit handlers run later. A group initialised outside such a block (a script calling
     :func:`beatlite.train.fit` or :func:`beatlite.train.recipes.retrain` itself) is destroyed at interpreter
     exit (``atexit``), while Python is still whole.
+
+    Examples
+    --------
+    A process not started by ``torchrun`` is the only one:
+
+    >>> distributed_rank()
+    (0, 1)
     """
     import torch.distributed as dist
 
@@ -93,7 +100,17 @@ def process_group() -> Iterator[None]:
 
 
 def local_device(device: torch.device) -> torch.device:
-    """``device``, made ``cuda:LOCAL_RANK`` for an un-numbered CUDA device under ``torchrun``."""
+    """``device``, made ``cuda:LOCAL_RANK`` for an un-numbered CUDA device under ``torchrun``.
+
+    Examples
+    --------
+    ``torchrun`` sets ``LOCAL_RANK`` (here by hand, on any machine: no GPU is touched):
+
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"LOCAL_RANK": "1"}):
+    ...     local_device(torch.device("cuda")), local_device(torch.device("cuda", 0)), local_device(torch.device("cpu"))
+    (device(type='cuda', index=1), device(type='cuda', index=0), device(type='cpu'))
+    """
     if device.type == "cuda" and device.index is None and "LOCAL_RANK" in os.environ:
         return torch.device("cuda", int(os.environ["LOCAL_RANK"]))
     return device
@@ -122,6 +139,23 @@ def generator_view(model: Any) -> nn.Module:
 
     Raises ``ValueError`` when the model holds parameters outside its child modules (a view could
     not share them) or when the view's trainable parameters are not ``model.generator_parameters()``.
+
+    Examples
+    --------
+    The S2G-style model's two views share its modules and split its parameters between them:
+
+    >>> from beatlite.models.base import GestureModel
+    >>> from beatlite.models.testing import fake_batch
+    >>> _ = torch.manual_seed(0)
+    >>> model = GestureModel.from_config({"name": "s2g", "preset": "tiny"}).eval()
+    >>> generator, discriminator = generator_view(model), discriminator_view(model)
+    >>> def count(module):
+    ...     return sum(p.numel() for p in module.parameters())
+    >>> count(generator) + count(discriminator) == count(model), "discriminator" in dict(generator.named_children())
+    (True, False)
+    >>> batch = fake_batch(2)
+    >>> bool(torch.equal(generator(batch)["pose"], model(batch)["pose"]))
+    True
     """
     if list(model.named_parameters(recurse=False)):
         raise ValueError(f"{type(model).__name__}: DDP needs every parameter inside a child module")
@@ -134,7 +168,16 @@ def generator_view(model: Any) -> nn.Module:
 
 
 def discriminator_view(model: Any) -> nn.Module:
-    """The discriminator alone; ``view(batch, out)`` is ``model.discriminator_losses(batch, out)``."""
+    """The discriminator alone; ``view(batch, out)`` is ``model.discriminator_losses(batch, out)``.
+
+    Examples
+    --------
+    >>> from beatlite.models.base import GestureModel
+    >>> model = GestureModel.from_config({"name": "s2g", "preset": "tiny"})
+    >>> view = discriminator_view(model)
+    >>> list(dict(view.named_children())), view.discriminator is model.discriminator
+    (['discriminator'], True)
+    """
     return _View(model, {"discriminator": model.discriminator}, model.discriminator_losses)
 
 

@@ -127,6 +127,22 @@ class ModelResults:
     info : dict
         Split, takes, frames, window counts, extractor path (as :func:`beatlite.paths.shareable` writes it:
         relative to the repository, else the file's name), total seconds.
+
+    Examples
+    --------
+    Two rows built by hand (:func:`evaluate_models` makes them from the test takes); a row is found by its
+    label or its checkpoint name:
+
+    >>> rows = [ResultRow("Ground truth", "ground_truth", "ground_truth", {"FGD": 0.0, "SRGR": 0.25}),
+    ...         ResultRow("CaMN", "camn_tiny", "euler141", {"FGD": 12.5, "SRGR": math.nan}, seconds=1.5)]
+    >>> results = ModelResults(rows, {"columns": ("FGD", "SRGR")})
+    >>> results.get("camn_tiny").label, results.value("CaMN", "FGD"), results.columns
+    ('CaMN', 12.5, ('FGD', 'SRGR'))
+    >>> print(results.to_markdown(caption=False))
+    | method | FGD ↓ | SRGR ↑ | gen. s |
+    |---|---|---|---|
+    | Ground truth | 0.00 | 0.250 |  |
+    | CaMN | 12.50 | — | 1.50 |
     """
 
     rows: list[ResultRow]
@@ -219,7 +235,14 @@ def column_headers(keys: Sequence[str]) -> list[str]:
 
 
 def fmt_metric(v: float, key: str) -> str:
-    """``v`` as printed in the results tables: 2 decimals for FGD/Diversity/L1div, 3 for the rest."""
+    """``v`` as printed in the results tables: 2 decimals for FGD/Diversity/L1div (1 from 100 on), 3 for the
+    rest; ``—`` for NaN or infinity.
+
+    Examples
+    --------
+    >>> fmt_metric(12.3456, "FGD"), fmt_metric(123.456, "FGD"), fmt_metric(0.23456, "SRGR"), fmt_metric(math.nan, "BC")
+    ('12.35', '123.5', '0.235', '—')
+    """
     if not math.isfinite(v):
         return "—"
     if METRICS[key].name in ("FGD", "Diversity", "L1div"):
@@ -363,7 +386,30 @@ def _model_row(
 
 
 def write_results(results: ModelResults, stem: str | Path | None = None) -> tuple[Path, Path]:
-    """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_models``)."""
+    """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_models``).
+
+    The Markdown page states the evaluation from ``results.info`` (``split``, ``takes``, ``frames``, ``fps``,
+    ``windows``, ``common_space``, ``extractor``, ``seconds``: what :func:`evaluate_models` records) above
+    :meth:`ModelResults.to_markdown`; the JSON is :meth:`ModelResults.to_dict` (NaN as null).
+
+    Returns
+    -------
+    (Path, Path)
+        The ``.md`` and ``.json`` files.
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> info = {"split": "test", "takes": ["a", "b"], "frames": 300, "fps": 15, "windows": 24,
+    ...         "common_space": "TED-43", "extractor": "fgd_dirvec.pt", "seconds": 3.0, "columns": ("FGD", "SRGR")}
+    >>> results = ModelResults([ResultRow("CaMN", "camn_tiny", "euler141", {"FGD": 12.5, "SRGR": math.nan})], info)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     md, js = write_results(results, Path(tmp) / "results")
+    ...     print(md.name, js.name, json.loads(js.read_text())["rows"][0]["metrics"])
+    ...     print(md.read_text().splitlines()[2])
+    results.md results.json {'FGD': 12.5, 'SRGR': None}
+    2 takes, 300 frames at 15 fps, 24 FGD windows (34 frames, stride 10). Common space: TED-43. FGD extractor: `fgd_dirvec.pt`.
+    """
     stem = Path(stem) if stem is not None else paths.build_dir() / "results_models"
     info = results.info
     text = (

@@ -46,7 +46,7 @@ class GeneratedTake:
         Euler models: a 228-channel BEAT :class:`Motion` at 15 fps (the 141 predicted
         channels denormalised to degrees, every other channel 0 = rest pose, root at the
         origin). ``None`` for direction models (no IK).
-    positions : (T, J, 3) float64 or None, centimetres
+    positions : (T, 43, 3) float64 or None, centimetres
         Direction models: TED-43 joint positions from the denormalised unit directions
         and the BEAT rest-pose bone lengths (root at the origin; the common space of the
         results tables, :func:`beatlite.skeleton.ted.rest_bone_lengths`). Euler models: ``None``
@@ -87,6 +87,18 @@ def unit_streams(streams: Mapping[str, np.ndarray], start: int, keys: Sequence[s
     ``[floor(start * 16000 / 15), + floor(34 / 15 * 16000))`` (zero-padded), mel frames
     ``[floor(a0 / 512), + 70)`` with ``a0`` the unit's first audio sample (edge-padded, as
     :mod:`beatlite.data.windows` slices the whole-take log-mel), ``speaker`` is copied.
+
+    Examples
+    --------
+    The last unit of a 100-frame take starts at frame 90: 10 real frames, then frame 99 repeated; its
+    36266 audio samples hold the take's last ``floor(10 / 15 * 16000) = 10666``, then silence.
+
+    >>> take = {"pose": np.arange(100.0)[:, None] * np.ones(141), "audio": np.ones(106666, np.float32)}
+    >>> unit = unit_streams(take, 90, ("pose", "audio"))
+    >>> unit["pose"].shape, unit["pose"][[0, 9, 10, 33], 0]
+    ((34, 141), array([90., 99., 99., 99.]))
+    >>> unit["audio"].shape, int(unit["audio"].sum())
+    ((36266,), 10666)
     """
     n_samples = int(np.floor(UNIT / FPS * SR))
     out: dict[str, np.ndarray] = {}
@@ -109,7 +121,17 @@ def unit_batch(
     streams: Mapping[str, np.ndarray], start: int, keys: tuple[str, ...]
 ) -> dict[str, torch.Tensor]:
     """The one-window batch (B = 1) of the unit starting at frame ``start`` (:func:`unit_streams` as tensors:
-    integers as int64, the rest float32, ``speaker`` of shape (1,))."""
+    integers as int64, the rest float32, ``speaker`` of shape (1,)).
+
+    Examples
+    --------
+    >>> take = {"pose": np.zeros((100, 141)), "word": np.ones(100, np.int32), "speaker": np.int64(2)}
+    >>> for key, value in unit_batch(take, 0, ("pose", "word", "speaker")).items():
+    ...     print(key, tuple(value.shape), value.dtype)
+    pose (1, 34, 141) torch.float32
+    word (1, 34) torch.int64
+    speaker (1,) torch.int64
+    """
     batch: dict[str, torch.Tensor] = {}
     for key, part in unit_streams(streams, start, keys).items():
         if key == "speaker":
@@ -140,6 +162,17 @@ def generate_sequence(
     Returns
     -------
     (T, D) float32
+
+    Examples
+    --------
+    A mean-pose model outputs its stored pose on every frame, so the 4 units of a 100-frame take (starts 0,
+    30, 60, 90) and their cross-fades give that pose on all 100 frames:
+
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> _ = model.mean.copy_(torch.linspace(-1.0, 1.0, 141))
+    >>> out = generate_sequence(model, {"pose": np.zeros((100, 141), np.float32)})
+    >>> out.shape, out.dtype, bool(np.allclose(out, np.linspace(-1.0, 1.0, 141)))
+    ((100, 141), dtype('float32'), True)
     """
     return generate_sequences(model, [streams], stride=stride)[0]
 
@@ -167,6 +200,18 @@ def generate_sequences(
     Returns
     -------
     list of (T_i, D) float32
+
+    Examples
+    --------
+    Two takes of 50 and 100 frames: each keeps its length, and a model that does not sample gives each what it
+    gives the take alone.
+
+    >>> model = GestureModel.from_config({"name": "mean_pose"})
+    >>> _ = model.mean.copy_(torch.linspace(-1.0, 1.0, 141))
+    >>> takes = [{"pose": np.zeros((50, 141))}, {"pose": np.zeros((100, 141))}]
+    >>> outs = generate_sequences(model, takes)
+    >>> [out.shape for out in outs], bool(np.allclose(outs[1], generate_sequence(model, takes[1])))
+    ([(50, 141), (100, 141)], True)
     """
     keys = tuple(k for k in dict.fromkeys(model.input_keys) if k != model.target_key)
     if not 1 <= stride <= UNIT - model.n_pre:
@@ -259,6 +304,23 @@ def generate(
     Returns
     -------
     GeneratedTake
+
+    Examples
+    --------
+    The shipped mean-pose baseline on a 3-second take: with the train statistics of its checkpoint the pose
+    becomes a 228-channel BEAT motion at 15 fps whose every frame is the mean pose in degrees
+    (``z * std + mean``).
+
+    >>> from beatlite.train.checkpoint import load_model
+    >>> model, checkpoint = load_model("mean_pose")
+    >>> normalizers = Normalizers.from_meta(checkpoint["meta"])
+    >>> take = generate(model, {"pose": np.zeros((45, 141), np.float32)}, normalizers=normalizers)
+    >>> take.representation, take.pose.shape, take.motion.channels.shape, take.motion.fps, take.positions
+    ('euler141', (45, 141), (45, 228), 15.0, None)
+    >>> degrees = normalizers.inverse_transform(model.mean.numpy(), "euler141")
+    >>> expected = expand_subset(degrees[None], "spine_neck_141", beat_skeleton())
+    >>> bool(np.allclose(take.motion.channels, expected, atol=1e-4))  # degrees, float32 cross-fades
+    True
     """
     pose = generate_sequence(model, take)
     motion = positions = None

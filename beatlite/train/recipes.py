@@ -91,6 +91,19 @@ class Recipe:
         reference trainer does; ``False`` exports the last epoch.
     paper_rows : tuple of PaperRow
         The published rows this checkpoint stands for (:func:`paper_rows` collects a table's).
+
+    Examples
+    --------
+    The shipped CaMN checkpoint: 40 epochs at lr 2e-3 (:data:`LR`), reading words, standing for two
+    published rows of BEAT:
+
+    >>> recipe = RECIPES["camn_tiny"]
+    >>> recipe.model, recipe.epochs, recipe.lr, recipe.uses_text
+    ('camn', 40, 0.002, True)
+    >>> [(row.table, row.row) for row in recipe.paper_rows]
+    [('Table 4', 'CaMN'), ('Table 5', 'full cascaded')]
+    >>> RECIPES["s2g_tiny"].uses_text  # audio only
+    False
     """
 
     model: str
@@ -273,6 +286,20 @@ def register_recipe(name: str, recipe: Recipe) -> None:
         is not a field of the model's config; a training setting ``TrainConfig`` refuses; ``epochs=0`` for a
         model with trainable parameters (only untrained baselines have 0 epochs: :func:`retrain` and the ``fit``
         command refuse ``epochs < 1`` for a recipe with ``epochs > 0``, and would train nothing for this one).
+
+    Examples
+    --------
+    A slower S2G-style run as a row of its own (removed again at the end); a label already in the tables is
+    refused:
+
+    >>> register_recipe("s2g_slow", Recipe("s2g", "S2G (lr 1e-4)", epochs=5, lr=1e-4))
+    >>> label_of("s2g_slow"), RECIPES["s2g_slow"].epochs
+    ('S2G (lr 1e-4)', 5)
+    >>> del RECIPES["s2g_slow"]
+    >>> register_recipe("s2g_again", Recipe("s2g", "CaMN"))
+    Traceback (most recent call last):
+    ...
+    ValueError: register_recipe: 's2g_again': label 'CaMN' is already the row of camn_tiny (a label keys the results tables and the seed record: give another)
     """
     from beatlite.models.base import config_from_preset
 
@@ -303,7 +330,13 @@ def register_recipe(name: str, recipe: Recipe) -> None:
 
 
 def label_of(name: str) -> str:
-    """The table row label of checkpoint ``name`` (its recipe's; the name itself when it has none)."""
+    """The table row label of checkpoint ``name`` (its recipe's; the name itself when it has none).
+
+    Examples
+    --------
+    >>> label_of("camn_tiny_no_audio"), label_of("my_model")
+    ('CaMN w/o audio', 'my_model')
+    """
     return RECIPES[name].label if name in RECIPES else name
 
 
@@ -383,7 +416,14 @@ def describe_row(name: str) -> str:
 
 
 def describe_rows(names: Sequence[str]) -> str:
-    """:func:`describe_row` of each recipe of ``names`` as a Markdown list (one ``- `` line each)."""
+    """:func:`describe_row` of each recipe of ``names`` as a Markdown list (one ``- `` line each).
+
+    Examples
+    --------
+    >>> text = describe_rows(["mean_pose", "s2g_tiny"])
+    >>> [line.split(":")[0] for line in text.splitlines()]  # one line per recipe, then describe_row's text
+    ['- **Mean pose** (`mean_pose`)', '- **S2G-style** (`s2g_tiny`)']
+    """
     return "\n".join(f"- {describe_row(n)}" for n in names)
 
 
@@ -447,7 +487,22 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     """The freshly initialised model of recipe ``name`` (torch seeded with ``seed``; word vectors set).
 
     ``seed`` also goes to configs with a ``seed`` field (:class:`~beatlite.models.baselines.RandomClip`'s
-    choice of clips).
+    choice of clips). Of ``data`` only ``vocab`` and ``sentences`` are read, for a recipe that reads words.
+
+    Examples
+    --------
+    Seq2Seq reads words: its embedding has one row per token of the vocabulary (3 words and the 4 special
+    tokens), and the same seed builds the same weights.
+
+    >>> import torch
+    >>> from beatlite.data.vocab import Vocab
+    >>> words = [["hello", "world"], ["hello", "again"], ["world", "again", "hello"]]
+    >>> data = TrainingData(None, Vocab(["hello", "world", "again"]), None, None, words, {})
+    >>> a, b = (build_recipe_model("seq2seq_tiny", data, seed=3) for _ in range(2))
+    >>> type(a).__name__, a.config.vocab_size
+    ('Seq2Seq', 7)
+    >>> all(torch.equal(x, y) for x, y in zip(a.state_dict().values(), b.state_dict().values()))
+    True
     """
     import torch
 

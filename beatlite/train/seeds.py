@@ -52,7 +52,13 @@ from beatlite.train.testset import load_test_set
 
 
 def seeds_dir() -> Path:
-    """``build/seeds``: one folder per extra seed."""
+    """``build/seeds`` (:func:`beatlite.paths.build_dir`, ``$BEATLITE_BUILD``): one folder per extra seed.
+
+    Examples
+    --------
+    >>> seeds_dir().relative_to(paths.build_dir()).as_posix()
+    'seeds'
+    """
 
     return paths.build_dir() / "seeds"
 
@@ -62,6 +68,13 @@ def checkpoint_path(name: str, seed: int) -> Path:
 
     ``build/seeds/<seed>/<name>.pt``; when that file does not exist and the shipped
     ``checkpoints/<name>.pt`` was trained with ``seed``, the shipped one.
+
+    Examples
+    --------
+    Seed 1 is not the shipped CaMN's (:func:`shipped_seed`), so its checkpoint is under ``build/seeds/1/``:
+
+    >>> checkpoint_path("camn_tiny", 1).relative_to(paths.build_dir()).as_posix()
+    'seeds/1/camn_tiny.pt'
     """
 
     path = seeds_dir() / str(seed) / f"{name}.pt"
@@ -72,7 +85,18 @@ def checkpoint_path(name: str, seed: int) -> Path:
 
 
 def shipped_seed(path: str | Path) -> int | None:
-    """The training seed stored in the checkpoint at ``path`` (None when there is no file or no seed)."""
+    """The training seed stored in the checkpoint at ``path`` (None when there is no file or no seed).
+
+    Examples
+    --------
+    The shipped CaMN is the copy of one seed of the recorded table, the one the record names:
+
+    >>> seed = shipped_seed(paths.checkpoints_dir() / "camn_tiny.pt")
+    >>> seed == recorded_shipped_seed("camn_tiny"), seed in recorded_seed_results().seeds
+    (True, True)
+    >>> print(shipped_seed(paths.checkpoints_dir() / "no_such_model.pt"))
+    None
+    """
     path = Path(path)
     if not path.is_file():
         return None
@@ -174,6 +198,18 @@ def recipe_mismatch(name: str, checkpoint: Mapping[str, Any]) -> str | None:
     an older recipe. Code changes that leave both unchanged are not seen here (the test
     ``test_the_first_training_steps_are_the_recorded_ones`` in ``tests/test_train_recipes.py`` sees them): retrain with
     ``force`` (``seeds --force``).
+
+    Examples
+    --------
+    The shipped S2G-style checkpoint is today's recipe; the same file claiming 3 epochs is not:
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> checkpoint = load_checkpoint(paths.checkpoints_dir() / "s2g_tiny.pt")
+    >>> print(recipe_mismatch("s2g_tiny", checkpoint))
+    None
+    >>> checkpoint["train_config"]["epochs"] = 3
+    >>> recipe_mismatch("s2g_tiny", checkpoint)
+    'trained with epochs=3; the recipe says epochs=40'
     """
 
     recipe = RECIPES[name]
@@ -278,6 +314,23 @@ class SeedResults:
     seeds : list of int
     info : dict
         Evaluation settings of :func:`beatlite.train.evaluate_models`, plus the checkpoint paths.
+
+    Examples
+    --------
+    Three seeds of two rows: means 2 and 3, sample sd 1 each, so the difference 1 has the standard error
+    ``sqrt(1/3 + 1/3) = 0.8165``:
+
+    >>> table = SeedResults({"Full": {"FGD": [1.0, 2.0, 3.0]}, "A": {"FGD": [2.0, 3.0, 4.0]}}, [1, 2, 3], {})
+    >>> table.mean("A", "FGD"), table.sd("A", "FGD"), table.count("A")
+    (3.0, 1.0, 3)
+    >>> delta, se = table.difference("A", "Full", "FGD")
+    >>> delta, round(se, 4)
+    (1.0, 0.8165)
+    >>> print(table.to_markdown(columns=("FGD",)))
+    | method | FGD ↓ | seeds | shipped |
+    |---|---|---|---|
+    | Full | 2.00 ± 1.00 | 3 |  |
+    | A | 3.00 ± 1.00 | 3 |  |
     """
 
     values: dict[str, dict[str, list[float]]]
@@ -439,6 +492,19 @@ def compare_rows(
     Returns
     -------
     list of Effect, variant-major.
+
+    Examples
+    --------
+    Against a full model at FGD 1, 2, 3 (sd 1), a variant 1 worse is within two standard errors
+    (``2 sqrt(2 / 3) = 1.63``): noise, which 9 seeds per row would decide (:func:`seeds_needed`); one 2 worse
+    is worse (FGD: lower is better).
+
+    >>> table = SeedResults({"Full": {"FGD": [1.0, 2.0, 3.0]}, "A": {"FGD": [2.0, 3.0, 4.0]},
+    ...                      "B": {"FGD": [3.0, 4.0, 5.0]}}, [1, 2, 3], {})
+    >>> for effect in compare_rows(table, "Full", ["A", "B"], metrics=("FGD",)):
+    ...     print(effect.variant, effect.verdict, effect.seeds_needed, effect.cell())
+    A noise 9 +1.00 ± 1.63 noise (9 seeds)
+    B worse 3 +2.00 ± 1.63 worse
     """
 
     higher = {key: m.higher_is_better for key, m in METRICS.items() if m.higher_is_better is not None}
@@ -465,7 +531,16 @@ def compare_rows(
 def seeds_needed(results: SeedResults, variant: str, full: str, metric: str, delta: float) -> int | None:
     """Seeds per row at which a difference ``delta`` between rows ``variant`` and ``full`` would exceed two
     standard errors, with the two rows' spreads as measured (:attr:`Effect.seeds_needed`; pass another
-    ``delta``, e.g. a paper's effect, to ask what it would take to see that)."""
+    ``delta``, e.g. a paper's effect, to ask what it would take to see that).
+
+    Examples
+    --------
+    Both rows with sd 1: the least n with ``|delta| > 2 sqrt(2 / n)``, i.e. ``n > 8 / delta**2``:
+
+    >>> table = SeedResults({"Full": {"FGD": [1.0, 2.0, 3.0]}, "A": {"FGD": [2.0, 3.0, 4.0]}}, [1, 2, 3], {})
+    >>> seeds_needed(table, "A", "Full", "FGD", 1.0), seeds_needed(table, "A", "Full", "FGD", 0.5)
+    (9, 33)
+    """
     spread = results.sd(variant, metric) ** 2 + results.sd(full, metric) ** 2
     if not math.isfinite(spread) or not math.isfinite(delta) or delta == 0:
         return None
@@ -583,6 +658,14 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
     ------
     FileNotFoundError
         No recorded table (names the file and the command that writes it).
+
+    Examples
+    --------
+    Every recorded CaMN seed has an FGD; the ground-truth rows have one value (they do not depend on a seed):
+
+    >>> record = recorded_seed_results()
+    >>> record.count("CaMN") == len(record.seeds), len(record.values[GROUND_TRUTH]["FGD"])
+    (True, 1)
     """
 
     path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
@@ -596,7 +679,15 @@ def recorded_seed_results(path: str | Path | None = None) -> SeedResults:
 
 def recorded_shipped_seed(name: str, path: str | Path | None = None) -> int:
     """The seed of recipe ``name``'s shipped checkpoint in the recorded seed table (``info["shipped"]``),
-    :data:`~beatlite.train.recipes.SEED` when there is no record or it does not name the row."""
+    :data:`~beatlite.train.recipes.SEED` when there is no record or it does not name the row.
+
+    Examples
+    --------
+    >>> recorded_shipped_seed("camn_tiny") == shipped_seed(paths.checkpoints_dir() / "camn_tiny.pt")
+    True
+    >>> recorded_shipped_seed("camn_tiny", path="no_such_record.json") == SEED  # no record: the default seed
+    True
+    """
 
     path = Path(path) if path is not None else paths.checkpoints_dir() / "results_seeds.json"
     if not path.is_file():
@@ -614,7 +705,13 @@ RECORD_RTOL, RECORD_ATOL = 1e-3, 1e-9
 
 
 def record_command(name: str | None = None) -> str:
-    """The command that records recipe ``name``'s rows (every row when None) in the shipped seed table."""
+    """The command that records recipe ``name``'s rows (every row when None) in the shipped seed table.
+
+    Examples
+    --------
+    >>> record_command("camn_tiny"), record_command()
+    ('make seeds ONLY=camn_tiny', 'make seeds')
+    """
     return "make seeds" + (f" ONLY={name}" if name else "")
 
 
@@ -633,6 +730,13 @@ class NotRecorded:
         The metric key the recorded row lacks; None when the whole row is missing.
     recipe : str or None
         The recipe to record (:func:`record_command`); None for the ground-truth rows (every row).
+
+    Examples
+    --------
+    >>> print(NotRecorded("CaMN", "Speed", "camn_tiny"))
+    CaMN Speed: not recorded: run `make seeds ONLY=camn_tiny`
+    >>> print(NotRecorded("Ground truth", None, None))
+    Ground truth: not recorded: run `make seeds`
     """
 
     row: str
@@ -703,7 +807,26 @@ def check_against_record(
 
 
 def write_seed_results(results: SeedResults, stem: str | Path | None = None) -> tuple[Path, Path]:
-    """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``)."""
+    """Write ``<stem>.md`` and ``<stem>.json`` atomically (default ``build/results_seeds``).
+
+    Returns
+    -------
+    (Path, Path)
+        The ``.md`` and ``.json`` files; the JSON reads back with :meth:`SeedResults.from_dict` (or
+        :func:`recorded_seed_results`).
+
+    Examples
+    --------
+    A round trip, NaN (a missing seed) included:
+
+    >>> import tempfile
+    >>> table = SeedResults({"CaMN": {"FGD": [3.0, math.nan, 4.0]}}, [1, 2, 3], {"windows": 143})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     md, js = write_seed_results(table, Path(tmp) / "seeds")
+    ...     back = recorded_seed_results(js)
+    >>> md.name, back.seeds, back.values["CaMN"]["FGD"], back.mean("CaMN", "FGD")
+    ('seeds.md', [1, 2, 3], [3.0, nan, 4.0], 3.5)
+    """
 
     stem = Path(stem) if stem is not None else paths.build_dir() / "results_seeds"
     info = results.info

@@ -81,6 +81,22 @@ class EvaluationSet:
     folder : str
         The data folder the takes were read from (the index's root, absolute; "" = unknown): the scores'
         captions name it.
+
+    Examples
+    --------
+    :func:`load_test_set` makes one from a corpus' window store; a one-take set built by hand (a 54-frame
+    take of the mean pose, the shipped checkpoints' train statistics) shows the layout:
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test.n_frames, len(test.takes), test.streams[0]["pose"].shape
+    (54, 1, (54, 141))
     """
 
     takes: list[str]
@@ -209,6 +225,22 @@ def clip_test_set(test: EvaluationSet, *, stride: int = WINDOW_STRIDE) -> Evalua
         Takes named ``{stem}@{start}``; streams cut by :func:`beatlite.train.generation.unit_streams`, as a unit
         of generation is (frames, the audio samples of the clip's 34 / 15 s, its 70 log-mel frames); the train
         statistics shared.
+
+    Examples
+    --------
+    A 54-frame take holds the 34-frame clips starting at 0, 10 and 20 (``(54 - 34) // 10 + 1 = 3``):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> clips = clip_test_set(test)
+    >>> clips.takes, clips.streams[0]["pose"].shape, clips.audio[0].shape
+    (['take@0', 'take@10', 'take@20'], (34, 141), (36266,))
     """
     from beatlite.train.generation import unit_streams
 
@@ -320,6 +352,27 @@ def generate_takes(
     -------
     (directions, euler)
         Per take (T, 42, 3) unit directions, and (T, 141) Euler degrees (None for direction models).
+
+    Examples
+    --------
+    The shipped mean-pose baseline on a one-take set (as :class:`EvaluationSet` builds it): its 54 frames as 42
+    bone directions of unit length and as 141 Euler channels.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> import torch
+    >>> from beatlite.train.checkpoint import load_model
+    >>> model = load_model("mean_pose")[0]
+    >>> with torch.no_grad():
+    ...     directions, euler = generate_takes(model, test, None)
+    >>> directions[0].shape, euler[0].shape, bool(np.allclose(np.linalg.norm(directions[0], axis=-1), 1.0))
+    ((54, 42, 3), (54, 141), True)
     """
     from beatlite.train.generation import generate_sequences
 
@@ -428,18 +481,90 @@ def fgd_scorer(
 
 # ------------------------------------------------------------------------------------ scoring
 def direction_features(directions: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
-    """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes."""
+    """(N, F) float64 extractor features of the mean-subtracted 34-frame windows (stride 10) of all takes.
+
+    Parameters
+    ----------
+    directions : list of (T_k, 42, 3) float
+        Per take, TED-43 unit bone directions.
+    test : EvaluationSet
+        Its ``normalizers.dirvec`` mean is subtracted (the train split's).
+    extractor : callable
+        (N, 34, 126) float32 -> (N, F).
+
+    Examples
+    --------
+    A 54-frame take has 3 windows; a take holding the train mean direction on every frame is all zeros once the
+    mean is subtracted. An extractor that flattens the windows shows both (one-take set as :class:`EvaluationSet`
+    builds it):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> mean = np.broadcast_to(normalizers.dirvec.mean.reshape(42, 3), (n, 42, 3))
+    >>> features = direction_features([mean], test, lambda w: w.reshape(len(w), -1))
+    >>> features.shape, float(np.abs(features).max())
+    ((3, 4284), 0.0)
+    """
     return _window_features(directions, "dirvec126", test, extractor)
 
 
 def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any) -> np.ndarray:
-    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10)."""
+    """(N, F) float64 features of the z-scored (train statistics) 34-frame Euler windows (stride 10).
+
+    Parameters
+    ----------
+    euler : list of (T_k, 141) float, degrees
+    test : EvaluationSet
+        Its ``normalizers.pose`` z-scores the windows (the train split's statistics).
+    extractor : callable
+        (N, 34, 141) float32 -> (N, F).
+
+    Examples
+    --------
+    A take one train standard deviation above the train mean on every channel z-scores to 1 everywhere
+    (one-take set as :class:`EvaluationSet` builds it, a flattening extractor):
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> above = np.tile(normalizers.pose.mean + normalizers.pose.std, (n, 1))
+    >>> features = euler_features([above], test, lambda w: w.reshape(len(w), -1))
+    >>> features.shape, bool(np.allclose(features, 1.0))
+    ((3, 4794), True)
+    """
     return _window_features(euler, "euler141", test, extractor)
 
 
 def rot6d_features(euler: list[np.ndarray], extractor: Any) -> np.ndarray:
     """(N, F) float64 features of the 34-frame windows (stride 10) of the 6D rotations of the Euler channels
-    (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself)."""
+    (:func:`beatlite.metrics.extractor.space_input`; the extractor normalises its input itself).
+
+    Parameters
+    ----------
+    euler : list of (T_k, 141) float, degrees
+    extractor : callable
+        (N, 34, 282) float32 -> (N, F): 47 joints x 6.
+
+    Examples
+    --------
+    A 54-frame take at rest has 3 windows; a joint at rest is the identity rotation, whose 6D representation
+    is its first two columns, ``(1, 0, 0)`` and ``(0, 1, 0)``. An extractor that flattens the windows shows it:
+
+    >>> features = rot6d_features([np.zeros((54, 141))], lambda w: w.reshape(len(w), -1))
+    >>> features.shape, bool(np.allclose(features[:, :6], [1.0, 0.0, 0.0, 0.0, 1.0, 0.0]))
+    ((3, 9588), True)
+    """
     windows = sliding_windows([euler_to_6d(x) for x in euler])
     if not len(windows):
         raise ValueError(f"no take has {WINDOW_LENGTH} frames: cannot cut FGD windows")
@@ -520,6 +645,31 @@ def load_checkpoint_for(source: str, test: EvaluationSet) -> tuple[Any, Normaliz
     vocabulary differs from the test set's, or normalisation statistics in its meta that do not make
     :class:`~beatlite.data.normalize.Normalizers`, are a :class:`~beatlite.io.FormatError` (field ``meta.vocab``,
     ``meta``), as are the checkpoint's own problems (:func:`beatlite.train.checkpoint.load_model`).
+
+    Examples
+    --------
+    The shipped mean-pose checkpoint against a set with its own train statistics (as :class:`EvaluationSet`
+    builds it), then against one whose statistics differ (another corpus): stale, with a warning.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> model, stats, fingerprint, stale = load_checkpoint_for("mean_pose", test)
+    >>> type(model).__name__, stats.matches(normalizers), stale
+    ('MeanPose', True, False)
+    >>> import warnings
+    >>> from beatlite.data.normalize import Normalizer
+    >>> shifted = Normalizers(Normalizer(normalizers.pose.mean + 1.0, normalizers.pose.std), normalizers.dirvec)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     stale = load_checkpoint_for("mean_pose", dataclasses.replace(test, normalizers=shifted))[3]
+    >>> stale, "was trained on other data" in str(caught[0].message)
+    (True, True)
     """
     from beatlite.train.checkpoint import load_model
 
@@ -584,6 +734,25 @@ def generated_euler(
     ------
     ValueError
         ``model`` predicts directions (``dirvec126``): it has no Euler angles.
+
+    Examples
+    --------
+    The shipped mean-pose baseline on a one-take set: every frame is its pose in degrees,
+    ``z * std + mean`` with the train statistics.
+
+    >>> from beatlite.train.checkpoint import load_checkpoint
+    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
+    >>> n = 54  # frames of the one take, 3.6 s at 15 fps
+    >>> test = EvaluationSet(
+    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> euler = generated_euler("mean_pose", test)
+    >>> from beatlite.train.checkpoint import load_model
+    >>> pose = load_model("mean_pose")[0].mean.numpy()
+    >>> euler[0].shape, bool(np.allclose(euler[0], normalizers.inverse_transform(pose, "euler141")))
+    ((54, 141), True)
     """
     import torch
 

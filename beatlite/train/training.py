@@ -90,6 +90,16 @@ def as_arrays(windows: Any) -> Mapping[str, np.ndarray]:
 
     A Mapping itself, an object's ``.arrays`` Mapping, or a mapping-like object with
     ``keys()`` and ``[key]`` (a :class:`beatlite.data.windows.Windows` in windowed mode).
+
+    Examples
+    --------
+    >>> windows = {"pose": np.zeros((2, 34, 141), np.float32)}
+    >>> as_arrays(windows) is windows
+    True
+    >>> class Holder:
+    ...     arrays = windows
+    >>> as_arrays(Holder()) is windows
+    True
     """
     if isinstance(windows, Mapping):
         return windows
@@ -118,6 +128,20 @@ def data_fingerprint(windows: Any) -> str:
     -------
     str
         16 hexadecimal characters.
+
+    Examples
+    --------
+    With 8 windows every window is hashed (``8 // 16`` rounds up to a step of 1): a copy has the same
+    fingerprint, one changed value in the last window gives another.
+
+    >>> from beatlite.models.testing import fake_windows
+    >>> windows = fake_windows(8)
+    >>> copy = {k: v.copy() for k, v in windows.items()}
+    >>> data_fingerprint(copy) == data_fingerprint(windows), len(data_fingerprint(windows))
+    (True, 16)
+    >>> copy["pose"][7, 0, 0] += 1.0
+    >>> data_fingerprint(copy) == data_fingerprint(windows)
+    False
     """
     fp = getattr(windows, "fingerprint", None)
     if isinstance(fp, str) and fp:
@@ -159,14 +183,31 @@ def _batch(
 
 
 def model_device(model: torch.nn.Module) -> torch.device:
-    """The device of a model's parameters (or buffers); the CPU for a model without either."""
+    """The device of a model's parameters (or buffers); the CPU for a model without either.
+
+    Examples
+    --------
+    >>> model_device(torch.nn.Linear(2, 3)), model_device(torch.nn.ReLU())
+    (device(type='cpu'), device(type='cpu'))
+    """
     for tensor in (*model.parameters(), *model.buffers()):
         return tensor.device
     return torch.device("cpu")
 
 
 def model_keys(model: GestureModel) -> tuple[str, ...]:
-    """The batch keys ``model`` reads in training and evaluation (its ``batch_keys``), in contract order."""
+    """The batch keys ``model`` reads in training and evaluation (its ``batch_keys``), in contract order
+    (:data:`TENSOR_KEYS`).
+
+    Examples
+    --------
+    The S2G-style baseline reads the seed pose and the mel spectrogram, Seq2Seq the seed pose and the words:
+
+    >>> model_keys(GestureModel.from_config({"name": "s2g", "preset": "tiny"}))
+    ('pose', 'mel')
+    >>> model_keys(GestureModel.from_config({"name": "seq2seq", "preset": "tiny"}))
+    ('pose', 'word')
+    """
     needed = set(type(model).batch_keys(model.config))
     return tuple(k for k in TENSOR_KEYS if k in needed)
 
@@ -184,7 +225,28 @@ def _needed_keys(model: GestureModel, windows: Any, who: str) -> tuple[str, ...]
 
 
 def configure_torch(seed: int, threads: int | None, deterministic: bool = True, device: Any = "cpu") -> None:
-    """Seed torch, set deterministic mode for ``device`` (:func:`set_deterministic`) and the CPU thread count."""
+    """Seed torch, set deterministic mode for ``device`` (:func:`set_deterministic`) and the CPU thread count.
+
+    Parameters
+    ----------
+    seed : int
+        ``torch.manual_seed(seed)``.
+    threads : int or None
+        ``torch.set_num_threads``; ``None`` = :func:`beatlite.paths.n_threads` (``$BEATLITE_THREADS``).
+    deterministic : bool
+    device : torch.device or str
+        Where the model trains (see :func:`set_deterministic`).
+
+    Examples
+    --------
+    The draws after it are those after ``torch.manual_seed(seed)``:
+
+    >>> configure_torch(7, None)
+    >>> first = torch.rand(3)
+    >>> _ = torch.manual_seed(7)
+    >>> bool(torch.equal(first, torch.rand(3))), torch.get_num_threads() == paths.n_threads()
+    (True, True)
+    """
     torch.manual_seed(seed)
     set_deterministic(deterministic, device)
     torch.set_num_threads(threads if threads is not None else paths.n_threads())
@@ -206,6 +268,12 @@ def set_deterministic(deterministic: bool, device: Any = "cpu") -> None:
     deterministic : bool
     device : torch.device or str
         Where the model trains: ``"cuda"`` (any index) turns the filling off, any other device on.
+
+    Examples
+    --------
+    >>> set_deterministic(True, "cpu")
+    >>> torch.are_deterministic_algorithms_enabled(), torch.utils.deterministic.fill_uninitialized_memory
+    (True, True)
     """
     import os
 
@@ -241,6 +309,24 @@ def evaluate_losses(
 
     ``windows``: in-memory windows, a window store view read batch by batch (only the model's keys), or
     :class:`~beatlite.data.resident.ResidentWindows` on the model's device.
+
+    Returns
+    -------
+    dict of str -> float
+        Each of ``model.losses``' keys (``"total"`` among them): its mean over the N windows.
+
+    Examples
+    --------
+    A mean weighted by batch size does not depend on how the 5 windows are batched (eval mode: no dropout,
+    BatchNorm's running statistics):
+
+    >>> from beatlite.models.testing import fake_windows
+    >>> _ = torch.manual_seed(0)
+    >>> model = GestureModel.from_config({"name": "s2g", "preset": "tiny"})
+    >>> windows = fake_windows(5)
+    >>> by_2, at_once = (evaluate_losses(model, windows, epoch=0, batch_size=b) for b in (2, 64))
+    >>> sorted(by_2), bool(np.isclose(by_2["total"], at_once["total"], rtol=1e-5))
+    (['adv', 'rec', 'total'], True)
     """
     device = model_device(model)
     if isinstance(windows, ResidentWindows):
@@ -318,6 +404,18 @@ def fit(
     -------
     FitResult
 
+    Raises
+    ------
+    KeyError
+        ``train_windows`` or ``val_windows`` lack a key the model reads (before any step).
+    ValueError
+        Before any step: arrays of different lengths, a batch or an epoch's windows too small to fill a step
+        (:func:`check_batch_split`, :func:`check_window_count`), a model inductor cannot compile
+        (:func:`check_compilable`). (Non-finite windows are not refused: the losses and weights become NaN and
+        the checkpoint then does not load.)
+    ResumeError
+        ``config.resume`` from a checkpoint of other data, another model config or (mid-epoch) another plan.
+
     Notes
     -----
     Per step: the forward pass, then (when ``model.adversarial_active(epoch)``) a
@@ -335,6 +433,32 @@ def fit(
     last step was not one (a finished run extended by resuming with more ``epochs`` keeps it). Under
     ``torchrun`` process 0 validates while the others go on to the next step (they wait for it in its
     gradient reduction).
+
+    Examples
+    --------
+    Two epochs of the tiny S2G-style model on 8 random windows, then the same run interrupted after one epoch
+    and resumed from its checkpoint: the resumed run's losses equal the uninterrupted run's to the bit.
+
+    >>> import tempfile
+    >>> from beatlite.models.testing import fake_windows
+    >>> def tiny_s2g():
+    ...     _ = torch.manual_seed(0)  # the same initial weights each time
+    ...     return GestureModel.from_config({"name": "s2g", "preset": "tiny"})
+    >>> train, val = fake_windows(8, seed=0), fake_windows(4, seed=1)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     config = TrainConfig(epochs=2, batch_size=4, progress=False, checkpoint=Path(tmp) / "a.pt")
+    ...     result = fit(tiny_s2g(), train, config, val)
+    ...     saved = load_checkpoint(result.checkpoint)
+    ...     half = TrainConfig(epochs=1, batch_size=4, progress=False, checkpoint=Path(tmp) / "b.pt")
+    ...     _ = fit(tiny_s2g(), train, half, val)
+    ...     again = dataclasses.replace(half, epochs=2, resume=True)
+    ...     resumed = fit(tiny_s2g(), train, again, val)
+    >>> [entry["epoch"] for entry in result.history], sorted(result.history[-1]["val"])
+    ([0, 1], ['adv', 'rec', 'total'])
+    >>> saved["epoch"], saved["fingerprint"] == result.fingerprint == data_fingerprint(train)
+    (2, True)
+    >>> resumed.history == result.history
+    True
     """
     if not isinstance(model, GestureModel):
         raise TypeError(f"fit: model must be a GestureModel, got {type(model).__name__}")
@@ -343,11 +467,15 @@ def fit(
 
     check_compilable(type(model), config.compile)  # before any work
     data = _Data.of(model, train_windows)
+    if val_windows is not None:  # before any step, not at the first validation after an epoch
+        _check_val_windows(model, val_windows)
     configure_torch(config.seed, config.threads, config.deterministic, config.torch_device())
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
     model.prepare(data.arrays if data.store is None else data.store, _normalizers_of(train_windows, meta))
     run = _Run(model, config, data.fingerprint, dict(meta or {}))
+    if run.g_opt is not None:  # (an untrained baseline takes no step)
+        check_window_count(data.n, config, run.world)
     resumed = False
     if config.resume:
         wait_for_all(run.world)  # every process reads the checkpoint process 0 wrote last, not an older one
@@ -373,6 +501,19 @@ def fit(
     if config.epochs == 0 and not resumed:  # no epoch: the initial weights' checkpoint (as a baseline's)
         run.save(0)
     return run.result()
+
+
+def _check_val_windows(model: GestureModel, windows: Any) -> None:
+    """``KeyError`` / ``ValueError`` (naming ``val_windows``) when validation windows lack a key ``model`` reads or
+    (in memory) hold arrays of different lengths: what :func:`evaluate_losses` would find after an epoch."""
+    who = "fit: val_windows"
+    if isinstance(windows, ResidentWindows):
+        _needed_keys(model, dict.fromkeys(windows.keys), who)
+    elif _is_store_view(windows):
+        _needed_keys(model, windows, who)
+    else:
+        arrays = as_arrays(windows)
+        _n_windows(arrays, _needed_keys(model, arrays, who), who)
 
 
 def _backward(totals: list[torch.Tensor], ddp: Any) -> None:
@@ -484,7 +625,22 @@ def _adam(params: list[torch.nn.Parameter], lr: float, betas: tuple[float, float
 
 def check_compilable(model_class: type[GestureModel], mode: str | None) -> None:
     """Raise ``ValueError`` when :attr:`TrainConfig.compile` ``mode`` uses inductor and the model class says
-    inductor cannot compile it (:attr:`beatlite.models.base.GestureModel.inductor_failure`)."""
+    inductor cannot compile it (:attr:`beatlite.models.base.GestureModel.inductor_failure`).
+
+    Examples
+    --------
+    A model class whose inductor compilation is known to fail may train eagerly or traced, not with inductor:
+
+    >>> class Fragile(GestureModel):
+    ...     name = "fragile"
+    ...     inductor_failure = "a kernel inductor miscompiles"
+    >>> check_compilable(Fragile, None), check_compilable(Fragile, "aot_eager")
+    (None, None)
+    >>> check_compilable(Fragile, "default")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: fit: fragile cannot be compiled with inductor (TrainConfig.compile='default', ...): a kernel inductor miscompiles; ...
+    """
     if mode in COMPILE_MODES and model_class.inductor_failure is not None:
         raise ValueError(
             f"fit: {model_class.name} cannot be compiled with inductor (TrainConfig.compile={mode!r}, "
@@ -513,6 +669,30 @@ def check_batch_split(config: TrainConfig, world: int) -> None:
             f"{'es' if world > 1 else ''}, micro_batches={config.micro_batches}) leaves fewer than 2 windows in "
             f"one (BatchNorm needs 2: no step would train); batch_size must be >= {2 * parts} (it is the global "
             "batch, split over the processes)"
+        )
+
+
+def check_window_count(n: int, config: TrainConfig, world: int) -> None:
+    """Raise ``ValueError`` when an epoch's ``n`` training windows (at most ``config.windows_per_epoch``) cannot fill
+    one step: each of its ``max(micro_batches, world)`` micro-batches needs 2 windows (BatchNorm), so every step
+    would be skipped and nothing trained (:func:`check_batch_split` is the same for the batch size).
+
+    Examples
+    --------
+    >>> check_window_count(2, TrainConfig(batch_size=8), world=1)
+    >>> check_window_count(3, TrainConfig(batch_size=8, micro_batches=2), world=1)
+    Traceback (most recent call last):
+    ...
+    ValueError: fit: 3 training windows per epoch fill no step: each of its 2 micro-batches needs 2 windows (BatchNorm), so nothing would train; give at least 4
+    """
+    parts = max(config.micro_batches, world)
+    used = n if config.windows_per_epoch is None else min(n, config.windows_per_epoch)
+    if used < 2 * parts:
+        cut = f" (windows_per_epoch={config.windows_per_epoch} of {n})" if used < n else ""
+        raise ValueError(
+            f"fit: {used} training window{'s' if used != 1 else ''} per epoch{cut} fill{'s' if used == 1 else ''} no step: each of its "
+            f"{parts} micro-batch{'es' if parts > 1 else ''} needs 2 windows (BatchNorm), so nothing would "
+            f"train; give at least {2 * parts}"
         )
 
 
