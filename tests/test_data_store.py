@@ -408,3 +408,22 @@ def test_processes_building_one_store_at_once_take_turns(corpus: Path, tmp_path:
     ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
     got = WindowStore.open(folder).windows("train", stats=ref.normalizers).batch()
     assert np.array_equal(got["pose_raw"], ref["pose_raw"])
+
+
+def test_a_rebuilt_take_is_read_from_its_new_files_in_the_same_process(
+    corpus: Path, store: WindowStore
+) -> None:
+    """Reading batches keeps each stream file open (by path) for later reads; a rebuild replaces the files (new
+    inodes, same paths), so a store reopened in the same process read the replaced take's old rows. The store
+    opened before the rebuild now refuses to read the replaced file."""
+    before = store.windows("train", keys=("pose_raw",)).batch()["pose_raw"]  # opens (and keeps) the files
+    write_take(corpus, "2_scott_0_9_9", TAKES["2_scott_0_9_9"], scale=2.0)  # same length, other motion
+    rebuilt = build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+    ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
+    got = rebuilt.windows("train", keys=("pose_raw",)).batch()["pose_raw"]
+    assert not np.array_equal(ref["pose_raw"], before)  # the take changed
+    assert np.array_equal(got, ref["pose_raw"])
+    with pytest.raises(
+        FormatError, match="pose_raw.npy.*replaced since"
+    ):  # the store opened before: no old rows
+        store.windows("train", keys=("pose_raw",)).batch()

@@ -272,7 +272,8 @@ def _need(data: Mapping[str, Any], path: Path, *fields: str) -> None:
 
 @dataclass(frozen=True)
 class StreamFile:
-    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``.
+    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``, and which file
+    that is (``ident``: its device and inode, so that rows are never read from a file that replaced it).
 
     Examples
     --------
@@ -291,6 +292,7 @@ class StreamFile:
     offset: int
     dtype: np.dtype
     shape: tuple[int, ...]
+    ident: tuple[int, int] = (0, 0)
 
     @classmethod
     def open(cls, path: Path, dtype: str, shape: Sequence[int]) -> StreamFile:
@@ -306,6 +308,7 @@ class StreamFile:
                     raise ValueError(f".npy format version {version} (expected 1.0 or 2.0)")
                 header = read_header(f)  # (shape, fortran, dtype)
                 offset = f.tell()
+                st = os.fstat(f.fileno())
         except (OSError, ValueError, SyntaxError) as e:
             raise FormatError(path, f"not a readable .npy file: {e}") from None
         got_shape, fortran, got_dtype = header
@@ -316,9 +319,9 @@ class StreamFile:
                 f"meta.json says {np.dtype(dtype).str} {tuple(shape)}",
             )
         size = offset + int(np.prod(shape, dtype=np.int64)) * got_dtype.itemsize
-        if path.stat().st_size != size:
-            raise FormatError(path, f"{path.stat().st_size} bytes, expected {size} (truncated or padded)")
-        return cls(path, offset, got_dtype, tuple(int(s) for s in shape))
+        if st.st_size != size:
+            raise FormatError(path, f"{st.st_size} bytes, expected {size} (truncated or padded)")
+        return cls(path, offset, got_dtype, tuple(int(s) for s in shape), (st.st_dev, st.st_ino))
 
     def row_bytes(self) -> int:
         return int(np.prod(self.shape[1:], dtype=np.int64)) * self.dtype.itemsize
@@ -328,7 +331,7 @@ class StreamFile:
         start, stop = max(0, start), min(stop, self.shape[0])
         n = max(0, stop - start)
         rb = self.row_bytes()
-        buf = os.pread(_FILES.fd(self.path), n * rb, self.offset + start * rb)
+        buf = os.pread(_FILES.fd(self.path, self.ident), n * rb, self.offset + start * rb)
         if len(buf) != n * rb:
             raise FormatError(self.path, f"short read at row {start}: file changed since it was opened")
         return np.frombuffer(buf, dtype=self.dtype).reshape(n, *self.shape[1:])
@@ -339,22 +342,31 @@ class StreamFile:
 
 
 class _FileCache:
-    """A small per-process cache of open read-only file descriptors (reset after a fork)."""
+    """A small per-process cache of open read-only file descriptors (reset after a fork), one per path: the
+    descriptor of the file ``ident`` (device, inode) names; one of a file since replaced at that path (a rebuilt
+    take) is closed, and a path that no longer holds that file is a ``FormatError``."""
 
     def __init__(self, size: int = 128) -> None:
         self.size = size
-        self._fds: dict[Path, int] = {}
+        self._fds: dict[Path, tuple[int, tuple[int, int]]] = {}
         self._pid = os.getpid()
 
-    def fd(self, path: Path) -> int:
+    def fd(self, path: Path, ident: tuple[int, int]) -> int:
         if os.getpid() != self._pid:  # a forked DataLoader worker: open its own descriptors
             self._fds, self._pid = {}, os.getpid()
-        fd = self._fds.pop(path, None)
+        fd, held = self._fds.pop(path, (None, None))
+        if fd is not None and held != ident:  # the file at this path was replaced (a rebuilt take)
+            os.close(fd)
+            fd = None
         if fd is None:
             if len(self._fds) >= self.size:
-                os.close(self._fds.pop(next(iter(self._fds))))
+                os.close(self._fds.pop(next(iter(self._fds)))[0])
             fd = os.open(path, os.O_RDONLY)
-        self._fds[path] = fd  # most recently used last
+            st = os.fstat(fd)
+            if (st.st_dev, st.st_ino) != tuple(ident):
+                os.close(fd)
+                raise FormatError(path, "replaced since the store was opened (open it again)")
+        self._fds[path] = (fd, ident)  # most recently used last
         return fd
 
 
