@@ -427,3 +427,21 @@ def test_a_rebuilt_take_is_read_from_its_new_files_in_the_same_process(
         FormatError, match="pose_raw.npy.*replaced since"
     ):  # the store opened before: no old rows
         store.windows("train", keys=("pose_raw",)).batch()
+
+
+def test_a_bit_flip_in_a_npy_header_is_a_format_error_and_healed(corpus: Path, store: WindowStore) -> None:
+    """numpy parses a ``.npy`` header as a Python literal: a flipped bit of its length field (byte 8) or of the
+    text made it raise ``tokenize.TokenError``, neither a FormatError nor healed by the next build."""
+    take = store.takes[int(store.windows("train").take_ids[0])]
+    pose = take.folder / "pose_raw.npy"
+    good = pose.read_bytes()
+    for at, bit in ((8, 6), (20, 2), (60, 0)):  # the header length, inside the dict, in its padding
+        bad = bytearray(good)
+        bad[at] ^= 1 << bit
+        pose.write_bytes(bytes(bad))
+        with pytest.raises(FormatError, match="pose_raw.npy"):
+            WindowStore.open(store.folder).windows("train", keys=("pose_raw",)).batch()
+        healed = build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+        assert (
+            pose.read_bytes() == good and healed.take(take.stem).stream("pose_raw").shape[0] == take.n_frames
+        )

@@ -309,7 +309,8 @@ class StreamFile:
                 header = read_header(f)  # (shape, fortran, dtype)
                 offset = f.tell()
                 st = os.fstat(f.fileno())
-        except (OSError, ValueError, SyntaxError) as e:
+        # (numpy parses the header as a Python literal: ValueError, SyntaxError, tokenize.TokenError, ...)
+        except Exception as e:
             raise FormatError(path, f"not a readable .npy file: {e}") from None
         got_shape, fortran, got_dtype = header
         if fortran or got_dtype != np.dtype(dtype) or tuple(got_shape) != tuple(shape):
