@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -445,3 +448,52 @@ def test_a_bit_flip_in_a_npy_header_is_a_format_error_and_healed(corpus: Path, s
         assert (
             pose.read_bytes() == good and healed.take(take.stem).stream("pose_raw").shape[0] == take.n_frames
         )
+
+
+_BUILD_CHILD = (
+    "import sys; from beatlite.data.index import index_folder; from beatlite.data.store import build_store; "
+    "from test_data_windows import VOCAB; build_store(index_folder(sys.argv[1], cache=False), sys.argv[2], "
+    "vocab=VOCAB, workers=0)"
+)
+
+
+def _limit_file_size(limit: int) -> None:
+    """(In the child, before exec) writes past ``limit`` bytes fail (EFBIG), as a full disk's do (ENOSPC)."""
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE and SIGXFSZ as on Linux")
+def test_a_build_that_cannot_write_names_the_store_and_leaves_nothing_misread(
+    corpus: Path, tmp_path: Path
+) -> None:
+    """A write that fails midway (the file-size limit here: 50 kB fails the first stream, 150 kB the third)
+    raised numpy's bare ``OSError: 14100 requested and 6234 written`` (no folder named) and left the take's
+    written streams behind; it names the store's entry and removes it, and a later build equals a fresh one."""
+    folder, fresh = tmp_path / "store", tmp_path / "fresh"
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")]),
+    }
+    for limit in (50_000, 150_000):
+        cmd = [sys.executable, "-c", _BUILD_CHILD, str(corpus), str(folder)]
+        done = subprocess.run(
+            cmd,
+            env=env,
+            capture_output=True,
+            text=True,
+            preexec_fn=functools.partial(_limit_file_size, limit),
+        )
+        last = done.stderr.strip().splitlines()[-1]
+        assert done.returncode == 1 and last.startswith("OSError:"), done.stderr
+        assert f"cannot write the window store {folder}" in last, done.stderr  # (or one of its takes)
+        assert not [p for p in folder.rglob("*") if p.name.endswith(".tmp")]
+        assert all((take / "meta.json").is_file() for take in (folder / "takes").iterdir()), done.stderr
+    build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+    build_store(index_folder(corpus), fresh, vocab=VOCAB, workers=0)
+    files = sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
+    assert sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file()) == files
+    assert all((folder / p).read_bytes() == (fresh / p).read_bytes() for p in files)

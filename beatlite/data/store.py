@@ -47,6 +47,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -182,6 +183,25 @@ def _moments(x: np.ndarray) -> dict[str, Any]:
     return {"n": int(len(x)), "sum": x.sum(axis=0).tolist(), "m2": ((x - mean) ** 2).sum(axis=0).tolist()}
 
 
+@contextlib.contextmanager
+def _writing(folder: Path, *, remove: bool = False) -> Iterator[None]:
+    """Re-raise an ``OSError`` of writing under ``folder`` (a full disk, a read-only or missing folder) as
+    one that names it (numpy's own is a bare ``N requested and M written``); ``remove``: remove ``folder``
+    first (a take's partial entry: no space held by files that nothing will read)."""
+    try:
+        yield
+    except OSError as e:
+        if remove:
+            shutil.rmtree(folder, ignore_errors=True)
+        if "cannot write the window store" in str(e):  # (named already)
+            raise
+        reason = (
+            f"cannot write the window store {folder} ({e.strerror or e}): free space there, or give a "
+            "writable one"
+        )
+        raise OSError(*(() if e.errno is None else (e.errno,)), reason) from None
+
+
 def _save_npy(path: Path, array: np.ndarray) -> None:
     from beatlite.io.atomic import atomic_write
 
@@ -208,8 +228,9 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
     >>> tmp.cleanup()
     """
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "meta.json").unlink(missing_ok=True)
+    with _writing(folder):
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "meta.json").unlink(missing_ok=True)
     recorder = _WordRecorder()
     f = take_features(
         record,
@@ -232,8 +253,6 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
     }
     if params["positions"]:
         streams["positions"] = f.positions.astype("<f4")
-    for name, arr in streams.items():
-        _save_npy(folder / f"{name}.npy", np.ascontiguousarray(arr, dtype=STREAMS[name]))
     meta = {
         "stem": record.stem,
         "split": record.split,
@@ -248,8 +267,11 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
     }
     from beatlite.io.atomic import atomic_write
 
-    with atomic_write(folder / "meta.json") as fh:
-        json.dump(meta, fh)
+    with _writing(folder, remove=True):
+        for name, arr in streams.items():
+            _save_npy(folder / f"{name}.npy", np.ascontiguousarray(arr, dtype=STREAMS[name]))
+        with atomic_write(folder / "meta.json") as fh:
+            json.dump(meta, fh)
     return meta
 
 
@@ -1050,6 +1072,9 @@ def build_store(
     ValueError
         Bad parameters or no usable take. A take that cannot be read raises its reader's
         ``FormatError``.
+    OSError
+        A file that cannot be written (a full disk, a read-only folder), naming the store folder or the take's
+        entry in it (whose partial files are removed: a later build with space equals a fresh one).
 
     Examples
     --------
@@ -1072,17 +1097,18 @@ def build_store(
     records = _usable_records(index)
     params = store_params(fps=fps, sr=sr, positions=positions, word_rule=word_rule)
     folder = Path(folder) if folder is not None else default_store_folder(index, params)
-    (folder / "takes").mkdir(parents=True, exist_ok=True)
     from beatlite.io.atomic import exclusive_lock
 
-    with exclusive_lock(
-        folder / ".build.lock"
-    ):  # other processes building this store wait, then find it current
+    with contextlib.ExitStack() as held:
+        with _writing(folder):  # other processes building this store wait, then find it current
+            (folder / "takes").mkdir(parents=True, exist_ok=True)
+            held.enter_context(exclusive_lock(folder / ".build.lock"))
         todo = [r for r in records if not _is_current(folder / "takes" / r.stem, r, params)]
-        _run_builds(todo, folder, params, workers, progress)
+        _run_builds(todo, folder, params, workers, progress)  # (build_take names the entry it cannot write)
         keep = {r.stem for r in records}
-        for stale in (folder / "takes").iterdir():
-            if stale.is_dir() and stale.name not in keep:
-                shutil.rmtree(stale)
-        _write_manifest(folder, index, records, params, vocab)
+        with _writing(folder):
+            for stale in (folder / "takes").iterdir():
+                if stale.is_dir() and stale.name not in keep:
+                    shutil.rmtree(stale)
+            _write_manifest(folder, index, records, params, vocab)
         return WindowStore.open(folder)
