@@ -10,6 +10,7 @@ import subprocess
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -497,3 +498,68 @@ def test_a_build_that_cannot_write_names_the_store_and_leaves_nothing_misread(
     files = sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
     assert sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file()) == files
     assert all((folder / p).read_bytes() == (fresh / p).read_bytes() for p in files)
+
+
+def _read_only(monkeypatch: pytest.MonkeyPatch, folder: Path) -> None:
+    """Make ``folder`` read-only as a read-only mount does (root ignores file modes): creating, opening for
+    writing, renaming or removing anything under it raises ``OSError(EROFS)``."""
+    import builtins
+    import errno
+
+    from beatlite.io import atomic
+
+    root = folder.resolve()
+
+    def under(path: Any) -> bool:
+        return isinstance(path, str | os.PathLike) and Path(os.fspath(path)).resolve().is_relative_to(root)
+
+    def refuse(path: Any) -> None:
+        raise OSError(errno.EROFS, "Read-only file system", str(path))
+
+    real_open, real_os_open, real_mkdir = builtins.open, os.open, os.mkdir
+
+    def fake_open(file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+        if under(file) and any(c in mode for c in "wax+"):
+            refuse(file)
+        return real_open(file, mode, *args, **kwargs)
+
+    def fake_os_open(path: Any, flags: int, *args: Any, **kwargs: Any) -> int:
+        if under(path) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT):
+            refuse(path)
+        return real_os_open(path, flags, *args, **kwargs)
+
+    def fake_mkdir(path: Any, *args: Any, **kwargs: Any) -> None:
+        if under(path) and not os.path.exists(path):
+            refuse(path)
+        real_mkdir(path, *args, **kwargs)
+
+    def refusing(real: Any) -> Any:
+        return lambda path, *args, **kwargs: refuse(path) if under(path) else real(path, *args, **kwargs)
+
+    monkeypatch.setattr(atomic, "open", fake_open, raising=False)
+    monkeypatch.setattr(os, "open", fake_os_open)
+    monkeypatch.setattr(os, "mkdir", fake_mkdir)
+    for name in ("unlink", "replace", "rename", "rmdir"):
+        monkeypatch.setattr(os, name, refusing(getattr(os, name)))
+
+
+def test_a_current_store_on_read_only_media_is_opened_without_writing(
+    corpus: Path, store: WindowStore, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Opening a current store wrote its lock file open (``a+b``) and store.json again, so on a read-only
+    mount (measured: a bind mount, ``OSError: [Errno 30] Read-only file system: '.../.build.lock'``) neither
+    ``open_if_current`` nor ``build_store`` could read it. They write nothing now; a stale one is a clear error."""
+    from beatlite.data.store import open_if_current, store_params
+
+    expected = store.windows("train").batch()
+    index = index_folder(corpus)
+    _read_only(monkeypatch, store.folder)
+    for opened in (
+        open_if_current(index, store.folder, store_params()),
+        build_store(index, store.folder, vocab=VOCAB),
+    ):
+        got = opened.windows("train").batch()
+        assert all(np.array_equal(got[k], expected[k]) for k in expected)
+    write_take(corpus, "2_scott_0_9_9", TAKES["2_scott_0_9_9"], scale=2.0)
+    with pytest.raises(OSError, match=f"cannot write the window store {store.folder}"):
+        build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)

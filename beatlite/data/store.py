@@ -1003,7 +1003,8 @@ def _write_manifest(
     folder: Path, index: TakeIndex, records: list[TakeRecord], params: dict, vocab: Vocab | None
 ) -> None:
     """``store.json``: version, parameters, takes and vocabulary (``build_vocab`` of the stored (usable) takes,
-    reused while none of their TextGrids changed; an unusable take's may not read)."""
+    reused while none of their TextGrids changed; an unusable take's may not read). Not written again when it
+    holds that already (a current store on read-only media opens)."""
     from beatlite.data.index import TakeIndex
     from beatlite.data.vocab import corpus_vocab
     from beatlite.io.atomic import atomic_write
@@ -1020,8 +1021,12 @@ def _write_manifest(
         "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
         "vocab_fingerprint": text_fp,
     }
+    text = json.dumps(manifest, indent=1)
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        if (folder / "store.json").read_text(encoding="utf-8") == text:
+            return
     with atomic_write(folder / "store.json") as f:
-        json.dump(manifest, f, indent=1)
+        f.write(text)
 
 
 def build_store(
@@ -1040,7 +1045,8 @@ def build_store(
 
     Takes whose entry is complete and whose fingerprint (files' content, ``bvh_fps`` override, parameters,
     :data:`STORE_VERSION`) matches are kept; the others are rebuilt; entries of takes no longer
-    in the index are removed. Memory: one take per worker (plus O(number of takes) meta data).
+    in the index are removed. A store that is current is opened without writing anything (it may lie on
+    read-only media). Memory: one take per worker (plus O(number of takes) meta data).
 
     Parameters
     ----------
