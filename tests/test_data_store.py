@@ -563,3 +563,34 @@ def test_a_current_store_on_read_only_media_is_opened_without_writing(
     write_take(corpus, "2_scott_0_9_9", TAKES["2_scott_0_9_9"], scale=2.0)
     with pytest.raises(OSError, match=f"cannot write the window store {store.folder}"):
         build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+
+
+def _flip_bit_after(path: Path, marker: str, *, skip: str = "") -> None:
+    """Flip the lowest bit of the first character after ``marker`` that is not in ``skip`` (a digit stays a
+    digit, a letter a letter: the JSON still parses)."""
+    data = bytearray(path.read_bytes())
+    at = data.index(marker.encode()) + len(marker)
+    while chr(data[at]) in skip:
+        at += 1
+    data[at] ^= 1
+    path.write_bytes(bytes(data))
+
+
+def test_a_flipped_bit_in_the_stores_json_is_a_format_error_and_healed(corpus: Path, tmp_path: Path) -> None:
+    """A bit flipped in a number of a take's meta.json (its statistics) or a word of store.json's vocabulary
+    still parses: the store gave other statistics or word ids without a word, and the next build kept them
+    (store.json's vocabulary is reused while the TextGrids are unchanged). Each file carries the sha256 of its
+    content now: a mismatch is a FormatError naming it, and the build rewrites the file."""
+    index = index_folder(corpus)
+    fresh = build_store(index, tmp_path / "fresh", workers=0)  # the default vocabulary: kept in store.json
+    assert "hello" in fresh.vocab.itos
+    files = sorted(p.relative_to(fresh.folder) for p in fresh.folder.rglob("*") if p.is_file())
+    take = fresh.takes[int(fresh.windows("train").take_ids[0])].folder.relative_to(fresh.folder)
+    for name, marker, skip in ((take / "meta.json", '"sum": [', "-"), ("store.json", '"hello', "")):
+        folder = tmp_path / f"flipped_{Path(name).stem}"
+        shutil.copytree(fresh.folder, folder)
+        _flip_bit_after(folder / name, marker, skip=skip)
+        with pytest.raises(FormatError, match=Path(name).name):
+            WindowStore.open(folder).statistics("train")
+        build_store(index, folder, workers=0)
+        assert all((folder / p).read_bytes() == (fresh.folder / p).read_bytes() for p in files), name

@@ -32,7 +32,8 @@ per take (count, sum, centred sum of squares; Chan et al.'s pairwise update) and
 
 The folder holds ``store.json`` (version, parameters, take stems in index order, the
 vocabulary) and ``takes/{stem}/`` with the ``.npy`` files and ``meta.json`` (shapes, audio step,
-word marks, statistics and a fingerprint of the source files and parameters). Building is
+word marks, statistics and a fingerprint of the source files and parameters); each JSON file carries the
+sha256 of its content (``digest``: a corrupt one is a ``FormatError``, rebuilt by the next build). Building is
 incremental: takes whose fingerprint matches are kept, the others are rebuilt in worker
 processes; every file is written atomically, ``meta.json`` last.
 
@@ -265,6 +266,7 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
         "dirs_moments": _moments(f.dirs),
         "fingerprint": take_fingerprint(record, params),
     }
+    meta["digest"] = _json_digest(meta)
     from beatlite.io.atomic import atomic_write
 
     with _writing(folder, remove=True):
@@ -276,6 +278,13 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
 
 
 # ---------------------------------------------------------------------- reading
+def _json_digest(data: Mapping[str, Any]) -> str:
+    """sha256 of a JSON object's fields other than ``digest`` (sorted keys): what a meta.json or store.json
+    carries as ``digest``, so that a flipped bit that still parses (a digit, a letter) is seen."""
+    body = {k: v for k, v in data.items() if k != "digest"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+
+
 def _read_json(path: Path) -> dict[str, Any]:
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -284,6 +293,15 @@ def _read_json(path: Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise FormatError(path, f"expected a JSON object, got {type(data).__name__}")
     return data
+
+
+def _check_digest(data: Mapping[str, Any], path: Path) -> None:
+    """FormatError naming ``path`` unless ``data`` (its JSON object) carries the :func:`_json_digest` of itself."""
+    if data.get("digest") != _json_digest(data):
+        raise FormatError(
+            path,
+            "content does not match its digest (corrupt, or written by an older beatlite): build the store",
+        )
 
 
 def _need(data: Mapping[str, Any], path: Path, *fields: str) -> None:
@@ -423,6 +441,7 @@ class StoreTake:
         meta = _read_json(path)
         _need(meta, path, "stem", "split", "speaker", "n_frames", "audio_scale", "word_marks", "shapes")
         _need(meta, path, "pose_moments", "dirs_moments", "fingerprint")
+        _check_digest(meta, path)
         return cls(folder, meta)
 
     @property
@@ -513,6 +532,7 @@ class WindowStore:
         _need(data, path, "version", "params", "takes", "vocab")
         if data["version"] != STORE_VERSION:
             raise FormatError(path, f"store version {data['version']}, this beatlite reads {STORE_VERSION}")
+        _check_digest(data, path)
         takes = [StoreTake.open(folder / "takes" / stem) for stem in data["takes"]]
         return cls(folder, data["params"], takes, Vocab(data["vocab"]))
 
@@ -911,8 +931,10 @@ def open_if_current(index: TakeIndex, folder: str | Path, params: Mapping[str, A
         return None
     with exclusive_lock(folder / ".build.lock"):
         try:
-            listed = json.loads((folder / "store.json").read_text())["takes"]
-        except (OSError, ValueError, KeyError, TypeError):
+            manifest = _read_json(folder / "store.json")
+            _check_digest(manifest, folder / "store.json")
+            listed = list(manifest["takes"])
+        except (FormatError, KeyError, TypeError):
             return None
         if sorted(listed) != sorted(r.stem for r in records):
             return None
@@ -938,6 +960,7 @@ def _stored_vocab(path: Path, text_fp: str) -> Vocab | None:
 
     try:
         data = _read_json(path)
+        _check_digest(data, path)
         if data.get("vocab_fingerprint") == text_fp and data.get("version") == STORE_VERSION:
             return Vocab(data["vocab"])
     except (FormatError, KeyError, TypeError, ValueError):
@@ -1021,6 +1044,7 @@ def _write_manifest(
         "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
         "vocab_fingerprint": text_fp,
     }
+    manifest["digest"] = _json_digest(manifest)
     text = json.dumps(manifest, indent=1)
     with contextlib.suppress(OSError, UnicodeDecodeError):
         if (folder / "store.json").read_text(encoding="utf-8") == text:
