@@ -19,6 +19,7 @@ from test_data_windows import TAKES, VOCAB, write_take
 from beatlite.data.index import index_folder
 from beatlite.data.normalize import Normalizer
 from beatlite.data.store import (
+    STREAMS,
     WindowStore,
     _combine,
     _moments,
@@ -594,3 +595,51 @@ def test_a_flipped_bit_in_the_stores_json_is_a_format_error_and_healed(corpus: P
             WindowStore.open(folder).statistics("train")
         build_store(index, folder, workers=0)
         assert all((folder / p).read_bytes() == (fresh.folder / p).read_bytes() for p in files), name
+
+
+def test_a_build_killed_at_any_rename_is_finished_by_the_next_one_bit_for_bit(
+    corpus: Path, tmp_path: Path
+) -> None:
+    """A build process killed just before its k-th rename (a stream's, a take's meta.json, store.json: each
+    leaves a complete temp file behind) leaves no lock held and nothing that the next build misreads: it
+    equals a fresh build file for file, and no temp file is left."""
+    folder, fresh = tmp_path / "store", tmp_path / "fresh"
+    build_store(index_folder(corpus), fresh, vocab=VOCAB, workers=0)
+    files = sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
+    per_take = len(STREAMS)  # its 8 streams (no positions) and meta.json
+    renames = len(TAKES) * per_take + 1  # then store.json
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")]),
+    }
+    kill = (
+        "import os, sys; real, n = os.replace, [0]\n"
+        "def replace(*a, **k):\n"
+        "    n[0] += 1\n"
+        "    if n[0] == int(sys.argv[3]): os._exit(9)\n"
+        "    real(*a, **k)\n"
+        "os.replace = replace\n"
+    )
+    for k in (1, per_take, renames):  # the first stream, the first take's meta.json, store.json
+        done = subprocess.run([sys.executable, "-c", kill + _BUILD_CHILD, str(corpus), str(folder), str(k)],
+                              env=env, capture_output=True, text=True)  # fmt: skip
+        assert done.returncode == 9, done.stderr
+        assert [p for p in folder.rglob("*") if p.name.endswith(".tmp")], (
+            "the killed writer left its temp file"
+        )
+        build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+        assert not [p for p in folder.rglob("*") if p.name.endswith(".tmp")]
+        assert sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file()) == files
+        assert all((folder / p).read_bytes() == (fresh / p).read_bytes() for p in files), k
+        shutil.rmtree(folder)
+
+
+def test_a_read_only_corpus_is_indexed_and_built(
+    corpus: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Readers never write: a corpus on read-only media is indexed (cache elsewhere) and stored elsewhere."""
+    expected = build_windows(index_folder(corpus, cache=False), split="train", vocab=VOCAB, cache=False)
+    _read_only(monkeypatch, corpus)
+    store = build_store(index_folder(corpus), tmp_path / "elsewhere", vocab=VOCAB, workers=0)
+    got = store.windows("train", stats=expected.normalizers).batch()
+    assert all(np.array_equal(got[k], expected[k]) for k in expected.keys())
