@@ -643,3 +643,23 @@ def test_a_read_only_corpus_is_indexed_and_built(
     store = build_store(index_folder(corpus), tmp_path / "elsewhere", vocab=VOCAB, workers=0)
     got = store.windows("train", stats=expected.normalizers).batch()
     assert all(np.array_equal(got[k], expected[k]) for k in expected.keys())
+
+
+def test_a_word_id_outside_the_takes_marks_is_a_format_error(store: WindowStore) -> None:
+    """A bit flipped in word.npy can give a take-local id past the take's word marks: batches raised numpy's
+    IndexError (measured: 13 of 24 bit flips of one take's word.npy), as did holding the streams on the device
+    (ResidentWindows); it is a FormatError naming the file."""
+    view = store.windows("train", keys=("word",))
+    take = store.takes[int(view.take_ids[-1])]
+    word = take.folder / "word.npy"
+    data = bytearray(word.read_bytes())
+    data[len(data) - 4 * take.n_frames + 3] ^= (
+        0x40  # the high byte of frame 0's little-endian int32: 2**30 more
+    )
+    word.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="word.npy.*word id"):
+        WindowStore.open(store.folder).windows("train", keys=("word",)).batch()
+    from beatlite.data.resident import ResidentWindows
+
+    with pytest.raises(FormatError, match="word.npy.*word id"):  # the streams held on the device: the same
+        ResidentWindows(WindowStore.open(store.folder).windows("train", keys=("word",)), ["word"])

@@ -773,6 +773,15 @@ class StoreWindows:
             self._word_tables[take_id] = np.array([0, 1, 2, 3, *ids], dtype=np.int64)
         return self._word_tables[take_id]
 
+    def _word_ids(self, take_id: int, local: np.ndarray) -> np.ndarray:
+        """Vocabulary ids of take-local word ids (FormatError naming word.npy for an id the take has no mark of)."""
+        table = self._word_table(take_id)
+        bad = local[(local < 0) | (local >= len(table))]
+        if bad.size:
+            path = self.store.takes[take_id].folder / "word.npy"
+            raise FormatError(path, f"word id {int(bad[0])} outside the take's {len(table)} ids (corrupt)")
+        return table[local]
+
     def batch(
         self, indices: Sequence[int] | np.ndarray | None = None, *, keys: Sequence[str] | None = None
     ) -> dict[str, np.ndarray]:
@@ -792,7 +801,7 @@ class StoreWindows:
         """Batch key ``k`` of the windows ``idx`` from their raw streams (normalised, mapped to the vocabulary)."""
         takes = self.store.takes
         if k == "word":
-            rows = [self._word_table(int(t))[w] for t, w in zip(self.take_ids[idx], raw["word"])]
+            rows = [self._word_ids(int(t), w) for t, w in zip(self.take_ids[idx], raw["word"])]
             return np.stack(rows).reshape(len(idx), self.length)
         if k == "speaker":
             return np.array([takes[t].meta["speaker"] for t in self.take_ids[idx]], np.int64)
