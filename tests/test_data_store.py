@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
+import subprocess
+import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -15,6 +19,7 @@ from test_data_windows import TAKES, VOCAB, write_take
 from beatlite.data.index import index_folder
 from beatlite.data.normalize import Normalizer
 from beatlite.data.store import (
+    STREAMS,
     WindowStore,
     _combine,
     _moments,
@@ -408,3 +413,253 @@ def test_processes_building_one_store_at_once_take_turns(corpus: Path, tmp_path:
     ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
     got = WindowStore.open(folder).windows("train", stats=ref.normalizers).batch()
     assert np.array_equal(got["pose_raw"], ref["pose_raw"])
+
+
+def test_a_rebuilt_take_is_read_from_its_new_files_in_the_same_process(
+    corpus: Path, store: WindowStore
+) -> None:
+    """Reading batches keeps each stream file open (by path) for later reads; a rebuild replaces the files (new
+    inodes, same paths), so a store reopened in the same process read the replaced take's old rows. The store
+    opened before the rebuild now refuses to read the replaced file."""
+    before = store.windows("train", keys=("pose_raw",)).batch()["pose_raw"]  # opens (and keeps) the files
+    write_take(corpus, "2_scott_0_9_9", TAKES["2_scott_0_9_9"], scale=2.0)  # same length, other motion
+    rebuilt = build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+    ref = build_windows(index_folder(corpus), split="train", vocab=VOCAB, cache=False)
+    got = rebuilt.windows("train", keys=("pose_raw",)).batch()["pose_raw"]
+    assert not np.array_equal(ref["pose_raw"], before)  # the take changed
+    assert np.array_equal(got, ref["pose_raw"])
+    with pytest.raises(
+        FormatError, match="pose_raw.npy.*replaced since"
+    ):  # the store opened before: no old rows
+        store.windows("train", keys=("pose_raw",)).batch()
+
+
+def test_a_bit_flip_in_a_npy_header_is_a_format_error_and_healed(corpus: Path, store: WindowStore) -> None:
+    """numpy parses a ``.npy`` header as a Python literal: a flipped bit of its length field (byte 8) or of the
+    text made it raise ``tokenize.TokenError``, neither a FormatError nor healed by the next build."""
+    take = store.takes[int(store.windows("train").take_ids[0])]
+    pose = take.folder / "pose_raw.npy"
+    good = pose.read_bytes()
+    for at, bit in ((8, 6), (20, 2), (60, 0)):  # the header length, inside the dict, in its padding
+        bad = bytearray(good)
+        bad[at] ^= 1 << bit
+        pose.write_bytes(bytes(bad))
+        with pytest.raises(FormatError, match="pose_raw.npy"):
+            WindowStore.open(store.folder).windows("train", keys=("pose_raw",)).batch()
+        healed = build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+        assert (
+            pose.read_bytes() == good and healed.take(take.stem).stream("pose_raw").shape[0] == take.n_frames
+        )
+
+
+_BUILD_CHILD = (
+    "import sys; from beatlite.data.index import index_folder; from beatlite.data.store import build_store; "
+    "from test_data_windows import VOCAB; build_store(index_folder(sys.argv[1], cache=False), sys.argv[2], "
+    "vocab=VOCAB, workers=0)"
+)
+
+
+def _limit_file_size(limit: int) -> None:
+    """(In the child, before exec) writes past ``limit`` bytes fail (EFBIG), as a full disk's do (ENOSPC)."""
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE and SIGXFSZ as on Linux")
+def test_a_build_that_cannot_write_names_the_store_and_leaves_nothing_misread(
+    corpus: Path, tmp_path: Path
+) -> None:
+    """A write that fails midway (the file-size limit here: 50 kB fails the first stream, 150 kB the third)
+    raised numpy's bare ``OSError: 14100 requested and 6234 written`` (no folder named) and left the take's
+    written streams behind; it names the store's entry and removes it, and a later build equals a fresh one."""
+    folder, fresh = tmp_path / "store", tmp_path / "fresh"
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")]),
+    }
+    for limit in (50_000, 150_000):
+        cmd = [sys.executable, "-c", _BUILD_CHILD, str(corpus), str(folder)]
+        done = subprocess.run(
+            cmd,
+            env=env,
+            capture_output=True,
+            text=True,
+            preexec_fn=functools.partial(_limit_file_size, limit),
+        )
+        last = done.stderr.strip().splitlines()[-1]
+        assert done.returncode == 1 and last.startswith("OSError:"), done.stderr
+        assert f"cannot write the window store {folder}" in last, done.stderr  # (or one of its takes)
+        assert not [p for p in folder.rglob("*") if p.name.endswith(".tmp")]
+        assert all((take / "meta.json").is_file() for take in (folder / "takes").iterdir()), done.stderr
+    build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+    build_store(index_folder(corpus), fresh, vocab=VOCAB, workers=0)
+    files = sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
+    assert sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file()) == files
+    assert all((folder / p).read_bytes() == (fresh / p).read_bytes() for p in files)
+
+
+def _read_only(monkeypatch: pytest.MonkeyPatch, folder: Path) -> None:
+    """Make ``folder`` read-only as a read-only mount does (root ignores file modes): creating, opening for
+    writing, renaming or removing anything under it raises ``OSError(EROFS)``."""
+    import builtins
+    import errno
+
+    from beatlite.io import atomic
+
+    root = folder.resolve()
+
+    def under(path: Any) -> bool:
+        return isinstance(path, str | os.PathLike) and Path(os.fspath(path)).resolve().is_relative_to(root)
+
+    def refuse(path: Any) -> None:
+        raise OSError(errno.EROFS, "Read-only file system", str(path))
+
+    real_open, real_os_open, real_mkdir = builtins.open, os.open, os.mkdir
+
+    def fake_open(file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+        if under(file) and any(c in mode for c in "wax+"):
+            refuse(file)
+        return real_open(file, mode, *args, **kwargs)
+
+    def fake_os_open(path: Any, flags: int, *args: Any, **kwargs: Any) -> int:
+        if under(path) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT):
+            refuse(path)
+        return real_os_open(path, flags, *args, **kwargs)
+
+    def fake_mkdir(path: Any, *args: Any, **kwargs: Any) -> None:
+        if under(path) and not os.path.exists(path):
+            refuse(path)
+        real_mkdir(path, *args, **kwargs)
+
+    def refusing(real: Any) -> Any:
+        return lambda path, *args, **kwargs: refuse(path) if under(path) else real(path, *args, **kwargs)
+
+    monkeypatch.setattr(atomic, "open", fake_open, raising=False)
+    monkeypatch.setattr(os, "open", fake_os_open)
+    monkeypatch.setattr(os, "mkdir", fake_mkdir)
+    for name in ("unlink", "replace", "rename", "rmdir"):
+        monkeypatch.setattr(os, name, refusing(getattr(os, name)))
+
+
+def test_a_current_store_on_read_only_media_is_opened_without_writing(
+    corpus: Path, store: WindowStore, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Opening a current store wrote its lock file open (``a+b``) and store.json again, so on a read-only
+    mount (measured: a bind mount, ``OSError: [Errno 30] Read-only file system: '.../.build.lock'``) neither
+    ``open_if_current`` nor ``build_store`` could read it. They write nothing now; a stale one is a clear error."""
+    from beatlite.data.store import open_if_current, store_params
+
+    expected = store.windows("train").batch()
+    index = index_folder(corpus)
+    _read_only(monkeypatch, store.folder)
+    for opened in (
+        open_if_current(index, store.folder, store_params()),
+        build_store(index, store.folder, vocab=VOCAB),
+    ):
+        got = opened.windows("train").batch()
+        assert all(np.array_equal(got[k], expected[k]) for k in expected)
+    write_take(corpus, "2_scott_0_9_9", TAKES["2_scott_0_9_9"], scale=2.0)
+    with pytest.raises(OSError, match=f"cannot write the window store {store.folder}"):
+        build_store(index_folder(corpus), store.folder, vocab=VOCAB, workers=0)
+
+
+def _flip_bit_after(path: Path, marker: str, *, skip: str = "") -> None:
+    """Flip the lowest bit of the first character after ``marker`` that is not in ``skip`` (a digit stays a
+    digit, a letter a letter: the JSON still parses)."""
+    data = bytearray(path.read_bytes())
+    at = data.index(marker.encode()) + len(marker)
+    while chr(data[at]) in skip:
+        at += 1
+    data[at] ^= 1
+    path.write_bytes(bytes(data))
+
+
+def test_a_flipped_bit_in_the_stores_json_is_a_format_error_and_healed(corpus: Path, tmp_path: Path) -> None:
+    """A bit flipped in a number of a take's meta.json (its statistics) or a word of store.json's vocabulary
+    still parses: the store gave other statistics or word ids without a word, and the next build kept them
+    (store.json's vocabulary is reused while the TextGrids are unchanged). Each file carries the sha256 of its
+    content now: a mismatch is a FormatError naming it, and the build rewrites the file."""
+    index = index_folder(corpus)
+    fresh = build_store(index, tmp_path / "fresh", workers=0)  # the default vocabulary: kept in store.json
+    assert "hello" in fresh.vocab.itos
+    files = sorted(p.relative_to(fresh.folder) for p in fresh.folder.rglob("*") if p.is_file())
+    take = fresh.takes[int(fresh.windows("train").take_ids[0])].folder.relative_to(fresh.folder)
+    for name, marker, skip in ((take / "meta.json", '"sum": [', "-"), ("store.json", '"hello', "")):
+        folder = tmp_path / f"flipped_{Path(name).stem}"
+        shutil.copytree(fresh.folder, folder)
+        _flip_bit_after(folder / name, marker, skip=skip)
+        with pytest.raises(FormatError, match=Path(name).name):
+            WindowStore.open(folder).statistics("train")
+        build_store(index, folder, workers=0)
+        assert all((folder / p).read_bytes() == (fresh.folder / p).read_bytes() for p in files), name
+
+
+def test_a_build_killed_at_any_rename_is_finished_by_the_next_one_bit_for_bit(
+    corpus: Path, tmp_path: Path
+) -> None:
+    """A build process killed just before its k-th rename (a stream's, a take's meta.json, store.json: each
+    leaves a complete temp file behind) leaves no lock held and nothing that the next build misreads: it
+    equals a fresh build file for file, and no temp file is left."""
+    folder, fresh = tmp_path / "store", tmp_path / "fresh"
+    build_store(index_folder(corpus), fresh, vocab=VOCAB, workers=0)
+    files = sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
+    per_take = len(STREAMS)  # its 8 streams (no positions) and meta.json
+    renames = len(TAKES) * per_take + 1  # then store.json
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")]),
+    }
+    kill = (
+        "import os, sys; real, n = os.replace, [0]\n"
+        "def replace(*a, **k):\n"
+        "    n[0] += 1\n"
+        "    if n[0] == int(sys.argv[3]): os._exit(9)\n"
+        "    real(*a, **k)\n"
+        "os.replace = replace\n"
+    )
+    for k in (1, per_take, renames):  # the first stream, the first take's meta.json, store.json
+        done = subprocess.run([sys.executable, "-c", kill + _BUILD_CHILD, str(corpus), str(folder), str(k)],
+                              env=env, capture_output=True, text=True)  # fmt: skip
+        assert done.returncode == 9, done.stderr
+        assert [p for p in folder.rglob("*") if p.name.endswith(".tmp")], (
+            "the killed writer left its temp file"
+        )
+        build_store(index_folder(corpus), folder, vocab=VOCAB, workers=0)
+        assert not [p for p in folder.rglob("*") if p.name.endswith(".tmp")]
+        assert sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file()) == files
+        assert all((folder / p).read_bytes() == (fresh / p).read_bytes() for p in files), k
+        shutil.rmtree(folder)
+
+
+def test_a_read_only_corpus_is_indexed_and_built(
+    corpus: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Readers never write: a corpus on read-only media is indexed (cache elsewhere) and stored elsewhere."""
+    expected = build_windows(index_folder(corpus, cache=False), split="train", vocab=VOCAB, cache=False)
+    _read_only(monkeypatch, corpus)
+    store = build_store(index_folder(corpus), tmp_path / "elsewhere", vocab=VOCAB, workers=0)
+    got = store.windows("train", stats=expected.normalizers).batch()
+    assert all(np.array_equal(got[k], expected[k]) for k in expected.keys())
+
+
+def test_a_word_id_outside_the_takes_marks_is_a_format_error(store: WindowStore) -> None:
+    """A bit flipped in word.npy can give a take-local id past the take's word marks: batches raised numpy's
+    IndexError (measured: 13 of 24 bit flips of one take's word.npy), as did holding the streams on the device
+    (ResidentWindows); it is a FormatError naming the file."""
+    view = store.windows("train", keys=("word",))
+    take = store.takes[int(view.take_ids[-1])]
+    word = take.folder / "word.npy"
+    data = bytearray(word.read_bytes())
+    data[len(data) - 4 * take.n_frames + 3] ^= (
+        0x40  # the high byte of frame 0's little-endian int32: 2**30 more
+    )
+    word.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="word.npy.*word id"):
+        WindowStore.open(store.folder).windows("train", keys=("word",)).batch()
+    from beatlite.data.resident import ResidentWindows
+
+    with pytest.raises(FormatError, match="word.npy.*word id"):  # the streams held on the device: the same
+        ResidentWindows(WindowStore.open(store.folder).windows("train", keys=("word",)), ["word"])

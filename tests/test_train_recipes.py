@@ -367,6 +367,25 @@ def test_fit_command_says_when_the_corpus_has_no_val_take(tmp_path, monkeypatch,
     assert "57-64" in err and not (out / "fgd_dirvec.pt").exists()
 
 
+def test_fit_command_names_the_folder_it_cannot_write_in_one_error_line(tmp_path, monkeypatch, capsys):
+    """A store or ``--out`` folder that cannot be written (here one under a regular file; a full disk or a
+    read-only folder alike) ended ``fit`` with a traceback (exit 1); it is one ``error:`` line naming it, exit 2."""
+    from beatlite.train import __main__ as command
+
+    root = small_corpus(tmp_path / "corpus", ["2_scott_0_9_9", "2_scott_0_57_57"])  # a train and a val take
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv(
+        "BEATLITE_BUILD", str(blocker / "build")
+    )  # the index cache is skipped, the store fails
+    argv = ["fit", "random_clip", "--data", str(root), "--epochs", "0"]
+    for out, said in ((tmp_path / "run", f"cannot write the window store {blocker / 'build'}"),
+                      (blocker / "run", f"cannot write --out {blocker / 'run'}")):  # fmt: skip
+        assert command.main([*argv, "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and said in err and err.count("\n") == 1, err
+
+
 class _Stop(Exception):
     """Raised by a stand-in ``fit``, with the config it was given."""
 

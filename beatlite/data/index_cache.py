@@ -5,7 +5,8 @@ Indexing reads every file of every take (about 32 CPU-s per hour of BEAT-rate co
 take's :class:`~beatlite.data.index.TakeRecord` with the key it was computed from: the take's
 candidate files (path, size, mtime_ns), its ``bvh_fps`` override and :data:`INDEX_VERSION`, plus
 the sha256 of each file's content (so :func:`beatlite.data.fingerprint.file_digest` does not read it
-again). A take is re-indexed when any part of its key differs. Files modified in the last
+again), and the sha256 of the entry itself (``check``: an entry whose bits changed is not served). A take is
+re-indexed when any part of its key differs. Files modified in the last
 :data:`~beatlite.data.fingerprint.SETTLE_S` seconds are never cached (their size and mtime could
 stay the same through a quick rewrite). The cache is written atomically; a broken or foreign
 cache file is ignored (rebuilt), never an error.
@@ -104,6 +105,8 @@ def cached_record(entry: Any, key: list[Any] | None) -> TakeRecord | None:
 
     if key is None or not isinstance(entry, dict) or entry.get("key") != key:
         return None
+    if entry.get("check") != _check(entry):  # a corrupt entry (or one written before entries had a check)
+        return None
     try:
         fields = dict(entry["record"])
         fields["files"] = {m: Path(p) for m, p in fields["files"].items()}
@@ -124,12 +127,19 @@ def entry(record: TakeRecord, key: list[Any]) -> dict[str, Any]:
     >>> from beatlite.paths import repo_root
     >>> files = {"motion": [repo_root() / "data_samples" / "2_scott_0_1_1.bvh.gz"]}
     >>> e = entry(index_take("2_scott_0_1_1", files), take_key(files, None))
-    >>> sorted(e), len(e["digests"]["motion"])  # sha256 of each file
-    (['digests', 'key', 'record'], 64)
+    >>> sorted(e), len(e["digests"]["motion"])  # sha256 of each file (and of the entry: check)
+    (['check', 'digests', 'key', 'record'], 64)
     """
     fields = dataclasses.asdict(record)
     fields["files"] = {m: str(p) for m, p in record.files.items()}
-    return {"key": key, "record": fields, "digests": {m: file_digest(p) for m, p in record.files.items()}}
+    made = {"key": key, "record": fields, "digests": {m: file_digest(p) for m, p in record.files.items()}}
+    return {**made, "check": _check(made)}
+
+
+def _check(entry: dict[str, Any]) -> str:
+    """sha256 of an entry's key, record and digests (sorted JSON): its ``check``."""
+    body = {k: entry.get(k) for k in ("key", "record", "digests")}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
 
 def save(path: Path, takes: dict[str, Any]) -> None:

@@ -171,7 +171,7 @@ class ResidentWindows:
         view, stream = self.view, KEY_STREAM[key]
         raw = take.stream(stream).read(0, int(take.meta["shapes"][stream][0]))
         if key == "word":
-            return view._word_table(take_id)[raw]
+            return view._word_ids(take_id, raw)
         if key == "audio":
             samples = (raw * np.float64(take.meta["audio_scale"])).astype(np.float32)
             return np.concatenate([samples, np.zeros(self.n_audio, np.float32)])

@@ -32,7 +32,8 @@ per take (count, sum, centred sum of squares; Chan et al.'s pairwise update) and
 
 The folder holds ``store.json`` (version, parameters, take stems in index order, the
 vocabulary) and ``takes/{stem}/`` with the ``.npy`` files and ``meta.json`` (shapes, audio step,
-word marks, statistics and a fingerprint of the source files and parameters). Building is
+word marks, statistics and a fingerprint of the source files and parameters); each JSON file carries the
+sha256 of its content (``digest``: a corrupt one is a ``FormatError``, rebuilt by the next build). Building is
 incremental: takes whose fingerprint matches are kept, the others are rebuilt in worker
 processes; every file is written atomically, ``meta.json`` last.
 
@@ -47,6 +48,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -182,6 +184,25 @@ def _moments(x: np.ndarray) -> dict[str, Any]:
     return {"n": int(len(x)), "sum": x.sum(axis=0).tolist(), "m2": ((x - mean) ** 2).sum(axis=0).tolist()}
 
 
+@contextlib.contextmanager
+def _writing(folder: Path, *, remove: bool = False) -> Iterator[None]:
+    """Re-raise an ``OSError`` of writing under ``folder`` (a full disk, a read-only or missing folder) as
+    one that names it (numpy's own is a bare ``N requested and M written``); ``remove``: remove ``folder``
+    first (a take's partial entry: no space held by files that nothing will read)."""
+    try:
+        yield
+    except OSError as e:
+        if remove:
+            shutil.rmtree(folder, ignore_errors=True)
+        if "cannot write the window store" in str(e):  # (named already)
+            raise
+        reason = (
+            f"cannot write the window store {folder} ({e.strerror or e}): free space there, or give a "
+            "writable one"
+        )
+        raise OSError(*(() if e.errno is None else (e.errno,)), reason) from None
+
+
 def _save_npy(path: Path, array: np.ndarray) -> None:
     from beatlite.io.atomic import atomic_write
 
@@ -208,8 +229,9 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
     >>> tmp.cleanup()
     """
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "meta.json").unlink(missing_ok=True)
+    with _writing(folder):
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "meta.json").unlink(missing_ok=True)
     recorder = _WordRecorder()
     f = take_features(
         record,
@@ -232,8 +254,6 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
     }
     if params["positions"]:
         streams["positions"] = f.positions.astype("<f4")
-    for name, arr in streams.items():
-        _save_npy(folder / f"{name}.npy", np.ascontiguousarray(arr, dtype=STREAMS[name]))
     meta = {
         "stem": record.stem,
         "split": record.split,
@@ -246,14 +266,25 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
         "dirs_moments": _moments(f.dirs),
         "fingerprint": take_fingerprint(record, params),
     }
+    meta["digest"] = _json_digest(meta)
     from beatlite.io.atomic import atomic_write
 
-    with atomic_write(folder / "meta.json") as fh:
-        json.dump(meta, fh)
+    with _writing(folder, remove=True):
+        for name, arr in streams.items():
+            _save_npy(folder / f"{name}.npy", np.ascontiguousarray(arr, dtype=STREAMS[name]))
+        with atomic_write(folder / "meta.json") as fh:
+            json.dump(meta, fh)
     return meta
 
 
 # ---------------------------------------------------------------------- reading
+def _json_digest(data: Mapping[str, Any]) -> str:
+    """sha256 of a JSON object's fields other than ``digest`` (sorted keys): what a meta.json or store.json
+    carries as ``digest``, so that a flipped bit that still parses (a digit, a letter) is seen."""
+    body = {k: v for k, v in data.items() if k != "digest"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+
+
 def _read_json(path: Path) -> dict[str, Any]:
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -264,6 +295,15 @@ def _read_json(path: Path) -> dict[str, Any]:
     return data
 
 
+def _check_digest(data: Mapping[str, Any], path: Path) -> None:
+    """FormatError naming ``path`` unless ``data`` (its JSON object) carries the :func:`_json_digest` of itself."""
+    if data.get("digest") != _json_digest(data):
+        raise FormatError(
+            path,
+            "content does not match its digest (corrupt, or written by an older beatlite): build the store",
+        )
+
+
 def _need(data: Mapping[str, Any], path: Path, *fields: str) -> None:
     for field in fields:
         if field not in data:
@@ -272,7 +312,8 @@ def _need(data: Mapping[str, Any], path: Path, *fields: str) -> None:
 
 @dataclass(frozen=True)
 class StreamFile:
-    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``.
+    """Where the rows of one ``.npy`` stream lie: data ``offset`` (bytes), ``dtype``, ``shape``, and which file
+    that is (``ident``: its device and inode, so that rows are never read from a file that replaced it).
 
     Examples
     --------
@@ -291,6 +332,7 @@ class StreamFile:
     offset: int
     dtype: np.dtype
     shape: tuple[int, ...]
+    ident: tuple[int, int] = (0, 0)
 
     @classmethod
     def open(cls, path: Path, dtype: str, shape: Sequence[int]) -> StreamFile:
@@ -306,7 +348,9 @@ class StreamFile:
                     raise ValueError(f".npy format version {version} (expected 1.0 or 2.0)")
                 header = read_header(f)  # (shape, fortran, dtype)
                 offset = f.tell()
-        except (OSError, ValueError, SyntaxError) as e:
+                st = os.fstat(f.fileno())
+        # (numpy parses the header as a Python literal: ValueError, SyntaxError, tokenize.TokenError, ...)
+        except Exception as e:
             raise FormatError(path, f"not a readable .npy file: {e}") from None
         got_shape, fortran, got_dtype = header
         if fortran or got_dtype != np.dtype(dtype) or tuple(got_shape) != tuple(shape):
@@ -316,9 +360,9 @@ class StreamFile:
                 f"meta.json says {np.dtype(dtype).str} {tuple(shape)}",
             )
         size = offset + int(np.prod(shape, dtype=np.int64)) * got_dtype.itemsize
-        if path.stat().st_size != size:
-            raise FormatError(path, f"{path.stat().st_size} bytes, expected {size} (truncated or padded)")
-        return cls(path, offset, got_dtype, tuple(int(s) for s in shape))
+        if st.st_size != size:
+            raise FormatError(path, f"{st.st_size} bytes, expected {size} (truncated or padded)")
+        return cls(path, offset, got_dtype, tuple(int(s) for s in shape), (st.st_dev, st.st_ino))
 
     def row_bytes(self) -> int:
         return int(np.prod(self.shape[1:], dtype=np.int64)) * self.dtype.itemsize
@@ -328,7 +372,7 @@ class StreamFile:
         start, stop = max(0, start), min(stop, self.shape[0])
         n = max(0, stop - start)
         rb = self.row_bytes()
-        buf = os.pread(_FILES.fd(self.path), n * rb, self.offset + start * rb)
+        buf = os.pread(_FILES.fd(self.path, self.ident), n * rb, self.offset + start * rb)
         if len(buf) != n * rb:
             raise FormatError(self.path, f"short read at row {start}: file changed since it was opened")
         return np.frombuffer(buf, dtype=self.dtype).reshape(n, *self.shape[1:])
@@ -339,22 +383,31 @@ class StreamFile:
 
 
 class _FileCache:
-    """A small per-process cache of open read-only file descriptors (reset after a fork)."""
+    """A small per-process cache of open read-only file descriptors (reset after a fork), one per path: the
+    descriptor of the file ``ident`` (device, inode) names; one of a file since replaced at that path (a rebuilt
+    take) is closed, and a path that no longer holds that file is a ``FormatError``."""
 
     def __init__(self, size: int = 128) -> None:
         self.size = size
-        self._fds: dict[Path, int] = {}
+        self._fds: dict[Path, tuple[int, tuple[int, int]]] = {}
         self._pid = os.getpid()
 
-    def fd(self, path: Path) -> int:
+    def fd(self, path: Path, ident: tuple[int, int]) -> int:
         if os.getpid() != self._pid:  # a forked DataLoader worker: open its own descriptors
             self._fds, self._pid = {}, os.getpid()
-        fd = self._fds.pop(path, None)
+        fd, held = self._fds.pop(path, (None, None))
+        if fd is not None and held != ident:  # the file at this path was replaced (a rebuilt take)
+            os.close(fd)
+            fd = None
         if fd is None:
             if len(self._fds) >= self.size:
-                os.close(self._fds.pop(next(iter(self._fds))))
+                os.close(self._fds.pop(next(iter(self._fds)))[0])
             fd = os.open(path, os.O_RDONLY)
-        self._fds[path] = fd  # most recently used last
+            st = os.fstat(fd)
+            if (st.st_dev, st.st_ino) != tuple(ident):
+                os.close(fd)
+                raise FormatError(path, "replaced since the store was opened (open it again)")
+        self._fds[path] = (fd, ident)  # most recently used last
         return fd
 
 
@@ -388,6 +441,7 @@ class StoreTake:
         meta = _read_json(path)
         _need(meta, path, "stem", "split", "speaker", "n_frames", "audio_scale", "word_marks", "shapes")
         _need(meta, path, "pose_moments", "dirs_moments", "fingerprint")
+        _check_digest(meta, path)
         return cls(folder, meta)
 
     @property
@@ -478,6 +532,7 @@ class WindowStore:
         _need(data, path, "version", "params", "takes", "vocab")
         if data["version"] != STORE_VERSION:
             raise FormatError(path, f"store version {data['version']}, this beatlite reads {STORE_VERSION}")
+        _check_digest(data, path)
         takes = [StoreTake.open(folder / "takes" / stem) for stem in data["takes"]]
         return cls(folder, data["params"], takes, Vocab(data["vocab"]))
 
@@ -718,6 +773,15 @@ class StoreWindows:
             self._word_tables[take_id] = np.array([0, 1, 2, 3, *ids], dtype=np.int64)
         return self._word_tables[take_id]
 
+    def _word_ids(self, take_id: int, local: np.ndarray) -> np.ndarray:
+        """Vocabulary ids of take-local word ids (FormatError naming word.npy for an id the take has no mark of)."""
+        table = self._word_table(take_id)
+        bad = local[(local < 0) | (local >= len(table))]
+        if bad.size:
+            path = self.store.takes[take_id].folder / "word.npy"
+            raise FormatError(path, f"word id {int(bad[0])} outside the take's {len(table)} ids (corrupt)")
+        return table[local]
+
     def batch(
         self, indices: Sequence[int] | np.ndarray | None = None, *, keys: Sequence[str] | None = None
     ) -> dict[str, np.ndarray]:
@@ -737,7 +801,7 @@ class StoreWindows:
         """Batch key ``k`` of the windows ``idx`` from their raw streams (normalised, mapped to the vocabulary)."""
         takes = self.store.takes
         if k == "word":
-            rows = [self._word_table(int(t))[w] for t, w in zip(self.take_ids[idx], raw["word"])]
+            rows = [self._word_ids(int(t), w) for t, w in zip(self.take_ids[idx], raw["word"])]
             return np.stack(rows).reshape(len(idx), self.length)
         if k == "speaker":
             return np.array([takes[t].meta["speaker"] for t in self.take_ids[idx]], np.int64)
@@ -876,8 +940,10 @@ def open_if_current(index: TakeIndex, folder: str | Path, params: Mapping[str, A
         return None
     with exclusive_lock(folder / ".build.lock"):
         try:
-            listed = json.loads((folder / "store.json").read_text())["takes"]
-        except (OSError, ValueError, KeyError, TypeError):
+            manifest = _read_json(folder / "store.json")
+            _check_digest(manifest, folder / "store.json")
+            listed = list(manifest["takes"])
+        except (FormatError, KeyError, TypeError):
             return None
         if sorted(listed) != sorted(r.stem for r in records):
             return None
@@ -903,6 +969,7 @@ def _stored_vocab(path: Path, text_fp: str) -> Vocab | None:
 
     try:
         data = _read_json(path)
+        _check_digest(data, path)
         if data.get("vocab_fingerprint") == text_fp and data.get("version") == STORE_VERSION:
             return Vocab(data["vocab"])
     except (FormatError, KeyError, TypeError, ValueError):
@@ -968,7 +1035,8 @@ def _write_manifest(
     folder: Path, index: TakeIndex, records: list[TakeRecord], params: dict, vocab: Vocab | None
 ) -> None:
     """``store.json``: version, parameters, takes and vocabulary (``build_vocab`` of the stored (usable) takes,
-    reused while none of their TextGrids changed; an unusable take's may not read)."""
+    reused while none of their TextGrids changed; an unusable take's may not read). Not written again when it
+    holds that already (a current store on read-only media opens)."""
     from beatlite.data.index import TakeIndex
     from beatlite.data.vocab import corpus_vocab
     from beatlite.io.atomic import atomic_write
@@ -985,8 +1053,13 @@ def _write_manifest(
         "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
         "vocab_fingerprint": text_fp,
     }
+    manifest["digest"] = _json_digest(manifest)
+    text = json.dumps(manifest, indent=1)
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        if (folder / "store.json").read_text(encoding="utf-8") == text:
+            return
     with atomic_write(folder / "store.json") as f:
-        json.dump(manifest, f, indent=1)
+        f.write(text)
 
 
 def build_store(
@@ -1005,7 +1078,8 @@ def build_store(
 
     Takes whose entry is complete and whose fingerprint (files' content, ``bvh_fps`` override, parameters,
     :data:`STORE_VERSION`) matches are kept; the others are rebuilt; entries of takes no longer
-    in the index are removed. Memory: one take per worker (plus O(number of takes) meta data).
+    in the index are removed. A store that is current is opened without writing anything (it may lie on
+    read-only media). Memory: one take per worker (plus O(number of takes) meta data).
 
     Parameters
     ----------
@@ -1037,6 +1111,9 @@ def build_store(
     ValueError
         Bad parameters or no usable take. A take that cannot be read raises its reader's
         ``FormatError``.
+    OSError
+        A file that cannot be written (a full disk, a read-only folder), naming the store folder or the take's
+        entry in it (whose partial files are removed: a later build with space equals a fresh one).
 
     Examples
     --------
@@ -1059,17 +1136,18 @@ def build_store(
     records = _usable_records(index)
     params = store_params(fps=fps, sr=sr, positions=positions, word_rule=word_rule)
     folder = Path(folder) if folder is not None else default_store_folder(index, params)
-    (folder / "takes").mkdir(parents=True, exist_ok=True)
     from beatlite.io.atomic import exclusive_lock
 
-    with exclusive_lock(
-        folder / ".build.lock"
-    ):  # other processes building this store wait, then find it current
+    with contextlib.ExitStack() as held:
+        with _writing(folder):  # other processes building this store wait, then find it current
+            (folder / "takes").mkdir(parents=True, exist_ok=True)
+            held.enter_context(exclusive_lock(folder / ".build.lock"))
         todo = [r for r in records if not _is_current(folder / "takes" / r.stem, r, params)]
-        _run_builds(todo, folder, params, workers, progress)
+        _run_builds(todo, folder, params, workers, progress)  # (build_take names the entry it cannot write)
         keep = {r.stem for r in records}
-        for stale in (folder / "takes").iterdir():
-            if stale.is_dir() and stale.name not in keep:
-                shutil.rmtree(stale)
-        _write_manifest(folder, index, records, params, vocab)
+        with _writing(folder):
+            for stale in (folder / "takes").iterdir():
+                if stale.is_dir() and stale.name not in keep:
+                    shutil.rmtree(stale)
+            _write_manifest(folder, index, records, params, vocab)
         return WindowStore.open(folder)

@@ -250,7 +250,8 @@ def exclusive_lock(path: str | os.PathLike[str], *, wait: bool = True) -> Iterat
     block ends or the process dies. POSIX only; elsewhere (Windows) the block runs unlocked.
 
     With ``wait=False`` a lock that another holder has raises ``BlockingIOError`` at once instead (what
-    ``fit`` does when another run trains the same recipe into the same ``--out``).
+    ``fit`` does when another run trains the same recipe into the same ``--out``). An existing lock file in a
+    folder that cannot be written (read-only media) is opened read-only: ``flock`` needs no write access.
 
     Examples
     --------
@@ -267,7 +268,13 @@ def exclusive_lock(path: str | os.PathLike[str], *, wait: bool = True) -> Iterat
         yield
         return
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "a+b") as f:
+    try:
+        f = open(path, "a+b")
+    except OSError:  # a read-only folder (a store on read-only media): an existing lock is taken read-only
+        if not Path(path).is_file():
+            raise
+        f = open(path, "rb")
+    with f:
         fcntl.flock(f.fileno(), fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
         try:
             yield

@@ -247,7 +247,10 @@ def _fit_command(args: argparse.Namespace) -> int:
     except ValueError as error:
         return _refused(error)
     data_dir, out = Path(args.data).expanduser().resolve(), Path(args.out).expanduser().resolve()
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        return _refused(f"cannot write --out {out}: {error}")
     os.environ.setdefault(
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
@@ -262,6 +265,8 @@ def _fit_command(args: argparse.Namespace) -> int:
                     f"another fit is training {args.recipe} into {out} (it holds {lock}); "
                     "wait for it to end, or give another --out"
                 )
+            except OSError as error:  # a read-only --out, a full disk
+                return _refused(f"cannot write --out {out}: {error}")
         # under torchrun: the process group the training initialises is destroyed when this block ends (also by
         # an exception), not left to an exit handler that handlers registered later run before
         with process_group():
@@ -276,7 +281,7 @@ def _fit_locked(
 
     try:
         data = training_data(data_dir, progress=rank == 0)
-    except ValueError as error:  # no val takes, no usable take, a file that cannot be read (FormatError)
+    except (ValueError, OSError) as error:  # no val take, a file that cannot be read (FormatError) or written
         return _refused(error)
     extractor = None
     if data_dir != (paths.repo_root() / "data_samples").resolve():
