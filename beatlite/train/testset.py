@@ -116,6 +116,28 @@ class EvaluationSet:
     mean_speed: np.ndarray | None = None
     folder: str = ""
 
+    @classmethod
+    def example(cls, n_frames: int = 54) -> EvaluationSet:
+        """A one-take set of ``n_frames`` still frames (every stream and target 0, silent audio) with the shipped
+        mean-pose checkpoint's normalisers: the set the Examples of this module score and generate on.
+
+        Examples
+        --------
+        >>> test = EvaluationSet.example(34)  # one FGD window
+        >>> test.takes, test.gt_directions[0].shape, len(test.audio[0])
+        (['take'], (34, 42, 3), 36266)
+        """
+        from beatlite.train.checkpoint import load_checkpoint
+
+        meta = load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"]
+        n = int(n_frames)
+        return cls(
+            takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
+            gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
+            gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
+            normalizers=Normalizers.from_meta(meta), change_angle=np.ones(41), vocab=(),
+        )  # fmt: skip
+
     def beats(self) -> list[np.ndarray]:
         """:attr:`audio_beats`, computed now if empty."""
         if len(self.audio_beats) != len(self.audio):
@@ -230,14 +252,8 @@ def clip_test_set(test: EvaluationSet, *, stride: int = WINDOW_STRIDE) -> Evalua
     --------
     A 54-frame take holds the 34-frame clips starting at 0, 10 and 20 (``(54 - 34) // 10 + 1 = 3``):
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
     >>> clips = clip_test_set(test)
     >>> clips.takes, clips.streams[0]["pose"].shape, clips.audio[0].shape
     (['take@0', 'take@10', 'take@20'], (34, 141), (36266,))
@@ -358,14 +374,8 @@ def generate_takes(
     The shipped mean-pose baseline on a one-take set (as :class:`EvaluationSet` builds it): its 54 frames as 42
     bone directions of unit length and as 141 Euler channels.
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
     >>> import torch
     >>> from beatlite.train.checkpoint import load_model
     >>> model = load_model("mean_pose")[0]
@@ -498,14 +508,9 @@ def direction_features(directions: list[np.ndarray], test: EvaluationSet, extrac
     mean is subtracted. An extractor that flattens the windows shows both (one-take set as :class:`EvaluationSet`
     builds it):
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
+    >>> normalizers = test.normalizers
     >>> mean = np.broadcast_to(normalizers.dirvec.mean.reshape(42, 3), (n, 42, 3))
     >>> features = direction_features([mean], test, lambda w: w.reshape(len(w), -1))
     >>> features.shape, float(np.abs(features).max())
@@ -530,14 +535,9 @@ def euler_features(euler: list[np.ndarray], test: EvaluationSet, extractor: Any)
     A take one train standard deviation above the train mean on every channel z-scores to 1 everywhere
     (one-take set as :class:`EvaluationSet` builds it, a flattening extractor):
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
+    >>> normalizers = test.normalizers
     >>> above = np.tile(normalizers.pose.mean + normalizers.pose.std, (n, 1))
     >>> features = euler_features([above], test, lambda w: w.reshape(len(w), -1))
     >>> features.shape, bool(np.allclose(features, 1.0))
@@ -651,14 +651,9 @@ def load_checkpoint_for(source: str, test: EvaluationSet) -> tuple[Any, Normaliz
     The shipped mean-pose checkpoint against a set with its own train statistics (as :class:`EvaluationSet`
     builds it), then against one whose statistics differ (another corpus): stale, with a warning.
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
+    >>> normalizers = test.normalizers
     >>> model, stats, fingerprint, stale = load_checkpoint_for("mean_pose", test)
     >>> type(model).__name__, stats.matches(normalizers), stale
     ('MeanPose', True, False)
@@ -740,14 +735,9 @@ def generated_euler(
     The shipped mean-pose baseline on a one-take set: every frame is its pose in degrees,
     ``z * std + mean`` with the train statistics.
 
-    >>> from beatlite.train.checkpoint import load_checkpoint
-    >>> normalizers = Normalizers.from_meta(load_checkpoint(paths.checkpoints_dir() / "mean_pose.pt")["meta"])
     >>> n = 54  # frames of the one take, 3.6 s at 15 fps
-    >>> test = EvaluationSet(
-    ...     takes=["take"], streams=[{"pose": np.zeros((n, 141), np.float32)}],
-    ...     gt_directions=[np.zeros((n, 42, 3))], gt_directions_141=[np.zeros((n, 42, 3))],
-    ...     gt_euler=[np.zeros((n, 141))], semantic=[np.zeros(n)], audio=[np.zeros(n * SR // FPS, np.float32)],
-    ...     normalizers=normalizers, change_angle=np.ones(41), vocab=())
+    >>> test = EvaluationSet.example(n)  # one take of still frames, the shipped mean-pose normalisers
+    >>> normalizers = test.normalizers
     >>> euler = generated_euler("mean_pose", test)
     >>> from beatlite.train.checkpoint import load_model
     >>> pose = load_model("mean_pose")[0].mean.numpy()
