@@ -8,8 +8,13 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from beatlite.paths import repo_root
+
+if TYPE_CHECKING:
+    from beatlite.data.index import TakeIndex
 
 #: The default takes: test take ``2_scott_0_1_1`` (222 frames) and train take ``2_scott_0_9_9``.
 DEFAULT_PATTERN = "2_scott_0_[19]_[19]"
@@ -36,6 +41,29 @@ def example_corpus(pattern: str = DEFAULT_PATTERN) -> tempfile.TemporaryDirector
     for path in sorted((repo_root() / "data_samples").glob(f"{pattern}.*")):
         shutil.copy(path, tmp.name)
     return tmp
+
+
+def example_index(seconds: dict[str, float]) -> TakeIndex:
+    """A :class:`~beatlite.data.index.TakeIndex` of BEAT takes named by ``{stem: seconds of motion}``.
+
+    Every field comes from the take's name (:func:`beatlite.data.index.index_take`); the takes' ``.bvh`` and
+    ``.wav`` files are listed, never read, so the names need not exist: for Examples of corpus statistics.
+
+    Examples
+    --------
+    >>> index = example_index({"2_scott_0_1_1": 45.0, "10_kieks_1_2_2": 30.0})
+    >>> [(r.speaker, r.language, r.durations["motion"]) for r in index]
+    [('scott', 'english', 45.0), ('kieks', 'english', 30.0)]
+    """
+    from beatlite.data.index import TakeIndex, index_take
+
+    records = []
+    for stem, duration in seconds.items():
+        files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
+        record = index_take(stem, files, read_durations=False)
+        record.durations["motion"] = float(duration)
+        records.append(record)
+    return TakeIndex(records)
 
 
 def example_beat2_corpus(pattern: str = DEFAULT_PATTERN) -> tempfile.TemporaryDirectory:

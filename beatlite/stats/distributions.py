@@ -59,15 +59,9 @@ def speaker_split_table(index: TakeIndex, *, splits: tuple[str, ...] | None = No
     BEAT's names give the split (sequence 1 of a speech session is a test take, a conversation's is
     train): speaker 2 has a 60-s train take and two 30-s test takes, speaker 10 one 30-s test take.
 
-    >>> from pathlib import Path
-    >>> from beatlite.data.index import TakeIndex, index_take
-    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
-    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
-    ...     r = index_take(stem, files, read_durations=False)
-    ...     r.durations["motion"] = seconds
-    ...     return r
-    >>> index = TakeIndex([record("2_scott_1_2_2", 60.0), record("2_scott_0_1_1", 30.0),
-    ...                    record("2_scott_0_73_73", 30.0), record("10_kieks_0_1_1", 30.0)])
+    >>> from beatlite.data.examples import example_index  # the files are listed, never read
+    >>> index = example_index({"2_scott_1_2_2": 60.0, "2_scott_0_1_1": 30.0, "2_scott_0_73_73": 30.0,
+    ...                        "10_kieks_0_1_1": 30.0})
     >>> print(speaker_split_table(index))
     | speaker | train takes | test takes | train min | test min |
     |---|---|---|---|---|
@@ -127,15 +121,8 @@ def emotion_shares(index: TakeIndex, *, speech_only: bool = True) -> dict[str, f
     45 s of neutral speech (sequence 1), 15 s of angry speech (sequence 73) and a 60-s conversation:
     the speech is 45/60 neutral; with the conversation, (45 + 60)/120.
 
-    >>> from pathlib import Path
-    >>> from beatlite.data.index import TakeIndex, index_take
-    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
-    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
-    ...     r = index_take(stem, files, read_durations=False)
-    ...     r.durations["motion"] = seconds
-    ...     return r
-    >>> index = TakeIndex([record("2_scott_0_1_1", 45.0), record("2_scott_0_73_73", 15.0),
-    ...                    record("2_scott_1_2_2", 60.0)])
+    >>> from beatlite.data.examples import example_index  # the files are listed, never read
+    >>> index = example_index({"2_scott_0_1_1": 45.0, "2_scott_0_73_73": 15.0, "2_scott_1_2_2": 60.0})
     >>> shares = emotion_shares(index)
     >>> shares["neutral"], shares["anger"], shares["sadness"]
     (0.75, 0.25, 0.0)
@@ -160,14 +147,8 @@ def language_shares(index: TakeIndex) -> dict[str, float]:
     --------
     The session type of a BEAT name gives the language (0, 1 English; 2, 3 Chinese): 90 s against 30 s.
 
-    >>> from pathlib import Path
-    >>> from beatlite.data.index import TakeIndex, index_take
-    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
-    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
-    ...     r = index_take(stem, files, read_durations=False)
-    ...     r.durations["motion"] = seconds
-    ...     return r
-    >>> index = TakeIndex([record("2_scott_0_1_1", 90.0), record("12_zhao_2_1_1", 30.0)])
+    >>> from beatlite.data.examples import example_index  # the files are listed, never read
+    >>> index = example_index({"2_scott_0_1_1": 90.0, "12_zhao_2_1_1": 30.0})
     >>> language_shares(index)
     {'english': 0.75, 'chinese': 0.25}
     """
@@ -179,15 +160,8 @@ def speaker_durations(index: TakeIndex) -> dict[str, float]:
 
     Examples
     --------
-    >>> from pathlib import Path
-    >>> from beatlite.data.index import TakeIndex, index_take
-    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
-    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
-    ...     r = index_take(stem, files, read_durations=False)
-    ...     r.durations["motion"] = seconds
-    ...     return r
-    >>> index = TakeIndex([record("10_kieks_0_1_1", 30.0), record("2_scott_0_1_1", 45.0),
-    ...                    record("2_scott_0_73_73", 15.0)])
+    >>> from beatlite.data.examples import example_index  # the files are listed, never read
+    >>> index = example_index({"10_kieks_0_1_1": 30.0, "2_scott_0_1_1": 45.0, "2_scott_0_73_73": 15.0})
     >>> speaker_durations(index)
     {'2_scott': 60.0, '10_kieks': 30.0}
     """
@@ -230,15 +204,9 @@ def plot_figure2(
     --------
     The left panel's two bar series are this corpus's and the paper's 8 emotion shares.
 
-    >>> from pathlib import Path
-    >>> from beatlite.data.index import TakeIndex, index_take
-    >>> def record(stem, seconds):  # fields from the BEAT name; the files are listed, never read
-    ...     files = {"motion": [Path(f"{stem}.bvh")], "audio": [Path(f"{stem}.wav")]}
-    ...     r = index_take(stem, files, read_durations=False)
-    ...     r.durations["motion"] = seconds
-    ...     return r
+    >>> from beatlite.data.examples import example_index  # the files are listed, never read
     >>> import matplotlib.pyplot as plt
-    >>> fig = plot_figure2(TakeIndex([record("2_scott_0_1_1", 45.0), record("2_scott_0_73_73", 15.0)]))
+    >>> fig = plot_figure2(example_index({"2_scott_0_1_1": 45.0, "2_scott_0_73_73": 15.0}))
     >>> len(fig.axes), len(fig.axes[0].patches)
     (3, 16)
     >>> plt.close(fig)
