@@ -28,7 +28,7 @@ Taught in notebooks/05_camn.ipynb, section 4 (training: loading a shipped checkp
 from __future__ import annotations
 
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -57,43 +57,46 @@ def _numpy_array_globals() -> list[Any]:
 NUMPY_ARRAY_GLOBALS = _numpy_array_globals()
 
 
-def _tensors_for_numpy(value: Any, other: Any = None, memo: dict[int, Any] | None = None) -> Any:
-    """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones;
-    anything else that is not a tensor or a plain value, and dict keys that are not int or str, go through
-    ``other`` (default: kept as they are).
+def _nested(value: Any, leaf: Callable[[Any], Any], memo: dict[int, Any], key: Any = None) -> Any:
+    """``value`` with its dicts (mappings), lists and tuples copied and every other object through ``leaf``;
+    dict keys through ``key`` (default: kept).
 
-    Each container or array is converted once (``memo``, by ``id``): what ``value`` shares stays shared, and a
-    container holding itself stays a cycle, so the work and the copy are the size of ``value``'s objects, not of
-    its paths (10 KB of metadata nesting each level twice, 40 deep, is 2**40 paths).
+    Each object is converted once (``memo``, by ``id``): what ``value`` shares stays shared, and a container
+    holding itself stays a cycle, so the work and the copy are the size of ``value``'s objects, not of its
+    paths (10 KB of metadata nesting each level twice, 40 deep, is 2**40 paths).
     """
-    memo = {} if memo is None else memo
     if id(value) in memo:
         return memo[id(value)]
-    if isinstance(value, np.ndarray):
-        memo[id(value)] = out = torch.from_numpy(np.array(value))
-        return out
-    if isinstance(value, np.generic):
-        return value.item()
     if isinstance(value, Mapping):
-        key = (lambda k: k) if other is None else (lambda k: k if isinstance(k, int | str) else other(k))
         memo[id(value)] = out = {}
-        out.update((key(k), _tensors_for_numpy(v, other, memo)) for k, v in value.items())
+        out.update(((k if key is None else key(k)), _nested(v, leaf, memo, key)) for k, v in value.items())
         return out
     if isinstance(value, list):
         memo[id(value)] = out = []
-        out.extend(_tensors_for_numpy(v, other, memo) for v in value)
+        out.extend(_nested(v, leaf, memo, key) for v in value)
         return out
     if isinstance(value, tuple):
-        memo[id(value)] = out = type(value)(_tensors_for_numpy(v, other, memo) for v in value)
+        memo[id(value)] = out = type(value)(_nested(v, leaf, memo, key) for v in value)
         return out
-    if (
-        other is None
-        or torch.is_tensor(value)
-        or value is None
-        or isinstance(value, bool | int | float | str)
-    ):
-        return value
-    return other(value)
+    memo[id(value)] = out = leaf(value)
+    return out
+
+
+def _tensors_for_numpy(value: Any, other: Any = None) -> Any:
+    """``value`` with every numpy array (in dicts, lists, tuples) as a tensor and numpy scalars as Python ones;
+    anything else that is not a tensor or a plain value, and dict keys that are not int or str, go through
+    ``other`` (default: kept as they are). Shared parts stay shared (:func:`_nested`)."""
+
+    def leaf(v: Any) -> Any:
+        if isinstance(v, np.ndarray):
+            return torch.from_numpy(np.array(v))
+        if isinstance(v, np.generic):
+            return v.item()
+        plain = torch.is_tensor(v) or v is None or isinstance(v, bool | int | float | str)
+        return v if other is None or plain else other(v)
+
+    key = None if other is None else (lambda k: k if isinstance(k, int | str) else other(k))
+    return _nested(value, leaf, {}, key)
 
 
 def save_checkpoint(path: str | Path, payload: Mapping[str, Any]) -> Path:
@@ -250,33 +253,15 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     for key in ("model", "state"):
         if key not in data:
             raise FormatError(path, f"checkpoint has no {key!r}", field=key)
-    if isinstance(data.get("meta"), dict):
+    if isinstance(
+        data.get("meta"), dict
+    ):  # every tensor, nested too, as a numpy array: the inverse of the save
         memo: dict[int, Any] = {}
-        data["meta"] = {k: _numpy_for_tensors(path, k, v, memo) for k, v in data["meta"].items()}
+        data["meta"] = {
+            k: _nested(v, lambda t, k=k: _meta_array(path, k, t) if torch.is_tensor(t) else t, memo)
+            for k, v in data["meta"].items()
+        }
     return data
-
-
-def _numpy_for_tensors(path: Path, key: Any, value: Any, memo: dict[int, Any]) -> Any:
-    """``value`` (metadata entry ``key``) with every tensor, in dicts, lists and tuples too, as a numpy array
-    (:func:`_meta_array`): the inverse of what :func:`save_checkpoint` stores. Each object is converted once
-    (``memo``, by ``id``), so shared parts stay shared and cycles stay cycles."""
-    if id(value) in memo:
-        return memo[id(value)]
-    if torch.is_tensor(value):
-        memo[id(value)] = out = _meta_array(path, key, value)
-        return out
-    if isinstance(value, dict):
-        memo[id(value)] = out = {}
-        out.update((k, _numpy_for_tensors(path, key, v, memo)) for k, v in value.items())
-        return out
-    if isinstance(value, list):
-        memo[id(value)] = out = []
-        out.extend(_numpy_for_tensors(path, key, v, memo) for v in value)
-        return out
-    if isinstance(value, tuple):
-        memo[id(value)] = out = tuple(_numpy_for_tensors(path, key, v, memo) for v in value)
-        return out
-    return value
 
 
 def _meta_array(path: Path, key: Any, value: torch.Tensor) -> np.ndarray:
