@@ -191,6 +191,18 @@ def takes_fingerprint(records: Iterable[TakeRecord], params: Mapping[str, Any]) 
     return h.hexdigest()
 
 
+def json_digest(data: Mapping[str, Any], skip: str) -> str:
+    """sha256 (64 hex digits) of a JSON object's fields other than ``skip`` (sorted keys): what a store's
+    ``meta.json``/``store.json`` (``digest``) and an index cache entry (``check``) carry, so that a flipped bit
+    that still parses (a digit, a letter) is seen.
+
+    >>> json_digest({"n": 1, "digest": "?"}, "digest") == json_digest({"n": 1}, "digest") != json_digest({"n": 2}, "digest")
+    True
+    """
+    body = {k: v for k, v in data.items() if k != skip}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+
+
 def vocab_hash(vocab: Iterable[str]) -> str:
     """sha256 (64 hex digits) of a vocabulary's words in id order (``Vocab.itos``).
 

@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from beatlite.data.fingerprint import file_digest, file_key, remember_digest, settled
+from beatlite.data.fingerprint import file_digest, file_key, json_digest, remember_digest, settled
 
 if TYPE_CHECKING:
     from beatlite.data.index import TakeRecord
@@ -105,7 +105,8 @@ def cached_record(entry: Any, key: list[Any] | None) -> TakeRecord | None:
 
     if key is None or not isinstance(entry, dict) or entry.get("key") != key:
         return None
-    if entry.get("check") != _check(entry):  # a corrupt entry (or one written before entries had a check)
+    # a corrupt entry (or one written before entries had a check)
+    if entry.get("check") != json_digest(entry, "check"):
         return None
     try:
         fields = dict(entry["record"])
@@ -133,13 +134,7 @@ def entry(record: TakeRecord, key: list[Any]) -> dict[str, Any]:
     fields = dataclasses.asdict(record)
     fields["files"] = {m: str(p) for m, p in record.files.items()}
     made = {"key": key, "record": fields, "digests": {m: file_digest(p) for m, p in record.files.items()}}
-    return {**made, "check": _check(made)}
-
-
-def _check(entry: dict[str, Any]) -> str:
-    """sha256 of an entry's key, record and digests (sorted JSON): its ``check``."""
-    body = {k: entry.get(k) for k in ("key", "record", "digests")}
-    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+    return {**made, "check": json_digest(made, "check")}
 
 
 def save(path: Path, takes: dict[str, Any]) -> None:

@@ -62,6 +62,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from beatlite.constants import FPS, SR, WINDOW_LENGTH, WINDOW_STRIDE
+from beatlite.data.fingerprint import json_digest
 from beatlite.data.normalize import MIN_STD, Normalizer, Normalizers
 from beatlite.data.windows import (
     MEL_SETTINGS,
@@ -266,7 +267,7 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
         "dirs_moments": _moments(f.dirs),
         "fingerprint": take_fingerprint(record, params),
     }
-    meta["digest"] = _json_digest(meta)
+    meta["digest"] = json_digest(meta, "digest")
     from beatlite.io.atomic import atomic_write
 
     with _writing(folder, remove=True):
@@ -278,13 +279,6 @@ def build_take(record: TakeRecord, folder: str | Path, params: Mapping[str, Any]
 
 
 # ---------------------------------------------------------------------- reading
-def _json_digest(data: Mapping[str, Any]) -> str:
-    """sha256 of a JSON object's fields other than ``digest`` (sorted keys): what a meta.json or store.json
-    carries as ``digest``, so that a flipped bit that still parses (a digit, a letter) is seen."""
-    body = {k: v for k, v in data.items() if k != "digest"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
-
-
 def _read_json(path: Path) -> dict[str, Any]:
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -296,8 +290,8 @@ def _read_json(path: Path) -> dict[str, Any]:
 
 
 def _check_digest(data: Mapping[str, Any], path: Path) -> None:
-    """FormatError naming ``path`` unless ``data`` (its JSON object) carries the :func:`_json_digest` of itself."""
-    if data.get("digest") != _json_digest(data):
+    """FormatError naming ``path`` unless ``data`` (its JSON object) carries the :func:`~beatlite.data.fingerprint.json_digest` of itself."""
+    if data.get("digest") != json_digest(data, "digest"):
         raise FormatError(
             path,
             "content does not match its digest (corrupt, or written by an older beatlite): build the store",
@@ -1053,7 +1047,7 @@ def _write_manifest(
         "vocab": list(vocab.itos[_FIRST_LOCAL_WORD:]),
         "vocab_fingerprint": text_fp,
     }
-    manifest["digest"] = _json_digest(manifest)
+    manifest["digest"] = json_digest(manifest, "digest")
     text = json.dumps(manifest, indent=1)
     with contextlib.suppress(OSError, UnicodeDecodeError):
         if (folder / "store.json").read_text(encoding="utf-8") == text:
