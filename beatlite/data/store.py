@@ -195,8 +195,6 @@ def _writing(folder: Path, *, remove: bool = False) -> Iterator[None]:
     except OSError as e:
         if remove:
             shutil.rmtree(folder, ignore_errors=True)
-        if "cannot write the window store" in str(e):  # (named already)
-            raise
         reason = (
             f"cannot write the window store {folder} ({e.strerror or e}): free space there, or give a "
             "writable one"
