@@ -301,6 +301,24 @@ def _accumulate(
         sums[prefix + k] = sums.get(prefix + k, 0.0) + v.detach().double() * weight
 
 
+def _window_reader(
+    model: GestureModel, windows: Any, who: str
+) -> tuple[int, Callable[[np.ndarray], dict[str, torch.Tensor]]]:
+    """``(n, read)``: the number of ``windows`` and ``read(idx)``, the batch of windows ``idx`` on the model's
+    device. ``KeyError`` / ``ValueError`` naming ``who`` when they lack a key ``model`` reads or (in memory) hold
+    arrays of different lengths."""
+    device = model_device(model)
+    if isinstance(windows, ResidentWindows):
+        _needed_keys(model, dict.fromkeys(windows.keys), who)
+        return len(windows), lambda idx: windows.batch(torch.from_numpy(idx).to(windows.device))
+    if _is_store_view(windows):
+        keys = _needed_keys(model, windows, who)
+        return len(windows), lambda idx: _batch(windows.batch(idx, keys=keys), keys, slice(None), device)
+    arrays = as_arrays(windows)
+    keys = _needed_keys(model, arrays, who)
+    return _n_windows(arrays, keys, who), lambda idx: _batch(arrays, keys, idx, device)
+
+
 @torch.no_grad()
 def evaluate_losses(
     model: GestureModel, windows: Any, *, epoch: int, batch_size: int = 64
@@ -328,29 +346,7 @@ def evaluate_losses(
     >>> sorted(by_2), bool(np.isclose(by_2["total"], at_once["total"], rtol=1e-5))
     (['adv', 'rec', 'total'], True)
     """
-    device = model_device(model)
-    if isinstance(windows, ResidentWindows):
-        _needed_keys(model, dict.fromkeys(windows.keys), "evaluate_losses")
-        n = len(windows)
-
-        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
-            return windows.batch(torch.from_numpy(idx).to(windows.device))
-
-    elif _is_store_view(windows):
-        keys = _needed_keys(model, windows, "evaluate_losses")
-        n = len(windows)
-
-        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
-            return _batch(windows.batch(idx, keys=keys), keys, slice(None), device)
-
-    else:
-        arrays = as_arrays(windows)
-        keys = _needed_keys(model, arrays, "evaluate_losses")
-        n = _n_windows(arrays, keys, "evaluate_losses")
-
-        def read(idx: np.ndarray) -> dict[str, torch.Tensor]:
-            return _batch(arrays, keys, idx, device)
-
+    n, read = _window_reader(model, windows, "evaluate_losses")
     was_training = model.training
     model.eval()
     sums: dict[str, Any] = {}
@@ -468,7 +464,7 @@ def fit(
     check_compilable(type(model), config.compile)  # before any work
     data = _Data.of(model, train_windows)
     if val_windows is not None:  # before any step, not at the first validation after an epoch
-        _check_val_windows(model, val_windows)
+        _window_reader(model, val_windows, "fit: val_windows")  # what evaluate_losses finds after an epoch
     configure_torch(config.seed, config.threads, config.deterministic, config.torch_device())
     if config.no_adv_epochs is not None and hasattr(model.config, "no_adv_epochs"):
         model.config.no_adv_epochs = int(config.no_adv_epochs)
@@ -501,19 +497,6 @@ def fit(
     if config.epochs == 0 and not resumed:  # no epoch: the initial weights' checkpoint (as a baseline's)
         run.save(0)
     return run.result()
-
-
-def _check_val_windows(model: GestureModel, windows: Any) -> None:
-    """``KeyError`` / ``ValueError`` (naming ``val_windows``) when validation windows lack a key ``model`` reads or
-    (in memory) hold arrays of different lengths: what :func:`evaluate_losses` would find after an epoch."""
-    who = "fit: val_windows"
-    if isinstance(windows, ResidentWindows):
-        _needed_keys(model, dict.fromkeys(windows.keys), who)
-    elif _is_store_view(windows):
-        _needed_keys(model, windows, who)
-    else:
-        arrays = as_arrays(windows)
-        _n_windows(arrays, _needed_keys(model, arrays, who), who)
 
 
 def _backward(totals: list[torch.Tensor], ddp: Any) -> None:
