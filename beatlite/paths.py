@@ -114,9 +114,28 @@ def mode() -> str:
     ...
     ValueError: BEATLITE_MODE must be one of ('lecture', 'full'), got 'train'
     """
-    value = os.environ.get("BEATLITE_MODE", "lecture").strip().lower() or "lecture"
-    if value not in MODES:
-        raise ValueError(f"BEATLITE_MODE must be one of {MODES}, got {value!r}")
+    return env_choice("BEATLITE_MODE", MODES)
+
+
+def env_choice(name: str, choices: tuple[str, ...]) -> str:
+    """The value of environment variable ``name``, one of ``choices`` (case and surrounding spaces ignored;
+    unset or empty: ``choices[0]``), read at every call.
+
+    Raises
+    ------
+    ValueError
+        Any other value, naming the variable and the choices.
+
+    Examples
+    --------
+    >>> from unittest import mock
+    >>> with mock.patch.dict(os.environ, {"BEATLITE_DEMO": " B "}):
+    ...     env_choice("BEATLITE_DEMO", ("a", "b")), env_choice("BEATLITE_UNSET_DEMO", ("a", "b"))
+    ('b', 'a')
+    """
+    value = os.environ.get(name, "").strip().lower() or choices[0]
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {choices}, got {value!r}")
     return value
 
 

@@ -43,13 +43,14 @@ and on the animation players of notebooks 05 and 08 (``to_html(dpi=80)``).
 from __future__ import annotations
 
 import functools
-import os
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from beatlite.paths import env_choice
 
 #: Smallest readable font size, pixels of the saved (or shown) picture.
 MIN_TEXT_PX = 8.0
@@ -98,6 +99,7 @@ def check_mode() -> str:
 
     Examples
     --------
+    >>> import os
     >>> from unittest import mock
     >>> with mock.patch.dict(os.environ, {"BEATLITE_FIGURE_CHECK": " Raise "}):
     ...     check_mode()
@@ -106,10 +108,7 @@ def check_mode() -> str:
     ...     check_mode()
     'warn'
     """
-    mode = os.environ.get("BEATLITE_FIGURE_CHECK", "warn").strip().lower() or "warn"
-    if mode not in CHECK_MODES:
-        raise ValueError(f"BEATLITE_FIGURE_CHECK must be one of {CHECK_MODES}, got {mode!r}")
-    return mode
+    return env_choice("BEATLITE_FIGURE_CHECK", CHECK_MODES)
 
 
 def check_figure(
