@@ -4,7 +4,7 @@ A session lent a GPU runs a stage there (``bash bench/gpu_session.sh next``, the
 in a folder holding ``next.json`` and ``next.md``), then, here:
 
 ``python bench/gpu_record.py add next FOLDER [--commit REV] [--not-measured TEXT] [--record RECORD]``
-    (stages ``full``, ``tune``, ``next`` and ``later``, whose rows ``gpu_session.sh`` merges into ``STAGE.json``)
+    (stages ``full``, ``tune``, ``next``, ``later`` and ``cudnn``, whose rows ``gpu_session.sh`` merges into ``STAGE.json``)
     appends the run to the record (default ``bench/records/bench_train_h200.json``; a run of that name
     replaced): its measured rows, the GEMM peaks, the GPU and torch named by the log's machine line, the date,
     the commit (default: this checkout's), and the rows that failed or were not measured, each with its note

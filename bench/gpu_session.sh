@@ -19,22 +19,23 @@
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  HA2G paper at 512, eager and compiled (reduce-overhead; its training pass compiles since the
 #                  style loss gathers its permutation: a new lead, not one tune left), both profiled
-#   STAGE later    after next (about 7 minutes): HA2G paper bf16 at 256 eager with determinism on and off (on no
+#   STAGE later    after next (about 5 minutes): HA2G paper bf16 at 256 eager with determinism on and off (on no
 #                  longer fills every new tensor on CUDA, set_deterministic: against full's 323 and 260 ms/step),
-#                  then CaMN paper bf16 at 1024 compiled with cudnn.benchmark, then with the LSTM traced into the
-#                  graph and the frame matmul on (a longer limit)
+#                  then HA2G paper bf16 at 1024 compiled (reduce-overhead), determinism off
+#   STAGE cudnn    after later (about 5 minutes): CaMN paper bf16 at 1024 compiled with the audio matmul, with
+#                  cudnn.benchmark, then with the LSTM traced into the graph (a longer limit)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
-# Back here: python bench/gpu_record.py add STAGE FOLDER (full, tune, next, later: into
+# Back here: python bench/gpu_record.py add STAGE FOLDER (full, tune, next, later, cudnn: into
 #             bench/records/bench_train_h200.json), then
 #             python bench/gpu_record.py table (the README's GPU table from the record)
 # Results: $OUT/<stage>.md (the log and tables) and bench_train's rows, written after every row, so a run
-# stopped by its time limit keeps the rows it measured: $OUT/<stage>.json for full, tune, next and later (all
+# stopped by its time limit keeps the rows it measured: $OUT/<stage>.json for full, tune, next, later and cudnn (all
 # of the stage's calls merged), $OUT/<stage>-<model>.json for the others.
 set -u -o pipefail
-stage=${1:?stage: eager, compile, full, tune, next, later, repeat or cpu}
-case "$stage" in eager | compile | full | tune | next | later | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, repeat or cpu)" >&2; exit 2 ;; esac
+stage=${1:?stage: eager, compile, full, tune, next, later, cudnn, repeat or cpu}
+case "$stage" in eager | compile | full | tune | next | later | cudnn | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, cudnn, repeat or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -63,12 +64,12 @@ PY
 python3 -c "$setup" 2>&1 | tee "$out/$stage.md"
 n=0
 parts=$(mktemp -d)
-bench() {  # bench SECONDS MODEL ARGS...  (full, tune, next, later: every call's rows merged into $out/$stage.json)
+bench() {  # bench SECONDS MODEL ARGS...  (full, tune, next, later, cudnn: every call's rows merged into $out/$stage.json)
     n=$((n + 1))
     local json="$out/$stage-$2.json"
-    case "$stage" in full | tune | next | later) json="$parts/$(printf %02d $n).json" ;; esac
+    case "$stage" in full | tune | next | later | cudnn) json="$parts/$(printf %02d $n).json" ;; esac
     timeout "$1" python3 bench/bench_train.py --models "$2" "${@:3}" --json "$json" 2>&1 | tee -a "$out/$stage.md"
-    case "$stage" in full | tune | next | later) python3 -c 'import json, sys
+    case "$stage" in full | tune | next | later | cudnn) python3 -c 'import json, sys
 docs = [json.load(open(p)) for p in sys.argv[2:]]
 json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r in d["rows"]]}, open(sys.argv[1], "w"), indent=1)' \
         "$out/$stage.json.tmp" "$parts"/*.json && mv "$out/$stage.json.tmp" "$out/$stage.json" ;; esac  # (whole or not at all)
@@ -85,8 +86,12 @@ if [ "$stage" = next ]; then
     exit 0
 fi
 if [ "$stage" = later ]; then
-    bench 70 ha2g --presets paper --devices cuda --precisions bf16 --deterministic on off --fit-steps 0 --profile 12 --batch-sizes 256
-    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --cudnn-benchmark
+    bench 80 ha2g --presets paper --devices cuda --precisions bf16 --deterministic on off --fit-steps 0 --profile 12 --batch-sizes 256
+    bench 165 ha2g "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead
+    exit 0
+fi
+if [ "$stage" = cudnn ]; then
+    bench 90 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --cudnn-benchmark
     bench 200 camn "${paper[@]}" --batch-sizes 1024 --compile reduce-overhead --frame-matmul on --trace-rnn
     exit 0
 fi

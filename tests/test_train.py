@@ -947,3 +947,33 @@ def test_set_deterministic_stops_filling_new_tensors_on_cuda_only():
     finally:
         torch.utils.deterministic.fill_uninitialized_memory = fill
         torch.use_deterministic_algorithms(mode)
+
+
+def test_fit_computes_the_raw_audio_block_as_its_config_says_with_the_kernels_losses(windows):
+    """``TrainConfig.audio_matmul``: ``"on"`` trains CaMN with its waveform block as one matrix product of the
+    waveform's frames, the convolutions' values to float32 rounding, so the same losses to rounding that the
+    steps carry on (after these 6 steps: 7.7e-7 relative at most, seen; bound 1e-4); ``"auto"`` on the CPU switches it back off (the recorded numbers
+    are the kernels'); an unknown value is refused."""
+    from beatlite.models.layers import BasicBlock1d
+
+    def switched(model):
+        return [
+            m.frames_as_matmul
+            for m in model.modules()
+            if isinstance(m, BasicBlock1d) and m.conv1.in_channels == 1
+        ]
+
+    train, val = windows
+    kernels, matmul = camn(), camn()
+    a = fit(kernels, train, cfg(audio_matmul="off"), val)
+    b = fit(matmul, train, cfg(audio_matmul="on"), val)
+    assert switched(kernels) == [False] and switched(matmul) == [True]
+    for x, y in zip(a.history, b.history, strict=True):
+        assert y["train"] == pytest.approx(x["train"], rel=1e-4)
+        assert y["val"] == pytest.approx(x["val"], rel=1e-4)
+    fit(matmul, train, cfg(epochs=1), val)  # "auto" on the CPU
+    assert switched(matmul) == [False]
+    default = fit(camn(), train, cfg(), val)
+    assert default.history == a.history  # auto on the CPU is the kernels' run, to the bit
+    with pytest.raises(ValueError, match="audio_matmul must be one of"):
+        TrainConfig(audio_matmul="yes")

@@ -416,7 +416,8 @@ def _fit_command_with(fit, tmp_path, monkeypatch) -> list[str]:
 
 
 def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypatch):
-    """``fit --val-every N`` reaches ``TrainConfig.val_every`` (data, model and training stood in for)."""
+    """``fit --val-every N``, ``--nondeterministic`` and ``--audio-matmul`` reach ``TrainConfig`` (data, model and
+    training stood in for)."""
     from beatlite.train import __main__ as command
 
     def stand_in_fit(model, train, config, val=None, **kw):
@@ -431,6 +432,14 @@ def test_fit_command_passes_val_every_to_the_training_config(tmp_path, monkeypat
         with pytest.raises(_Stop) as stopped:
             command.main([*argv, "--epochs", "1", *extra])
         assert stopped.value.args[0].deterministic is expected
+    for extra, expected in (
+        ([], "auto"),
+        (["--audio-matmul", "on"], "on"),
+        (["--audio-matmul", "off"], "off"),
+    ):
+        with pytest.raises(_Stop) as stopped:
+            command.main([*argv, "--epochs", "1", *extra])
+        assert stopped.value.args[0].audio_matmul == expected
 
 
 def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path, monkeypatch, capsys):
@@ -905,3 +914,25 @@ def test_the_first_training_steps_are_the_recorded_ones():
         if not np.allclose(got, FIRST_STEPS[name], rtol=2e-5, atol=0):
             moved[name] = got
     assert not moved, f"training numbers changed (recorded: FIRST_STEPS): {moved}"
+
+
+def test_a_recipe_states_its_batch_on_cuda_with_the_learning_rate_scaled_to_it(monkeypatch):
+    """``Recipe.gpu_batch_size``: with no batch size given, ``recipe_train_config`` (the ``fit`` command) trains
+    on CUDA with it, the learning rates scaled as ``lr_scaling`` says; on the CPU, or with a batch size given,
+    the recipe's. (CUDA is stood in for: ``torch.device("cuda")`` needs no GPU to be named.)"""
+    torch = pytest.importorskip("torch")
+    from beatlite.train.recipes import RECIPES, recipe_train_config, scaled_lr
+
+    recipe = RECIPES["camn_tiny"]
+    assert recipe.gpu_batch_size == 256 and recipe.batch_size == 32  # the reference trainer's batch, and ours
+    assert recipe_train_config("camn_tiny", device="cpu").batch_size == 32
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
+    for rule, factor in (("linear", 8.0), ("sqrt", 8.0**0.5)):
+        config = recipe_train_config("camn_tiny", device="cuda", lr_scaling=rule)
+        assert config.batch_size == 256 and config.lr == pytest.approx(recipe.lr * factor, rel=1e-12)
+        assert config.lr == scaled_lr(recipe, 256, rule)
+    assert recipe_train_config("camn_tiny", device="auto").batch_size == 256
+    given = recipe_train_config("camn_tiny", device="cuda", batch_size=64)
+    assert given.batch_size == 64 and given.lr == pytest.approx(recipe.lr * 2, rel=1e-12)
+    assert RECIPES["s2g_tiny"].gpu_batch_size is None
+    assert recipe_train_config("s2g_tiny", device="cuda").batch_size == RECIPES["s2g_tiny"].batch_size

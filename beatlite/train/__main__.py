@@ -1,7 +1,7 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
 ``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B [--lr-scaling sqrt]]
-[--precision bf16] [--compile MODE] [--nondeterministic] [--val-every N]`` trains one recipe
+[--precision bf16] [--compile MODE] [--nondeterministic] [--audio-matmul auto] [--val-every N]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
@@ -45,7 +45,7 @@ from pathlib import Path
 from beatlite import paths
 from beatlite.io.atomic import atomic_write, exclusive_lock
 from beatlite.models import model_class
-from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES
+from beatlite.train.config import AUDIO_MATMUL, COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
 from beatlite.train.recipes import RECIPES, SEED, recipe_train_config, retrain, retrain_many, training_data
 from beatlite.train.seeds import (
@@ -96,7 +96,7 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument(
         "--batch-size",
         type=int,
-        help="windows per step (default: the recipe's); learning rates scale with it (--lr-scaling)",
+        help="windows per step (default: the recipe's, its gpu_batch_size on CUDA); learning rates scale with it (--lr-scaling)",
     )
     f.add_argument(
         "--lr-scaling",
@@ -125,6 +125,12 @@ def _parser() -> argparse.ArgumentParser:
         "--nondeterministic",
         action="store_true",
         help="let CUDA use its faster nondeterministic kernels (TrainConfig.deterministic=False)",
+    )
+    f.add_argument(
+        "--audio-matmul",
+        choices=AUDIO_MATMUL,
+        default="auto",
+        help="raw-audio convolutions as one matrix product of the waveform's frames (auto: on CUDA; TrainConfig.audio_matmul)",
     )
     f.add_argument(
         "--extractor-epochs",
@@ -238,6 +244,7 @@ def _fit_command(args: argparse.Namespace) -> int:
         "val_every": args.val_every,
         "deterministic": not args.nondeterministic,
         "lr_scaling": args.lr_scaling,
+        "audio_matmul": args.audio_matmul,
     }
     try:  # before anything is prepared or written: the flags' values, the device, the compiler
         config = recipe_train_config(args.recipe, **options)

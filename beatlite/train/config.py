@@ -20,6 +20,8 @@ COMPILE_MODES = ("default", "reduce-overhead", "max-autotune", "max-autotune-no-
 """Values of :attr:`TrainConfig.compile` that are ``torch.compile`` modes (of its default backend, inductor)."""
 COMPILE_BACKENDS = ("cudagraphs", "aot_eager")
 """Values of :attr:`TrainConfig.compile` that are other ``torch.compile`` backends."""
+AUDIO_MATMUL = ("auto", "on", "off")
+"""Values of :attr:`TrainConfig.audio_matmul`."""
 
 
 @dataclasses.dataclass
@@ -76,8 +78,9 @@ class TrainConfig:
     deterministic : bool
         What :func:`beatlite.train.fit` passes to ``torch.use_deterministic_algorithms`` (torch's setting is
         process-wide: it stays set after ``fit``). ``True`` (default): only deterministic kernels, what repeatable
-        CUDA runs need (whether two CUDA runs repeat to the bit was not measured here; new tensors are not filled on
-        CUDA, :func:`~beatlite.train.training.set_deterministic`). ``False`` lets CUDA use its faster
+        CUDA runs need (on an H200 two CUDA trainings of camn_tiny and of ha2g_tiny with one seed gave the same
+        weights to the bit, and with ``False`` they did not: ``bench/records/repeat_fit_h200.json``; new tensors are
+        not filled on CUDA, :func:`~beatlite.train.training.set_deterministic`). ``False`` lets CUDA use its faster
         nondeterministic kernels and skips deterministic mode's filling of every new tensor: on an H200 it
         took CaMN's paper preset (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260
         (``bench/bench_train.py --deterministic on off``; README, "Using real BEAT"); the same seed may then give
@@ -112,8 +115,18 @@ class TrainConfig:
         ``"reduce-overhead"`` took CaMN's paper preset (bf16) from 112 to 57 ms per step at batch 256 and,
         with ``deterministic=False``, from 235 to 146 ms at 1024 (README, "Using real BEAT"). Every
         trainable model's pass compiled with inductor on the CPU (README; HA2G's since its style loss gathers
-        its permutation, tested; on a GPU, HA2G compiled is unmeasured). A compiled pass draws dropout
+        its permutation, tested; on an H200 ``"reduce-overhead"`` took HA2G's paper-preset step, bf16 at batch
+        512, from 375 to 273 ms). A compiled pass draws dropout
         masks with inductor's own generator: seeded, repeatable, but not the eager run's masks.
+    audio_matmul : {"auto", "on", "off"}
+        How the model's one-channel raw-audio blocks (CaMN's first waveform block) compute their two
+        first convolutions while ``fit`` trains: ``"on"``, as one matrix product of the waveform's frames
+        (:func:`beatlite.models.layers.use_frame_matmul`: the same parameters, the same values to float
+        rounding); ``"off"``, as convolution kernels; ``"auto"`` (default): ``"on"`` on CUDA, ``"off"``
+        elsewhere (:meth:`frame_matmul`). The model keeps the switch after ``fit``; checkpoints do not record
+        it. On an H200 it took CaMN's compiled paper-preset step (bf16, batch 1024, ``deterministic=False``)
+        from 141 to 69 ms (README, "Using real BEAT"). On the CPU the kernels stay, so CPU runs train the
+        recorded numbers.
     micro_batches : int
         Split every batch into this many micro-batches whose gradients are averaged before the step
         (gradient accumulation: the same step in less memory). Under ``torchrun`` with K processes a
@@ -165,6 +178,7 @@ class TrainConfig:
     data_on_device: str = "auto"
     compile: str | None = None
     deterministic: bool = True
+    audio_matmul: str = "auto"
 
     def __post_init__(self) -> None:
         if self.epochs < 0:
@@ -194,6 +208,10 @@ class TrainConfig:
                 f"TrainConfig: compile must be None or one of {COMPILE_MODES + COMPILE_BACKENDS}, "
                 f"got {self.compile!r}"
             )
+        if self.audio_matmul not in AUDIO_MATMUL:
+            raise ValueError(
+                f"TrainConfig: audio_matmul must be one of {AUDIO_MATMUL}, got {self.audio_matmul!r}"
+            )
         if self.workers < 0:
             raise ValueError(f"TrainConfig: workers must be >= 0, got {self.workers}")
         if self.micro_batches < 1:
@@ -217,6 +235,21 @@ class TrainConfig:
                 f"TrainConfig: device {self.device!r} asked for CUDA, which this machine does not have"
             )
         return device
+
+    def frame_matmul(self, device: Any) -> bool:
+        """Whether ``fit`` on ``device`` (a ``torch.device``) computes raw-audio blocks as a matrix product
+        (:attr:`audio_matmul`).
+
+        >>> import torch
+        >>> config = TrainConfig()
+        >>> config.frame_matmul(torch.device("cuda")), config.frame_matmul(torch.device("cpu"))
+        (True, False)
+        >>> TrainConfig(audio_matmul="on").frame_matmul(torch.device("cpu"))
+        True
+        """
+        if self.audio_matmul == "auto":
+            return device.type == "cuda"
+        return self.audio_matmul == "on"
 
     @property
     def learning_rate(self) -> float:

@@ -91,6 +91,11 @@ class Recipe:
         reference trainer does; ``False`` exports the last epoch.
     paper_rows : tuple of PaperRow
         The published rows this checkpoint stands for (:func:`paper_rows` collects a table's).
+    gpu_batch_size : int or None
+        The batch :func:`recipe_train_config` (the ``fit`` command) trains with on CUDA when no batch size is
+        given, the learning rates scaled to it (:func:`scaled_lr`); ``None``: ``batch_size`` on every device.
+        A GPU steps a larger batch in about the same time (README, "Using real BEAT"). The shipped numbers are
+        the CPU's, at ``batch_size``.
 
     Examples
     --------
@@ -115,6 +120,7 @@ class Recipe:
     lr_schedule: str = "constant"
     select_best: bool = True
     paper_rows: tuple[PaperRow, ...] = ()
+    gpu_batch_size: int | None = None
 
     @property
     def uses_text(self) -> bool:
@@ -222,6 +228,11 @@ one per switch of :data:`beatlite.models.ha2g_ablations.ABLATIONS`. HA2G-ASR (Ta
 needs a pretrained ASR network."""
 
 
+CAMN_GPU_BATCH = 256
+"""The CaMN recipes' batch on CUDA (:attr:`Recipe.gpu_batch_size`): the reference trainer's
+(docs/reference_code.md#camn-training), the recipe's learning rate scaled to it (linearly unless told otherwise).
+What larger batches did on ``data_samples/``: README, "Larger batches"; their scores on real BEAT are unmeasured."""
+
 RECIPES: dict[str, Recipe] = {
     "mean_pose": Recipe("mean_pose", "Mean pose", epochs=0),
     "random_clip": Recipe("random_clip", "Random clip", epochs=0),
@@ -249,6 +260,7 @@ RECIPES: dict[str, Recipe] = {
             "camn", label, kw, epochs=EPOCHS, lr=LR,
             paper_rows=((PaperRow("BEAT", "Table 4", "CaMN"),) if name == "camn_tiny" else ())
             + (PaperRow("BEAT", "Table 5", BEAT_TABLE5_ROWS[name]),),
+            gpu_batch_size=CAMN_GPU_BATCH,
         )
         for name, (label, kw) in CAMN_ABLATIONS.items()
     },
@@ -573,6 +585,7 @@ def recipe_train_config(
     val_every: int | None = None,
     deterministic: bool = True,
     lr_scaling: str = "linear",
+    audio_matmul: str = "auto",
 ) -> TrainConfig:
     """The :class:`~beatlite.train.TrainConfig` :func:`retrain` trains recipe ``name`` with (its parameters;
     ``checkpoint``: the full checkpoint's path), with the device resolved: what the ``fit`` command checks
@@ -590,6 +603,8 @@ def recipe_train_config(
     >>> config = recipe_train_config("camn_tiny", batch_size=64, lr_scaling="sqrt")
     >>> config.epochs == RECIPES["camn_tiny"].epochs, config.lr == scaled_lr(RECIPES["camn_tiny"], 64, "sqrt")
     (True, True)
+    >>> recipe_train_config("camn_tiny", device="cpu").batch_size, RECIPES["camn_tiny"].gpu_batch_size  # (on CUDA: 256)
+    (32, 256)
     >>> recipe_train_config("camn_tiny", epochs=0)
     Traceback (most recent call last):
     ...
@@ -602,6 +617,12 @@ def recipe_train_config(
             f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); {epochs} would export untrained weights"
         )
     batch = recipe.batch_size if batch_size is None else int(batch_size)
+    if (
+        batch_size is None
+        and recipe.gpu_batch_size
+        and TrainConfig(device=device).torch_device().type == "cuda"
+    ):
+        batch = recipe.gpu_batch_size
     config = TrainConfig(
         epochs=epochs,
         batch_size=batch,
@@ -618,6 +639,7 @@ def recipe_train_config(
         compile=compile,
         val_every=val_every,
         deterministic=deterministic,
+        audio_matmul=audio_matmul,
     )
     config.torch_device()
     return config
@@ -642,6 +664,7 @@ def retrain(
     val_every: int | None = None,
     deterministic: bool = True,
     lr_scaling: str = "linear",
+    audio_matmul: str = "auto",
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -671,8 +694,8 @@ def retrain(
     checkpoint_every : int, optional
         :attr:`beatlite.train.TrainConfig.checkpoint_every` (mid-epoch checkpoints, resumable).
     batch_size : int, optional
-        Windows per step instead of the recipe's (a GPU takes larger batches at about the same time per
-        step); the learning rates scale with it as ``lr_scaling`` says (:func:`scaled_lr`). Not the recipe the
+        Windows per step instead of the recipe's (its :attr:`Recipe.gpu_batch_size` on CUDA, else its
+        ``batch_size``; a GPU takes larger batches at about the same time per step); the learning rates scale with it as ``lr_scaling`` says (:func:`scaled_lr`). Not the recipe the
         shipped numbers were measured with (``bench/batch_scaling.py`` measures what it changes).
     data_on_device : {"auto", "always", "never"}
         :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
@@ -688,6 +711,8 @@ def retrain(
         :attr:`beatlite.train.TrainConfig.deterministic` (``False``: CUDA's faster nondeterministic kernels).
     lr_scaling : {"linear", "sqrt"}
         How the learning rates follow ``batch_size`` (:func:`scaled_lr`).
+    audio_matmul : {"auto", "on", "off"}
+        :attr:`beatlite.train.TrainConfig.audio_matmul` (raw-audio blocks as a matrix product; auto: on CUDA).
 
     Returns
     -------
@@ -719,6 +744,7 @@ def retrain(
         val_every=val_every,
         deterministic=deterministic,
         lr_scaling=lr_scaling,
+        audio_matmul=audio_matmul,
     )  # bad values raise here, before any data work
     data = training_data() if data is None else data
     model = build_recipe_model(name, data, seed=seed)

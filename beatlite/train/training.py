@@ -19,6 +19,7 @@ from beatlite import paths
 from beatlite.data.normalize import Normalizers
 from beatlite.data.resident import ResidentWindows, fits_on_device
 from beatlite.models.base import GestureModel
+from beatlite.models.layers import use_frame_matmul
 from beatlite.notebook import progress
 from beatlite.train.checkpoint import FORMAT, load_checkpoint, save_checkpoint
 from beatlite.train.config import COMPILE_BACKENDS, COMPILE_MODES, TrainConfig
@@ -712,6 +713,7 @@ class _Run:
         self.parts = max(config.micro_batches, self.world)
         self.device = local_device(config.torch_device())
         model.to(self.device)
+        use_frame_matmul(model, config.frame_matmul(self.device))
         self.amp = bool(config.amp)
         self.lr = config.learning_rate
         self.g_params = model.generator_parameters()
