@@ -138,6 +138,13 @@ def test_the_readme_gpu_sentences_match_the_records_and_the_logs():
     )
     bf16_64 = _row("full", "camn", "paper", "bf16", 64, "eager", True)
     tiny = _row("full", "camn", "tiny", "fp32", 64, "eager", True)
+    source = (ROOT / "bench" / "bench_train.py").read_text()  # `full` ran bench_train's default fit steps
+    fit_steps = int(re.search(r"args.fit_steps = 2 if args.quick else (\d+)", source).group(1))
+    session = (ROOT / "bench" / "gpu_session.sh").read_text()
+    assert "bench 35 camn ha2g --presets tiny --devices cuda --precisions fp32 --batch-sizes 64\n" in session
+    assert (
+        fit_steps * 64 <= 658
+    )  # (no --fit-steps on that line: 10 full batches of data_samples' 658 windows)
     best_ha2g = _row("tune", "ha2g", "paper", "bf16", 512, "eager", False)
     ha2g_fp32 = _row("full", "ha2g", "paper", "fp32", 64, "eager", True)
     issue = _record("issue28_h200_9fb39d3.json")
@@ -240,18 +247,30 @@ def test_the_readme_targets_met_paragraph_is_the_later_runs_records_and_logs():
     gru = _self_cuda_ms(h_step, "aten::_cudnn_rnn_backward")
     assert gru > _gpu_ms(h_step) / 2  # "over half"
     h_on, h_off = (_row("later", "ha2g", "paper", "bf16", 256, "eager", d) for d in (True, False))
+    tiny = _row("full", "camn", "tiny", "fp32", 64, "eager", True)
+    source = (ROOT / "bench" / "bench_train.py").read_text()  # `full` ran bench_train's default fit steps
+    fit_steps = int(re.search(r"args.fit_steps = 2 if args.quick else (\d+)", source).group(1))
+    session = (ROOT / "bench" / "gpu_session.sh").read_text()
+    assert "bench 35 camn ha2g --presets tiny --devices cuda --precisions fp32 --batch-sizes 64\n" in session
+    assert (
+        fit_steps * 64 <= 658
+    )  # (no --fit-steps on that line: 10 full batches of data_samples' 658 windows)
     full_on, full_off = (_row("full", "ha2g", "paper", "bf16", 256, "eager", d) for d in (True, False))
     assert h_on["step_ms"] <= h_off["step_ms"]  # "no longer costs time"
     for sentence in (
         f"from {ms(eager)} to {ms(eager_mm)} ms eager and from {ms(comp)} to {ms(comp_mm)} ms compiled: "
-        f"**{wps(comp_mm)} windows/s**, of the 10,000 asked, at a GPU peak of {mib(comp_mm)} MiB",
+        f"**{wps(comp_mm)} windows/s** against the 10,000 asked, at a GPU peak of {mib(comp_mm)} MiB",
         f"its LSTM's backward takes {lstm:.0f} of its {_gpu_ms(step):.0f} ms of GPU time",
         f"its step at 512 went from {ms(h_eager)} ms eager to {ms(h_comp)}, and at batch 1024 it runs at "
-        f"**{wps(h_wide)} windows/s**, of the 3,000 asked ({ms(h_wide)} ms, GPU peak {mib(h_wide)} MiB)",
+        f"**{wps(h_wide)} windows/s** against the 3,000 asked ({ms(h_wide)} ms, GPU peak {mib(h_wide)} MiB)",
         f"({gru:.0f} of {_gpu_ms(h_step):.0f} ms in the profiled step)",
         f"takes about {EPOCH_WINDOWS / comp_mm['step_wps']:.0f} s for CaMN's paper preset and "
         f"{EPOCH_WINDOWS / h_wide['step_wps']:.0f} s for HA2G's (all of BEAT: about "
         f"{4.75 * EPOCH_WINDOWS / comp_mm['step_wps']:.0f} s and {4.75 * EPOCH_WINDOWS / h_wide['step_wps'] / 60:.0f} min)",
+        f"`fit` ran CaMN tiny at {_n(tiny['fit_resident_wps'])} windows/s on `data_samples/` with its streams on the "
+        f"GPU, which would make a BEAT-4english epoch about {EPOCH_WINDOWS / tiny['fit_resident_wps']:.0f} s "
+        f"and one of all of BEAT about {4.75 * EPOCH_WINDOWS / tiny['fit_resident_wps'] / 60:.0f} min (estimates from a "
+        f"run of {fit_steps} steps)",
         f"HA2G's step at 256 in bf16 took {ms(h_on)} ms with determinism on and {ms(h_off)} with it off "
         f"(in `full`: {ms(full_on)} and {ms(full_off)})",
     ):

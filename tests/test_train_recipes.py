@@ -403,7 +403,7 @@ def _fit_command_with(fit, tmp_path, monkeypatch) -> list[str]:
     monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
     data = types.SimpleNamespace(train=None, val=None, meta={})
     monkeypatch.setattr(command, "training_data", lambda folder, progress: data)
-    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed: None)
+    monkeypatch.setattr(recipes, "build_recipe_model", lambda name, data, seed, preset="tiny": None)
     monkeypatch.setattr(training, "fit", fit)
     return [
         "fit",
@@ -460,7 +460,9 @@ def test_fit_command_refuses_bad_flag_values_before_preparing_anything(tmp_path,
     cases = ((["--checkpoint-every", "0"], "checkpoint_every must be >= 1"),
              (["--batch-size", "1"], "batch_size must be >= 2"), (["--val-every", "0"], "val_every must be >= 1"),
              (["--epochs", "-1"], "camn_tiny: epochs must be >= 1"), (["--epochs", "0"], "camn_tiny: epochs must be >= 1"),
-             (["--device", "cuda"], "device 'cuda' asked for CUDA"), (["--device", "gpu"], "not a torch device"))  # fmt: skip
+             (["--device", "cuda"], "device 'cuda' asked for CUDA"), (["--device", "gpu"], "not a torch device"),
+             (["--preset", "huge"], "camn_tiny: camn has no preset 'huge' (its presets: paper, tiny)"),
+             (["--lr", "0"], "lr must be positive"))  # fmt: skip
     for extra, said in cases:
         assert command.main([*argv, *extra]) == 2, extra
         err = capsys.readouterr().err
@@ -936,3 +938,54 @@ def test_a_recipe_states_its_batch_on_cuda_with_the_learning_rate_scaled_to_it(m
     assert given.batch_size == 64 and given.lr == pytest.approx(recipe.lr * 2, rel=1e-12)
     assert RECIPES["s2g_tiny"].gpu_batch_size is None
     assert recipe_train_config("s2g_tiny", device="cuda").batch_size == RECIPES["s2g_tiny"].batch_size
+
+
+def test_fit_command_trains_the_paper_preset_under_its_own_name_at_the_lr_given(tmp_path, monkeypatch):
+    """``fit RECIPE --preset paper --lr LR``: the recipe's model at the paper's size (the recipe's switches on
+    top), the generator at ``LR`` whatever the batch, the checkpoints named ``RECIPE-paper`` (a tiny run's
+    beside it is another file). The model is built for real; the training is stood in for."""
+    from beatlite.models import build_model
+    from beatlite.train import __main__ as command
+    from beatlite.train import recipes
+
+    real_build = recipes.build_recipe_model  # (_fit_command_with stands one in)
+    seen = {}
+
+    def stand_in_fit(model, train, config, val=None, **kw):
+        seen.update(model=model, config=config)
+        raise _Stop(config)
+
+    argv = _fit_command_with(stand_in_fit, tmp_path, monkeypatch)
+    monkeypatch.setattr(recipes, "build_recipe_model", real_build)
+    with pytest.raises(_Stop):
+        command.main([*argv, "--epochs", "1", "--preset", "paper", "--batch-size", "8", "--lr", "5e-4"])
+    model, config = seen["model"], seen["config"]
+    paper = build_model("diffgesture", preset="paper", seed=SEED)  # (its config draws with the training seed)
+    assert model.config.preset == "paper" and model.config == paper.config
+    assert config.lr == 5e-4 and config.batch_size == 8
+    assert str(config.checkpoint).endswith("train/diffgesture_tiny-paper.pt")
+    with pytest.raises(_Stop):
+        command.main([*argv, "--epochs", "1", "--batch-size", "8"])
+    assert seen["model"].config.preset == "tiny"
+    assert str(seen["config"].checkpoint).endswith("train/diffgesture_tiny.pt")
+    assert seen["config"].lr == recipes.scaled_lr(recipes.RECIPES["diffgesture_tiny"], 8)
+
+
+def test_retrain_writes_a_paper_preset_run_under_its_own_name(tmp_path, monkeypatch):
+    """``retrain(name, preset="paper")`` exports ``name-paper.pt`` (and its resumable ``train/`` copy), whose
+    config is the paper preset's: it loads as that model (mean_pose, a recipe of no training steps)."""
+    from beatlite.train.checkpoint import load_model
+    from beatlite.train.recipes import training_data
+
+    monkeypatch.setenv("BEATLITE_BUILD", str(tmp_path / "build"))
+    data = training_data(small_corpus(tmp_path / "corpus", ["2_scott_0_9_9", "2_scott_0_57_57"]))
+    retrain("mean_pose", out_dir=tmp_path / "run", data=data, progress=False, preset="paper")
+    assert sorted(p.name for p in (tmp_path / "run").rglob("*.pt")) == [
+        "mean_pose-paper.pt",
+        "mean_pose-paper.pt",
+    ]
+    for path in (tmp_path / "run" / "mean_pose-paper.pt", tmp_path / "run" / "train" / "mean_pose-paper.pt"):
+        model, _ = load_model(path)
+        assert model.config.preset == "paper"
+    with pytest.raises(ValueError, match="mean_pose has no preset 'huge'"):
+        retrain("mean_pose", out_dir=tmp_path / "run", data=data, progress=False, preset="huge")

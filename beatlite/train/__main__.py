@@ -1,11 +1,13 @@
 """Command line: ``python -m beatlite.train {fit,retrain-all,results,seeds}``.
 
-``fit RECIPE --data DIR --out DIR [--epochs N] [--seed S] [--device auto] [--resume] [--batch-size B [--lr-scaling sqrt]]
+``fit RECIPE --data DIR --out DIR [--preset paper] [--epochs N] [--seed S] [--device auto] [--resume]
+[--batch-size B [--lr-scaling sqrt]] [--lr LR]
 [--precision bf16] [--compile MODE] [--nondeterministic] [--audio-matmul auto] [--val-every N]`` trains one recipe
 (the same command under ``torchrun --nproc_per_node=K -m beatlite.train fit ...`` trains on K processes: every
 batch split over them, gradients averaged by ``DistributedDataParallel``, process 0 writing)
 on any BEAT-format folder and writes everything under ``--out`` (never into the repository): the
-float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` and, unless the data
+float16 checkpoint ``<out>/<RECIPE>.pt``, the resumable one ``<out>/train/<RECIPE>.pt`` (``RECIPE-paper`` for
+``--preset paper``: the model at the paper's size, the recipe's switches on top) and, unless the data
 are the shipped ``data_samples/``, an FGD extractor trained on that data (``<out>/fgd_dirvec.pt``, once;
 again when the train windows' fingerprint or ``--extractor-epochs`` changed)
 for the per-epoch validation FGD (``--val-every N``: every N optimiser steps instead).
@@ -47,7 +49,16 @@ from beatlite.io.atomic import atomic_write, exclusive_lock
 from beatlite.models import model_class
 from beatlite.train.config import AUDIO_MATMUL, COMPILE_BACKENDS, COMPILE_MODES
 from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_results
-from beatlite.train.recipes import RECIPES, SEED, recipe_train_config, retrain, retrain_many, training_data
+from beatlite.train.recipes import (
+    RECIPES,
+    SEED,
+    check_preset,
+    recipe_train_config,
+    retrain,
+    retrain_many,
+    run_name,
+    training_data,
+)
 from beatlite.train.seeds import (
     evaluate_seeds,
     recorded_seed_results,
@@ -97,6 +108,16 @@ def _parser() -> argparse.ArgumentParser:
         "--batch-size",
         type=int,
         help="windows per step (default: the recipe's, its gpu_batch_size on CUDA); learning rates scale with it (--lr-scaling)",
+    )
+    f.add_argument(
+        "--lr",
+        type=float,
+        help="generator learning rate at the run's batch (default: the recipe's, scaled to the batch)",
+    )
+    f.add_argument(
+        "--preset",
+        default="tiny",
+        help="the model's size: tiny (the recipes', default) or paper; checkpoints of paper are named RECIPE-paper.pt",
     )
     f.add_argument(
         "--lr-scaling",
@@ -245,9 +266,11 @@ def _fit_command(args: argparse.Namespace) -> int:
         "deterministic": not args.nondeterministic,
         "lr_scaling": args.lr_scaling,
         "audio_matmul": args.audio_matmul,
+        "lr": args.lr,
     }
     try:  # before anything is prepared or written: the flags' values, the device, the compiler
         config = recipe_train_config(args.recipe, **options)
+        check_preset(args.recipe, args.preset)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
         if config.epochs > 0:  # (an untrained baseline takes no step)
             check_batch_split(config, int(os.environ.get("WORLD_SIZE", "1")))  # (torchrun's process count)
@@ -262,14 +285,15 @@ def _fit_command(args: argparse.Namespace) -> int:
         "BEATLITE_BUILD", str(out / "build")
     )  # the index, the store and caches under --out too
     rank = int(os.environ.get("RANK", "0"))
-    lock = out / "train" / f".{args.recipe}.lock"
+    stem = run_name(args.recipe, args.preset)
+    lock = out / "train" / f".{stem}.lock"
     with contextlib.ExitStack() as held:
         if rank == 0:  # one run of a recipe per --out at a time (under torchrun, process 0 holds it for all)
             try:
                 held.enter_context(exclusive_lock(lock, wait=False))
             except BlockingIOError:
                 return _refused(
-                    f"another fit is training {args.recipe} into {out} (it holds {lock}); "
+                    f"another fit is training {stem} into {out} (it holds {lock}); "
                     "wait for it to end, or give another --out"
                 )
             except OSError as error:  # a read-only --out, a full disk
@@ -300,11 +324,14 @@ def _fit_locked(
                     print(f"{extractor} is stale ({stale}): training it again", flush=True)
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
     try:
-        seconds = retrain(args.recipe, out_dir=out, data=data, extractor=extractor, **options)
+        seconds = retrain(
+            args.recipe, out_dir=out, data=data, extractor=extractor, preset=args.preset, **options
+        )
     except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
         return _refused(error)
     if rank == 0:
-        print(f"{args.recipe}: {seconds:.1f} s of training; wrote {out / (args.recipe + '.pt')}", flush=True)
+        stem = run_name(args.recipe, args.preset)
+        print(f"{stem}: {seconds:.1f} s of training; wrote {out / (stem + '.pt')}", flush=True)
     return 0
 
 

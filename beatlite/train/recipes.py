@@ -495,8 +495,10 @@ def training_data(data: str | Path | None = None, *, progress: bool = False) -> 
     return TrainingData(index, vocab, train, val, take_sentences(usable), meta, store)
 
 
-def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> Any:
-    """The freshly initialised model of recipe ``name`` (torch seeded with ``seed``; word vectors set).
+def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED, preset: str = "tiny") -> Any:
+    """The freshly initialised model of recipe ``name`` (torch seeded with ``seed``; word vectors set), of
+    ``preset`` (a key of :func:`beatlite.models.presets`; the recipes' ``"tiny"`` by default) with the recipe's
+    switches on top.
 
     ``seed`` also goes to configs with a ``seed`` field (:class:`~beatlite.models.baselines.RandomClip`'s
     choice of clips). Of ``data`` only ``vocab`` and ``sentences`` are read, for a recipe that reads words.
@@ -515,6 +517,8 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     ('Seq2Seq', 7)
     >>> all(torch.equal(x, y) for x, y in zip(a.state_dict().values(), b.state_dict().values()))
     True
+    >>> build_recipe_model("seq2seq_tiny", data, preset="paper").config.preset
+    'paper'
     """
     import torch
 
@@ -525,7 +529,7 @@ def build_recipe_model(name: str, data: TrainingData, *, seed: int = SEED) -> An
     if "seed" in {f.name for f in dataclasses.fields(model_class(recipe.model).config_class)}:
         kw["seed"] = seed  # models that draw from numpy (the random clip row)
     torch.manual_seed(seed)
-    model = build_model(recipe.model, preset="tiny", **kw)
+    model = build_model(recipe.model, preset=preset, **kw)
     if recipe.uses_text and hasattr(model, "set_word_vectors"):
         model.set_word_vectors(word_vectors(data.vocab, data.sentences, dim=model.config.word_dim, seed=seed))
     return model
@@ -586,6 +590,7 @@ def recipe_train_config(
     deterministic: bool = True,
     lr_scaling: str = "linear",
     audio_matmul: str = "auto",
+    lr: float | None = None,
 ) -> TrainConfig:
     """The :class:`~beatlite.train.TrainConfig` :func:`retrain` trains recipe ``name`` with (its parameters;
     ``checkpoint``: the full checkpoint's path), with the device resolved: what the ``fit`` command checks
@@ -626,7 +631,7 @@ def recipe_train_config(
     config = TrainConfig(
         epochs=epochs,
         batch_size=batch,
-        lr=scaled_lr(recipe, batch, lr_scaling),
+        lr=scaled_lr(recipe, batch, lr_scaling) if lr is None else float(lr),
         lr_schedule=recipe.lr_schedule,
         seed=seed,
         checkpoint=checkpoint,
@@ -665,6 +670,8 @@ def retrain(
     deterministic: bool = True,
     lr_scaling: str = "linear",
     audio_matmul: str = "auto",
+    lr: float | None = None,
+    preset: str = "tiny",
 ) -> float:
     """Train recipe ``name`` and export its inference checkpoint.
 
@@ -713,6 +720,12 @@ def retrain(
         How the learning rates follow ``batch_size`` (:func:`scaled_lr`).
     audio_matmul : {"auto", "on", "off"}
         :attr:`beatlite.train.TrainConfig.audio_matmul` (raw-audio blocks as a matrix product; auto: on CUDA).
+    lr : float, optional
+        The generator learning rate at the run's batch, instead of the recipe's scaled to it (the
+        discriminator's is 0.2 times it).
+    preset : str
+        The model's size (a key of :func:`beatlite.models.presets`), with the recipe's switches on top; the
+        checkpoints of another preset than ``"tiny"`` are named :func:`run_name` (``camn_tiny-paper.pt``).
 
     Returns
     -------
@@ -724,10 +737,11 @@ def retrain(
     from beatlite.train.training import fit
 
     recipe = _recipe(name)
+    stem = run_name(name, preset)
     if out_dir is None:
-        export, full = paths.checkpoints_dir() / f"{name}.pt", paths.build_dir() / "train" / f"{name}.pt"
+        export, full = paths.checkpoints_dir() / f"{stem}.pt", paths.build_dir() / "train" / f"{stem}.pt"
     else:
-        export, full = Path(out_dir) / f"{name}.pt", Path(out_dir) / "train" / f"{name}.pt"
+        export, full = Path(out_dir) / f"{stem}.pt", Path(out_dir) / "train" / f"{stem}.pt"
     config = recipe_train_config(
         name,
         seed=seed,
@@ -745,9 +759,11 @@ def retrain(
         deterministic=deterministic,
         lr_scaling=lr_scaling,
         audio_matmul=audio_matmul,
+        lr=lr,
     )  # bad values raise here, before any data work
+    check_preset(name, preset)
     data = training_data() if data is None else data
-    model = build_recipe_model(name, data, seed=seed)
+    model = build_recipe_model(name, data, seed=seed, preset=preset)
     score = None
     if recipe.select_best and config.epochs > 0:
         from beatlite.metrics.extractor import load_extractor
@@ -826,6 +842,32 @@ def retrain_many(
         for future in as_completed(futures):
             record(*future.result())
     return done
+
+
+def run_name(name: str, preset: str = "tiny") -> str:
+    """The stem of the checkpoints of recipe ``name`` trained at ``preset``: ``name`` for the recipes'
+    ``"tiny"``, else ``name-preset``.
+
+    >>> run_name("camn_tiny"), run_name("camn_tiny", "paper")
+    ('camn_tiny', 'camn_tiny-paper')
+    """
+    return name if preset == "tiny" else f"{name}-{preset}"
+
+
+def check_preset(name: str, preset: str) -> None:
+    """``ValueError`` unless ``preset`` is a preset of recipe ``name``'s model.
+
+    >>> check_preset("camn_tiny", "paper")
+    >>> check_preset("camn_tiny", "huge")
+    Traceback (most recent call last):
+    ...
+    ValueError: camn_tiny: camn has no preset 'huge' (its presets: paper, tiny)
+    """
+    model = _recipe(name).model
+    if preset not in presets(model):
+        raise ValueError(
+            f"{name}: {model} has no preset {preset!r} (its presets: {', '.join(sorted(presets(model)))})"
+        )
 
 
 def _recipe(name: str) -> Recipe:
