@@ -19,10 +19,10 @@
 #                  frames (--frame-matmul off on: cuDNN's slow bf16 weight gradient of the raw-audio convolutions);
 #                  HA2G paper at 512, eager and compiled (reduce-overhead; its training pass compiles since the
 #                  style loss gathers its permutation: a new lead, not one tune left), both profiled
-#   STAGE later    after next (about 5 minutes): HA2G paper bf16 at 256 eager with determinism on and off (on no
+#   STAGE later    after next (about 4 minutes, measured as two calls): HA2G paper bf16 at 256 eager with determinism on and off (on no
 #                  longer fills every new tensor on CUDA, set_deterministic: against full's 323 and 260 ms/step),
 #                  then HA2G paper bf16 at 1024 compiled (reduce-overhead), determinism off
-#   STAGE cudnn    after later (about 5 minutes): CaMN paper bf16 at 1024 compiled with the audio matmul, with
+#   STAGE cudnn    after later (at most 5 minutes, its limits; never run yet): CaMN paper bf16 at 1024 compiled with the audio matmul, with
 #                  cudnn.benchmark, then with the LSTM traced into the graph (a longer limit)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)

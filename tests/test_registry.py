@@ -160,7 +160,13 @@ def test_a_recipe_mistake_is_refused_when_it_is_registered(monkeypatch):
         recipes.register_recipe("s2g_copy", recipes.Recipe("s2g", "CaMN"))
     with pytest.raises(ValueError, match=r"label 'Ground truth' is already the row of the ground truth"):
         recipes.register_recipe("s2g_gt", recipes.Recipe("s2g", "Ground truth"))
-    assert not {"s2g_wide", "s2g_cos", "s2g_copy", "s2g_gt"} & set(recipes.RECIPES)
+    with pytest.raises(
+        ValueError, match=r"'s2g_gpu': TrainConfig: batch_size must be >= 2 \(BatchNorm\), got 1"
+    ):
+        recipes.register_recipe("s2g_gpu", recipes.Recipe("s2g", "S2G gpu", gpu_batch_size=1))
+    with pytest.raises(ValueError, match=r"'s2g_gpu': TrainConfig: lr must be positive, got 0.0"):
+        recipes.register_recipe("s2g_gpu", recipes.Recipe("s2g", "S2G gpu", gpu_batch_size=64, gpu_lr=0.0))
+    assert not {"s2g_wide", "s2g_cos", "s2g_copy", "s2g_gt", "s2g_gpu"} & set(recipes.RECIPES)
 
 
 def test_a_recipe_of_zero_epochs_is_refused_for_a_model_that_trains(monkeypatch):

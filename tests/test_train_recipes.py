@@ -918,26 +918,31 @@ def test_the_first_training_steps_are_the_recorded_ones():
     assert not moved, f"training numbers changed (recorded: FIRST_STEPS): {moved}"
 
 
-def test_a_recipe_states_its_batch_on_cuda_with_the_learning_rate_scaled_to_it(monkeypatch):
-    """``Recipe.gpu_batch_size``: with no batch size given, ``recipe_train_config`` (the ``fit`` command) trains
-    on CUDA with it, the learning rates scaled as ``lr_scaling`` says; on the CPU, or with a batch size given,
-    the recipe's. (CUDA is stood in for: ``torch.device("cuda")`` needs no GPU to be named.)"""
+def test_a_recipe_states_its_batch_and_learning_rate_on_cuda(monkeypatch):
+    """``Recipe.gpu_batch_size`` and ``gpu_lr``: with no batch size given, ``recipe_train_config`` (the ``fit``
+    command) trains on CUDA at that batch and rate (CaMN's: the reference trainer's 256 at 5e-4,
+    docs/reference_code.md), ``--lr`` still overriding the rate; on the CPU, or with a batch size given, the
+    recipe's batch and its rate scaled to it. (CUDA is stood in for: ``torch.device("cuda")`` needs no GPU.)"""
     torch = pytest.importorskip("torch")
-    from beatlite.train.recipes import RECIPES, recipe_train_config, scaled_lr
+    from beatlite.train.recipes import RECIPES, recipe_train_config
 
     recipe = RECIPES["camn_tiny"]
-    assert recipe.gpu_batch_size == 256 and recipe.batch_size == 32  # the reference trainer's batch, and ours
-    assert recipe_train_config("camn_tiny", device="cpu").batch_size == 32
+    assert (recipe.gpu_batch_size, recipe.gpu_lr, recipe.batch_size, recipe.lr) == (256, 5e-4, 32, 2e-3)
+    cpu = recipe_train_config("camn_tiny", device="cpu")
+    assert (cpu.batch_size, cpu.lr) == (32, 2e-3)
     monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
-    for rule, factor in (("linear", 8.0), ("sqrt", 8.0**0.5)):
+    for rule in ("linear", "sqrt"):  # (a stated rate is not scaled)
         config = recipe_train_config("camn_tiny", device="cuda", lr_scaling=rule)
-        assert config.batch_size == 256 and config.lr == pytest.approx(recipe.lr * factor, rel=1e-12)
-        assert config.lr == scaled_lr(recipe, 256, rule)
+        assert (config.batch_size, config.lr) == (256, 5e-4)
     assert recipe_train_config("camn_tiny", device="auto").batch_size == 256
+    assert recipe_train_config("camn_tiny", device="cuda", lr=1e-3).lr == 1e-3
     given = recipe_train_config("camn_tiny", device="cuda", batch_size=64)
-    assert given.batch_size == 64 and given.lr == pytest.approx(recipe.lr * 2, rel=1e-12)
+    assert given.batch_size == 64 and given.lr == pytest.approx(
+        recipe.lr * 2, rel=1e-12
+    )  # linear, 2e-3 x 64/32
     assert RECIPES["s2g_tiny"].gpu_batch_size is None
-    assert recipe_train_config("s2g_tiny", device="cuda").batch_size == RECIPES["s2g_tiny"].batch_size
+    s2g = recipe_train_config("s2g_tiny", device="cuda")
+    assert (s2g.batch_size, s2g.lr) == (RECIPES["s2g_tiny"].batch_size, RECIPES["s2g_tiny"].lr)
 
 
 def test_fit_command_trains_the_paper_preset_under_its_own_name_at_the_lr_given(tmp_path, monkeypatch):

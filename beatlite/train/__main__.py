@@ -107,12 +107,12 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument(
         "--batch-size",
         type=int,
-        help="windows per step (default: the recipe's, its gpu_batch_size on CUDA); learning rates scale with it (--lr-scaling)",
+        help="windows per step (default: the recipe's, its gpu_batch_size and gpu_lr on CUDA); learning rates scale with it (--lr-scaling)",
     )
     f.add_argument(
         "--lr",
         type=float,
-        help="generator learning rate at the run's batch (default: the recipe's, scaled to the batch)",
+        help="generator learning rate at the run's batch, as given (--lr-scaling then unused; default: the recipe's, scaled to the batch)",
     )
     f.add_argument(
         "--preset",

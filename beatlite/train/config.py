@@ -79,10 +79,10 @@ class TrainConfig:
         What :func:`beatlite.train.fit` passes to ``torch.use_deterministic_algorithms`` (torch's setting is
         process-wide: it stays set after ``fit``). ``True`` (default): only deterministic kernels, what repeatable
         CUDA runs need (on an H200 two CUDA trainings of camn_tiny and of ha2g_tiny with one seed gave the same
-        weights to the bit, and with ``False`` they did not: ``bench/records/repeat_fit_h200.json``; new tensors are
-        not filled on CUDA, :func:`~beatlite.train.training.set_deterministic`). ``False`` lets CUDA use its faster
-        nondeterministic kernels and skips deterministic mode's filling of every new tensor: on an H200 it
-        took CaMN's paper preset (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260
+        weights to the bit, and with ``False`` they did not, at 4b776c0, before ``audio_matmul``'s ``"auto"`` was on
+        for CUDA: ``bench/records/repeat_fit_h200.json``; new tensors are not filled on CUDA,
+        :func:`~beatlite.train.training.set_deterministic`). ``False`` lets CUDA use its faster nondeterministic
+        kernels: on an H200, before deterministic mode stopped filling every new tensor on CUDA, it took CaMN's paper preset (bf16, batch 256) from 112 to 70 ms per step and HA2G's from 323 to 260
         (``bench/bench_train.py --deterministic on off``; README, "Using real BEAT"); the same seed may then give
         slightly different numbers from run to run on a GPU. No effect on CPU results (its kernels are
         deterministic either way).

@@ -93,9 +93,10 @@ class Recipe:
         The published rows this checkpoint stands for (:func:`paper_rows` collects a table's).
     gpu_batch_size : int or None
         The batch :func:`recipe_train_config` (the ``fit`` command) trains with on CUDA when no batch size is
-        given, the learning rates scaled to it (:func:`scaled_lr`); ``None``: ``batch_size`` on every device.
-        A GPU steps a larger batch in about the same time (README, "Using real BEAT"). The shipped numbers are
-        the CPU's, at ``batch_size``.
+        given; ``None``: ``batch_size`` on every device. On a GPU a step's time grows far less than its batch
+        (README, "Using real BEAT"). The shipped numbers are the CPU's, at ``batch_size``.
+    gpu_lr : float or None
+        The generator learning rate at ``gpu_batch_size`` (``None``: ``lr`` scaled to it, :func:`scaled_lr`).
 
     Examples
     --------
@@ -121,6 +122,7 @@ class Recipe:
     select_best: bool = True
     paper_rows: tuple[PaperRow, ...] = ()
     gpu_batch_size: int | None = None
+    gpu_lr: float | None = None
 
     @property
     def uses_text(self) -> bool:
@@ -228,10 +230,10 @@ one per switch of :data:`beatlite.models.ha2g_ablations.ABLATIONS`. HA2G-ASR (Ta
 needs a pretrained ASR network."""
 
 
-CAMN_GPU_BATCH = 256
-"""The CaMN recipes' batch on CUDA (:attr:`Recipe.gpu_batch_size`): the reference trainer's
-(docs/reference_code.md#camn-training), the recipe's learning rate scaled to it (linearly unless told otherwise).
-What larger batches did on ``data_samples/``: README, "Larger batches"; their scores on real BEAT are unmeasured."""
+CAMN_GPU_BATCH, CAMN_GPU_LR = 256, 5e-4
+"""The CaMN recipes' batch and generator learning rate on CUDA (:attr:`Recipe.gpu_batch_size`,
+:attr:`Recipe.gpu_lr`): the reference trainer's, for real BEAT (docs/reference_code.md#camn-training), not the
+recipe's 2e-3 at batch 32 scaled up (1.6e-2). What they score, on ``data_samples/`` or real BEAT, is unmeasured."""
 
 RECIPES: dict[str, Recipe] = {
     "mean_pose": Recipe("mean_pose", "Mean pose", epochs=0),
@@ -260,7 +262,7 @@ RECIPES: dict[str, Recipe] = {
             "camn", label, kw, epochs=EPOCHS, lr=LR,
             paper_rows=((PaperRow("BEAT", "Table 4", "CaMN"),) if name == "camn_tiny" else ())
             + (PaperRow("BEAT", "Table 5", BEAT_TABLE5_ROWS[name]),),
-            gpu_batch_size=CAMN_GPU_BATCH,
+            gpu_batch_size=CAMN_GPU_BATCH, gpu_lr=CAMN_GPU_LR,
         )
         for name, (label, kw) in CAMN_ABLATIONS.items()
     },
@@ -331,6 +333,9 @@ def register_recipe(name: str, recipe: Recipe) -> None:
         TrainConfig(
             epochs=recipe.epochs, batch_size=recipe.batch_size, lr=recipe.lr, lr_schedule=recipe.lr_schedule
         )
+        if recipe.gpu_batch_size is not None or recipe.gpu_lr is not None:
+            gpu_batch = recipe.batch_size if recipe.gpu_batch_size is None else recipe.gpu_batch_size
+            TrainConfig(batch_size=gpu_batch, lr=recipe.gpu_lr)  # (checks both)
     except (TypeError, ValueError) as error:
         raise ValueError(f"register_recipe: {name!r}: {error}") from error
     if recipe.epochs < 1 and cls(config).trainable:  # (0 epochs: an untrained baseline's recipe)
@@ -608,8 +613,9 @@ def recipe_train_config(
     >>> config = recipe_train_config("camn_tiny", batch_size=64, lr_scaling="sqrt")
     >>> config.epochs == RECIPES["camn_tiny"].epochs, config.lr == scaled_lr(RECIPES["camn_tiny"], 64, "sqrt")
     (True, True)
-    >>> recipe_train_config("camn_tiny", device="cpu").batch_size, RECIPES["camn_tiny"].gpu_batch_size  # (on CUDA: 256)
-    (32, 256)
+    >>> config = recipe_train_config("camn_tiny", device="cpu")
+    >>> config.batch_size, config.lr, RECIPES["camn_tiny"].gpu_batch_size, RECIPES["camn_tiny"].gpu_lr  # (CUDA's)
+    (32, 0.002, 256, 0.0005)
     >>> recipe_train_config("camn_tiny", epochs=0)
     Traceback (most recent call last):
     ...
@@ -622,16 +628,15 @@ def recipe_train_config(
             f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); {epochs} would export untrained weights"
         )
     batch = recipe.batch_size if batch_size is None else int(batch_size)
-    if (
-        batch_size is None
-        and recipe.gpu_batch_size
-        and TrainConfig(device=device).torch_device().type == "cuda"
-    ):
+    rate = None if lr is None else float(lr)
+    on_gpu = batch_size is None and recipe.gpu_batch_size
+    if on_gpu and TrainConfig(device=device).torch_device().type == "cuda":
         batch = recipe.gpu_batch_size
+        rate = recipe.gpu_lr if rate is None else rate
     config = TrainConfig(
         epochs=epochs,
         batch_size=batch,
-        lr=scaled_lr(recipe, batch, lr_scaling) if lr is None else float(lr),
+        lr=scaled_lr(recipe, batch, lr_scaling) if rate is None else rate,
         lr_schedule=recipe.lr_schedule,
         seed=seed,
         checkpoint=checkpoint,
@@ -701,8 +706,8 @@ def retrain(
     checkpoint_every : int, optional
         :attr:`beatlite.train.TrainConfig.checkpoint_every` (mid-epoch checkpoints, resumable).
     batch_size : int, optional
-        Windows per step instead of the recipe's (its :attr:`Recipe.gpu_batch_size` on CUDA, else its
-        ``batch_size``; a GPU takes larger batches at about the same time per step); the learning rates scale with it as ``lr_scaling`` says (:func:`scaled_lr`). Not the recipe the
+        Windows per step instead of the recipe's (its :attr:`Recipe.gpu_batch_size` and ``gpu_lr`` on CUDA,
+        else its ``batch_size`` and ``lr``); the learning rates scale with it as ``lr_scaling`` says (:func:`scaled_lr`). Not the recipe the
         shipped numbers were measured with (``bench/batch_scaling.py`` measures what it changes).
     data_on_device : {"auto", "always", "never"}
         :attr:`beatlite.train.TrainConfig.data_on_device` (the store's streams held on the GPU).
@@ -725,7 +730,8 @@ def retrain(
         discriminator's is 0.2 times it).
     preset : str
         The model's size (a key of :func:`beatlite.models.presets`), with the recipe's switches on top; the
-        checkpoints of another preset than ``"tiny"`` are named :func:`run_name` (``camn_tiny-paper.pt``).
+        checkpoints of another preset than ``"tiny"`` are named :func:`run_name` (``camn_tiny-paper.pt``; in
+        ``checkpoints/`` without ``out_dir``, where no results table reads them).
 
     Returns
     -------
