@@ -15,7 +15,10 @@ Where the time goes is read from the command's own lines, each stamped with the 
 ``fit`` prints for training and its validations).
 
 Usage: ``python bench/bench_fit_command.py [--hours 4] [--recipe camn_tiny] [--corpus DIR] [--keep DIR]
-[--json FILE]``. A 4-hour corpus needs about 8 GB of temporary disk and about 10 minutes on 2 cores.
+[--json FILE] [--fit-args="--device cuda --preset paper ..."]``: ``--fit-args`` (one string, given with ``=``)
+is appended to the command, so its flags override the defaults (``--device cuda``: the command on a GPU,
+``bash bench/gpu_session.sh fit``). A 4-hour corpus needs about 8 GB of temporary disk and about 10 minutes on
+2 cores.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import json
 import os
 import re
 import resource
+import shlex
 import shutil
 import subprocess
 import sys
@@ -47,11 +51,18 @@ EXTRACTOR_WROTE = re.compile(r"^wrote .*fgd_dirvec\.pt .* in (\d+) s")
 TRAINED = re.compile(r"^\S+: ([0-9.]+) s of training; wrote ")
 
 
-def fit_command(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> list[str]:
-    """The README's command for real data, as an argument list (``extractor_epochs``: None for fit's default)."""
+def fit_command(
+    recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None, fit_args: str = ""
+) -> list[str]:
+    """The README's command for real data, as an argument list (``extractor_epochs``: None for fit's default;
+    ``fit_args``: more flags, appended, so that they override the defaults).
+
+    >>> fit_command("camn_tiny", Path("c"), Path("o"), 2, "--device cuda --preset paper")[4:]
+    ['camn_tiny', '--data', 'c', '--out', 'o', '--epochs', '1', '--device', 'cpu', '--extractor-epochs', '2', '--device', 'cuda', '--preset', 'paper']
+    """
     extra = [] if extractor_epochs is None else ["--extractor-epochs", str(extractor_epochs)]
     return [sys.executable, "-m", "beatlite.train", "fit", recipe, "--data", str(corpus), "--out", str(out),
-            "--epochs", "1", "--device", "cpu", *extra]  # fmt: skip
+            "--epochs", "1", "--device", "cpu", *extra, *shlex.split(fit_args)]  # fmt: skip
 
 
 def phases(lines: list[tuple[float, str]], wall_s: float) -> dict[str, float | None]:
@@ -93,9 +104,11 @@ def measure(command: list[str], **popen: object) -> tuple[dict, list[tuple[float
     }, lines
 
 
-def step_fit(recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None) -> dict:
+def step_fit(
+    recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None, fit_args: str = ""
+) -> dict:
     """Run the command once (in this fresh process's only child); its wall seconds, peak RSS and phases."""
-    got, lines = measure(fit_command(recipe, corpus, out, extractor_epochs))
+    got, lines = measure(fit_command(recipe, corpus, out, extractor_epochs, fit_args))
     tail = [line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-6:]]
     return {**got, **phases(lines, got["wall_s"]), "output_tail": tail}
 
@@ -112,19 +125,28 @@ def main() -> int:
         "--json", type=Path, default=None, help="write the runs, command, revision and machine here"
     )
     p.add_argument("--extractor-epochs", type=int, default=None, help="passed to fit (default: fit's own)")
+    p.add_argument(
+        "--fit-args", default="", help='more fit flags, one string: --fit-args="--device cuda ..."'
+    )
     p.add_argument("--step", nargs=3, metavar=("RECIPE", "CORPUS", "OUT"), help=argparse.SUPPRESS)
     args = p.parse_args()
     if args.step:
-        print(
-            json.dumps(step_fit(args.step[0], Path(args.step[1]), Path(args.step[2]), args.extractor_epochs))
+        step = step_fit(
+            args.step[0], Path(args.step[1]), Path(args.step[2]), args.extractor_epochs, args.fit_args
         )
+        print(json.dumps(step))
         return 0
     if args.keep is not None:
         args.keep.mkdir(parents=True, exist_ok=True)
     about = {
         **record_about(threads=n_threads()),
         "fit_command": " ".join(
-            ["python", *fit_command(args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs)[1:]]
+            [
+                "python",
+                *fit_command(
+                    args.recipe, Path("<corpus>"), Path("<run>"), args.extractor_epochs, args.fit_args
+                )[1:],
+            ]
         ),
         "hours": args.hours if args.corpus is None else None,
     }  # fmt: skip  (before the corpus is made: the load average is what else ran)
@@ -140,7 +162,10 @@ def main() -> int:
             epochs = (
                 [] if args.extractor_epochs is None else ["--extractor-epochs", str(args.extractor_epochs)]
             )
-            runs[name] = run_step(["--step", args.recipe, str(corpus), str(base / "run"), *epochs], __file__)
+            more = [f"--fit-args={args.fit_args}"] if args.fit_args else []
+            runs[name] = run_step(
+                ["--step", args.recipe, str(corpus), str(base / "run"), *epochs, *more], __file__
+            )
             print(
                 f"{name}: {json.dumps({k: v for k, v in runs[name].items() if k != 'output_tail'})}",
                 flush=True,

@@ -24,6 +24,9 @@
 #                  then HA2G paper bf16 at 1024 compiled (reduce-overhead), determinism off
 #   STAGE cudnn    after later (at most 5 minutes, its limits; never run yet): CaMN paper bf16 at 1024 compiled with the audio matmul, with
 #                  cudnn.benchmark, then with the LSTM traced into the graph (a longer limit)
+#   STAGE fit      the fit command itself at the fast settings (about 8 minutes, estimated; never run yet):
+#                  bench/bench_fit_command.py on a 4-hour BEAT-rate corpus made there, fresh and again on one
+#                  --out, CaMN at the paper's size, bf16, batch 1024, compiled, determinism off (the extractor 2 epochs)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
@@ -34,8 +37,8 @@
 # stopped by its time limit keeps the rows it measured: $OUT/<stage>.json for full, tune, next, later and cudnn (all
 # of the stage's calls merged), $OUT/<stage>-<model>.json for the others.
 set -u -o pipefail
-stage=${1:?stage: eager, compile, full, tune, next, later, cudnn, repeat or cpu}
-case "$stage" in eager | compile | full | tune | next | later | cudnn | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, cudnn, repeat or cpu)" >&2; exit 2 ;; esac
+stage=${1:?stage: eager, compile, full, tune, next, later, cudnn, fit, repeat or cpu}
+case "$stage" in eager | compile | full | tune | next | later | cudnn | fit | repeat | cpu) ;; *) echo "unknown stage $stage (eager, compile, full, tune, next, later, cudnn, fit, repeat or cpu)" >&2; exit 2 ;; esac
 out=${OUT:-build/gpu_session}
 mkdir -p "$out"
 if [ -d .whl ] && ! python3 -c "import librosa" 2>/dev/null; then
@@ -75,6 +78,12 @@ json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r i
         "$out/$stage.json.tmp" "$parts"/*.json && mv "$out/$stage.json.tmp" "$out/$stage.json" ;; esac  # (whole or not at all)
     return 0
 }
+if [ "$stage" = fit ]; then
+    fast="--device cuda --preset paper --batch-size 1024 --lr 2e-3 --precision bf16 --compile reduce-overhead --nondeterministic"
+    timeout 540 python3 bench/bench_fit_command.py --hours 4 --workers "$BEATLITE_THREADS" --extractor-epochs 2 \
+        --fit-args="$fast" --json "$out/fit.json" 2>&1 | tee -a "$out/$stage.md"
+    exit 0
+fi
 if [ "$stage" = repeat ]; then
     timeout 400 python3 bench/repeat_fit.py --device cuda --epochs 2 --json "$out/repeat.json" 2>&1 | tee -a "$out/$stage.md"
     exit 0

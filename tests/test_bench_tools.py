@@ -200,7 +200,8 @@ def test_bench_data_without_out_leaves_nothing_in_the_temp_folder(tmp_path):
 def test_bench_fit_command_times_each_phase_of_a_fresh_and_a_repeated_fit(tmp_path):
     """bench/bench_fit_command.py runs the README's ``fit`` command twice on one ``--out``: the fresh run
     prepares the store and trains the FGD extractor, the repeated one only trains; the phases come from the
-    command's own lines (the extractor's ``wrote ... in N s``, fit's ``N s of training``)."""
+    command's own lines (the extractor's ``wrote ... in N s``, fit's ``N s of training``); ``--fit-args`` reach
+    the command."""
     import json
     import os
 
@@ -214,10 +215,12 @@ def test_bench_fit_command_times_each_phase_of_a_fresh_and_a_repeated_fit(tmp_pa
     record = tmp_path / "fit.json"
     env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp_path)}
     run_ok([sys.executable, str(ROOT / "bench" / "bench_fit_command.py"), "--corpus", str(corpus),
-            "--extractor-epochs", "2", "--json", str(record)], env=env, cwd=tmp_path, timeout=900)  # fmt: skip
+            "--extractor-epochs", "2", "--fit-args=--batch-size 24", "--json", str(record)],
+           env=env, cwd=tmp_path, timeout=900)  # fmt: skip
     got = json.loads(record.read_text())
     assert (
-        got["fit_command"].endswith("--epochs 1 --device cpu --extractor-epochs 2") and got["hours"] is None
+        got["fit_command"].endswith("--epochs 1 --device cpu --extractor-epochs 2 --batch-size 24")
+        and got["hours"] is None
     )
     fresh, again = got["runs"]["fresh"], got["runs"]["again"]
     assert fresh["extractor_s"] is not None and again["extractor_s"] is None  # kept: not trained again
