@@ -52,7 +52,6 @@ from beatlite.train.evaluation import RECORD_COLUMNS, evaluate_models, write_res
 from beatlite.train.recipes import (
     RECIPES,
     SEED,
-    check_preset,
     recipe_train_config,
     retrain,
     retrain_many,
@@ -267,10 +266,10 @@ def _fit_command(args: argparse.Namespace) -> int:
         "lr_scaling": args.lr_scaling,
         "audio_matmul": args.audio_matmul,
         "lr": args.lr,
+        "preset": args.preset,
     }
     try:  # before anything is prepared or written: the flags' values, the device, the compiler
         config = recipe_train_config(args.recipe, **options)
-        check_preset(args.recipe, args.preset)
         check_compilable(model_class(RECIPES[args.recipe].model), args.compile)
         if config.epochs > 0:  # (an untrained baseline takes no step)
             check_batch_split(config, int(os.environ.get("WORLD_SIZE", "1")))  # (torchrun's process count)
@@ -324,9 +323,7 @@ def _fit_locked(
                     print(f"{extractor} is stale ({stale}): training it again", flush=True)
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
     try:
-        seconds = retrain(
-            args.recipe, out_dir=out, data=data, extractor=extractor, preset=args.preset, **options
-        )
+        seconds = retrain(args.recipe, out_dir=out, data=data, extractor=extractor, **options)
     except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
         return _refused(error)
     if rank == 0:

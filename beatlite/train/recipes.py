@@ -596,15 +596,17 @@ def recipe_train_config(
     lr_scaling: str = "linear",
     audio_matmul: str = "auto",
     lr: float | None = None,
+    preset: str = "tiny",
 ) -> TrainConfig:
     """The :class:`~beatlite.train.TrainConfig` :func:`retrain` trains recipe ``name`` with (its parameters;
     ``checkpoint``: the full checkpoint's path), with the device resolved: what the ``fit`` command checks
-    before it indexes anything.
+    before it indexes anything (``preset``, the model's size, is checked here too, :func:`check_preset`, though
+    the config does not hold it).
 
     Raises
     ------
     ValueError
-        An unknown recipe, a value ``TrainConfig`` refuses, a device this machine lacks
+        An unknown recipe or preset, a value ``TrainConfig`` refuses, a device this machine lacks
         (:meth:`~beatlite.train.TrainConfig.torch_device`), or ``epochs < 1`` for a recipe that trains (its
         ``epochs > 0``: zero epochs would export weights never trained).
 
@@ -627,13 +629,15 @@ def recipe_train_config(
         raise ValueError(
             f"{name}: epochs must be >= 1 (the recipe's: {recipe.epochs}); {epochs} would export untrained weights"
         )
+    check_preset(name, preset)
+    # the device resolved once (one this machine lacks: ValueError), before the batch and rate it decides
+    cuda = TrainConfig(device=device).torch_device().type == "cuda"
     batch = recipe.batch_size if batch_size is None else int(batch_size)
     rate = None if lr is None else float(lr)
-    on_gpu = batch_size is None and recipe.gpu_batch_size
-    if on_gpu and TrainConfig(device=device).torch_device().type == "cuda":
+    if cuda and batch_size is None and recipe.gpu_batch_size:
         batch = recipe.gpu_batch_size
         rate = recipe.gpu_lr if rate is None else rate
-    config = TrainConfig(
+    return TrainConfig(
         epochs=epochs,
         batch_size=batch,
         lr=scaled_lr(recipe, batch, lr_scaling) if rate is None else rate,
@@ -651,8 +655,6 @@ def recipe_train_config(
         deterministic=deterministic,
         audio_matmul=audio_matmul,
     )
-    config.torch_device()
-    return config
 
 
 def retrain(
@@ -766,8 +768,8 @@ def retrain(
         lr_scaling=lr_scaling,
         audio_matmul=audio_matmul,
         lr=lr,
+        preset=preset,
     )  # bad values raise here, before any data work
-    check_preset(name, preset)
     data = training_data() if data is None else data
     model = build_recipe_model(name, data, seed=seed, preset=preset)
     score = None
