@@ -80,6 +80,32 @@ def phases(lines: list[tuple[float, str]], wall_s: float) -> dict[str, float | N
     return {"prepare_s": prepare, "extractor_s": wrote, "train_s": train}
 
 
+# fit's bar, e.g. "camn:  33%|###  | 1/3 [00:09<00:18, 4.5s/epoch, rec=0.4]"
+EPOCH_BAR = re.compile(r" (\d+)/(\d+) \[[^]]*epoch")
+
+
+def epoch_ends(lines: list[tuple[float, str]]) -> list[float]:
+    """The second each epoch of fit's training ended (its checkpoint written), from the ``(arrival second, line)``
+    pairs: the arrival of the last state of fit's bar at each count (after the extractor's lines).
+
+    The bar redraws its line after a carriage return, which the reader (text mode) takes as a line end, and
+    a line ending so arrives with the next write: the last state at count k arrives when the bar moves to k+1,
+    after epoch k's validation and checkpoint.
+
+    >>> bar = "camn: {}/3 [00:0{}<?, {}s/epoch, rec={}]"
+    >>> epoch_ends([(5.0, bar.format(0, 0, "?", "?")), (5.1, bar.format(0, 4, "?", 0.5)), (8.0, bar.format(1, 4, 4, 0.5)),
+    ...             (8.1, bar.format(1, 7, 4, 0.4)), (11.0, bar.format(2, 7, 3.5, 0.4)), (11.1, bar.format(2, 9, 3.5, 0.3)),
+    ...             (11.2, bar.format(3, 9, 3.3, 0.3)), (11.3, "camn_tiny: 10.4 s of training; wrote o")])
+    [5.1, 8.1, 11.1]
+    """
+    start = max((i for i, (_, line) in enumerate(lines) if EXTRACTOR_WROTE.match(line)), default=-1) + 1
+    last: dict[int, float] = {}
+    for t, line in lines[start:]:
+        if (m := EPOCH_BAR.search(line)) and int(m[1]) < int(m[2]):
+            last[int(m[1])] = t
+    return [last[k] for k in sorted(last)]
+
+
 def measure(command: list[str], **popen: object) -> tuple[dict, list[tuple[float, str]]]:
     """Run ``command`` as this process's only child (call it once per fresh process, so that the peak is the
     command's own): its wall and CPU seconds and peak RSS (``ru_maxrss`` of the largest process of its tree,
@@ -107,10 +133,15 @@ def measure(command: list[str], **popen: object) -> tuple[dict, list[tuple[float
 def step_fit(
     recipe: str, corpus: Path, out: Path, extractor_epochs: int | None = None, fit_args: str = ""
 ) -> dict:
-    """Run the command once (in this fresh process's only child); its wall seconds, peak RSS and phases."""
+    """Run the command once (in this fresh process's only child): its wall seconds, peak RSS and phases, and
+    its last 16 output lines with the second each arrived."""
     got, lines = measure(fit_command(recipe, corpus, out, extractor_epochs, fit_args))
-    tail = [line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-6:]]
-    return {**got, **phases(lines, got["wall_s"]), "output_tail": tail}
+    tail = [line.replace(str(out), "<run>").replace(str(corpus), "<corpus>") for _, line in lines[-16:]]
+    at = [round(t, 2) for t, _ in lines[-16:]]  # (when each arrived: the epochs' progress lines time them)
+    ends = epoch_ends(lines)
+    return {**got, **phases(lines, got["wall_s"]), "epoch_ends_s": [round(t, 2) for t in ends],
+            "epoch_s": [round(b - a, 2) for a, b in zip(ends, ends[1:])],  # (every epoch after the first)
+            "output_tail": tail, "output_tail_at_s": at}  # fmt: skip
 
 
 def main() -> int:

@@ -26,7 +26,8 @@
 #                  cudnn.benchmark, then with the LSTM traced into the graph (a longer limit)
 #   STAGE fit      the fit command itself at the fast settings (about 8 minutes, estimated; never run yet):
 #                  bench/bench_fit_command.py on a 4-hour BEAT-rate corpus made there, fresh and again on one
-#                  --out, CaMN at the paper's size, bf16, batch 1024, compiled, determinism off (the extractor 2 epochs)
+#                  --out, CaMN at the paper's size, bf16, batch 1024, compiled, determinism off (the extractor 2 epochs),
+#                  3 epochs each: the first compiles, the next two time an epoch (bench_fit_command's epoch_s)
 #   STAGE repeat   bench/repeat_fit.py: camn_tiny and ha2g_tiny trained twice each (2 epochs, seed 2022) on CUDA with
 #                  TrainConfig.deterministic on and off: are the two runs' weights equal to the bit? (about 3 minutes)
 #   STAGE cpu      a 1-minute rehearsal of both on this machine's CPU (tiny presets, 2 steps)
@@ -79,9 +80,10 @@ json.dump({"peaks": [d["peaks"] for d in docs], "rows": [r for d in docs for r i
     return 0
 }
 if [ "$stage" = fit ]; then
-    fast="--device cuda --preset paper --batch-size 1024 --lr 2e-3 --precision bf16 --compile reduce-overhead --nondeterministic"
-    timeout 540 python3 bench/bench_fit_command.py --hours 4 --workers "$BEATLITE_THREADS" --extractor-epochs 2 \
-        --fit-args="$fast" --json "$out/fit.json" 2>&1 | tee -a "$out/$stage.md"
+    # (FIT_HOURS and FIT_ARGS: a rehearsal's smaller corpus and CPU flags; the corpus made by every core)
+    fast="--epochs 3 --device cuda --preset paper --batch-size 1024 --lr 2e-3 --precision bf16 --compile reduce-overhead --nondeterministic"
+    timeout 540 python3 bench/bench_fit_command.py --hours "${FIT_HOURS:-4}" --workers "$(nproc)" --extractor-epochs 2 \
+        --fit-args="${FIT_ARGS:-$fast}" --json "$out/fit.json" 2>&1 | tee -a "$out/$stage.md"
     exit 0
 fi
 if [ "$stage" = repeat ]; then
