@@ -82,3 +82,24 @@ def test_fit_on_resident_windows_takes_the_same_steps_as_the_store_loader(store:
         runs[mode] = (history, [p.detach().clone() for p in model.parameters()])
     assert runs["always"][0] == runs["never"][0]
     assert all(torch.equal(a, b) for a, b in zip(runs["always"][1], runs["never"][1], strict=True))
+
+
+def test_streams_reach_the_device_a_take_at_a_time(tmp_path) -> None:
+    """Host memory while the streams are gathered holds one take's rows, never a whole stream: numpy's peak
+    (tracemalloc) stays under the bytes of the audio stream itself, where a concatenation of every take held
+    it twice (the list of takes and their concatenation)."""
+    import tracemalloc
+
+    for k in range(1, 11):  # ten equal takes: one take's temporaries are a tenth of the stream's
+        write_take(tmp_path, f"2_scott_0_{k}_{k}", 40)
+    store = build_store(index_folder(tmp_path, cache=False), tmp_path / "store", workers=0)
+    view = store.windows(None, keys=("audio",))
+    stream = resident_bytes(view, ["audio"]) - 24 * len(view)  # (float32 samples and padding, no offsets)
+    tracemalloc.start()
+    try:
+        resident = ResidentWindows(view, ["audio"], device="cpu")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert resident.nbytes - 24 * len(view) == stream
+    assert peak < stream / 2, (peak, stream)

@@ -688,6 +688,56 @@ def test_the_readme_fit_command_sentences_are_the_record():
     )
 
 
+def test_the_readme_gpu_fit_command_paragraph_is_the_records():
+    """The ``fit`` command on the H200 (``gpu_session.sh fit``, twice): times, phases, epochs, peaks, estimates."""
+    per_epoch, val_end = _record("fit_command_h200.json"), _record("fit_command_h200_val_end.json")
+    for record in (per_epoch, val_end):
+        assert record["hours"] == 4 and record["machine"]["cuda"] == "NVIDIA H200"
+        assert (
+            "--device cuda --preset paper --batch-size 1024 --lr 2e-3 --precision bf16 --compile reduce-overhead --nondeterministic"
+            in record["fit_command"]
+        )
+    assert "--epochs 4 --val-every 1000" in val_end["fit_command"]
+    fresh, again = per_epoch["runs"]["fresh"], per_epoch["runs"]["again"]
+    alone = [val_end["runs"][r]["epoch_s"] for r in ("fresh", "again")]  # epochs 1, 2 alone; 3 validates
+    windows = int(re.search(r"autoencoder on (\d+) windows", " ".join(fresh["output_tail"])).group(1))
+
+    def first_epoch(run: dict) -> float:  # tqdm's s/epoch when the bar reached 1 (its first epoch, compiling)
+        return float(
+            next(
+                m.group(1)
+                for line in run["output_tail"]
+                if (m := re.search(r" 1/\d+ \[.*?([0-9.]+)s/epoch", line))
+            )
+        )
+
+    fastest, slowest = min(e for run in alone for e in run[:2]), max(e for run in alone for e in run[:2])
+    validating = fresh["epoch_s"] + again["epoch_s"]
+    assert min(validating) - slowest > slowest  # "the validation ... is most of an epoch that runs it"
+    text = " ".join(_readme().split())
+    for sentence in (
+        f"a 4-hour BEAT-rate corpus made on that machine, {windows:,} train windows",
+        f"with a fresh `--out` it took {_minutes(fresh['wall_s'])}, {fresh['prepare_s']:.0f} s for the index and the "
+        f"store, {fresh['extractor_s']:.0f} s for the extractor and {fresh['train_s']:.0f} s of training, of which the "
+        f"first epoch, compiling, took {first_epoch(fresh):.0f} s and the next two {fresh['epoch_s'][0]:.1f} and "
+        f"{fresh['epoch_s'][1]:.1f} s with their validation",
+        f"it took {_minutes(again['wall_s'])}, its first epoch {first_epoch(again):.0f} s and the next two "
+        f"{again['epoch_s'][0]:.1f} and {again['epoch_s'][1]:.1f} s",
+        f"an epoch with its checkpoint took {alone[0][1]:.2f} and {alone[1][1]:.2f} s (the first after compiling: "
+        f"{alone[0][0]:.2f} and {alone[1][0]:.2f} s), {windows / fastest:,.0f} windows/s against the step's "
+        f"{_n(_row('next', 'camn', 'paper', 'bf16', 1024, 'reduce-overhead', False, 'frame_matmul')['step_wps'])}",
+        f"`fit` at its fast settings trains CaMN's paper preset at about {EPOCH_WINDOWS / windows * fastest:.0f} to "
+        f"{EPOCH_WINDOWS / windows * slowest:.0f} s per BEAT-4english epoch, its validations apart",
+        f"takes about {EPOCH_WINDOWS / windows * fastest:.0f} to {EPOCH_WINDOWS / windows * slowest:.0f} s of training "
+        f"and one of all of BEAT about {4.75 * EPOCH_WINDOWS / windows * fastest:.0f} to "
+        f"{4.75 * EPOCH_WINDOWS / windows * slowest:.0f} s",
+        f"was {fresh['peak_rss_gib']:.2f} GiB with a fresh `--out` and {again['peak_rss_gib']:.2f} GiB run again, over "
+        f"the 2.5 GiB asked ({_record('fit_command_cpu.json')['runs']['fresh']['peak_rss_gib']:.2f} on the CPU, above)",
+    ):
+        assert sentence in text, sentence
+    assert min(fresh["peak_rss_gib"], again["peak_rss_gib"]) > 2.5
+
+
 def test_the_documented_command_times_are_the_commands_record():
     """README's bootstrap scoring, the guide's data_samples route and store build, architecture's rot6d extractor."""
     record = _record("commands_cpu.json")

@@ -316,6 +316,33 @@ def test_fgd_scorer_equals_the_fgd_column(test_set, results):
     assert score(mean_pose) == pytest.approx(results.value("Mean pose", "FGD"), rel=1e-9)
 
 
+def test_a_set_loaded_for_fgd_alone_has_the_full_sets_takes_and_fgd():
+    """``load_test_set(fgd_only=True)``, fit's validation set: the same takes, streams and ground truth, so the
+    same FGD, without BC's change angle, the mean speed and the onsets (and scoring it is refused)."""
+    from beatlite.train.testset import fgd_scorer, load_test_set
+
+    full, fgd_only = load_test_set(split="val"), load_test_set(split="val", fgd_only=True)
+    assert fgd_only.takes == full.takes and len(full.takes) > 0
+    for a, b in zip(
+        full.gt_directions + full.gt_euler, fgd_only.gt_directions + fgd_only.gt_euler, strict=True
+    ):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(full.streams, fgd_only.streams, strict=True):
+        assert a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+    assert (
+        full.change_angle.shape == (41,)
+        and full.mean_speed.shape == (43,)
+        and len(full.audio_beats) == len(full.takes)
+    )
+    assert fgd_only.change_angle is None and fgd_only.mean_speed is None and fgd_only.audio_beats == []
+    with pytest.raises(ValueError, match="fgd_only=False"):
+        fgd_only.ground_truth(_features)
+    mean_pose = build_model("mean_pose")
+    mean_pose.prepare({"pose": np.zeros((2, 34, 141), np.float32)})
+    want = fgd_scorer(takes=full, extractor=_features)(mean_pose)
+    assert fgd_scorer(takes=fgd_only, extractor=_features)(mean_pose) == want and want > 0
+
+
 @pytest.mark.slow
 def test_ha2g_code_protocol_is_seeded_and_differs_from_the_deterministic_one():
     from beatlite.paths import checkpoints_dir

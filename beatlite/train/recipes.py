@@ -460,9 +460,9 @@ class TrainingData:
     @functools.cached_property
     def val_takes(self) -> Any:
         """The whole validation takes that :func:`~beatlite.train.testset.fgd_scorer` generates
-        (an :class:`~beatlite.train.testset.EvaluationSet`, prepared on first use, then shared)."""
+        (an :class:`~beatlite.train.testset.EvaluationSet` for FGD alone, prepared on first use, then shared)."""
 
-        return load_test_set(self.index, split="val", vocab=self.vocab, store=self.store)
+        return load_test_set(self.index, split="val", vocab=self.vocab, store=self.store, fgd_only=True)
 
 
 def training_data(data: str | Path | None = None, *, progress: bool = False) -> TrainingData:

@@ -63,8 +63,9 @@ class EvaluationSet:
     audio : list of (S,) float32, 16 kHz
     normalizers : Normalizers
         The train split's fitted normalisers the streams were normalised with.
-    change_angle : (41,) float64
-        HA2G's MAAC per angle pair from the train windows (for BC).
+    change_angle : (41,) float64 or None
+        HA2G's MAAC per angle pair from the train windows (for BC); None in a set loaded for FGD alone
+        (:func:`load_test_set` ``fgd_only``).
     vocab : tuple of str
         The vocabulary the word ids refer to.
     audio_beats : list of (K,) float64
@@ -107,7 +108,7 @@ class EvaluationSet:
     semantic: list[np.ndarray]
     audio: list[np.ndarray]
     normalizers: Normalizers
-    change_angle: np.ndarray
+    change_angle: np.ndarray | None
     vocab: tuple[str, ...]
     split: str = "test"
     audio_beats: list[np.ndarray] = dataclasses.field(default_factory=list)
@@ -150,6 +151,11 @@ class EvaluationSet:
         """The :class:`~beatlite.metrics.scoring.GroundTruth` every row is scored against
         (``euler_extractor``: the Euler autoencoder of ``"FGD (BEAT AE)"``; ``rot6d_extractor``: the 6D one of
         ``"FGD (rot6d)"``; both optional)."""
+        if self.change_angle is None:
+            raise ValueError(
+                f"EvaluationSet.ground_truth: the {self.split!r} takes were loaded for FGD alone (load_test_set("
+                "fgd_only=True): no train change angle or mean speed); load them with fgd_only=False to score them"
+            )
         takes = directions_takes(
             self.gt_directions, self, extractor, euler=self.gt_euler, euler_extractor=euler_extractor,
             rot6d_extractor=rot6d_extractor,
@@ -171,7 +177,7 @@ class EvaluationSet:
 
 
 def load_test_set(
-    index: Any = None, *, split: str = "test", vocab: Any = None, store: Any = None
+    index: Any = None, *, split: str = "test", vocab: Any = None, store: Any = None, fgd_only: bool = False
 ) -> EvaluationSet:
     """Load the whole takes of ``split`` from the window store, with train-split normalisation.
 
@@ -188,6 +194,11 @@ def load_test_set(
         Default :func:`beatlite.data.store.build_store` of ``index`` (built once, then only takes
         whose files changed are rebuilt). The statistics are the store's train statistics
         (:meth:`~beatlite.data.store.WindowStore.statistics`); the train windows are never held in memory.
+    fgd_only : bool
+        Only what FGD needs (:func:`fgd_scorer`, ``fit``'s validation): no audio onsets, and no pass over the
+        train windows for the change angle and mean speed of BC and the speed metrics (``change_angle`` and
+        ``mean_speed`` None, :meth:`EvaluationSet.ground_truth` refuses the set): the time of a pass over
+        every train window, which grows with the corpus, and of the onset detection.
 
     Returns
     -------
@@ -212,8 +223,8 @@ def load_test_set(
         semantic=[np.asarray(item["semantic"], np.float64) for item in items],
         audio=[np.asarray(item["audio"], np.float32) for item in items],
         normalizers=norms,
-        change_angle=train_change_angle(train),
-        mean_speed=train_mean_speed(train),
+        change_angle=None if fgd_only else train_change_angle(train),
+        mean_speed=None if fgd_only else train_mean_speed(train),
         vocab=tuple(vocab.itos),
         split=split,
         fingerprint=train.fingerprint,
@@ -222,7 +233,8 @@ def load_test_set(
             sorted({int(store.takes[i].meta["speaker"]) for i in np.unique(train.take_ids)})
         ),
     )
-    test.beats()
+    if not fgd_only:
+        test.beats()
     return test
 
 
