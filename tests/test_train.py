@@ -259,6 +259,42 @@ def test_untrained_baselines_fit_saves_and_loads(windows, tmp_path):
     np.testing.assert_allclose(loaded.mean.numpy(), train["pose"].mean(axis=(0, 1)), atol=1e-5)
 
 
+def _with_nan(train: dict) -> dict:
+    """The windows with one NaN in window 0's pose (the target every model's loss reads)."""
+    pose = train["pose"].copy()
+    pose[0, 5, 7] = np.nan
+    return {**train, "pose": pose}
+
+
+def test_a_diverged_run_stops_before_writing_a_checkpoint_load_would_refuse(windows, tmp_path):
+    """NaN losses (here NaN in the data; a too high learning rate or bf16 overflow alike): fit raises
+    FloatingPointError at the epoch's end instead of saving weights that load_checkpoint refuses."""
+    train, val = windows
+    path = tmp_path / "nan.pt"
+    with pytest.raises(
+        FloatingPointError, match="camn diverged: the mean training losses of epoch 0 are not finite"
+    ):
+        fit(camn(), _with_nan(train), cfg(checkpoint=path), val)
+    assert not path.exists()
+    assert fit(
+        camn(), train, cfg(checkpoint=path), val
+    ).history  # the same run on finite data trains and saves
+    load_model(path)
+
+
+def test_a_mid_epoch_checkpoint_of_diverged_weights_is_not_written(windows, tmp_path):
+    """With checkpoint_every, the first save after the step that read the NaN window raises; any checkpoint
+    written before it (finite weights) stays and loads."""
+    train, _ = windows
+    path = tmp_path / "mid.pt"
+    with pytest.raises(
+        FloatingPointError, match=r"camn diverged: its weights after \d+ steps are not finite"
+    ):
+        fit(camn(), _with_nan(train), cfg(checkpoint=path, checkpoint_every=1))
+    if path.exists():
+        load_model(path)
+
+
 def test_zero_epochs_write_the_checkpoint_of_the_initial_weights(windows, tmp_path):
     """TrainConfig allows epochs=0: fit returned FitResult.checkpoint without writing it (export_checkpoint then
     failed, 'checkpoint not found', or exported an older run's file at that path). It writes the untrained

@@ -324,7 +324,7 @@ def _fit_locked(
                 _train_extractor(data_dir, extractor, args.extractor_epochs)
     try:
         seconds = retrain(args.recipe, out_dir=out, data=data, extractor=extractor, **options)
-    except ResumeError as error:  # --resume of a checkpoint of other data, model or batch plan
+    except (ResumeError, FloatingPointError) as error:  # --resume of other data, model or plan; diverged
         return _refused(error)
     if rank == 0:
         stem = run_name(args.recipe, args.preset)

@@ -491,6 +491,7 @@ def fit(
     bar = progress(range(run.start_epoch, config.epochs), disable=not show, desc=model.name, unit="epoch")
     for epoch in bar:
         entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch)}
+        check_diverged(model.name, f"the mean training losses of epoch {epoch}", entry["train"].items())
         entry.update(run.epoch_validation(epoch))
         run.history.append(entry)
         bar.set_postfix(_shown_losses(entry))
@@ -521,6 +522,31 @@ def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers
     if isinstance(norms, Normalizers):
         return norms
     return Normalizers.in_meta(meta)
+
+
+def check_diverged(name: str, what: str, values: Any) -> None:
+    """Raise ``FloatingPointError`` when a value of ``values`` (``(name, float or tensor)`` pairs) is not finite:
+    training diverged (too high a learning rate, bf16 overflow, or NaN in the data), and :func:`fit` stops before
+    writing a checkpoint that :func:`~beatlite.train.checkpoint.load_checkpoint` would refuse (the last one stays).
+
+    Examples
+    --------
+    >>> check_diverged("camn", "the mean training losses of epoch 3", {"rec": 0.4, "total": 0.5}.items())
+    >>> check_diverged("camn", "the mean training losses of epoch 3", {"rec": float("nan")}.items())
+    Traceback (most recent call last):
+    ...
+    FloatingPointError: fit: camn diverged: the mean training losses of epoch 3 are not finite (rec); no checkpoint of it was written (the last one stays). Lower the learning rate (fit --lr), train in fp32 (--precision fp32), or look for NaN or inf in the training windows
+    """
+    items = list(values)
+    tensors = [v for _, v in items if isinstance(v, torch.Tensor)]  # (one device read for all of them)
+    finite = iter(torch.stack([torch.isfinite(t).all() for t in tensors]).tolist() if tensors else [])
+    bad = [k for k, v in items if not (next(finite) if isinstance(v, torch.Tensor) else math.isfinite(v))]
+    if bad:
+        raise FloatingPointError(
+            f"fit: {name} diverged: {what} are not finite ({', '.join(bad[:5])}); no checkpoint of it was written "
+            "(the last one stays). Lower the learning rate (fit --lr), train in fp32 (--precision fp32), or look "
+            "for NaN or inf in the training windows"
+        )
 
 
 def _shown_losses(entry: dict[str, Any]) -> dict[str, str]:
@@ -961,6 +987,8 @@ class _Run:
         calls it, for the generators' states)."""
         if self.path is None:
             return
+        weights = ((k, v) for k, v in self.model.state_dict().items() if v.is_floating_point())
+        check_diverged(self.model.name, f"its weights after {self.steps} steps", weights)  # (every process)
         states = rng_states(self.world)
         if self.rank != 0:
             return
