@@ -172,7 +172,9 @@ class ResidentWindows:
         out = None
         for take, take_id, start, size in zip(takes, ids, np.cumsum([0, *sizes[:-1]]), sizes):
             rows = self._rows(key, take, take_id)
-            rows = torch.from_numpy(rows if rows.flags.writeable else rows.copy())  # (a store's read-only map)
+            rows = torch.from_numpy(
+                rows if rows.flags.writeable else rows.copy()
+            )  # (a store's read-only map)
             if rows.shape[0] != size:  # (_n_rows and _rows describe the same padding)
                 raise RuntimeError(
                     f"ResidentWindows: {key} of take {take_id}: {rows.shape[0]} rows, not {size}"
