@@ -10,7 +10,8 @@ import pytest
 torch = pytest.importorskip("torch")
 
 from beatlite.models import build_model  # noqa: E402
-from beatlite.models.a2g import kl_reference, kl_schedule, kl_standard_normal, reparameterize  # noqa: E402
+from beatlite.models.a2g import kl_reference, kl_schedule  # noqa: E402
+from beatlite.models.layers import kl_standard_normal, reparameterize  # noqa: E402
 from beatlite.models.testing import fake_batch  # noqa: E402
 
 

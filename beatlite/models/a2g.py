@@ -97,6 +97,7 @@ import torch
 from torch import nn
 
 from beatlite.models.base import Batch, GestureModel, ModelConfig, check_batch
+from beatlite.models.layers import reparameterize
 
 POSE_DIM = 141
 N_MELS = 128
@@ -240,37 +241,10 @@ def _head(c_in: int, hidden: int, c_out: int) -> nn.Sequential:
     return nn.Sequential(nn.Linear(c_in, hidden), nn.ReLU(), nn.Linear(hidden, c_out))
 
 
-def kl_standard_normal(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
-    """Mean over elements of KL(N(mu, exp(logvar)) || N(0, 1)) = ``-0.5 (1 + logvar - mu^2 - exp(logvar))``.
-
-    Parameters
-    ----------
-    mu, logvar : (...) float tensors of one shape
-        Means and natural-log variances of independent Gaussians.
-
-    Returns
-    -------
-    () float tensor, nats per element.
-
-    Examples
-    --------
-    N(1, 1) is 0.5 nat from N(0, 1) (``mu^2 / 2``); N(0, e) is ``(e - 1 - 1) / 2 = 0.3591`` nat; the mean of
-    the two:
-
-    >>> import math, torch
-    >>> from beatlite.models.a2g import kl_standard_normal
-    >>> round(float(kl_standard_normal(torch.tensor([1.0, 0.0]), torch.tensor([0.0, 1.0]))), 4)
-    0.4296
-    >>> round((0.5 + (math.e - 2) / 2) / 2, 4)
-    0.4296
-    """
-    return -0.5 * torch.mean(1 + logvar - mu.pow(2) - logvar.exp())
-
-
 def kl_reference(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
     """The reference's KL of a (B, T, C) code: summed over frames T, averaged over B and C.
 
-    ``= T * kl_standard_normal(mu, logvar)``.
+    ``= T * layers.kl_standard_normal(mu, logvar)``.
 
     Parameters
     ----------
@@ -317,32 +291,6 @@ def _weighted(weight: float | torch.Tensor, loss: torch.Tensor) -> torch.Tensor:
     if not torch.is_tensor(weight):
         return weight * loss
     return (weight.float() * loss.float()).to(loss.dtype)
-
-
-def reparameterize(mu: torch.Tensor, logvar: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
-    """``mu + exp(logvar / 2) * noise``: a draw of N(mu, exp(logvar)) that is differentiable in mu, logvar.
-
-    Parameters
-    ----------
-    mu, logvar : (...) float tensors
-        Means and log-variances.
-    noise : (...) float tensor of their shape
-        Standard-normal draws.
-
-    Returns
-    -------
-    (...) float tensor, in the units of ``mu``.
-
-    Examples
-    --------
-    Variance 4 (standard deviation 2) around 1: noise 0 gives the mean, noise 1.5 gives ``1 + 2 * 1.5``.
-
-    >>> import math, torch
-    >>> from beatlite.models.a2g import reparameterize
-    >>> reparameterize(torch.ones(2), torch.full((2,), math.log(4.0)), torch.tensor([0.0, 1.5]))
-    tensor([1., 4.])
-    """
-    return mu + torch.exp(0.5 * logvar) * noise
 
 
 def speed(x: torch.Tensor) -> torch.Tensor:

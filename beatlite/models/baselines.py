@@ -46,9 +46,11 @@ from beatlite.models.layers import (
     PlainWavEncoder,
     TextEncoderTCN,
     check_ids,
+    kl_standard_normal,
     match_length,
     ns_gan_d_loss,
     ns_gan_g_loss,
+    reparameterize,
     sum_directions,
 )
 
@@ -384,7 +386,7 @@ class Trimodal(_Adversarial):
 
     >>> import torch
     >>> from beatlite.models import build_model
-    >>> from beatlite.models.a2g import kl_standard_normal
+    >>> from beatlite.models.layers import kl_standard_normal
     >>> from beatlite.models.testing import fake_batch
     >>> _ = torch.manual_seed(0)
     >>> model = build_model("trimodal", preset="tiny")
@@ -449,7 +451,7 @@ class Trimodal(_Adversarial):
         audio = match_length(self.audio_encoder(batch["audio"]), t)
         h = self.speaker_embedding(speaker)
         mu, logvar = self.speaker_mu(h), self.speaker_logvar(h)
-        z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
+        z = reparameterize(mu, logvar, torch.randn_like(mu)) if self.training else mu
         x = torch.cat([seed_input(pose, self.n_pre), text, audio, z.unsqueeze(1).expand(b, t, -1)], -1)
         seq, _ = self.gru(x)
         return {"pose": self.head(sum_directions(seq, self.config.hidden)), "z_mu": mu, "z_logvar": logvar}
@@ -458,7 +460,7 @@ class Trimodal(_Adversarial):
         """``{"rec", "adv", "kld", "total"}``; KLD = ``-0.5 mean(1 + logvar - mu^2 - exp(logvar))``."""
         parts = self._losses(batch, out, epoch)
         mu, logvar = out["z_mu"], out["z_logvar"]
-        kld = -0.5 * torch.mean(1 + logvar - mu.pow(2) - logvar.exp())
+        kld = kl_standard_normal(mu, logvar)
         parts["kld"] = kld
         parts["total"] = parts["total"] + self.config.kld_weight * kld
         return parts

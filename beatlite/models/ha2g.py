@@ -82,7 +82,6 @@ from beatlite.models.ha2g_losses import (
     angle_statistics,
     bone_angles,
     hierarchical_huber,
-    kl_divergence,
     multilevel_contrastive_loss,
     physical_constraint_loss,
     style_diverging_loss,
@@ -91,8 +90,10 @@ from beatlite.models.layers import (
     ConvDiscriminator,
     TextEncoderTCN,
     check_ids,
+    kl_standard_normal,
     ns_gan_d_loss,
     ns_gan_g_loss,
+    reparameterize,
     sum_directions,
 )
 
@@ -360,7 +361,7 @@ def reparameterise(
         eps = torch.randn_like(mu)
     else:
         eps = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
-    return mu + eps * torch.exp(0.5 * logvar)
+    return reparameterize(mu, logvar, eps)
 
 
 class SpeakerStyle(nn.Module):
@@ -877,7 +878,7 @@ class HA2G(GestureModel):
         targets = [target[..., getattr(self, f"_cols{k}")] for k in range(self.n_levels)]
         terms: dict[str, torch.Tensor] = {
             "huber": hierarchical_huber(preds, targets, beta=c.huber_beta),
-            "kld": kl_divergence(out["mu"], out["logvar"]),
+            "kld": kl_standard_normal(out["mu"], out["logvar"]),
         }
         total = c.huber_weight * terms["huber"] + c.kld_weight * terms["kld"]
         if self.discriminator is not None and self.adversarial_active(epoch):

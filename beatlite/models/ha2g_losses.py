@@ -209,33 +209,6 @@ def hierarchical_huber(
     return total
 
 
-def kl_divergence(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
-    """KL(N(mu, exp(logvar)) || N(0, I)) averaged over batch and dimensions.
-
-    ``-0.5 * mean(1 + logvar - mu^2 - exp(logvar))``; 0 exactly for mu = 0, logvar = 0.
-
-    Parameters
-    ----------
-    mu, logvar : (B, Z) tensors
-
-    Returns
-    -------
-    scalar tensor, nats per element.
-
-    Examples
-    --------
-    N(1, 1) is ``1 / 2`` nat from N(0, 1), N(0, 1) is 0: their mean is 0.25.
-
-    >>> import torch
-    >>> from beatlite.models.ha2g_losses import kl_divergence
-    >>> float(kl_divergence(torch.tensor([[1.0, 0.0]]), torch.zeros(1, 2)))
-    0.25
-    """
-    if mu.shape != logvar.shape:
-        raise ValueError(f"mu {tuple(mu.shape)} and logvar {tuple(logvar.shape)} must have one shape")
-    return -0.5 * torch.mean(1.0 + logvar - mu.pow(2) - logvar.exp())
-
-
 def style_diverging_loss(
     pose: torch.Tensor,
     pose_other: torch.Tensor,

@@ -63,7 +63,13 @@ from torch import nn
 
 from beatlite.constants import WINDOW_LENGTH
 from beatlite.models.base import N_PRE, Batch, GestureModel, TextConfig, check_batch
-from beatlite.models.layers import PlainWavEncoder, TextEncoderTCN, match_length, sum_directions
+from beatlite.models.layers import (
+    PlainWavEncoder,
+    TextEncoderTCN,
+    match_length,
+    reparameterize,
+    sum_directions,
+)
 
 POSE_DIM = 141
 EVAL_Z = ("sample", "mean")
@@ -298,7 +304,7 @@ class JointEmbedding(GestureModel):
             gen = torch.Generator().manual_seed(int(self.config.seed) + self._calls)
             self._calls += 1
             noise = torch.randn(mu.shape, generator=gen).to(mu)
-        z_context = mu + torch.exp(0.5 * logvar) * noise
+        z_context = reparameterize(mu, logvar, noise)
         z_pose = self.embed_pose(pose)
         return {
             "pose": self.decode(z_context, pose),

@@ -614,3 +614,60 @@ def ns_gan_g_loss(fake_logit: torch.Tensor) -> torch.Tensor:
     (0.6931, 0.0)
     """
     return -nn.functional.logsigmoid(fake_logit).mean()
+
+
+def kl_standard_normal(mu: torch.Tensor, logvar: torch.Tensor) -> torch.Tensor:
+    """Mean over elements of KL(N(mu, exp(logvar)) || N(0, 1)) = ``-0.5 (1 + logvar - mu^2 - exp(logvar))``: the
+    KL term of every model with a sampled Gaussian code (A2G, HA2G's style, Trimodal's speaker style).
+
+    Parameters
+    ----------
+    mu, logvar : (...) float tensors of one shape
+        Means and natural-log variances of independent Gaussians.
+
+    Returns
+    -------
+    () float tensor, nats per element.
+
+    Examples
+    --------
+    N(1, 1) is 0.5 nat from N(0, 1) (``mu^2 / 2``); N(0, e) is ``(e - 1 - 1) / 2 = 0.3591`` nat; the mean of
+    the two:
+
+    >>> import math, torch
+    >>> from beatlite.models.layers import kl_standard_normal
+    >>> round(float(kl_standard_normal(torch.tensor([1.0, 0.0]), torch.tensor([0.0, 1.0]))), 4)
+    0.4296
+    >>> round((0.5 + (math.e - 2) / 2) / 2, 4)
+    0.4296
+    """
+    if mu.shape != logvar.shape:
+        raise ValueError(f"mu {tuple(mu.shape)} and logvar {tuple(logvar.shape)} must have one shape")
+    return -0.5 * torch.mean(1 + logvar - mu.pow(2) - logvar.exp())
+
+
+def reparameterize(mu: torch.Tensor, logvar: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
+    """``mu + exp(logvar / 2) * noise``: a draw of N(mu, exp(logvar)) that is differentiable in mu, logvar (each
+    model draws ``noise`` its own way: its generators and dtypes fix its numbers).
+
+    Parameters
+    ----------
+    mu, logvar : (...) float tensors
+        Means and log-variances.
+    noise : (...) float tensor of their shape
+        Standard-normal draws.
+
+    Returns
+    -------
+    (...) float tensor, in the units of ``mu``.
+
+    Examples
+    --------
+    Variance 4 (standard deviation 2) around 1: noise 0 gives the mean, noise 1.5 gives ``1 + 2 * 1.5``.
+
+    >>> import math, torch
+    >>> from beatlite.models.layers import reparameterize
+    >>> reparameterize(torch.ones(2), torch.full((2,), math.log(4.0)), torch.tensor([0.0, 1.5]))
+    tensor([1., 4.])
+    """
+    return mu + torch.exp(0.5 * logvar) * noise
