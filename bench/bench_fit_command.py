@@ -115,8 +115,8 @@ def measure(command: list[str], **popen: object) -> tuple[dict, list[tuple[float
     child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1,
                              **popen)  # fmt: skip
     lines = []
-    for line in child.stdout:  # tqdm's bars end in \r, so a bar's updates arrive with the next \n
-        lines.append((time.perf_counter() - tic, line.rstrip("\n").split("\r")[-1]))
+    for line in child.stdout:  # (text mode ends a line at \r too: every state of a progress bar is a line)
+        lines.append((time.perf_counter() - tic, line.rstrip("\n")))
     if child.wait() != 0:
         tail = "\n".join(line for _, line in lines[-40:])
         raise RuntimeError(f"{' '.join(command)} exited {child.returncode}:\n{tail}")

@@ -24,7 +24,7 @@
 #                  then HA2G paper bf16 at 1024 compiled (reduce-overhead), determinism off
 #   STAGE cudnn    after later (at most 5 minutes, its limits; never run yet): CaMN paper bf16 at 1024 compiled with the audio matmul, with
 #                  cudnn.benchmark, then with the LSTM traced into the graph (a longer limit)
-#   STAGE fit      the fit command itself at the fast settings (about 8 minutes, estimated; never run yet):
+#   STAGE fit      the fit command itself at the fast settings (347 and 375 s in its two runs, 2026-11-27):
 #                  bench/bench_fit_command.py on a 4-hour BEAT-rate corpus made there, fresh and again on one
 #                  --out, CaMN at the paper's size, bf16, batch 1024, compiled, determinism off (the extractor 2 epochs),
 #                  3 epochs each: the first compiles, the next two time an epoch (bench_fit_command's epoch_s)

@@ -166,8 +166,8 @@ class ResidentWindows:
 
     def _stack(self, key: str, takes: list[Any], ids: list[int]) -> torch.Tensor:
         """The takes' :meth:`_rows` of ``key`` one after another, in one tensor on the device, filled a take at
-        a time: host memory holds one take's rows at once, not the whole stream (twice, as a concatenation did:
-        1.8 GB more for CaMN's audio on a 4-hour corpus)."""
+        a time: host memory holds one take's rows and their temporaries at once, not the whole stream (twice, as
+        a concatenation of every take's rows did)."""
         sizes = [self._n_rows(key, t) for t in takes]
         out = None
         for take, take_id, start, size in zip(takes, ids, np.cumsum([0, *sizes[:-1]]), sizes):

@@ -489,13 +489,14 @@ def fit(
     run.val_windows, run.val_score = val_windows, val_score
     show = config.progress and run.rank == 0  # under torchrun, process 0 logs, scores and saves
     bar = progress(range(run.start_epoch, config.epochs), disable=not show, desc=model.name, unit="epoch")
-    for epoch in bar:
-        entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch)}
-        check_diverged(model.name, f"the mean training losses of epoch {epoch}", entry["train"].items())
-        entry.update(run.epoch_validation(epoch))
-        run.history.append(entry)
-        bar.set_postfix(_shown_losses(entry))
-        run.save(epoch + 1)
+    with bar:  # (closed before an error is printed after it)
+        for epoch in bar:
+            entry: dict[str, Any] = {"epoch": epoch, "train": run.train_epoch(data, epoch)}
+            check_diverged(model.name, f"the mean training losses of epoch {epoch}", entry["train"].items())
+            entry.update(run.epoch_validation(epoch))
+            run.history.append(entry)
+            bar.set_postfix(_shown_losses(entry))
+            run.save(epoch + 1)
     if config.epochs == 0 and not resumed:  # no epoch: the initial weights' checkpoint (as a baseline's)
         run.save(0)
     return run.result()
@@ -524,10 +525,12 @@ def _normalizers_of(windows: Any, meta: Mapping[str, Any] | None) -> Normalizers
     return Normalizers.in_meta(meta)
 
 
-def check_diverged(name: str, what: str, values: Any) -> None:
+def check_diverged(name: str, what: str, values: Any, world: int = 1) -> None:
     """Raise ``FloatingPointError`` when a value of ``values`` (``(name, float or tensor)`` pairs) is not finite:
     training diverged (too high a learning rate, bf16 overflow, or NaN in the data), and :func:`fit` stops before
     writing a checkpoint that :func:`~beatlite.train.checkpoint.load_checkpoint` would refuse (the last one stays).
+    With ``world`` > 1 it is a collective (every process calls it) and every process raises when one would, so
+    that none waits for the others in the next one (their values may differ: BatchNorm's running statistics).
 
     Examples
     --------
@@ -541,6 +544,8 @@ def check_diverged(name: str, what: str, values: Any) -> None:
     tensors = [v for _, v in items if isinstance(v, torch.Tensor)]  # (one device read for all of them)
     finite = iter(torch.stack([torch.isfinite(t).all() for t in tensors]).tolist() if tensors else [])
     bad = [k for k, v in items if not (next(finite) if isinstance(v, torch.Tensor) else math.isfinite(v))]
+    if world > 1 and sum_over_processes({"bad": float(bool(bad))}, world)["bad"] and not bad:
+        bad = ["on another process"]
     if bad:
         raise FloatingPointError(
             f"fit: {name} diverged: {what} are not finite ({', '.join(bad[:5])}); no checkpoint of it was written "
@@ -988,7 +993,7 @@ class _Run:
         if self.path is None:
             return
         weights = ((k, v) for k, v in self.model.state_dict().items() if v.is_floating_point())
-        check_diverged(self.model.name, f"its weights after {self.steps} steps", weights)  # (every process)
+        check_diverged(self.model.name, f"its weights after {self.steps} steps", weights, self.world)
         states = rng_states(self.world)
         if self.rank != 0:
             return
