@@ -54,8 +54,7 @@ def resident_bytes(view: StoreWindows, keys: Sequence[str]) -> int:
         stream = KEY_STREAM[key]
         per_row = int(np.prod(takes[0].meta["shapes"][stream][1:], dtype=np.int64))
         itemsize = 8 if key in ("word", "emotion") else 4
-        pad = view.n_audio if stream == "audio" else view.n_mel if stream == "mel" else 0
-        rows = sum(int(t.meta["shapes"][stream][0]) + pad for t in takes)
+        rows = sum(_n_rows(view, key, t) for t in takes)
         total += itemsize * per_row * rows
     return int(total)
 
@@ -81,6 +80,17 @@ def fits_on_device(view: StoreWindows, keys: Sequence[str], device: Any, *, shar
         return False
     free, _ = torch.cuda.mem_get_info(device)
     return resident_bytes(view, keys) <= share * free
+
+
+def _pad(view: StoreWindows, key: str) -> int:
+    """Rows added at the end of each take's ``key`` for windows running past it (audio: zeros; mel: its last
+    row repeated)."""
+    return {"audio": view.n_audio, "mel": view.n_mel}.get(key, 0)
+
+
+def _n_rows(view: StoreWindows, key: str, take: Any) -> int:
+    """The rows of ``key`` that :class:`ResidentWindows` holds for ``take``, from its metadata (nothing read)."""
+    return int(take.meta["shapes"][KEY_STREAM[key]][0]) + _pad(view, key)
 
 
 def _keys(keys: Sequence[str]) -> list[str]:
@@ -168,7 +178,7 @@ class ResidentWindows:
         """The takes' :meth:`_rows` of ``key`` one after another, in one tensor on the device, filled a take at
         a time: host memory holds one take's rows and their temporaries at once, not the whole stream (twice, as
         a concatenation of every take's rows did)."""
-        sizes = [self._n_rows(key, t) for t in takes]
+        sizes = [_n_rows(self.view, key, t) for t in takes]
         out = None
         for take, take_id, start, size in zip(takes, ids, np.cumsum([0, *sizes[:-1]]), sizes):
             rows = self._rows(key, take, take_id)
@@ -186,15 +196,6 @@ class ResidentWindows:
             raise ValueError("ResidentWindows: the view has no windows")
         return out
 
-    def _pad(self, key: str) -> int:
-        """Rows added at the end of each take's ``key`` for windows running past it (audio: zeros; mel: its
-        last row repeated)."""
-        return {"audio": self.n_audio, "mel": self.n_mel}.get(key, 0)
-
-    def _n_rows(self, key: str, take: Any) -> int:
-        """The number of :meth:`_rows` of ``key`` for ``take``, from its metadata (nothing read)."""
-        return int(take.meta["shapes"][KEY_STREAM[key]][0]) + self._pad(key)
-
     def _rows(self, key: str, take: Any, take_id: int) -> np.ndarray:
         """One take's stream of ``key`` as its batches hold it, padded at the end for windows running past it."""
         view, stream = self.view, KEY_STREAM[key]
@@ -203,10 +204,10 @@ class ResidentWindows:
             return view._word_ids(take_id, raw)
         if key == "audio":
             samples = (raw * np.float64(take.meta["audio_scale"])).astype(np.float32)
-            return np.concatenate([samples, np.zeros(self._pad(key), np.float32)])
+            return np.concatenate([samples, np.zeros(_pad(self.view, key), np.float32)])
         rows = view._row_values(key, raw)
         if key == "mel":
-            return np.concatenate([rows, np.repeat(rows[-1:], self._pad(key), axis=0)])
+            return np.concatenate([rows, np.repeat(rows[-1:], _pad(self.view, key), axis=0)])
         return rows
 
     def __len__(self) -> int:
